@@ -1,0 +1,33 @@
+//! The error type of the decimation core.
+
+/// What can go wrong in the core; each variant says what the caller should fix.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The grid's dimensions and its value count disagree, or a dimension is zero.
+    #[error("grid of {width}x{height} needs {expected} values, got {actual}")]
+    GridSize {
+        /// Columns.
+        width: u32,
+        /// Rows.
+        height: u32,
+        /// width * height.
+        expected: usize,
+        /// Values supplied.
+        actual: usize,
+    },
+    /// The grid is too large to index with 32-bit vertex handles.
+    #[error("grid of {width}x{height} has more than 2^32-1 samples")]
+    GridTooLarge {
+        /// Columns.
+        width: u32,
+        /// Rows.
+        height: u32,
+    },
+    /// The maximum error is negative, NaN or infinite.
+    #[error("maximum error must be a finite number >= 0, got {0}")]
+    InvalidMaxError(f64),
+}
+
+/// Result of the core's fallible functions.
+pub type Result<T> = std::result::Result<T, Error>;

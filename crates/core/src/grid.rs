@@ -1,0 +1,87 @@
+//! A rectangular grid of scalar samples; NaN marks a sample outside the domain.
+
+use crate::{Error, Result};
+
+/// A `width` x `height` grid of samples in row-major order (row 0 first).
+///
+/// Sample `(x, y)` (column, row) sits at integer position `(x, y)`. A sample is *valid* when
+/// it is finite; NaN and infinities mark nodata. A *cell* is the unit square with corners
+/// `(x, y)`..`(x + 1, y + 1)`; it belongs to the domain when its four corners are valid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grid {
+    width: u32,
+    height: u32,
+    values: Vec<f64>,
+}
+
+impl Grid {
+    /// Wraps row-major `values`; fails if `values.len() != width * height`, if either
+    /// dimension is zero, or if the grid has 2^32 samples or more.
+    pub fn new(width: u32, height: u32, values: Vec<f64>) -> Result<Grid> {
+        let expected = width as usize * height as usize;
+        if width == 0 || height == 0 || values.len() != expected {
+            return Err(Error::GridSize { width, height, expected, actual: values.len() });
+        }
+        if expected as u64 >= u32::MAX as u64 {
+            return Err(Error::GridTooLarge { width, height });
+        }
+        Ok(Grid { width, height, values })
+    }
+
+    /// Number of columns.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Number of rows.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// All samples, row-major; nodata samples are non-finite.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// The value at column `x`, row `y`, or `None` when it is nodata or out of range.
+    pub fn get(&self, x: u32, y: u32) -> Option<f64> {
+        if x >= self.width || y >= self.height {
+            return None;
+        }
+        let v = self.values[y as usize * self.width as usize + x as usize];
+        v.is_finite().then_some(v)
+    }
+
+    /// Number of valid (finite) samples.
+    pub fn valid_count(&self) -> usize {
+        self.values.iter().filter(|v| v.is_finite()).count()
+    }
+
+    /// Number of cells whose four corners are valid: the domain's area in cell units.
+    pub fn valid_cell_count(&self) -> usize {
+        let w = self.width as usize;
+        let mut n = 0;
+        for y in 0..self.height as usize - 1 {
+            for x in 0..w - 1 {
+                if self.cell_is_valid(x, y) {
+                    n += 1;
+                }
+            }
+        }
+        n
+    }
+
+    pub(crate) fn cell_is_valid(&self, x: usize, y: usize) -> bool {
+        let w = self.width as usize;
+        let i = y * w + x;
+        self.values[i].is_finite()
+            && self.values[i + 1].is_finite()
+            && self.values[i + w].is_finite()
+            && self.values[i + w + 1].is_finite()
+    }
+
+    /// Largest absolute valid value (0 for a grid without valid samples).
+    pub(crate) fn max_abs_value(&self) -> f64 {
+        self.values.iter().filter(|v| v.is_finite()).fold(0.0, |m, v| m.max(v.abs()))
+    }
+}

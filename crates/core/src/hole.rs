@@ -1,0 +1,350 @@
+//! Retriangulation of the hole left by removing one vertex, with the paper's error
+//! propagation (§3.3) and ear selection (§3.4).
+//!
+//! The hole is the star of the removed vertex `c`: the ring `r_0 .. r_{m-1}` of its
+//! neighbours, counter-clockwise. For an interior vertex the ring is closed and star
+//! triangle `i` is `(c, r_i, r_{i+1 mod m})`; for a boundary vertex `c` lies on the domain
+//! edge `r_{m-1} r_0` and star triangle `i` is `(c, r_i, r_{i+1})` for `i < m - 1`.
+//!
+//! # Error propagation
+//! Each star triangle `T` carries an [`ErrorBound`] valid for every original sample in it.
+//! For a new triangle `N`, every sample in `N ∩ T` satisfies
+//! `sample - new ≤ T.above - min δ` and `new - sample ≤ T.below + max δ`, where
+//! `δ = new - old` is linear on the convex polygon `N ∩ T`, so its extremes sit at that
+//! polygon's corners. Those corners are (a) the entry and exit points of `N`'s edges in `T`
+//! (the paper's §3.3.1 rule, computed here by exact clipping of each edge against each
+//! closed star triangle), and (b) the removed vertex `c` when it lies in `N`.
+//!
+//! Case (b) is not in the paper, which propagates errors along edges only. Without it the
+//! removed vertex's own error is not counted (a peak removed from the middle of its ring
+//! is lower than its ring's chords suggest), and for a boundary vertex only the two
+//! outermost star triangles would feed the new boundary edge. Counting (b) keeps the
+//! bound a true bound; the paper's boundary rule (§3.3.2) is the special case of (a) and
+//! (b) on the new boundary edge, which passes through `c`.
+
+use crate::predicates::{in_closed_triangle, orient, plane_gradient, Point};
+use crate::{EdgeSelection, ErrorBound};
+
+/// A triangle of the retriangulated hole: ring positions (counter-clockwise) and bound.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct HoleTriangle {
+    pub corners: [u32; 3],
+    pub bound: ErrorBound,
+}
+
+/// The bound and introduced error of one segment between ring vertices.
+#[derive(Debug, Clone, Copy, Default)]
+struct SegmentError {
+    bound: ErrorBound,
+    /// Largest |new - old| at the segment's entry and exit points (§3.4 "introduced").
+    introduced: f64,
+}
+
+/// An ear at ring vertex `q`, cutting off `(prev q, q, next q)`.
+#[derive(Debug, Clone, Copy)]
+struct Ear {
+    diagonal: SegmentError,
+    triangle: ErrorBound,
+}
+
+/// Reusable buffers for [`Retriangulator::retriangulate`]; one per thread.
+#[derive(Debug, Default)]
+pub(crate) struct Retriangulator {
+    ring: Vec<Point>,
+    star_bounds: Vec<ErrorBound>,
+    star_gradients: Vec<[f64; 2]>,
+    centre: Option<Point>,
+    boundary: bool,
+    max_star_above: f64,
+    max_star_below: f64,
+    // Current polygon during ear clipping.
+    prev: Vec<u32>,
+    next: Vec<u32>,
+    edge: Vec<SegmentError>,
+    ears: Vec<Option<Option<Ear>>>,
+    triangles: Vec<HoleTriangle>,
+}
+
+impl Retriangulator {
+    /// Loads a hole: the removed vertex, its ring and the bounds of its star triangles
+    /// (`ring.len()` of them for an interior vertex, `ring.len() - 1` for a boundary one).
+    pub(crate) fn load(&mut self, centre: Point, ring: &[Point], star_bounds: &[ErrorBound]) {
+        let boundary = star_bounds.len() + 1 == ring.len();
+        debug_assert!(boundary || star_bounds.len() == ring.len());
+        self.centre = Some(centre);
+        self.boundary = boundary;
+        self.ring.clear();
+        self.ring.extend_from_slice(ring);
+        self.star_bounds.clear();
+        self.star_bounds.extend_from_slice(star_bounds);
+        self.star_gradients.clear();
+        let m = ring.len();
+        for i in 0..star_bounds.len() {
+            let g = plane_gradient(&centre, &ring[i], &ring[(i + 1) % m]);
+            self.star_gradients.push(g);
+        }
+        self.max_star_above = star_bounds.iter().fold(f64::NEG_INFINITY, |m, b| m.max(b.above));
+        self.max_star_below = star_bounds.iter().fold(f64::NEG_INFINITY, |m, b| m.max(b.below));
+    }
+
+    /// Triangulates the loaded hole by ear clipping with `selection`, accepting only
+    /// triangles whose bound is at most `limit` on both sides. Returns the triangles
+    /// (corners index the ring) or `None` on a dead end (paper §3.4).
+    pub(crate) fn retriangulate(
+        &mut self,
+        selection: EdgeSelection,
+        limit: f64,
+    ) -> Option<&[HoleTriangle]> {
+        match selection {
+            EdgeSelection::Hybrid => {
+                if self.clip_ears(EdgeSelection::MinIntroduced, limit) {
+                    return Some(&self.triangles);
+                }
+                self.clip_ears(EdgeSelection::MinError, limit).then_some(&self.triangles)
+            }
+            rule => self.clip_ears(rule, limit).then_some(&self.triangles),
+        }
+    }
+
+    fn clip_ears(&mut self, rule: EdgeSelection, limit: f64) -> bool {
+        let m = self.ring.len();
+        self.triangles.clear();
+        self.prev.clear();
+        self.next.clear();
+        self.edge.clear();
+        self.ears.clear();
+        for i in 0..m {
+            self.prev.push(((i + m - 1) % m) as u32);
+            self.next.push(((i + 1) % m) as u32);
+            let e = self.segment_error(i, (i + 1) % m);
+            self.edge.push(e);
+            self.ears.push(None);
+        }
+        let mut remaining = m;
+        let mut start = 0usize;
+        while remaining > 3 {
+            let mut best: Option<(usize, f64)> = None;
+            let mut q = start;
+            for _ in 0..remaining {
+                if self.ears[q].is_none() {
+                    let ear = self.ear(q, limit);
+                    self.ears[q] = Some(ear);
+                }
+                // Geometric validity can change as other vertices leave the polygon, so it
+                // is re-tested every round; the error part is cached per ear.
+                if let Some(Some(ear)) = self.ears[q] {
+                    if self.ear_is_empty(q) {
+                        let key = match rule {
+                            EdgeSelection::MinIntroduced => ear.diagonal.introduced,
+                            _ => ear.diagonal.bound.max(),
+                        };
+                        if best.is_none_or(|(_, k)| key < k) {
+                            best = Some((q, key));
+                        }
+                    }
+                }
+                q = self.next[q] as usize;
+            }
+            let Some((q, _)) = best else { return false };
+            let Some(Some(ear)) = self.ears[q] else { return false };
+            let (p, r) = (self.prev[q] as usize, self.next[q] as usize);
+            self.triangles.push(HoleTriangle {
+                corners: [p as u32, q as u32, r as u32],
+                bound: ear.triangle,
+            });
+            self.next[p] = r as u32;
+            self.prev[r] = p as u32;
+            self.edge[p] = ear.diagonal;
+            self.ears[p] = None;
+            self.ears[r] = None;
+            remaining -= 1;
+            start = p;
+        }
+        let a = start;
+        let (b, c) = (self.next[a] as usize, self.next[self.next[a] as usize] as usize);
+        if orient(&self.ring[a], &self.ring[b], &self.ring[c]) <= 0 {
+            return false;
+        }
+        let bound = self.triangle_bound(a, b, c, [self.edge[a], self.edge[b], self.edge[c]]);
+        if !within(bound, limit) {
+            return false;
+        }
+        self.triangles.push(HoleTriangle { corners: [a as u32, b as u32, c as u32], bound });
+        true
+    }
+
+    /// The ear at `q` if it is convex and its triangle's bound is within `limit`.
+    fn ear(&self, q: usize, limit: f64) -> Option<Ear> {
+        let (p, r) = (self.prev[q] as usize, self.next[q] as usize);
+        if orient(&self.ring[p], &self.ring[q], &self.ring[r]) <= 0 {
+            return None;
+        }
+        let diagonal = self.segment_error(r, p);
+        let triangle = self.triangle_bound(p, q, r, [self.edge[p], self.edge[q], diagonal]);
+        within(triangle, limit).then_some(Ear { diagonal, triangle })
+    }
+
+    /// Whether no other vertex of the current polygon lies in the closed ear at `q`.
+    fn ear_is_empty(&self, q: usize) -> bool {
+        let (p, r) = (self.prev[q] as usize, self.next[q] as usize);
+        let (a, b, c) = (&self.ring[p], &self.ring[q], &self.ring[r]);
+        let mut s = self.next[r] as usize;
+        while s != p {
+            if in_closed_triangle(a, b, c, &self.ring[s]) {
+                return false;
+            }
+            s = self.next[s] as usize;
+        }
+        true
+    }
+
+    /// Bound of new triangle `abc` from its edges' bounds and, when the removed vertex lies
+    /// in it, from the removed vertex's own error against every star triangle.
+    fn triangle_bound(&self, a: usize, b: usize, c: usize, edges: [SegmentError; 3]) -> ErrorBound {
+        let mut bound = edges[0].bound;
+        for e in &edges[1..] {
+            bound.above = bound.above.max(e.bound.above);
+            bound.below = bound.below.max(e.bound.below);
+        }
+        let centre = self.centre.expect("hole loaded");
+        let (pa, pb, pc) = (&self.ring[a], &self.ring[b], &self.ring[c]);
+        if in_closed_triangle(pa, pb, pc, &centre) {
+            let g = plane_gradient(pa, pb, pc);
+            let new_at_centre =
+                pa.z + g[0] * (centre.x - pa.x) as f64 + g[1] * (centre.y - pa.y) as f64;
+            let delta = new_at_centre - centre.z;
+            bound.above = bound.above.max(self.max_star_above - delta);
+            bound.below = bound.below.max(self.max_star_below + delta);
+        }
+        bound
+    }
+
+    /// Error of the segment from ring vertex `from` to ring vertex `to`: for each closed
+    /// star triangle it meets, the signed introduced error at its entry and exit points
+    /// folded into that triangle's bound (paper §3.3.1).
+    fn segment_error(&self, from: usize, to: usize) -> SegmentError {
+        let centre = self.centre.expect("hole loaded");
+        let (p, q) = (self.ring[from], self.ring[to]);
+        let m = self.ring.len();
+        let mut out = SegmentError {
+            bound: ErrorBound { above: f64::NEG_INFINITY, below: f64::NEG_INFINITY },
+            introduced: 0.0,
+        };
+        for (i, (star_bound, g)) in self.star_bounds.iter().zip(&self.star_gradients).enumerate() {
+            let tri = [centre, self.ring[i], self.ring[(i + 1) % m]];
+            let Some((t_lo, t_hi)) = clip_segment(&p, &q, &tri) else { continue };
+            let delta = |t: f64| {
+                let (sx, sy) = (p.x as f64 + t * (q.x - p.x) as f64, p.y as f64 + t * (q.y - p.y) as f64);
+                let new = p.z + t * (q.z - p.z);
+                let old = centre.z + g[0] * (sx - centre.x as f64) + g[1] * (sy - centre.y as f64);
+                new - old
+            };
+            let (d0, d1) = (delta(t_lo), delta(t_hi));
+            let (lo, hi) = (d0.min(d1), d0.max(d1));
+            out.bound.above = out.bound.above.max(star_bound.above - lo);
+            out.bound.below = out.bound.below.max(star_bound.below + hi);
+            out.introduced = out.introduced.max(lo.abs()).max(hi.abs());
+        }
+        debug_assert!(out.bound.above.is_finite(), "a ring segment meets its star");
+        out
+    }
+}
+
+fn within(bound: ErrorBound, limit: f64) -> bool {
+    bound.above <= limit && bound.below <= limit
+}
+
+/// The parameter interval `[t_lo, t_hi]` of segment `p + t (q - p)`, `t ∈ [0, 1]`, inside
+/// the closed counter-clockwise triangle `tri`, or `None` when they do not meet. Whether
+/// they meet is decided exactly; the interval ends are then rounded to `f64`.
+fn clip_segment(p: &Point, q: &Point, tri: &[Point; 3]) -> Option<(f64, f64)> {
+    // Rationals num/den with den > 0.
+    let (mut lo_n, mut lo_d) = (0i128, 1i128);
+    let (mut hi_n, mut hi_d) = (1i128, 1i128);
+    for k in 0..3 {
+        let (a, b) = (&tri[k], &tri[(k + 1) % 3]);
+        let f0 = orient(a, b, p) as i128;
+        let f1 = orient(a, b, q) as i128;
+        match (f0 >= 0, f1 >= 0) {
+            (true, true) => {}
+            (false, false) => return None,
+            (true, false) => {
+                // t <= f0 / (f0 - f1)
+                let (n, d) = (f0, f0 - f1);
+                if n * hi_d < hi_n * d {
+                    (hi_n, hi_d) = (n, d);
+                }
+            }
+            (false, true) => {
+                // t >= -f0 / (f1 - f0)
+                let (n, d) = (-f0, f1 - f0);
+                if n * lo_d > lo_n * d {
+                    (lo_n, lo_d) = (n, d);
+                }
+            }
+        }
+    }
+    if lo_n * hi_d > hi_n * lo_d {
+        return None;
+    }
+    Some((lo_n as f64 / lo_d as f64, hi_n as f64 / hi_d as f64))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pt(x: i64, y: i64, z: f64) -> Point {
+        Point { x, y, z }
+    }
+
+    #[test]
+    fn clipping_finds_entry_and_exit() {
+        let tri = [pt(0, 0, 0.0), pt(4, 0, 0.0), pt(0, 4, 0.0)];
+        let (lo, hi) = clip_segment(&pt(-1, 1, 0.0), &pt(5, 1, 0.0), &tri).unwrap();
+        assert!((lo - 1.0 / 6.0).abs() < 1e-15 && (hi - 4.0 / 6.0).abs() < 1e-15);
+        assert!(clip_segment(&pt(5, 5, 0.0), &pt(6, 5, 0.0), &tri).is_none());
+        // Touching a corner counts (closed triangle).
+        let (lo, hi) = clip_segment(&pt(-2, 2, 0.0), &pt(2, -2, 0.0), &tri).unwrap();
+        assert_eq!((lo, hi), (0.5, 0.5));
+    }
+
+    #[test]
+    fn removing_a_peak_counts_its_own_error() {
+        // A peak of 10 in the middle of a flat square ring: removing it costs 10 below.
+        let ring = [pt(0, 0, 0.0), pt(2, 0, 0.0), pt(2, 2, 0.0), pt(0, 2, 0.0)];
+        let mut r = Retriangulator::default();
+        r.load(pt(1, 1, 10.0), &ring, &[ErrorBound::default(); 4]);
+        assert!(r.retriangulate(EdgeSelection::Hybrid, 9.9).is_none());
+        let tris = r.retriangulate(EdgeSelection::Hybrid, 10.0).unwrap();
+        assert_eq!(tris.len(), 2);
+        let worst = tris.iter().map(|t| t.bound.above).fold(0.0, f64::max);
+        assert_eq!(worst, 10.0);
+    }
+
+    #[test]
+    fn planar_star_retriangulates_with_zero_error() {
+        let f = |x: i64, y: i64| pt(x, y, 1.0 + x as f64);
+        let ring = [f(0, 0), f(1, 0), f(2, 0), f(2, 1), f(2, 2), f(1, 2), f(0, 2), f(0, 1)];
+        let mut r = Retriangulator::default();
+        r.load(f(1, 1), &ring, &[ErrorBound::default(); 8]);
+        let tris = r.retriangulate(EdgeSelection::MinError, 0.0).unwrap();
+        assert_eq!(tris.len(), 6);
+        for t in tris {
+            let [a, b, c] = t.corners.map(|i| ring[i as usize]);
+            assert!(orient(&a, &b, &c) > 0);
+        }
+    }
+
+    #[test]
+    fn boundary_vertex_error_goes_to_the_new_edge() {
+        // Boundary vertex (1,0) at height 4 on the straight edge from (0,0) to (2,0).
+        let ring = [pt(2, 0, 0.0), pt(2, 1, 0.0), pt(1, 1, 0.0), pt(0, 1, 0.0), pt(0, 0, 0.0)];
+        let mut r = Retriangulator::default();
+        r.load(pt(1, 0, 4.0), &ring, &[ErrorBound::default(); 4]);
+        assert!(r.retriangulate(EdgeSelection::Hybrid, 3.0).is_none());
+        let tris = r.retriangulate(EdgeSelection::Hybrid, 4.0).unwrap();
+        assert_eq!(tris.len(), 3);
+        assert!(tris.iter().any(|t| t.bound.above == 4.0));
+    }
+}

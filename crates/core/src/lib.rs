@@ -1,0 +1,47 @@
+//! Error-bounded decimation of 2D scalar grids into triangulated irregular networks.
+//!
+//! This crate implements the vertex-removal decimation of Schikore & Bajaj,
+//! "Decimation of 2D Scalar Data with Error Control" (Purdue CSD-TR-95-004, 1995).
+//! It knows only the grid of samples, the mesh topology and heights: no files, no GDAL.
+//!
+//! # Guarantee
+//! For every valid sample of the input [`Grid`] that lies in the domain (a corner of a cell
+//! whose four corners are valid), the linear interpolation of the output [`Tin`] at the
+//! sample's position differs from the sample value by at most
+//! [`DecimationOptions::max_error`]. The domain (the union of valid cells) is never changed.
+//!
+//! # Example
+//! ```
+//! use tinsmith_core::{decimate, DecimationOptions, Grid};
+//! # fn main() -> Result<(), tinsmith_core::Error> {
+//! // A tilted plane: every vertex but the domain's corners can go.
+//! let values: Vec<f64> = (0..25).map(|i| (i % 5) as f64 + 2.0 * (i / 5) as f64).collect();
+//! let grid = Grid::new(5, 5, values)?;
+//! let result = decimate(&grid, &DecimationOptions::new(0.5))?;
+//! assert_eq!(result.tin.triangles().len(), 2);
+//! # Ok(())
+//! # }
+//! ```
+#![deny(missing_docs)]
+#![deny(rustdoc::broken_intra_doc_links)]
+#![forbid(unsafe_code)]
+
+mod decimate;
+mod error;
+mod error_bound;
+mod geo_transform;
+mod grid;
+mod hole;
+mod mesh;
+mod options;
+mod predicates;
+mod tin;
+
+pub use decimate::{decimate, Decimation, DecimationReport};
+pub use error::{Error, Result};
+pub use error_bound::ErrorBound;
+pub use geo_transform::GeoTransform;
+pub use grid::Grid;
+pub use mesh::VertexClass;
+pub use options::{DecimationOptions, EdgeSelection, ErrorModel};
+pub use tin::{Tin, TinVertex};

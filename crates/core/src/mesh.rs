@@ -1,0 +1,331 @@
+//! The working triangle mesh over a grid: triangles with neighbour links, per-triangle
+//! error bounds, and vertex stars (paper §3.2).
+//!
+//! Vertices are grid sample indices (`y * width + x`). Triangle `t` stores its corners
+//! counter-clockwise and, for each edge `i` (from corner `i` to corner `i + 1`), the
+//! triangle across it or [`NONE`] on the domain boundary. Removing a vertex reuses its star
+//! triangles' slots, so the triangle array never grows.
+
+use crate::predicates::{orient, Point};
+use crate::{ErrorBound, Grid};
+
+/// Marks a missing triangle, neighbour or vertex link.
+pub(crate) const NONE: u32 = u32::MAX;
+
+/// The paper's vertex classes (§3.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VertexClass {
+    /// A complete cycle of triangles around the vertex.
+    Interior,
+    /// A half cycle of triangles whose two boundary edges are collinear (a 180° angle).
+    Boundary,
+    /// Any other vertex on the domain boundary, including vertices where the domain
+    /// pinches (two separate fans of triangles). Never removed: it shapes the domain.
+    Corner,
+}
+
+/// The star of a vertex: its neighbours counter-clockwise and the triangles between them.
+#[derive(Debug, Default)]
+pub(crate) struct Star {
+    /// Neighbour vertices, counter-clockwise. For a boundary star the first and last are
+    /// the ends of the two boundary edges.
+    pub ring: Vec<u32>,
+    /// `triangles[i]` has corners `(centre, ring[i], ring[i + 1 mod len])`.
+    pub triangles: Vec<u32>,
+    /// Whether the star is a half cycle (the vertex is on the domain boundary).
+    pub open: bool,
+}
+
+/// Triangle mesh over a grid's domain, with per-triangle [`ErrorBound`]s.
+#[derive(Debug)]
+pub(crate) struct Mesh<'g> {
+    grid: &'g Grid,
+    corners: Vec<[u32; 3]>,
+    neighbours: Vec<[u32; 3]>,
+    bounds: Vec<ErrorBound>,
+    /// One live triangle incident to each vertex, or `NONE` if the vertex is not in the mesh.
+    vertex_triangle: Vec<u32>,
+    /// Vertices where the domain pinches: never removable.
+    pinched: Vec<bool>,
+    live_triangles: usize,
+}
+
+impl<'g> Mesh<'g> {
+    /// The initial mesh (paper §4): each valid cell split into two triangles along its
+    /// `(x, y)`-`(x + 1, y + 1)` diagonal, all bounds zero.
+    pub(crate) fn from_grid(grid: &'g Grid) -> Mesh<'g> {
+        let (w, h) = (grid.width() as usize, grid.height() as usize);
+        let cells_w = w.saturating_sub(1);
+        let cells = cells_w * h.saturating_sub(1);
+        let mut corners = vec![[NONE; 3]; 2 * cells];
+        let mut neighbours = vec![[NONE; 3]; 2 * cells];
+        let mut vertex_triangle = vec![NONE; w * h];
+        let mut incident = vec![0u8; w * h];
+        let mut live = 0;
+        let valid = |cx: usize, cy: usize| cx < cells_w && cy < h - 1 && grid.cell_is_valid(cx, cy);
+        for cy in 0..h.saturating_sub(1) {
+            for cx in 0..cells_w {
+                if !valid(cx, cy) {
+                    continue;
+                }
+                let c = cy * cells_w + cx;
+                let a = (cy * w + cx) as u32;
+                let (b, cc, d) = (a + 1, a + 1 + w as u32, a + w as u32);
+                let (lower, upper) = (2 * c, 2 * c + 1);
+                // lower = (a, b, cc): edges a->b (row above), b->cc (cell to the right),
+                // cc->a (diagonal). upper = (a, cc, d): a->cc (diagonal), cc->d (row
+                // below), d->a (cell to the left).
+                corners[lower] = [a, b, cc];
+                corners[upper] = [a, cc, d];
+                neighbours[lower] = [
+                    if cy > 0 && valid(cx, cy - 1) { (2 * (c - cells_w) + 1) as u32 } else { NONE },
+                    if valid(cx + 1, cy) { (2 * (c + 1) + 1) as u32 } else { NONE },
+                    upper as u32,
+                ];
+                neighbours[upper] = [
+                    lower as u32,
+                    if valid(cx, cy + 1) { (2 * (c + cells_w)) as u32 } else { NONE },
+                    if cx > 0 && valid(cx - 1, cy) { (2 * (c - 1)) as u32 } else { NONE },
+                ];
+                for v in [a, b, cc] {
+                    vertex_triangle[v as usize] = lower as u32;
+                    incident[v as usize] += 1;
+                }
+                for v in [a, cc, d] {
+                    vertex_triangle[v as usize] = upper as u32;
+                    incident[v as usize] += 1;
+                }
+                live += 2;
+            }
+        }
+        let mut mesh = Mesh {
+            grid,
+            corners,
+            bounds: vec![ErrorBound::default(); 2 * cells],
+            neighbours,
+            vertex_triangle,
+            pinched: vec![false; w * h],
+            live_triangles: live,
+        };
+        let mut star = Star::default();
+        for v in 0..w * h {
+            if mesh.vertex_triangle[v] != NONE {
+                mesh.star(v as u32, &mut star);
+                mesh.pinched[v] = star.triangles.len() != incident[v] as usize;
+            }
+        }
+        mesh
+    }
+
+    /// Number of live triangles.
+    pub(crate) fn triangle_count(&self) -> usize {
+        self.live_triangles
+    }
+
+    /// Whether vertex `v` is in the mesh.
+    pub(crate) fn contains_vertex(&self, v: u32) -> bool {
+        self.vertex_triangle[v as usize] != NONE
+    }
+
+    /// Number of vertex slots (grid samples).
+    pub(crate) fn vertex_slots(&self) -> usize {
+        self.vertex_triangle.len()
+    }
+
+    /// Position and value of vertex `v`.
+    pub(crate) fn point(&self, v: u32) -> Point {
+        let w = self.grid.width() as usize;
+        let i = v as usize;
+        Point { x: (i % w) as i64, y: (i / w) as i64, z: self.grid.values()[i] }
+    }
+
+    /// Bound of triangle `t`.
+    pub(crate) fn bound(&self, t: u32) -> ErrorBound {
+        self.bounds[t as usize]
+    }
+
+    /// Live triangles in slot order, as corner triples.
+    pub(crate) fn live_triangles(&self) -> impl Iterator<Item = (u32, [u32; 3])> + '_ {
+        self.corners
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c[0] != NONE)
+            .map(|(t, c)| (t as u32, *c))
+    }
+
+    /// Fills `star` with the fan around `v` (which must be in the mesh).
+    pub(crate) fn star(&self, v: u32, star: &mut Star) {
+        star.ring.clear();
+        star.triangles.clear();
+        let start = self.vertex_triangle[v as usize];
+        debug_assert_ne!(start, NONE);
+        // Turn clockwise to the first triangle of an open fan, or back to `start`.
+        let mut first = start;
+        star.open = false;
+        loop {
+            let i = self.local(first, v);
+            let cw = self.neighbours[first as usize][i];
+            if cw == NONE {
+                star.open = true;
+                break;
+            }
+            if cw == start {
+                break;
+            }
+            first = cw;
+        }
+        // Walk counter-clockwise from `first`.
+        let mut t = first;
+        loop {
+            let i = self.local(t, v);
+            let c = self.corners[t as usize];
+            star.ring.push(c[(i + 1) % 3]);
+            star.triangles.push(t);
+            let ccw = self.neighbours[t as usize][(i + 2) % 3];
+            if ccw == NONE {
+                star.ring.push(c[(i + 2) % 3]);
+                break;
+            }
+            if ccw == first {
+                break;
+            }
+            t = ccw;
+        }
+    }
+
+    /// Class of vertex `v` given its star (paper §3.2).
+    pub(crate) fn classify(&self, v: u32, star: &Star) -> VertexClass {
+        if self.pinched[v as usize] {
+            return VertexClass::Corner;
+        }
+        if !star.open {
+            return VertexClass::Interior;
+        }
+        let c = self.point(v);
+        let a = self.point(star.ring[0]);
+        let b = self.point(*star.ring.last().expect("a star has neighbours"));
+        let straight = orient(&a, &c, &b) == 0 && (a.x - c.x) * (b.x - c.x) + (a.y - c.y) * (b.y - c.y) < 0;
+        if straight {
+            VertexClass::Boundary
+        } else {
+            VertexClass::Corner
+        }
+    }
+
+    /// Replaces the star of `v` by `new_triangles` (corners index `star.ring`) and removes
+    /// `v`. The new triangles must tile the star exactly.
+    pub(crate) fn replace_star(
+        &mut self,
+        v: u32,
+        star: &Star,
+        new_triangles: &[(u32, [u32; 3], ErrorBound)],
+    ) {
+        // Outer links of the ring edges, read before the star's slots are reused:
+        // ring edge i (ring[i] -> ring[i+1]) belongs to star triangle i.
+        let mut ring_edges: Vec<(u32, u32, u32)> = star
+            .triangles
+            .iter()
+            .map(|&t| {
+                let i = self.local(t, v);
+                let c = self.corners[t as usize];
+                (c[(i + 1) % 3], c[(i + 2) % 3], self.neighbours[t as usize][(i + 1) % 3])
+            })
+            .collect();
+        if star.open {
+            // The new domain edge that replaces the two boundary edges through `v`.
+            let last = *star.ring.last().expect("a star has neighbours");
+            ring_edges.push((last, star.ring[0], NONE));
+        }
+        debug_assert!(new_triangles.len() < star.triangles.len());
+        for &t in &star.triangles {
+            self.corners[t as usize] = [NONE; 3];
+            self.neighbours[t as usize] = [NONE; 3];
+        }
+        for &(slot, c, bound) in new_triangles {
+            self.corners[slot as usize] = c;
+            self.bounds[slot as usize] = bound;
+            for &x in &c {
+                self.vertex_triangle[x as usize] = slot;
+            }
+        }
+        // Link each new triangle edge to its twin: another new triangle, or the outside.
+        for (n, &(slot, c, _)) in new_triangles.iter().enumerate() {
+            for e in 0..3 {
+                let (a, b) = (c[e], c[(e + 1) % 3]);
+                let twin = new_triangles.iter().enumerate().find_map(|(m, &(s2, c2, _))| {
+                    (m != n && (0..3).any(|k| c2[k] == b && c2[(k + 1) % 3] == a)).then_some(s2)
+                });
+                let across = match twin {
+                    Some(s2) => s2,
+                    None => {
+                        let outside = ring_edges
+                            .iter()
+                            .find(|&&(ra, rb, _)| ra == a && rb == b)
+                            .map(|&(_, _, o)| o)
+                            .expect("a hole edge is a ring edge or a shared diagonal");
+                        if outside != NONE {
+                            let k = self.edge_index(outside, b, a);
+                            self.neighbours[outside as usize][k] = slot;
+                        }
+                        outside
+                    }
+                };
+                self.neighbours[slot as usize][e] = across;
+            }
+        }
+        self.vertex_triangle[v as usize] = NONE;
+        self.live_triangles -= star.triangles.len() - new_triangles.len();
+    }
+
+    /// Index of corner `v` in triangle `t`.
+    fn local(&self, t: u32, v: u32) -> usize {
+        let c = &self.corners[t as usize];
+        if c[0] == v {
+            0
+        } else if c[1] == v {
+            1
+        } else {
+            debug_assert_eq!(c[2], v, "vertex {v} not in triangle {t}");
+            2
+        }
+    }
+
+    /// Index of the edge `a -> b` in triangle `t`.
+    fn edge_index(&self, t: u32, a: u32, b: u32) -> usize {
+        let i = self.local(t, a);
+        debug_assert_eq!(self.corners[t as usize][(i + 1) % 3], b);
+        i
+    }
+
+    /// Checks every structural invariant; panics with a description on the first broken one.
+    #[cfg(any(test, debug_assertions))]
+    pub(crate) fn check_invariants(&self) {
+        let mut live = 0;
+        for (t, c) in self.live_triangles() {
+            live += 1;
+            let (a, b, cc) = (self.point(c[0]), self.point(c[1]), self.point(c[2]));
+            assert!(orient(&a, &b, &cc) > 0, "triangle {t} {c:?} is not counter-clockwise");
+            for e in 0..3 {
+                let n = self.neighbours[t as usize][e];
+                if n != NONE {
+                    let nc = self.corners[n as usize];
+                    assert_ne!(nc[0], NONE, "triangle {t} links to dead triangle {n}");
+                    let (x, y) = (c[e], c[(e + 1) % 3]);
+                    assert!(
+                        (0..3).any(|k| nc[k] == y && nc[(k + 1) % 3] == x),
+                        "triangle {t} edge {e} and triangle {n} are not twins"
+                    );
+                }
+            }
+            for &v in &c {
+                assert_ne!(self.vertex_triangle[v as usize], NONE, "vertex {v} lost its link");
+            }
+        }
+        assert_eq!(live, self.live_triangles, "live triangle count");
+        for (v, &t) in self.vertex_triangle.iter().enumerate() {
+            if t != NONE {
+                assert!(self.corners[t as usize].contains(&(v as u32)), "vertex {v} link");
+            }
+        }
+    }
+}

@@ -1,0 +1,123 @@
+//! Property tests: on random small grids, for every selection rule and bound, the
+//! independent verifier measures an error within the bound, the mesh is a valid tiling of
+//! the domain, and every domain corner is kept.
+
+use proptest::prelude::*;
+use tinsmith_core::{decimate, DecimationOptions, EdgeSelection, Grid, Tin};
+use tinsmith_testkit::{max_error, small_grid, GridSpec};
+use tinsmith_verify::{verify, GridRef, MeshRef, Orientation, VerifyOptions};
+
+const SELECTIONS: [EdgeSelection; 3] =
+    [EdgeSelection::Hybrid, EdgeSelection::MinError, EdgeSelection::MinIntroduced];
+
+fn check(spec: &GridSpec, bound: f64, selection: EdgeSelection) -> Result<Tin, TestCaseError> {
+    let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
+    let result = decimate(&grid, &DecimationOptions::new(bound).with_selection(selection)).unwrap();
+    let tin = result.tin;
+    let positions: Vec<[i64; 2]> = tin.vertices().iter().map(|v| [v.x as i64, v.y as i64]).collect();
+    let heights: Vec<f64> = tin.vertices().iter().map(|v| v.z).collect();
+    let report = verify(
+        GridRef::new(spec.width, spec.height, &spec.values),
+        MeshRef::new(&positions, &heights, tin.triangles()),
+        &VerifyOptions::new().with_max_error(bound).with_orientation(Orientation::CounterClockwise),
+    )
+    .unwrap();
+    prop_assert!(report.passed(), "bound {bound} {selection:?}: {:?}", report.problems);
+    prop_assert!(report.max_error <= bound);
+    prop_assert!(result.report.max_bound <= bound);
+    prop_assert_eq!(result.report.final_triangles, tin.triangles().len());
+    for [x, y] in domain_corners(spec) {
+        prop_assert!(
+            tin.vertices().iter().any(|v| v.x == x && v.y == y),
+            "corner ({x}, {y}) was removed"
+        );
+    }
+    Ok(tin)
+}
+
+/// Samples where the domain's outline turns or pinches, found from the cells alone: one or
+/// three of the four cells around the sample are valid, or two diagonal ones.
+fn domain_corners(spec: &GridSpec) -> Vec<[u32; 2]> {
+    let (w, h) = (spec.width as i64, spec.height as i64);
+    let valid = |x: i64, y: i64| {
+        (0..w).contains(&x) && (0..h).contains(&y) && spec.values[(y * w + x) as usize].is_finite()
+    };
+    let cell = |x: i64, y: i64| valid(x, y) && valid(x + 1, y) && valid(x, y + 1) && valid(x + 1, y + 1);
+    let mut corners = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let around = [cell(x - 1, y - 1), cell(x, y - 1), cell(x, y), cell(x - 1, y)];
+            let n = around.iter().filter(|&&c| c).count();
+            let diagonal = n == 2 && around[0] == around[2];
+            if n == 1 || n == 3 || diagonal {
+                corners.push([x as u32, y as u32]);
+            }
+        }
+    }
+    corners
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    #[test]
+    fn bound_holds_for_every_selection(spec in small_grid(), bound in max_error()) {
+        for selection in SELECTIONS {
+            check(&spec, bound, selection)?;
+        }
+    }
+
+    #[test]
+    fn decimation_is_deterministic(spec in small_grid(), bound in max_error()) {
+        let a = check(&spec, bound, EdgeSelection::Hybrid)?;
+        let b = check(&spec, bound, EdgeSelection::Hybrid)?;
+        prop_assert_eq!(a, b);
+    }
+}
+
+#[test]
+fn planar_grid_keeps_only_its_corners() {
+    let spec = GridSpec {
+        width: 20,
+        height: 15,
+        values: (0..300).map(|i| 0.25 * (i % 20) as f64 - 1.5 * (i / 20) as f64).collect(),
+    };
+    let tin = check(&spec, 0.01, EdgeSelection::Hybrid).unwrap();
+    assert_eq!(tin.vertices().len(), 4);
+    assert_eq!(tin.triangles().len(), 2);
+}
+
+#[test]
+fn constant_grid_decimates_even_at_zero_error() {
+    let spec = GridSpec { width: 9, height: 9, values: vec![0.1; 81] };
+    let tin = check(&spec, 0.0, EdgeSelection::Hybrid).unwrap();
+    assert_eq!(tin.triangles().len(), 2);
+}
+
+#[test]
+fn a_single_spike_is_kept_and_the_rest_goes() {
+    let mut values = vec![0.0; 121];
+    values[5 * 11 + 5] = 50.0;
+    let spec = GridSpec { width: 11, height: 11, values };
+    let tin = check(&spec, 1.0, EdgeSelection::Hybrid).unwrap();
+    assert!(tin.vertices().iter().any(|v| v.x == 5 && v.y == 5 && v.z == 50.0));
+    // The four corners, the spike and at most its eight neighbours.
+    assert!(tin.vertices().len() <= 13, "kept {}", tin.vertices().len());
+}
+
+#[test]
+fn rough_terrain_with_holes_stays_within_bound() {
+    let spec = tinsmith_testkit::with_nodata_disc(tinsmith_testkit::terrain(60, 45, 4.0, 7), 20.0, 20.0, 6.0);
+    for bound in [0.5, 2.0, 10.0] {
+        for selection in SELECTIONS {
+            check(&spec, bound, selection).unwrap();
+        }
+    }
+}
+
+#[test]
+fn empty_domain_gives_an_empty_tin() {
+    let spec = GridSpec { width: 1, height: 7, values: vec![1.0; 7] };
+    let tin = check(&spec, 1.0, EdgeSelection::Hybrid).unwrap();
+    assert!(tin.triangles().is_empty() && tin.vertices().is_empty());
+}

@@ -1,1 +1,6 @@
+//! End-to-end tests of the `tinsmith` binary: one temp dir per test, the real binary.
 
+mod util;
+
+mod bad_input;
+mod mesh_and_verify;

@@ -1,1 +1,67 @@
-fn main() {}
+//! `tinsmith`: error-bounded DEM to TIN conversion on the command line.
+//!
+//! Exit codes: 0 success; 1 the verifier found the mesh outside the bound or invalid;
+//! 2 bad input or any other error (the message names the file and the problem).
+
+mod args;
+mod georef;
+mod info;
+mod mesh;
+mod output;
+mod verify;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+use crate::args::{Cli, Command};
+
+/// Exit code when verification fails.
+const EXIT_VERIFY_FAILED: u8 = 1;
+/// Exit code for bad input and other errors.
+const EXIT_ERROR: u8 = 2;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    // Errors come back as values with GDAL's message; GDAL need not print them too.
+    tinsmith_raster::silence_gdal_errors();
+    let result = match cli.command {
+        Command::Info(a) => info::run(&a),
+        Command::Mesh(a) => mesh::run(&a),
+        Command::Verify(a) => verify::run(&a),
+    };
+    match result {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(EXIT_VERIFY_FAILED),
+        Err(err) => {
+            if is_broken_pipe(&err) {
+                return ExitCode::SUCCESS;
+            }
+            eprintln!("tinsmith: {}", one_line(&err));
+            ExitCode::from(EXIT_ERROR)
+        }
+    }
+}
+
+/// The error and its causes on one line, skipping a cause already quoted by the message
+/// above it, and the gdal crate's wrapper text (the raster errors quote GDAL's reason).
+fn one_line(err: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        if !line.contains(&text) && !text.starts_with("GDAL method") {
+            if !line.is_empty() {
+                line.push_str(": ");
+            }
+            line.push_str(&text);
+        }
+    }
+    line.replace('\n', " ")
+}
+
+fn is_broken_pipe(err: &anyhow::Error) -> bool {
+    err.chain().any(|e| {
+        e.downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}

@@ -1,7 +1,7 @@
 //! The decimation driver: the paper's sweep over candidate vertices (§3.1).
 
-use std::collections::BinaryHeap;
 use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 use std::time::Instant;
 
 use crate::hole::Retriangulator;
@@ -73,13 +73,27 @@ pub fn decimate(grid: &Grid, options: &DecimationOptions) -> Result<Decimation> 
     let started = Instant::now();
     let mut mesh = Mesh::from_grid(grid);
     let initial_triangles = mesh.triangle_count();
-    let initial_vertices = (0..mesh.vertex_slots() as u32).filter(|&v| mesh.contains_vertex(v)).count();
+    let initial_vertices = (0..mesh.vertex_slots() as u32)
+        .filter(|&v| mesh.contains_vertex(v))
+        .count();
     let seconds_initial_mesh = started.elapsed().as_secs_f64();
 
     let slack = ROUNDING_SLACK * (max_error + grid.max_abs_value());
-    let limit = if max_error > slack { max_error - slack } else { 0.0 };
+    let limit = if max_error > slack {
+        max_error - slack
+    } else {
+        0.0
+    };
     let started = Instant::now();
-    let mut remover = Remover { star: Star::default(), hole: Retriangulator::default(), points: Vec::new(), bounds: Vec::new(), new_triangles: Vec::new(), selection: options.selection, limit };
+    let mut remover = Remover {
+        star: Star::default(),
+        hole: Retriangulator::default(),
+        points: Vec::new(),
+        bounds: Vec::new(),
+        new_triangles: Vec::new(),
+        selection: options.selection,
+        limit,
+    };
 
     // The paper's sweep, made cheap: a vertex whose star did not change since it last
     // failed would fail again, so each sweep visits only vertices whose star changed, in
@@ -157,7 +171,8 @@ impl Remover {
             return false;
         }
         self.points.clear();
-        self.points.extend(self.star.ring.iter().map(|&u| mesh.point(u)));
+        self.points
+            .extend(self.star.ring.iter().map(|&u| mesh.point(u)));
         let centre = mesh.point(v);
         if self.limit == 0.0 && self.points.iter().any(|p| p.z != centre.z) {
             // Below the rounding slack only exactly flat stars go: their bound arithmetic
@@ -165,7 +180,8 @@ impl Remover {
             return false;
         }
         self.bounds.clear();
-        self.bounds.extend(self.star.triangles.iter().map(|&t| mesh.bound(t)));
+        self.bounds
+            .extend(self.star.triangles.iter().map(|&t| mesh.bound(t)));
         self.hole.load(centre, &self.points, &self.bounds);
         let Some(triangles) = self.hole.retriangulate(self.selection, self.limit) else {
             return false;
@@ -190,7 +206,11 @@ fn extract(mesh: &Mesh<'_>) -> (Tin, f64) {
         if mesh.contains_vertex(v) {
             index[v as usize] = vertices.len() as u32;
             let p = mesh.point(v);
-            vertices.push(TinVertex { x: p.x as u32, y: p.y as u32, z: p.z });
+            vertices.push(TinVertex {
+                x: p.x as u32,
+                y: p.y as u32,
+                z: p.z,
+            });
         }
     }
     let mut triangles = Vec::with_capacity(mesh.triangle_count());
@@ -199,5 +219,11 @@ fn extract(mesh: &Mesh<'_>) -> (Tin, f64) {
         triangles.push(c.map(|v| index[v as usize]));
         max_bound = max_bound.max(mesh.bound(t).max());
     }
-    (Tin { vertices, triangles }, max_bound)
+    (
+        Tin {
+            vertices,
+            triangles,
+        },
+        max_bound,
+    )
 }

@@ -15,7 +15,10 @@ impl GeoTransform {
     pub fn sample_centre(&self, x: f64, y: f64) -> [f64; 2] {
         let c = &self.0;
         let (col, row) = (x + 0.5, y + 0.5);
-        [c[0] + col * c[1] + row * c[2], c[3] + col * c[4] + row * c[5]]
+        [
+            c[0] + col * c[1] + row * c[2],
+            c[3] + col * c[4] + row * c[5],
+        ]
     }
 
     /// The sample `(x, y)` whose centre maps to `world`, as fractional grid coordinates,

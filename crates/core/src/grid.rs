@@ -20,12 +20,21 @@ impl Grid {
     pub fn new(width: u32, height: u32, values: Vec<f64>) -> Result<Grid> {
         let expected = width as usize * height as usize;
         if width == 0 || height == 0 || values.len() != expected {
-            return Err(Error::GridSize { width, height, expected, actual: values.len() });
+            return Err(Error::GridSize {
+                width,
+                height,
+                expected,
+                actual: values.len(),
+            });
         }
         if expected as u64 >= u32::MAX as u64 {
             return Err(Error::GridTooLarge { width, height });
         }
-        Ok(Grid { width, height, values })
+        Ok(Grid {
+            width,
+            height,
+            values,
+        })
     }
 
     /// Number of columns.
@@ -82,6 +91,9 @@ impl Grid {
 
     /// Largest absolute valid value (0 for a grid without valid samples).
     pub(crate) fn max_abs_value(&self) -> f64 {
-        self.values.iter().filter(|v| v.is_finite()).fold(0.0, |m, v| m.max(v.abs()))
+        self.values
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0, |m, v| m.max(v.abs()))
     }
 }

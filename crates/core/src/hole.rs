@@ -83,8 +83,12 @@ impl Retriangulator {
             let g = plane_gradient(&centre, &ring[i], &ring[(i + 1) % m]);
             self.star_gradients.push(g);
         }
-        self.max_star_above = star_bounds.iter().fold(f64::NEG_INFINITY, |m, b| m.max(b.above));
-        self.max_star_below = star_bounds.iter().fold(f64::NEG_INFINITY, |m, b| m.max(b.below));
+        self.max_star_above = star_bounds
+            .iter()
+            .fold(f64::NEG_INFINITY, |m, b| m.max(b.above));
+        self.max_star_below = star_bounds
+            .iter()
+            .fold(f64::NEG_INFINITY, |m, b| m.max(b.below));
     }
 
     /// Triangulates the loaded hole by ear clipping with `selection`, accepting only
@@ -100,7 +104,8 @@ impl Retriangulator {
                 if self.clip_ears(EdgeSelection::MinIntroduced, limit) {
                     return Some(&self.triangles);
                 }
-                self.clip_ears(EdgeSelection::MinError, limit).then_some(&self.triangles)
+                self.clip_ears(EdgeSelection::MinError, limit)
+                    .then_some(&self.triangles)
             }
             rule => self.clip_ears(rule, limit).then_some(&self.triangles),
         }
@@ -146,7 +151,9 @@ impl Retriangulator {
                 q = self.next[q] as usize;
             }
             let Some((q, _)) = best else { return false };
-            let Some(Some(ear)) = self.ears[q] else { return false };
+            let Some(Some(ear)) = self.ears[q] else {
+                return false;
+            };
             let (p, r) = (self.prev[q] as usize, self.next[q] as usize);
             self.triangles.push(HoleTriangle {
                 corners: [p as u32, q as u32, r as u32],
@@ -161,7 +168,10 @@ impl Retriangulator {
             start = p;
         }
         let a = start;
-        let (b, c) = (self.next[a] as usize, self.next[self.next[a] as usize] as usize);
+        let (b, c) = (
+            self.next[a] as usize,
+            self.next[self.next[a] as usize] as usize,
+        );
         if orient(&self.ring[a], &self.ring[b], &self.ring[c]) <= 0 {
             return false;
         }
@@ -169,7 +179,10 @@ impl Retriangulator {
         if !within(bound, limit) {
             return false;
         }
-        self.triangles.push(HoleTriangle { corners: [a as u32, b as u32, c as u32], bound });
+        self.triangles.push(HoleTriangle {
+            corners: [a as u32, b as u32, c as u32],
+            bound,
+        });
         true
     }
 
@@ -227,14 +240,27 @@ impl Retriangulator {
         let (p, q) = (self.ring[from], self.ring[to]);
         let m = self.ring.len();
         let mut out = SegmentError {
-            bound: ErrorBound { above: f64::NEG_INFINITY, below: f64::NEG_INFINITY },
+            bound: ErrorBound {
+                above: f64::NEG_INFINITY,
+                below: f64::NEG_INFINITY,
+            },
             introduced: 0.0,
         };
-        for (i, (star_bound, g)) in self.star_bounds.iter().zip(&self.star_gradients).enumerate() {
+        for (i, (star_bound, g)) in self
+            .star_bounds
+            .iter()
+            .zip(&self.star_gradients)
+            .enumerate()
+        {
             let tri = [centre, self.ring[i], self.ring[(i + 1) % m]];
-            let Some((t_lo, t_hi)) = clip_segment(&p, &q, &tri) else { continue };
+            let Some((t_lo, t_hi)) = clip_segment(&p, &q, &tri) else {
+                continue;
+            };
             let delta = |t: f64| {
-                let (sx, sy) = (p.x as f64 + t * (q.x - p.x) as f64, p.y as f64 + t * (q.y - p.y) as f64);
+                let (sx, sy) = (
+                    p.x as f64 + t * (q.x - p.x) as f64,
+                    p.y as f64 + t * (q.y - p.y) as f64,
+                );
                 let new = p.z + t * (q.z - p.z);
                 let old = centre.z + g[0] * (sx - centre.x as f64) + g[1] * (sy - centre.y as f64);
                 new - old
@@ -325,7 +351,16 @@ mod tests {
     #[test]
     fn planar_star_retriangulates_with_zero_error() {
         let f = |x: i64, y: i64| pt(x, y, 1.0 + x as f64);
-        let ring = [f(0, 0), f(1, 0), f(2, 0), f(2, 1), f(2, 2), f(1, 2), f(0, 2), f(0, 1)];
+        let ring = [
+            f(0, 0),
+            f(1, 0),
+            f(2, 0),
+            f(2, 1),
+            f(2, 2),
+            f(1, 2),
+            f(0, 2),
+            f(0, 1),
+        ];
         let mut r = Retriangulator::default();
         r.load(f(1, 1), &ring, &[ErrorBound::default(); 8]);
         let tris = r.retriangulate(EdgeSelection::MinError, 0.0).unwrap();
@@ -339,7 +374,13 @@ mod tests {
     #[test]
     fn boundary_vertex_error_goes_to_the_new_edge() {
         // Boundary vertex (1,0) at height 4 on the straight edge from (0,0) to (2,0).
-        let ring = [pt(2, 0, 0.0), pt(2, 1, 0.0), pt(1, 1, 0.0), pt(0, 1, 0.0), pt(0, 0, 0.0)];
+        let ring = [
+            pt(2, 0, 0.0),
+            pt(2, 1, 0.0),
+            pt(1, 1, 0.0),
+            pt(0, 1, 0.0),
+            pt(0, 0, 0.0),
+        ];
         let mut r = Retriangulator::default();
         r.load(pt(1, 0, 4.0), &ring, &[ErrorBound::default(); 4]);
         assert!(r.retriangulate(EdgeSelection::Hybrid, 3.0).is_none());

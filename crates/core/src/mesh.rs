@@ -78,14 +78,30 @@ impl<'g> Mesh<'g> {
                 corners[lower] = [a, b, cc];
                 corners[upper] = [a, cc, d];
                 neighbours[lower] = [
-                    if cy > 0 && valid(cx, cy - 1) { (2 * (c - cells_w) + 1) as u32 } else { NONE },
-                    if valid(cx + 1, cy) { (2 * (c + 1) + 1) as u32 } else { NONE },
+                    if cy > 0 && valid(cx, cy - 1) {
+                        (2 * (c - cells_w) + 1) as u32
+                    } else {
+                        NONE
+                    },
+                    if valid(cx + 1, cy) {
+                        (2 * (c + 1) + 1) as u32
+                    } else {
+                        NONE
+                    },
                     upper as u32,
                 ];
                 neighbours[upper] = [
                     lower as u32,
-                    if valid(cx, cy + 1) { (2 * (c + cells_w)) as u32 } else { NONE },
-                    if cx > 0 && valid(cx - 1, cy) { (2 * (c - 1)) as u32 } else { NONE },
+                    if valid(cx, cy + 1) {
+                        (2 * (c + cells_w)) as u32
+                    } else {
+                        NONE
+                    },
+                    if cx > 0 && valid(cx - 1, cy) {
+                        (2 * (c - 1)) as u32
+                    } else {
+                        NONE
+                    },
                 ];
                 for v in [a, b, cc] {
                     vertex_triangle[v as usize] = lower as u32;
@@ -108,10 +124,10 @@ impl<'g> Mesh<'g> {
             live_triangles: live,
         };
         let mut star = Star::default();
-        for v in 0..w * h {
-            if mesh.vertex_triangle[v] != NONE {
+        for (v, &count) in incident.iter().enumerate() {
+            if count > 0 {
                 mesh.star(v as u32, &mut star);
-                mesh.pinched[v] = star.triangles.len() != incident[v] as usize;
+                mesh.pinched[v] = star.triangles.len() != count as usize;
             }
         }
         mesh
@@ -136,7 +152,11 @@ impl<'g> Mesh<'g> {
     pub(crate) fn point(&self, v: u32) -> Point {
         let w = self.grid.width() as usize;
         let i = v as usize;
-        Point { x: (i % w) as i64, y: (i / w) as i64, z: self.grid.values()[i] }
+        Point {
+            x: (i % w) as i64,
+            y: (i / w) as i64,
+            z: self.grid.values()[i],
+        }
     }
 
     /// Bound of triangle `t`.
@@ -204,7 +224,8 @@ impl<'g> Mesh<'g> {
         let c = self.point(v);
         let a = self.point(star.ring[0]);
         let b = self.point(*star.ring.last().expect("a star has neighbours"));
-        let straight = orient(&a, &c, &b) == 0 && (a.x - c.x) * (b.x - c.x) + (a.y - c.y) * (b.y - c.y) < 0;
+        let straight =
+            orient(&a, &c, &b) == 0 && (a.x - c.x) * (b.x - c.x) + (a.y - c.y) * (b.y - c.y) < 0;
         if straight {
             VertexClass::Boundary
         } else {
@@ -228,7 +249,11 @@ impl<'g> Mesh<'g> {
             .map(|&t| {
                 let i = self.local(t, v);
                 let c = self.corners[t as usize];
-                (c[(i + 1) % 3], c[(i + 2) % 3], self.neighbours[t as usize][(i + 1) % 3])
+                (
+                    c[(i + 1) % 3],
+                    c[(i + 2) % 3],
+                    self.neighbours[t as usize][(i + 1) % 3],
+                )
             })
             .collect();
         if star.open {
@@ -252,9 +277,12 @@ impl<'g> Mesh<'g> {
         for (n, &(slot, c, _)) in new_triangles.iter().enumerate() {
             for e in 0..3 {
                 let (a, b) = (c[e], c[(e + 1) % 3]);
-                let twin = new_triangles.iter().enumerate().find_map(|(m, &(s2, c2, _))| {
-                    (m != n && (0..3).any(|k| c2[k] == b && c2[(k + 1) % 3] == a)).then_some(s2)
-                });
+                let twin = new_triangles
+                    .iter()
+                    .enumerate()
+                    .find_map(|(m, &(s2, c2, _))| {
+                        (m != n && (0..3).any(|k| c2[k] == b && c2[(k + 1) % 3] == a)).then_some(s2)
+                    });
                 let across = match twin {
                     Some(s2) => s2,
                     None => {
@@ -304,7 +332,10 @@ impl<'g> Mesh<'g> {
         for (t, c) in self.live_triangles() {
             live += 1;
             let (a, b, cc) = (self.point(c[0]), self.point(c[1]), self.point(c[2]));
-            assert!(orient(&a, &b, &cc) > 0, "triangle {t} {c:?} is not counter-clockwise");
+            assert!(
+                orient(&a, &b, &cc) > 0,
+                "triangle {t} {c:?} is not counter-clockwise"
+            );
             for e in 0..3 {
                 let n = self.neighbours[t as usize][e];
                 if n != NONE {
@@ -318,13 +349,19 @@ impl<'g> Mesh<'g> {
                 }
             }
             for &v in &c {
-                assert_ne!(self.vertex_triangle[v as usize], NONE, "vertex {v} lost its link");
+                assert_ne!(
+                    self.vertex_triangle[v as usize], NONE,
+                    "vertex {v} lost its link"
+                );
             }
         }
         assert_eq!(live, self.live_triangles, "live triangle count");
         for (v, &t) in self.vertex_triangle.iter().enumerate() {
             if t != NONE {
-                assert!(self.corners[t as usize].contains(&(v as u32)), "vertex {v} link");
+                assert!(
+                    self.corners[t as usize].contains(&(v as u32)),
+                    "vertex {v} link"
+                );
             }
         }
     }

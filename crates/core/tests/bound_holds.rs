@@ -7,22 +7,39 @@ use tinsmith_core::{decimate, DecimationOptions, EdgeSelection, Grid, Tin};
 use tinsmith_testkit::{max_error, small_grid, GridSpec};
 use tinsmith_verify::{verify, GridRef, MeshRef, Orientation, VerifyOptions};
 
-const SELECTIONS: [EdgeSelection; 3] =
-    [EdgeSelection::Hybrid, EdgeSelection::MinError, EdgeSelection::MinIntroduced];
+const SELECTIONS: [EdgeSelection; 3] = [
+    EdgeSelection::Hybrid,
+    EdgeSelection::MinError,
+    EdgeSelection::MinIntroduced,
+];
 
 fn check(spec: &GridSpec, bound: f64, selection: EdgeSelection) -> Result<Tin, TestCaseError> {
     let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
-    let result = decimate(&grid, &DecimationOptions::new(bound).with_selection(selection)).unwrap();
+    let result = decimate(
+        &grid,
+        &DecimationOptions::new(bound).with_selection(selection),
+    )
+    .unwrap();
     let tin = result.tin;
-    let positions: Vec<[i64; 2]> = tin.vertices().iter().map(|v| [v.x as i64, v.y as i64]).collect();
+    let positions: Vec<[i64; 2]> = tin
+        .vertices()
+        .iter()
+        .map(|v| [v.x as i64, v.y as i64])
+        .collect();
     let heights: Vec<f64> = tin.vertices().iter().map(|v| v.z).collect();
     let report = verify(
         GridRef::new(spec.width, spec.height, &spec.values),
         MeshRef::new(&positions, &heights, tin.triangles()),
-        &VerifyOptions::new().with_max_error(bound).with_orientation(Orientation::CounterClockwise),
+        &VerifyOptions::new()
+            .with_max_error(bound)
+            .with_orientation(Orientation::CounterClockwise),
     )
     .unwrap();
-    prop_assert!(report.passed(), "bound {bound} {selection:?}: {:?}", report.problems);
+    prop_assert!(
+        report.passed(),
+        "bound {bound} {selection:?}: {:?}",
+        report.problems
+    );
     prop_assert!(report.max_error <= bound);
     prop_assert!(result.report.max_bound <= bound);
     prop_assert_eq!(result.report.final_triangles, tin.triangles().len());
@@ -42,11 +59,17 @@ fn domain_corners(spec: &GridSpec) -> Vec<[u32; 2]> {
     let valid = |x: i64, y: i64| {
         (0..w).contains(&x) && (0..h).contains(&y) && spec.values[(y * w + x) as usize].is_finite()
     };
-    let cell = |x: i64, y: i64| valid(x, y) && valid(x + 1, y) && valid(x, y + 1) && valid(x + 1, y + 1);
+    let cell =
+        |x: i64, y: i64| valid(x, y) && valid(x + 1, y) && valid(x, y + 1) && valid(x + 1, y + 1);
     let mut corners = Vec::new();
     for y in 0..h {
         for x in 0..w {
-            let around = [cell(x - 1, y - 1), cell(x, y - 1), cell(x, y), cell(x - 1, y)];
+            let around = [
+                cell(x - 1, y - 1),
+                cell(x, y - 1),
+                cell(x, y),
+                cell(x - 1, y),
+            ];
             let n = around.iter().filter(|&&c| c).count();
             let diagonal = n == 2 && around[0] == around[2];
             if n == 1 || n == 3 || diagonal {
@@ -80,7 +103,9 @@ fn planar_grid_keeps_only_its_corners() {
     let spec = GridSpec {
         width: 20,
         height: 15,
-        values: (0..300).map(|i| 0.25 * (i % 20) as f64 - 1.5 * (i / 20) as f64).collect(),
+        values: (0..300)
+            .map(|i| 0.25 * (i % 20) as f64 - 1.5 * (i / 20) as f64)
+            .collect(),
     };
     let tin = check(&spec, 0.01, EdgeSelection::Hybrid).unwrap();
     assert_eq!(tin.vertices().len(), 4);
@@ -89,7 +114,11 @@ fn planar_grid_keeps_only_its_corners() {
 
 #[test]
 fn constant_grid_decimates_even_at_zero_error() {
-    let spec = GridSpec { width: 9, height: 9, values: vec![0.1; 81] };
+    let spec = GridSpec {
+        width: 9,
+        height: 9,
+        values: vec![0.1; 81],
+    };
     let tin = check(&spec, 0.0, EdgeSelection::Hybrid).unwrap();
     assert_eq!(tin.triangles().len(), 2);
 }
@@ -98,16 +127,28 @@ fn constant_grid_decimates_even_at_zero_error() {
 fn a_single_spike_is_kept_and_the_rest_goes() {
     let mut values = vec![0.0; 121];
     values[5 * 11 + 5] = 50.0;
-    let spec = GridSpec { width: 11, height: 11, values };
+    let spec = GridSpec {
+        width: 11,
+        height: 11,
+        values,
+    };
     let tin = check(&spec, 1.0, EdgeSelection::Hybrid).unwrap();
-    assert!(tin.vertices().iter().any(|v| v.x == 5 && v.y == 5 && v.z == 50.0));
+    assert!(tin
+        .vertices()
+        .iter()
+        .any(|v| v.x == 5 && v.y == 5 && v.z == 50.0));
     // The four corners, the spike and at most its eight neighbours.
     assert!(tin.vertices().len() <= 13, "kept {}", tin.vertices().len());
 }
 
 #[test]
 fn rough_terrain_with_holes_stays_within_bound() {
-    let spec = tinsmith_testkit::with_nodata_disc(tinsmith_testkit::terrain(60, 45, 4.0, 7), 20.0, 20.0, 6.0);
+    let spec = tinsmith_testkit::with_nodata_disc(
+        tinsmith_testkit::terrain(60, 45, 4.0, 7),
+        20.0,
+        20.0,
+        6.0,
+    );
     for bound in [0.5, 2.0, 10.0] {
         for selection in SELECTIONS {
             check(&spec, bound, selection).unwrap();
@@ -117,7 +158,11 @@ fn rough_terrain_with_holes_stays_within_bound() {
 
 #[test]
 fn empty_domain_gives_an_empty_tin() {
-    let spec = GridSpec { width: 1, height: 7, values: vec![1.0; 7] };
+    let spec = GridSpec {
+        width: 1,
+        height: 7,
+        values: vec![1.0; 7],
+    };
     let tin = check(&spec, 1.0, EdgeSelection::Hybrid).unwrap();
     assert!(tin.triangles().is_empty() && tin.vertices().is_empty());
 }

@@ -1,1 +1,63 @@
-//! stub
+//! Writes and reads triangulated irregular networks as mesh files (binary PLY, OBJ).
+//!
+//! A mesh is given as plain slices ([`MeshRef`]): world `[x, y, z]` vertices, `[u32; 3]`
+//! triangles in the orientation to be written, and an optional CRS as WKT. This crate knows
+//! nothing about how the mesh was made; it depends on no other tinsmith crate.
+//!
+//! # Guarantees
+//! - **Atomic output.** [`write_mesh`] writes a temporary file next to the target and
+//!   renames it into place. After an error there is no partial file and no temporary file;
+//!   an existing file at the target keeps its content.
+//! - **Exact round trip.** [`read_mesh`] of a file written by [`write_mesh`] returns the
+//!   same coordinates bit for bit (PLY stores `double`s, OBJ the shortest decimal that parses
+//!   back to the same `f64`), the same triangles in the same order and orientation, and the
+//!   CRS on one line.
+//! - **Validated input.** [`write_mesh`] refuses meshes with out-of-range indices or
+//!   non-finite coordinates before creating any file; [`read_mesh`] returns only meshes
+//!   with finite coordinates and in-range indices, and reports every malformed file as an
+//!   [`Error`] naming the file, never by panicking.
+//!
+//! # Formats
+//! See [`MeshFormat`]: [`MeshFormat::Ply`] is written as `binary_little_endian 1.0`
+//! (`double` x, y, z; `list uchar int vertex_indices`; `comment crs <wkt>`) and read as
+//! ASCII or binary; [`MeshFormat::Obj`] as `v`/`f` lines with a `# crs: <wkt>` comment.
+//!
+//! # Example
+//! ```
+//! use tinsmith_export::{read_mesh, write_mesh, MeshFormat, MeshRef};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let dir = tempfile::tempdir()?;
+//! let path = dir.path().join("tile.ply");
+//!
+//! let vertices = [
+//!     [500_000.0, 4_649_776.0, 312.5],
+//!     [500_030.0, 4_649_776.0, 313.25],
+//!     [500_000.0, 4_649_806.0, 311.0],
+//! ];
+//! let triangles = [[0, 1, 2]];
+//! let mesh = MeshRef::new(&vertices, &triangles).with_crs_wkt("EPSG:32633");
+//! write_mesh(&path, MeshFormat::from_path(&path)?, mesh)?;
+//!
+//! let back = read_mesh(&path)?;
+//! assert_eq!(back.vertices, vertices);
+//! assert_eq!(back.triangles, triangles);
+//! assert_eq!(back.crs_wkt.as_deref(), Some("EPSG:32633"));
+//! # Ok(())
+//! # }
+//! ```
+#![deny(missing_docs)]
+#![deny(rustdoc::broken_intra_doc_links)]
+#![forbid(unsafe_code)]
+
+mod atomic;
+mod error;
+mod file;
+mod format;
+mod mesh;
+mod obj;
+mod ply;
+
+pub use error::{Error, Result};
+pub use file::{read_mesh, read_mesh_as, write_mesh};
+pub use format::MeshFormat;
+pub use mesh::{Mesh, MeshRef};

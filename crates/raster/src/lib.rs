@@ -1,1 +1,57 @@
-//! stub
+//! Reads one band of any raster GDAL can open into a [`tinsmith_core::Grid`] of heights.
+//!
+//! [`read_grid`] returns the grid (nodata as NaN) with a [`RasterInfo`]: driver, size, data
+//! type, nodata value, CRS (WKT and EPSG code), geotransform and statistics of the samples.
+//! [`open_info`] gives the same [`RasterInfo`] without keeping the samples.
+//!
+//! # What callers can rely on
+//! - **Nodata.** A sample is nodata exactly when it is NaN or infinite, or equals the band's
+//!   nodata value compared in the band's own type: Float32 bands compare in single precision
+//!   (a `-3.4e38` declared in text matches the `f32` stored in the pixels), integer bands
+//!   compare with the nodata value rounded to the type (and ignore one the type cannot
+//!   hold). Nodata samples are NaN in the grid; all other samples are finite.
+//! - **Heights.** Valid samples are mapped through the band's scale and offset when it has
+//!   them, so every height is in the band's real unit.
+//! - **Geotransform.** `None` when the dataset has none (GDAL reports an identity default
+//!   with an error for such files; that default is never returned as a geotransform).
+//! - **Errors.** Every [`Error`] message starts with the path and names the problem: a
+//!   missing file, a file no GDAL raster driver can read, a band out of range, a
+//!   non-real-valued band, a raster too large for one grid, a failed read, or a band with
+//!   no valid sample ([`read_grid`] only). GDAL's explanation, when it gave one, is part of
+//!   the message (without its repetition of the path), and GDAL's error is kept as the
+//!   [`std::error::Error::source`].
+//! - **Threads.** Each call opens its own GDAL dataset and closes it before returning, so
+//!   the functions can be called from several threads at once.
+//!
+//! GDAL also prints its errors to standard error by default; [`silence_gdal_errors`] stops
+//! that for the whole process (the messages stay in the returned errors).
+//!
+//! # Example
+//! ```no_run
+//! use std::path::Path;
+//!
+//! # fn main() -> Result<(), tinsmith_raster::Error> {
+//! let raster = tinsmith_raster::read_grid(Path::new("tests/fixtures/landlab_hugo_site.asc"), 1)?;
+//! let info = &raster.info;
+//! println!(
+//!     "{}: {}x{} {} ({} valid samples, heights {:?}..{:?})",
+//!     info.driver, info.width, info.height, info.data_type, info.valid_samples, info.min, info.max
+//! );
+//! assert_eq!(raster.grid.valid_count() as u64, info.valid_samples);
+//! # Ok(())
+//! # }
+//! ```
+#![deny(missing_docs)]
+#![deny(rustdoc::broken_intra_doc_links)]
+#![forbid(unsafe_code)]
+
+mod decode;
+mod error;
+mod info;
+mod quiet;
+mod read;
+
+pub use error::{Error, Result};
+pub use info::{Raster, RasterInfo};
+pub use quiet::silence_gdal_errors;
+pub use read::{open_info, read_grid};

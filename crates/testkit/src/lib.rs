@@ -47,7 +47,14 @@ impl SplitMix {
 pub fn terrain(width: u32, height: u32, roughness: f64, seed: u64) -> GridSpec {
     let mut rng = SplitMix::new(seed);
     let waves: Vec<[f64; 4]> = (0..6)
-        .map(|_| [rng.unit() * 0.2, rng.unit() * 0.2, rng.unit() * 6.3, 20.0 + rng.unit() * 80.0])
+        .map(|_| {
+            [
+                rng.unit() * 0.2,
+                rng.unit() * 0.2,
+                rng.unit() * 6.3,
+                20.0 + rng.unit() * 80.0,
+            ]
+        })
         .collect();
     let mut values = Vec::with_capacity(width as usize * height as usize);
     for y in 0..height {
@@ -60,7 +67,11 @@ pub fn terrain(width: u32, height: u32, roughness: f64, seed: u64) -> GridSpec {
             values.push(z);
         }
     }
-    GridSpec { width, height, values }
+    GridSpec {
+        width,
+        height,
+        values,
+    }
 }
 
 /// Punches nodata into `grid`: a disc of radius `r` at `(cx, cy)`.
@@ -91,10 +102,18 @@ pub fn small_grid() -> impl Strategy<Value = GridSpec> {
             0 => vec![rng.unit() * 10.0; n],
             1 => {
                 let (a, b) = (rng.unit() * 4.0 - 2.0, rng.unit() * 4.0 - 2.0);
-                (0..n).map(|i| a * (i % w as usize) as f64 + b * (i / w as usize) as f64).collect()
+                (0..n)
+                    .map(|i| a * (i % w as usize) as f64 + b * (i / w as usize) as f64)
+                    .collect()
             }
             2 => (0..n)
-                .map(|_| if rng.unit() < 0.15 { 100.0 * rng.unit() } else { rng.unit() })
+                .map(|_| {
+                    if rng.unit() < 0.15 {
+                        100.0 * rng.unit()
+                    } else {
+                        rng.unit()
+                    }
+                })
                 .collect(),
             3 => (0..n).map(|_| (rng.unit() * 8.0).floor()).collect(),
             4 => terrain(w, h, 3.0, seed).values,
@@ -111,7 +130,11 @@ pub fn small_grid() -> impl Strategy<Value = GridSpec> {
                 }
             }
         }
-        GridSpec { width: w, height: h, values }
+        GridSpec {
+            width: w,
+            height: h,
+            values,
+        }
     })
 }
 

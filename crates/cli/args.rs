@@ -1,0 +1,120 @@
+//! Command-line flags (clap), parsed into plain values the commands use.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use tinsmith_core::EdgeSelection;
+
+/// Turns DEMs and other 2D scalar grids into TINs whose error is guaranteed.
+#[derive(Debug, Parser)]
+#[command(name = "tinsmith", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Print a raster's size, type, nodata, CRS, geotransform and value range.
+    Info(InfoArgs),
+    /// Decimate a raster into a TIN within --max-error of every valid sample.
+    Mesh(MeshArgs),
+    /// Measure a TIN's true error against its raster at every valid sample.
+    Verify(VerifyArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// Any raster GDAL can read.
+    pub input: PathBuf,
+    /// Band to describe (1-based).
+    #[arg(long, default_value_t = 1)]
+    pub band: usize,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct MeshArgs {
+    /// Any single-band raster GDAL can read (GeoTIFF, ESRI ASCII, HGT, VRT, PNG...).
+    pub input: PathBuf,
+    /// Output mesh; the format follows the extension (.ply, .obj).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Largest allowed |sample - TIN| at any valid sample, in data units.
+    #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true)]
+    pub max_error: f64,
+    /// Band to read (1-based).
+    #[arg(long, default_value_t = 1)]
+    pub band: usize,
+    /// Error model.
+    #[arg(long, value_enum, default_value_t = ErrorModelArg::Bounds)]
+    pub error_model: ErrorModelArg,
+    /// Edge selection rule for retriangulating holes (paper §3.4).
+    #[arg(long, value_enum, default_value_t = SelectionArg::Hybrid)]
+    pub selection: SelectionArg,
+    /// Write (column, row, value) instead of georeferenced coordinates.
+    #[arg(long)]
+    pub pixel_coords: bool,
+    /// Write a JSON report of sizes, counts, measured error and timings.
+    #[arg(long, value_name = "FILE.json")]
+    pub report: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct VerifyArgs {
+    /// The raster the mesh was made from.
+    pub input: PathBuf,
+    /// The mesh to check (.ply, .obj).
+    pub mesh: PathBuf,
+    /// Fail (exit 1) when the measured error exceeds this.
+    #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true)]
+    pub max_error: Option<f64>,
+    /// Band the mesh was made from (1-based).
+    #[arg(long, default_value_t = 1)]
+    pub band: usize,
+    /// The mesh holds (column, row, value) coordinates (it was written with --pixel-coords).
+    #[arg(long)]
+    pub pixel_coords: bool,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum ErrorModelArg {
+    /// The paper's accumulated bounds above and below each triangle.
+    Bounds,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum SelectionArg {
+    /// Least-introduced first, least-error on a dead end (the paper's choice).
+    Hybrid,
+    /// The candidate edge with the least error bound.
+    MinError,
+    /// The candidate edge that changes the surface least.
+    MinIntroduced,
+}
+
+impl From<SelectionArg> for EdgeSelection {
+    fn from(s: SelectionArg) -> EdgeSelection {
+        match s {
+            SelectionArg::Hybrid => EdgeSelection::Hybrid,
+            SelectionArg::MinError => EdgeSelection::MinError,
+            SelectionArg::MinIntroduced => EdgeSelection::MinIntroduced,
+        }
+    }
+}
+
+fn parse_max_error(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number"))?;
+    if !v.is_finite() || v < 0.0 {
+        return Err(format!("must be a finite number >= 0, got {s}"));
+    }
+    Ok(v)
+}

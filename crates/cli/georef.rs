@@ -1,0 +1,61 @@
+//! Between grid positions and the coordinates written in mesh files.
+
+use anyhow::{bail, Result};
+use tinsmith_core::GeoTransform;
+
+/// How grid positions map to file coordinates: pixel (column, row) or a geotransform to
+/// the world position of the sample's centre.
+#[derive(Debug, Clone, Copy)]
+pub enum Georef {
+    /// `(column, row)` as written.
+    Pixel,
+    /// World coordinates of sample centres.
+    World(GeoTransform),
+}
+
+impl Georef {
+    /// Pixel coordinates when asked for or when the raster has no geotransform.
+    pub fn new(transform: Option<GeoTransform>, pixel_coords: bool) -> Georef {
+        match transform {
+            Some(t) if !pixel_coords => Georef::World(t),
+            _ => Georef::Pixel,
+        }
+    }
+
+    /// File coordinates of sample `(x, y)`.
+    pub fn file_position(self, x: u32, y: u32) -> [f64; 2] {
+        match self {
+            Georef::Pixel => [x as f64, y as f64],
+            Georef::World(t) => t.sample_centre(x as f64, y as f64),
+        }
+    }
+
+    /// The sample whose file coordinates are `p`; fails when `p` is not (within a
+    /// thousandth of a pixel) on a sample centre.
+    pub fn sample_at(self, p: [f64; 2]) -> Result<[i64; 2]> {
+        let s = match self {
+            Georef::Pixel => p,
+            Georef::World(t) => match t.world_to_sample(p) {
+                Some(s) => s,
+                None => bail!("the raster's geotransform is singular"),
+            },
+        };
+        let r = [s[0].round(), s[1].round()];
+        if !((s[0] - r[0]).abs() <= 1e-3 && (s[1] - r[1]).abs() <= 1e-3) {
+            bail!(
+                "({}, {}) is not on a sample centre (grid position {:.4}, {:.4})",
+                p[0],
+                p[1],
+                s[0],
+                s[1]
+            );
+        }
+        Ok([r[0] as i64, r[1] as i64])
+    }
+
+    /// Whether triangles counter-clockwise in grid coordinates are clockwise in file
+    /// coordinates (a north-up raster's rows run south).
+    pub fn flips_orientation(self) -> bool {
+        matches!(self, Georef::World(t) if t.flips_orientation())
+    }
+}

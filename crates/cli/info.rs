@@ -1,0 +1,43 @@
+//! `tinsmith info`: describe a raster band.
+
+use anyhow::Result;
+
+use crate::args::InfoArgs;
+
+/// Prints the band's metadata and value statistics; always `Ok(true)` on success.
+pub fn run(args: &InfoArgs) -> Result<bool> {
+    let info = tinsmith_raster::open_info(&args.input, args.band)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&info)?);
+        return Ok(true);
+    }
+    println!("file:          {}", info.path.display());
+    println!("driver:        {}", info.driver);
+    println!(
+        "size:          {} x {} ({} band(s), showing band {})",
+        info.width, info.height, info.band_count, info.band
+    );
+    println!("type:          {}", info.data_type);
+    match info.nodata {
+        Some(n) => println!("nodata:        {n}"),
+        None => println!("nodata:        none"),
+    }
+    println!(
+        "valid samples: {} ({} nodata)",
+        info.valid_samples, info.nodata_samples
+    );
+    match (info.min, info.max) {
+        (Some(lo), Some(hi)) => println!("value range:   {lo} .. {hi}"),
+        _ => println!("value range:   no valid sample"),
+    }
+    match info.epsg {
+        Some(code) => println!("crs:           EPSG:{code}"),
+        None if info.crs_wkt.is_some() => println!("crs:           (WKT, no EPSG code)"),
+        None => println!("crs:           none"),
+    }
+    match info.geo_transform {
+        Some(g) => println!("geotransform:  {g:?}"),
+        None => println!("geotransform:  none (pixel coordinates)"),
+    }
+    Ok(true)
+}

@@ -1,0 +1,173 @@
+//! `tinsmith mesh`: decimate a raster into a TIN, check it, write it.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+use tinsmith_core::{decimate, DecimationOptions, Tin};
+use tinsmith_export::{MeshFormat, MeshRef};
+use tinsmith_verify::{GridRef, VerifyOptions};
+
+use crate::args::{ErrorModelArg, MeshArgs};
+use crate::georef::Georef;
+use crate::output::{check_writable_target, write_atomically};
+
+/// The `--report` JSON.
+#[derive(Debug, Serialize)]
+struct MeshReport<'a> {
+    input: &'a Path,
+    band: usize,
+    width: u32,
+    height: u32,
+    valid_samples: u64,
+    max_error: f64,
+    error_model: &'static str,
+    selection: String,
+    triangles_before: usize,
+    triangles_after: usize,
+    vertices_before: usize,
+    vertices_after: usize,
+    decimation_percent: f64,
+    max_error_bound: f64,
+    measured_max_error: f64,
+    output: &'a Path,
+    seconds: Seconds,
+}
+
+#[derive(Debug, Serialize)]
+struct Seconds {
+    read: f64,
+    initial_mesh: f64,
+    decimate: f64,
+    verify: f64,
+    write: f64,
+    total: f64,
+}
+
+/// Reads, decimates, verifies in memory and writes; the mesh is written only if the
+/// independent verifier confirms the bound.
+pub fn run(args: &MeshArgs) -> Result<bool> {
+    let total = Instant::now();
+    let format = MeshFormat::from_path(&args.output)?;
+    check_writable_target(&args.output)?;
+    if let Some(report) = &args.report {
+        check_writable_target(report)?;
+    }
+
+    let t = Instant::now();
+    let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
+    let read_seconds = t.elapsed().as_secs_f64();
+    let grid = &raster.grid;
+    if grid.valid_cell_count() == 0 {
+        bail!(
+            "{}: band {} has no 2x2 block of valid samples, so there is nothing to triangulate",
+            args.input.display(),
+            args.band
+        );
+    }
+
+    let options = DecimationOptions::new(args.max_error).with_selection(args.selection.into());
+    let result = decimate(grid, &options).with_context(|| format!("{}", args.input.display()))?;
+    let tin = &result.tin;
+
+    // The promise is checked, independently, before anything is written.
+    let georef = Georef::new(raster.info.transform(), args.pixel_coords);
+    let t = Instant::now();
+    let positions: Vec<[i64; 2]> = tin
+        .vertices()
+        .iter()
+        .map(|v| [v.x as i64, v.y as i64])
+        .collect();
+    let heights: Vec<f64> = tin.vertices().iter().map(|v| v.z).collect();
+    let check = tinsmith_verify::verify(
+        GridRef::new(grid.width(), grid.height(), grid.values()),
+        tinsmith_verify::MeshRef::new(&positions, &heights, tin.triangles()),
+        &VerifyOptions::new().with_max_error(args.max_error),
+    )?;
+    let verify_seconds = t.elapsed().as_secs_f64();
+    if !check.passed() {
+        bail!(
+            "{}: internal error, the decimated mesh failed verification ({}); nothing written",
+            args.input.display(),
+            check.problems.join("; ")
+        );
+    }
+
+    let t = Instant::now();
+    let (vertices, triangles) = file_mesh(tin, &georef);
+    let crs = if args.pixel_coords {
+        None
+    } else {
+        raster.info.crs_wkt.as_deref()
+    };
+    tinsmith_export::write_mesh(
+        &args.output,
+        format,
+        MeshRef::new(&vertices, &triangles).with_crs_wkt(crs),
+    )?;
+    let write_seconds = t.elapsed().as_secs_f64();
+
+    let r = &result.report;
+    let report = MeshReport {
+        input: &args.input,
+        band: args.band,
+        width: grid.width(),
+        height: grid.height(),
+        valid_samples: raster.info.valid_samples,
+        max_error: args.max_error,
+        error_model: match args.error_model {
+            ErrorModelArg::Bounds => "bounds",
+        },
+        selection: format!("{:?}", args.selection).to_lowercase(),
+        triangles_before: r.initial_triangles,
+        triangles_after: r.final_triangles,
+        vertices_before: r.initial_vertices,
+        vertices_after: r.final_vertices,
+        decimation_percent: 100.0 * (1.0 - r.final_triangles as f64 / r.initial_triangles as f64),
+        max_error_bound: r.max_bound,
+        measured_max_error: check.max_error,
+        output: &args.output,
+        seconds: Seconds {
+            read: read_seconds,
+            initial_mesh: r.seconds_initial_mesh,
+            decimate: r.seconds_decimation,
+            verify: verify_seconds,
+            write: write_seconds,
+            total: total.elapsed().as_secs_f64(),
+        },
+    };
+    eprintln!(
+        "{}: {} -> {} triangles ({:.1}% decimated), measured max error {} <= {}",
+        args.output.display(),
+        report.triangles_before,
+        report.triangles_after,
+        report.decimation_percent,
+        report.measured_max_error,
+        args.max_error
+    );
+    if let Some(path) = &args.report {
+        let json = serde_json::to_vec_pretty(&report)?;
+        write_atomically(path, &json)?;
+    }
+    Ok(true)
+}
+
+/// Vertices in file coordinates and triangles counter-clockwise in them (normals up).
+fn file_mesh(tin: &Tin, georef: &Georef) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let vertices = tin
+        .vertices()
+        .iter()
+        .map(|v| {
+            let [x, y] = georef.file_position(v.x, v.y);
+            [x, y, v.z]
+        })
+        .collect();
+    let flip = georef.flips_orientation();
+    let triangles = tin
+        .triangles()
+        .iter()
+        .map(|&[a, b, c]| if flip { [a, c, b] } else { [a, b, c] })
+        .collect();
+    (vertices, triangles)
+}

@@ -1,0 +1,86 @@
+//! `tinsmith verify`: measure a mesh file's true error against its raster.
+
+use anyhow::{Context, Result};
+use tinsmith_verify::{GridRef, MeshRef, Orientation, Report, VerifyOptions};
+
+use crate::args::VerifyArgs;
+use crate::georef::Georef;
+
+/// Runs the verifier; `Ok(false)` when the mesh is invalid or exceeds `--max-error`.
+pub fn run(args: &VerifyArgs) -> Result<bool> {
+    let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
+    let mesh = tinsmith_export::read_mesh(&args.mesh)?;
+    let georef = Georef::new(raster.info.transform(), args.pixel_coords);
+    let mut positions = Vec::with_capacity(mesh.vertices.len());
+    for (i, v) in mesh.vertices.iter().enumerate() {
+        let p = georef
+            .sample_at([v[0], v[1]])
+            .with_context(|| format!("{}: vertex {i}", args.mesh.display()))?;
+        positions.push(p);
+    }
+    let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();
+    let grid = &raster.grid;
+    let mut options = VerifyOptions::new().with_orientation(expected_orientation(&georef));
+    if let Some(e) = args.max_error {
+        options = options.with_max_error(e);
+    }
+    let report = tinsmith_verify::verify(
+        GridRef::new(grid.width(), grid.height(), grid.values()),
+        MeshRef::new(&positions, &heights, &mesh.triangles),
+        &options,
+    )
+    .with_context(|| format!("{}: cannot verify", args.mesh.display()))?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_report(&report, args);
+    }
+    Ok(report.passed())
+}
+
+/// Mesh files hold triangles counter-clockwise in file coordinates (normals up), which is
+/// clockwise in grid coordinates when the georeference flips orientation.
+pub fn expected_orientation(georef: &Georef) -> Orientation {
+    if georef.flips_orientation() {
+        Orientation::Clockwise
+    } else {
+        Orientation::CounterClockwise
+    }
+}
+
+fn print_report(report: &Report, args: &VerifyArgs) {
+    println!(
+        "mesh:            {} ({} vertices, {} triangles)",
+        args.mesh.display(),
+        report.vertices,
+        report.triangles
+    );
+    println!(
+        "raster:          {} ({} x {}, {} valid samples)",
+        args.input.display(),
+        report.width,
+        report.height,
+        report.valid_samples
+    );
+    match &report.max_error_at {
+        Some(at) => println!(
+            "max error:       {} at column {}, row {} (sample {}, TIN {})",
+            report.max_error, at.x, at.y, at.sample, at.interpolated
+        ),
+        None => println!("max error:       {}", report.max_error),
+    }
+    if let Some(e) = report.max_error_allowed {
+        println!("allowed:         {e}");
+    }
+    println!(
+        "mesh valid:      {}",
+        if report.mesh_is_valid() { "yes" } else { "NO" }
+    );
+    for p in &report.problems {
+        println!("problem:         {p}");
+    }
+    println!(
+        "result:          {}",
+        if report.passed() { "PASS" } else { "FAIL" }
+    );
+}

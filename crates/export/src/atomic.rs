@@ -1,0 +1,206 @@
+//! All-or-nothing file output: write a temporary file next to the target, then rename it.
+
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::Path;
+
+use crate::error::{Error, Result};
+
+/// Size of the write buffer.
+const BUFFER_SIZE: usize = 1 << 16;
+
+/// Writes `path` through `write`, atomically.
+///
+/// The data goes to a temporary file (`.tinsmith-*.tmp`) in `path`'s directory, is flushed
+/// and synced, then renamed over `path`. If anything fails, the temporary file is removed
+/// and `path` is left as it was: absent, or holding its previous content.
+pub(crate) fn write_atomically<F>(path: &Path, write: F) -> Result<()>
+where
+    F: FnOnce(&mut BufWriter<&mut File>) -> io::Result<()>,
+{
+    let dir = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let io_error = |action: &'static str| {
+        move |source: io::Error| Error::Io {
+            path: path.to_path_buf(),
+            action,
+            source,
+        }
+    };
+    match std::fs::metadata(dir) {
+        Err(error) if error.kind() == io::ErrorKind::NotFound => {
+            return Err(Error::MissingDirectory {
+                path: path.to_path_buf(),
+                dir: dir.to_path_buf(),
+            });
+        }
+        // Anything else (not a directory, no permission) surfaces below with its cause.
+        _ => {}
+    }
+
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".tinsmith-").suffix(".tmp");
+    #[cfg(unix)]
+    {
+        // Like `File::create`: the umask decides, instead of tempfile's private 0o600.
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut temp = builder
+        .tempfile_in(dir)
+        .map_err(io_error("create a temporary file in the output directory"))?;
+
+    {
+        let mut writer = BufWriter::with_capacity(BUFFER_SIZE, temp.as_file_mut());
+        write(&mut writer).map_err(io_error("write"))?;
+        writer.flush().map_err(io_error("write"))?;
+    }
+    temp.as_file().sync_all().map_err(io_error("write"))?;
+    temp.persist(path)
+        .map_err(|error| io_error("move the finished temporary file into place")(error.error))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    fn entries(dir: &Path) -> Vec<PathBuf> {
+        let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+            .expect("read test dir")
+            .map(|entry| entry.expect("dir entry").path())
+            .collect();
+        entries.sort();
+        entries
+    }
+
+    #[test]
+    fn writes_the_file_and_leaves_nothing_else() -> Result<()> {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("out.bin");
+        write_atomically(&path, |w| w.write_all(b"hello"))?;
+        assert_eq!(std::fs::read(&path).expect("read back"), b"hello");
+        assert_eq!(entries(dir.path()), vec![path]);
+        Ok(())
+    }
+
+    #[test]
+    fn failure_leaves_no_file_and_no_temporary() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("out.bin");
+        let result = write_atomically(&path, |w| {
+            w.write_all(&[7; 100_000])?;
+            Err(io::Error::other("generator failed"))
+        });
+        assert!(
+            matches!(
+                result,
+                Err(Error::Io {
+                    action: "write",
+                    ..
+                })
+            ),
+            "{result:?}"
+        );
+        assert!(entries(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn failure_keeps_the_previous_content() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("out.bin");
+        std::fs::write(&path, b"old").expect("seed");
+        let result = write_atomically(&path, |w| {
+            w.write_all(b"new but partial")?;
+            Err(io::Error::other("generator failed"))
+        });
+        assert!(result.is_err());
+        assert_eq!(std::fs::read(&path).expect("read back"), b"old");
+        assert_eq!(entries(dir.path()), vec![path]);
+    }
+
+    #[test]
+    fn success_replaces_the_previous_content() -> Result<()> {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("out.bin");
+        std::fs::write(&path, b"old content").expect("seed");
+        write_atomically(&path, |w| w.write_all(b"new"))?;
+        assert_eq!(std::fs::read(&path).expect("read back"), b"new");
+        Ok(())
+    }
+
+    #[test]
+    fn missing_directory_is_named() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let missing = dir.path().join("no").join("such");
+        let path = missing.join("out.bin");
+        let result = write_atomically(&path, |w| w.write_all(b"x"));
+        match &result {
+            Err(Error::MissingDirectory { path: p, dir: d }) => {
+                assert_eq!((p, d), (&path, &missing));
+            }
+            other => panic!("{other:?}"),
+        }
+        let message = result.err().map(|e| e.to_string()).unwrap_or_default();
+        assert_eq!(
+            message,
+            format!(
+                "{}: output directory {} does not exist",
+                path.display(),
+                missing.display()
+            )
+        );
+        assert!(entries(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn target_that_is_a_directory_fails_cleanly() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("taken");
+        std::fs::create_dir(&path).expect("mkdir");
+        let result = write_atomically(&path, |w| w.write_all(b"x"));
+        match &result {
+            Err(Error::Io { path: p, .. }) => assert_eq!(p, &path),
+            other => panic!("{other:?}"),
+        }
+        assert!(std::error::Error::source(&result.expect_err("error")).is_some());
+        assert!(path.is_dir());
+        assert_eq!(entries(dir.path()), vec![path]);
+    }
+
+    #[test]
+    fn parent_that_is_a_file_fails_with_the_cause() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let file = dir.path().join("plain");
+        std::fs::write(&file, b"").expect("seed");
+        let path = file.join("out.bin");
+        let result = write_atomically(&path, |w| w.write_all(b"x"));
+        assert!(
+            matches!(&result, Err(Error::Io { path: p, .. }) if p == &path),
+            "{result:?}"
+        );
+        assert_eq!(entries(dir.path()), vec![file]);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn output_is_not_private_to_the_owner() -> Result<()> {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("out.bin");
+        write_atomically(&path, |w| w.write_all(b"x"))?;
+        let mode = std::fs::metadata(&path).expect("stat").permissions().mode();
+        // What `File::create` gives under the current umask.
+        let reference = dir.path().join("reference");
+        File::create(&reference).expect("create");
+        let expected = std::fs::metadata(&reference)
+            .expect("stat")
+            .permissions()
+            .mode();
+        assert_eq!(mode & 0o777, expected & 0o777);
+        Ok(())
+    }
+}

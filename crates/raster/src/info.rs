@@ -1,0 +1,69 @@
+//! What a raster band is: its metadata and the statistics of its samples.
+
+use std::path::PathBuf;
+
+use tinsmith_core::{GeoTransform, Grid};
+
+/// Metadata of one band of a raster file, plus statistics over its samples.
+///
+/// Serialises with serde (for `--json` style output). A NaN nodata value serialises as
+/// `null` in JSON, like a missing one; [`RasterInfo::nodata`] itself tells them apart.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[non_exhaustive]
+pub struct RasterInfo {
+    /// The path the raster was opened from.
+    pub path: PathBuf,
+    /// GDAL's short driver name, such as `GTiff`, `AAIGrid` or `PNG`.
+    pub driver: String,
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// Number of bands in the file.
+    pub band_count: usize,
+    /// The band described here (1-based).
+    pub band: usize,
+    /// GDAL's name of the band's data type (`Byte`, `Int16`, `Float32`, ...). A Byte band
+    /// marked `PIXELTYPE=SIGNEDBYTE` is reported as `Int8`.
+    pub data_type: String,
+    /// The band's declared nodata value, as GDAL reports it (before scale and offset).
+    pub nodata: Option<f64>,
+    /// The band's scale: heights are `sample * scale + offset` (1 when the band has none).
+    pub scale: f64,
+    /// The band's offset (0 when the band has none).
+    pub offset: f64,
+    /// The dataset's coordinate reference system as WKT, if it has one.
+    pub crs_wkt: Option<String>,
+    /// The EPSG code of the CRS when it has one or GDAL can identify one; `None` otherwise
+    /// (for example for a compound CRS named "unknown").
+    pub epsg: Option<u32>,
+    /// The dataset's geotransform (GDAL's six coefficients), or `None` when the dataset has
+    /// none (GDAL then reports a failure and an identity default, which is not returned).
+    pub geo_transform: Option<[f64; 6]>,
+    /// Samples that are not nodata.
+    pub valid_samples: u64,
+    /// Samples that are nodata: equal to [`RasterInfo::nodata`] in the band's type, NaN or
+    /// infinite. `valid_samples + nodata_samples == width * height`.
+    pub nodata_samples: u64,
+    /// Smallest valid height (after scale and offset); `None` when no sample is valid.
+    pub min: Option<f64>,
+    /// Largest valid height (after scale and offset); `None` when no sample is valid.
+    pub max: Option<f64>,
+}
+
+impl RasterInfo {
+    /// The geotransform as the core's type, if the dataset has one.
+    pub fn transform(&self) -> Option<GeoTransform> {
+        self.geo_transform.map(GeoTransform)
+    }
+}
+
+/// A band read into a [`Grid`] (nodata as NaN), with its [`RasterInfo`].
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct Raster {
+    /// The band's heights, row 0 first; nodata samples are NaN.
+    pub grid: Grid,
+    /// What was read, with statistics matching `grid`.
+    pub info: RasterInfo,
+}

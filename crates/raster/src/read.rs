@@ -1,0 +1,335 @@
+//! Opening a raster with GDAL and reading one band, strip by strip, into heights.
+
+use std::io;
+use std::path::Path;
+
+use gdal::raster::RasterBand;
+use gdal::spatial_ref::SpatialRef;
+use gdal::{Dataset, DatasetOptions, GdalOpenFlags, Metadata};
+use tinsmith_core::Grid;
+
+use crate::decode::{SampleDecoder, SampleType, Stats};
+use crate::error::{gdal_reason, Error, Result};
+use crate::info::{Raster, RasterInfo};
+
+/// Samples read per GDAL call (about 8 MB of `f64`), rounded to whole rows of blocks.
+const STRIP_SAMPLES: usize = 1 << 20;
+
+/// Opens band `band` (1-based) of the raster at `path` and returns its metadata and the
+/// statistics of its samples (valid and nodata counts, min and max).
+///
+/// Reads the whole band, one strip of rows at a time, but keeps no samples: this works for
+/// rasters too large for a [`Grid`]. A band without any valid sample is not an error here
+/// (`valid_samples == 0`, `min` and `max` are `None`).
+///
+/// # Errors
+/// [`Error::NotFound`], [`Error::NotARaster`], [`Error::BandOutOfRange`],
+/// [`Error::UnsupportedType`] and [`Error::Read`], each naming `path`.
+pub fn open_info(path: &Path, band: usize) -> Result<RasterInfo> {
+    let opened = OpenBand::open(path, band)?;
+    let rb = opened.band()?;
+    let mut stats = Stats::default();
+    let mut buf = Vec::new();
+    for (y0, rows) in opened.strips(&rb) {
+        buf.resize(rows * opened.width(), 0.0);
+        opened.read_strip(&rb, y0, rows, &mut buf)?;
+        stats.add(&buf);
+    }
+    Ok(opened.finish(stats))
+}
+
+/// Reads band `band` (1-based) of the raster at `path` into a [`Grid`] of heights.
+///
+/// Every sample type GDAL has for real numbers is accepted (Byte, Int8, UInt16, Int16,
+/// UInt32, Int32, UInt64, Int64, Float32, Float64; 64-bit integers beyond 2^53 lose
+/// precision). A sample becomes NaN (nodata) when it is NaN or infinite, or when it equals
+/// the band's nodata value compared in the band's own type: a Float32 band's nodata value is
+/// rounded to `f32` first (so `-3.4e38` declared in text matches the stored `f32`), an integer
+/// band's is rounded to the nearest integer and matches nothing when the type cannot hold it.
+/// Valid samples are mapped through the band's scale and offset, if any. GDAL mask bands
+/// are not consulted. The returned [`RasterInfo`] has the statistics of the grid.
+///
+/// # Errors
+/// As [`open_info`], plus [`Error::TooLarge`] (checked before any sample is read) and
+/// [`Error::AllNodata`] when no sample is valid.
+pub fn read_grid(path: &Path, band: usize) -> Result<Raster> {
+    let opened = OpenBand::open(path, band)?;
+    let (width, height) = (opened.info.width, opened.info.height);
+    let samples = width as u64 * height as u64;
+    if samples >= u32::MAX as u64 {
+        return Err(Error::TooLarge {
+            path: path.to_path_buf(),
+            width: width as usize,
+            height: height as usize,
+        });
+    }
+    let rb = opened.band()?;
+    let mut values = vec![0.0; samples as usize];
+    let mut stats = Stats::default();
+    for (y0, rows) in opened.strips(&rb) {
+        let strip = &mut values[y0 * opened.width()..(y0 + rows) * opened.width()];
+        opened.read_strip(&rb, y0, rows, strip)?;
+        stats.add(strip);
+    }
+    if stats.valid == 0 {
+        return Err(Error::AllNodata {
+            path: path.to_path_buf(),
+            band,
+        });
+    }
+    let grid = Grid::new(width, height, values).map_err(|source| Error::Grid {
+        path: path.to_path_buf(),
+        band,
+        source,
+    })?;
+    Ok(Raster {
+        grid,
+        info: opened.finish(stats),
+    })
+}
+
+/// An open dataset with a checked band and everything known before reading samples.
+struct OpenBand {
+    dataset: Dataset,
+    /// Metadata; the statistics are still zero.
+    info: RasterInfo,
+    decoder: SampleDecoder,
+}
+
+impl OpenBand {
+    fn open(path: &Path, band: usize) -> Result<OpenBand> {
+        let dataset = open_dataset(path)?;
+        let count = dataset.raster_count();
+        if band == 0 || band > count {
+            return Err(Error::BandOutOfRange {
+                path: path.to_path_buf(),
+                band,
+                count,
+            });
+        }
+        let (w, h) = dataset.raster_size();
+        let (Ok(width), Ok(height)) = (u32::try_from(w), u32::try_from(h)) else {
+            return Err(Error::TooLarge {
+                path: path.to_path_buf(),
+                width: w,
+                height: h,
+            });
+        };
+
+        let rb = dataset.rasterband(band).map_err(|source| Error::Read {
+            path: path.to_path_buf(),
+            band,
+            reason: gdal_reason(&source, path),
+            source: Box::new(source),
+        })?;
+        let gdal_type = rb.band_type().name();
+        let pixel_type = rb.metadata_item("PIXELTYPE", "IMAGE_STRUCTURE");
+        let Some(sample_type) = SampleType::from_gdal(&gdal_type, pixel_type.as_deref()) else {
+            return Err(Error::UnsupportedType {
+                path: path.to_path_buf(),
+                band,
+                data_type: gdal_type,
+            });
+        };
+        let nodata = rb.no_data_value();
+        let scale = rb.scale().filter(|s| s.is_finite()).unwrap_or(1.0);
+        let offset = rb.offset().filter(|o| o.is_finite()).unwrap_or(0.0);
+        let decoder = SampleDecoder::new(sample_type, nodata, scale, offset);
+        let data_type = sample_type.display_name(&gdal_type);
+
+        let srs = dataset.spatial_ref().ok();
+        let crs_wkt = srs
+            .as_ref()
+            .and_then(|s| s.to_wkt().ok())
+            .filter(|w| !w.is_empty());
+        let epsg = srs.and_then(epsg_code);
+        // GDAL fails (and fills in an identity) when the dataset has no geotransform.
+        let geo_transform = dataset.geo_transform().ok();
+
+        let info = RasterInfo {
+            path: path.to_path_buf(),
+            driver: dataset.driver().short_name(),
+            width,
+            height,
+            band_count: count,
+            band,
+            data_type,
+            nodata,
+            scale,
+            offset,
+            crs_wkt,
+            epsg,
+            geo_transform,
+            valid_samples: 0,
+            nodata_samples: 0,
+            min: None,
+            max: None,
+        };
+        Ok(OpenBand {
+            dataset,
+            info,
+            decoder,
+        })
+    }
+
+    fn width(&self) -> usize {
+        self.info.width as usize
+    }
+
+    fn band(&self) -> Result<RasterBand<'_>> {
+        self.dataset
+            .rasterband(self.info.band)
+            .map_err(|e| self.read_error(e))
+    }
+
+    /// `(first row, row count)` of each strip, top to bottom; strips are whole rows of blocks.
+    fn strips(&self, rb: &RasterBand<'_>) -> impl Iterator<Item = (usize, usize)> {
+        let height = self.info.height as usize;
+        let block_rows = rb.block_size().1.clamp(1, height.max(1));
+        let blocks = (STRIP_SAMPLES / (self.width().max(1) * block_rows)).max(1);
+        let step = block_rows * blocks;
+        (0..height)
+            .step_by(step)
+            .map(move |y0| (y0, step.min(height - y0)))
+    }
+
+    /// Reads `rows` rows from `y0` into `dst` (row-major) and decodes them in place.
+    fn read_strip(
+        &self,
+        rb: &RasterBand<'_>,
+        y0: usize,
+        rows: usize,
+        dst: &mut [f64],
+    ) -> Result<()> {
+        let size = (self.width(), rows);
+        rb.read_into_slice::<f64>((0, y0 as isize), size, size, dst, None)
+            .map_err(|e| self.read_error(e))?;
+        for v in dst.iter_mut() {
+            *v = self.decoder.decode(*v);
+        }
+        Ok(())
+    }
+
+    fn read_error(&self, source: gdal::errors::GdalError) -> Error {
+        Error::Read {
+            path: self.info.path.clone(),
+            band: self.info.band,
+            reason: gdal_reason(&source, &self.info.path),
+            source: Box::new(source),
+        }
+    }
+
+    fn finish(self, stats: Stats) -> RasterInfo {
+        RasterInfo {
+            valid_samples: stats.valid,
+            nodata_samples: stats.nodata,
+            min: stats.min,
+            max: stats.max,
+            ..self.info
+        }
+    }
+}
+
+/// Opens `path` read-only with GDAL's raster drivers, asking GDAL to say why it cannot.
+fn open_dataset(path: &Path) -> Result<Dataset> {
+    if is_missing_file(path) {
+        return Err(Error::NotFound {
+            path: path.to_path_buf(),
+        });
+    }
+    let options = DatasetOptions {
+        open_flags: GdalOpenFlags::GDAL_OF_RASTER
+            | GdalOpenFlags::GDAL_OF_READONLY
+            | GdalOpenFlags::GDAL_OF_VERBOSE_ERROR,
+        ..Default::default()
+    };
+    Dataset::open_ex(path, options).map_err(|source| {
+        let reason = gdal_reason(&source, path);
+        let reason = match std::fs::metadata(path) {
+            Ok(m) if m.is_dir() => format!("a directory: {reason}"),
+            Ok(m) if m.len() == 0 => format!("an empty file: {reason}"),
+            _ => reason,
+        };
+        Error::NotARaster {
+            path: path.to_path_buf(),
+            reason,
+            source: Box::new(source),
+        }
+    })
+}
+
+/// Whether `path` is a plain file system path at which nothing exists. GDAL's virtual file
+/// systems (`/vsizip/...`) and connection strings (`NETCDF:file.nc:var`) are left to GDAL.
+fn is_missing_file(path: &Path) -> bool {
+    let text = path.to_string_lossy();
+    if text.starts_with("/vsi") || has_driver_prefix(&text) {
+        return false;
+    }
+    match std::fs::metadata(path) {
+        Ok(_) => false,
+        Err(e) => matches!(
+            e.kind(),
+            io::ErrorKind::NotFound | io::ErrorKind::NotADirectory
+        ),
+    }
+}
+
+/// Whether `text` starts like a GDAL connection string, `NAME:` with a name of two or more
+/// letters, digits or underscores (a Windows drive letter has one).
+fn has_driver_prefix(text: &str) -> bool {
+    text.split_once(':').is_some_and(|(name, _)| {
+        name.len() >= 2 && name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_')
+    })
+}
+
+/// The EPSG code of `srs`: its own authority code if that is EPSG, else whatever GDAL's
+/// auto-identification finds; `None` when neither works (e.g. a compound CRS "unknown").
+fn epsg_code(mut srs: SpatialRef) -> Option<u32> {
+    fn from_authority(srs: &SpatialRef) -> Option<u32> {
+        let name = srs.auth_name()?;
+        if !name.eq_ignore_ascii_case("EPSG") {
+            return None;
+        }
+        u32::try_from(srs.auth_code().ok()?).ok()
+    }
+    if let Some(code) = from_authority(&srs) {
+        return Some(code);
+    }
+    srs.auto_identify_epsg().ok()?;
+    from_authority(&srs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn connection_strings_are_left_to_gdal() {
+        assert!(has_driver_prefix("NETCDF:foo.nc:z"));
+        assert!(has_driver_prefix("GTIFF_DIR:1:a.tif"));
+        assert!(!has_driver_prefix("C:\\dem.tif"));
+        assert!(!has_driver_prefix("dir/a:b.tif"));
+        assert!(!has_driver_prefix("dem.tif"));
+        assert!(!is_missing_file(Path::new("/vsimem/nothing.tif")));
+        assert!(!is_missing_file(Path::new("HDF5:missing.h5://x")));
+    }
+
+    #[test]
+    fn plain_missing_paths_are_detected() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        assert!(is_missing_file(&dir.path().join("absent.tif")));
+        assert!(is_missing_file(&dir.path().join("absent/deeper.tif")));
+        assert!(!is_missing_file(dir.path()));
+    }
+
+    #[test]
+    fn epsg_of_plain_and_unidentifiable_crs() {
+        let srs = SpatialRef::from_epsg(32632).expect("EPSG:32632");
+        assert_eq!(epsg_code(srs), Some(32632));
+        let srs = SpatialRef::from_proj4(
+            "+proj=tmerc +lat_0=0 +lon_0=7.3 +k=1 +x_0=0 +y_0=0 +ellps=bessel",
+        )
+        .expect("proj4");
+        assert_eq!(epsg_code(srs), None);
+    }
+}

@@ -1,0 +1,136 @@
+//! Each bad input gives one clear line naming the file, exit code 2 and no output file.
+
+use crate::util::{assert_fails_naming, fixture, Dir};
+
+fn dem() -> String {
+    fixture("tintn_valid_raster_3857.tif")
+}
+
+#[test]
+fn missing_input_file() {
+    let d = Dir::new();
+    let o = d.run(&["mesh", "nope.tif", "-o", "out.ply", "--max-error", "1"]);
+    assert_fails_naming(&o, &["nope.tif"]);
+    assert!(d.files().is_empty());
+}
+
+#[test]
+fn input_that_is_not_a_raster() {
+    let d = Dir::new();
+    d.write("notes.txt", "hello, I am not a raster\n");
+    let o = d.run(&["mesh", "notes.txt", "-o", "out.ply", "--max-error", "1"]);
+    assert_fails_naming(&o, &["notes.txt", "raster"]);
+    assert_eq!(d.files(), vec!["notes.txt"]);
+}
+
+#[test]
+fn band_out_of_range() {
+    let d = Dir::new();
+    let o = d.run(&[
+        "mesh",
+        &dem(),
+        "-o",
+        "out.ply",
+        "--max-error",
+        "1",
+        "--band",
+        "2",
+    ]);
+    assert_fails_naming(&o, &["tintn_valid_raster_3857.tif", "band 2"]);
+    assert!(d.files().is_empty());
+}
+
+#[test]
+fn all_nodata() {
+    let d = Dir::new();
+    d.write(
+        "empty.asc",
+        "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n-9999 -9999 -9999\n-9999 -9999 -9999\n",
+    );
+    let o = d.run(&["mesh", "empty.asc", "-o", "out.ply", "--max-error", "1"]);
+    assert_fails_naming(&o, &["empty.asc", "nodata"]);
+    assert_eq!(d.files(), vec!["empty.asc"]);
+}
+
+#[test]
+fn no_valid_cell() {
+    let d = Dir::new();
+    d.write(
+        "row.asc",
+        "ncols 4\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n1 2 3 4\n-9999 -9999 -9999 -9999\n",
+    );
+    let o = d.run(&["mesh", "row.asc", "-o", "out.ply", "--max-error", "1"]);
+    assert_fails_naming(&o, &["row.asc", "2x2"]);
+    assert_eq!(d.files(), vec!["row.asc"]);
+}
+
+#[test]
+fn bad_max_error_values() {
+    let d = Dir::new();
+    for bad in ["-1", "NaN", "inf", "abc"] {
+        let o = d.run(&["mesh", &dem(), "-o", "out.ply", "--max-error", bad]);
+        assert!(!o.status.success(), "--max-error {bad} accepted");
+        let err = crate::util::stderr(&o);
+        assert!(err.contains("--max-error"), "{err}");
+        assert!(d.files().is_empty());
+    }
+    let o = d.run(&["mesh", &dem(), "-o", "out.ply"]);
+    assert!(!o.status.success());
+    assert!(crate::util::stderr(&o).contains("--max-error"));
+    assert!(d.files().is_empty());
+}
+
+#[test]
+fn missing_output_directory() {
+    let d = Dir::new();
+    let o = d.run(&[
+        "mesh",
+        &dem(),
+        "-o",
+        "no/such/dir/out.ply",
+        "--max-error",
+        "1",
+    ]);
+    assert_fails_naming(&o, &["no/such/dir/out.ply", "does not exist"]);
+    assert!(d.files().is_empty());
+}
+
+#[test]
+fn unwritable_output_directory() {
+    let d = Dir::new();
+    let ro = d.path("ro");
+    std::fs::create_dir(&ro).unwrap();
+    let mut perms = std::fs::metadata(&ro).unwrap().permissions();
+    std::os::unix::fs::PermissionsExt::set_mode(&mut perms, 0o555);
+    std::fs::set_permissions(&ro, perms).unwrap();
+    // Root ignores directory permissions; a file where a directory is expected fails for
+    // everyone.
+    d.write("file", "");
+    let o = d.run(&["mesh", &dem(), "-o", "file/out.ply", "--max-error", "1"]);
+    assert_fails_naming(&o, &["file/out.ply"]);
+    let is_root = std::process::Command::new("id")
+        .arg("-u")
+        .output()
+        .map(|o| o.stdout == b"0\n")
+        .unwrap_or(false);
+    if !is_root {
+        let o = d.run(&["mesh", &dem(), "-o", "ro/out.ply", "--max-error", "1"]);
+        assert_fails_naming(&o, &["ro/out.ply"]);
+    }
+    assert_eq!(std::fs::read_dir(&ro).unwrap().count(), 0);
+}
+
+#[test]
+fn unknown_output_extension() {
+    let d = Dir::new();
+    let o = d.run(&["mesh", &dem(), "-o", "out.xyz", "--max-error", "1"]);
+    assert_fails_naming(&o, &["out.xyz"]);
+    assert!(d.files().is_empty());
+}
+
+#[test]
+fn verify_with_a_missing_mesh() {
+    let d = Dir::new();
+    let o = d.run(&["verify", &dem(), "gone.ply"]);
+    assert_fails_naming(&o, &["gone.ply"]);
+}

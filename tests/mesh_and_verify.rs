@@ -1,0 +1,130 @@
+//! `tinsmith mesh` then `tinsmith verify` on real rasters, in every coordinate mode.
+
+use crate::util::{fixture, stdout, Dir};
+
+/// Meshes `input` at `e` and verifies the written file independently; returns the report.
+fn mesh_then_verify(input: &str, e: f64, extra: &[&str], ext: &str) -> serde_json::Value {
+    let d = Dir::new();
+    let out = format!("out.{ext}");
+    let es = e.to_string();
+    let mut args = vec![
+        "mesh",
+        input,
+        "-o",
+        &out,
+        "--max-error",
+        &es,
+        "--report",
+        "r.json",
+    ];
+    args.extend_from_slice(extra);
+    let o = d.run(&args);
+    assert!(
+        o.status.success(),
+        "mesh failed: {}",
+        crate::util::stderr(&o)
+    );
+    let mut vargs = vec!["verify", input, &out, "--max-error", &es, "--json"];
+    if extra.contains(&"--pixel-coords") {
+        vargs.push("--pixel-coords");
+    }
+    let v = d.run(&vargs);
+    let json: serde_json::Value = serde_json::from_str(&stdout(&v)).expect("verify --json");
+    assert!(v.status.success(), "verify failed: {json:#}");
+    assert!(json["max_error"].as_f64().unwrap() <= e);
+    assert_eq!(json["uncovered_samples"], 0);
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path("r.json")).unwrap()).unwrap();
+    assert_eq!(report["triangles_after"], json["triangles"]);
+    assert_eq!(report["measured_max_error"], json["max_error"]);
+    report
+}
+
+#[test]
+fn float32_dem_with_flt_max_nodata() {
+    let r = mesh_then_verify(&fixture("tintn_valid_raster_3857.tif"), 0.5, &[], "ply");
+    assert_eq!(r["width"], 100);
+    assert!(r["triangles_after"].as_u64().unwrap() < r["triangles_before"].as_u64().unwrap());
+}
+
+#[test]
+fn ascii_grid_with_zero_nodata_as_obj() {
+    mesh_then_verify(&fixture("landlab_west_bijou_gully.asc"), 0.25, &[], "obj");
+}
+
+#[test]
+fn sample_dem_in_pixel_coordinates() {
+    mesh_then_verify(
+        &fixture("becmodel_dem_bc_albers_50m.tif"),
+        10.0,
+        &["--pixel-coords"],
+        "ply",
+    );
+}
+
+#[test]
+fn image_without_geotransform_each_selection() {
+    let heart = fixture("mr_heart_256x256_u8_frame07.png");
+    for sel in ["hybrid", "min-error", "min-introduced"] {
+        let r = mesh_then_verify(&heart, 8.0, &["--selection", sel], "ply");
+        assert!(
+            r["decimation_percent"].as_f64().unwrap() > 30.0,
+            "{sel}: {r}"
+        );
+    }
+}
+
+#[test]
+fn same_input_same_bytes() {
+    let d = Dir::new();
+    let dem = fixture("tintn_valid_raster_3857.tif");
+    for name in ["a.ply", "b.ply"] {
+        assert!(d
+            .run(&["mesh", &dem, "-o", name, "--max-error", "1"])
+            .status
+            .success());
+    }
+    assert_eq!(
+        std::fs::read(d.path("a.ply")).unwrap(),
+        std::fs::read(d.path("b.ply")).unwrap()
+    );
+}
+
+#[test]
+fn verify_rejects_a_mesh_beyond_the_bound() {
+    let d = Dir::new();
+    let dem = fixture("tintn_valid_raster_3857.tif");
+    assert!(d
+        .run(&["mesh", &dem, "-o", "m.ply", "--max-error", "2"])
+        .status
+        .success());
+    let o = d.run(&["verify", &dem, "m.ply", "--max-error", "0.01"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
+    assert!(stdout(&o).contains("FAIL"));
+}
+
+#[test]
+fn verify_rejects_a_mesh_with_a_hole() {
+    // A 3x3 grid meshed by hand with one triangle missing.
+    let d = Dir::new();
+    let asc = d.write(
+        "g.asc",
+        "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n1 1 1\n1 1 1\n1 1 1\n",
+    );
+    d.write("m.obj", "v 0 0 1\nv 2 0 1\nv 2 2 1\nv 0 2 1\nf 1 2 3\n");
+    let o = d.run(&["verify", asc.to_str().unwrap(), "m.obj", "--pixel-coords"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
+    assert!(stdout(&o).contains("NO"), "{}", stdout(&o));
+}
+
+#[test]
+fn info_reports_nodata_and_crs() {
+    let d = Dir::new();
+    let o = d.run(&["info", &fixture("tintn_valid_raster_3857.tif"), "--json"]);
+    assert!(o.status.success());
+    let j: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(j["width"], 100);
+    assert_eq!(j["height"], 80);
+    assert_eq!(j["nodata_samples"], 970);
+    assert_eq!(j["epsg"], 3857);
+}

@@ -75,6 +75,27 @@ fn image_without_geotransform_each_selection() {
 }
 
 #[test]
+fn signed_ct_slice_at_the_papers_bounds() {
+    let ct = fixture("ct_brain_crop_128_i16.tif");
+    let mut last = 0.0;
+    for e in [2.0, 20.0, 100.0, 1000.0] {
+        let r = mesh_then_verify(&ct, e, &[], "ply");
+        let pct = r["decimation_percent"].as_f64().unwrap();
+        assert!(
+            pct > last,
+            "decimation should grow with the bound: {pct} at {e}"
+        );
+        last = pct;
+    }
+}
+
+#[test]
+fn ascii_grid_half_nodata_watershed() {
+    let r = mesh_then_verify(&fixture("landlab_hugo_site.asc"), 0.5, &[], "ply");
+    assert_eq!(r["valid_samples"], 2152);
+}
+
+#[test]
 fn same_input_same_bytes() {
     let d = Dir::new();
     let dem = fixture("tintn_valid_raster_3857.tif");

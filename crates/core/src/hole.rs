@@ -121,7 +121,7 @@ impl Retriangulator {
         for i in 0..m {
             self.prev.push(((i + m - 1) % m) as u32);
             self.next.push(((i + 1) % m) as u32);
-            let e = self.segment_error(i, (i + 1) % m);
+            let e = self.ring_edge_error(i);
             self.edge.push(e);
             self.ears.push(None);
         }
@@ -239,6 +239,7 @@ impl Retriangulator {
         let centre = self.centre.expect("hole loaded");
         let (p, q) = (self.ring[from], self.ring[to]);
         let m = self.ring.len();
+        let stars = self.star_bounds.len();
         let mut out = SegmentError {
             bound: ErrorBound {
                 above: f64::NEG_INFINITY,
@@ -246,21 +247,29 @@ impl Retriangulator {
             },
             introduced: 0.0,
         };
-        for (i, (star_bound, g)) in self
-            .star_bounds
-            .iter()
-            .zip(&self.star_gradients)
-            .enumerate()
-        {
+        // Which star triangles the segment can meet. A diagonal of the (star-shaped) hole
+        // splits it in two; it crosses the triangles of the chain on the far side from the
+        // centre and touches the two triangles beyond its ends at a shared corner. When
+        // the centre is on the segment, it touches every triangle.
+        let side = orient(&p, &q, &centre);
+        let (first, count) = match side.cmp(&0) {
+            std::cmp::Ordering::Greater => ((from + m - 1) % m, (to + m - from) % m + 2),
+            std::cmp::Ordering::Less => ((to + m - 1) % m, (from + m - to) % m + 2),
+            std::cmp::Ordering::Equal => (0, m),
+        };
+        for k in 0..count.min(m) {
+            let i = (first + k) % m;
+            if i >= stars {
+                continue;
+            }
+            let (star_bound, g) = (&self.star_bounds[i], &self.star_gradients[i]);
             let tri = [centre, self.ring[i], self.ring[(i + 1) % m]];
             let Some((t_lo, t_hi)) = clip_segment(&p, &q, &tri) else {
                 continue;
             };
             let delta = |t: f64| {
-                let (sx, sy) = (
-                    p.x as f64 + t * (q.x - p.x) as f64,
-                    p.y as f64 + t * (q.y - p.y) as f64,
-                );
+                let sx = p.x as f64 + t * (q.x - p.x) as f64;
+                let sy = p.y as f64 + t * (q.y - p.y) as f64;
                 let new = p.z + t * (q.z - p.z);
                 let old = centre.z + g[0] * (sx - centre.x as f64) + g[1] * (sy - centre.y as f64);
                 new - old
@@ -274,6 +283,29 @@ impl Retriangulator {
         debug_assert!(out.bound.above.is_finite(), "a ring segment meets its star");
         out
     }
+
+    /// Error of ring edge `i` (from ring vertex `i` to the next): the surface does not
+    /// change along it, so it carries the bounds of the star triangles that contain it or
+    /// touch its ends. The domain edge of a boundary star goes through the centre and is
+    /// computed in full.
+    fn ring_edge_error(&self, i: usize) -> SegmentError {
+        let m = self.ring.len();
+        let stars = self.star_bounds.len();
+        if i >= stars {
+            return self.segment_error(i, (i + 1) % m);
+        }
+        let mut bound = self.star_bounds[i];
+        for j in [(i + m - 1) % m, (i + 1) % m] {
+            if j < stars {
+                bound.above = bound.above.max(self.star_bounds[j].above);
+                bound.below = bound.below.max(self.star_bounds[j].below);
+            }
+        }
+        SegmentError {
+            bound,
+            introduced: 0.0,
+        }
+    }
 }
 
 fn within(bound: ErrorBound, limit: f64) -> bool {
@@ -284,33 +316,37 @@ fn within(bound: ErrorBound, limit: f64) -> bool {
 /// the closed counter-clockwise triangle `tri`, or `None` when they do not meet. Whether
 /// they meet is decided exactly; the interval ends are then rounded to `f64`.
 fn clip_segment(p: &Point, q: &Point, tri: &[Point; 3]) -> Option<(f64, f64)> {
-    // Rationals num/den with den > 0.
-    let (mut lo_n, mut lo_d) = (0i128, 1i128);
-    let (mut hi_n, mut hi_d) = (1i128, 1i128);
+    // Rationals num/den with den > 0; numerators and denominators are differences of
+    // orientations (below 2^34), their cross products are compared in i128.
+    let (mut lo_n, mut lo_d) = (0i64, 1i64);
+    let (mut hi_n, mut hi_d) = (1i64, 1i64);
+    let less = |n1: i64, d1: i64, n2: i64, d2: i64| {
+        (n1 as i128) * (d2 as i128) < (n2 as i128) * (d1 as i128)
+    };
     for k in 0..3 {
         let (a, b) = (&tri[k], &tri[(k + 1) % 3]);
-        let f0 = orient(a, b, p) as i128;
-        let f1 = orient(a, b, q) as i128;
+        let f0 = orient(a, b, p);
+        let f1 = orient(a, b, q);
         match (f0 >= 0, f1 >= 0) {
             (true, true) => {}
             (false, false) => return None,
             (true, false) => {
                 // t <= f0 / (f0 - f1)
                 let (n, d) = (f0, f0 - f1);
-                if n * hi_d < hi_n * d {
+                if less(n, d, hi_n, hi_d) {
                     (hi_n, hi_d) = (n, d);
                 }
             }
             (false, true) => {
                 // t >= -f0 / (f1 - f0)
                 let (n, d) = (-f0, f1 - f0);
-                if n * lo_d > lo_n * d {
+                if less(lo_n, lo_d, n, d) {
                     (lo_n, lo_d) = (n, d);
                 }
             }
         }
     }
-    if lo_n * hi_d > hi_n * lo_d {
+    if less(hi_n, hi_d, lo_n, lo_d) {
         return None;
     }
     Some((lo_n as f64 / lo_d as f64, hi_n as f64 / hi_d as f64))

@@ -80,8 +80,16 @@ fn domain_corners(spec: &GridSpec) -> Vec<[u32; 2]> {
     corners
 }
 
+fn cases() -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(256)
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(200))]
+    // PROPTEST_CASES raises the count for a longer run (default 256).
+    #![proptest_config(ProptestConfig::with_cases(cases()))]
 
     #[test]
     fn bound_holds_for_every_selection(spec in small_grid(), bound in max_error()) {

@@ -94,6 +94,7 @@ pub fn small_grid() -> impl Strategy<Value = GridSpec> {
         (1u32..12, 1u32..=1),
         (2u32..=2, 2u32..=2),
         (2u32..14, 2u32..14),
+        (14u32..48, 14u32..48),
     ];
     (dims, 0u8..6, any::<u64>(), 0u8..4).prop_map(|((w, h), kind, seed, holes)| {
         let mut rng = SplitMix::new(seed);

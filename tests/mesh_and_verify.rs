@@ -149,3 +149,43 @@ fn info_reports_nodata_and_crs() {
     assert_eq!(j["nodata_samples"], 970);
     assert_eq!(j["epsg"], 3857);
 }
+
+#[test]
+fn quiet_mesh_prints_nothing_and_report_has_every_phase() {
+    let d = Dir::new();
+    let dem = fixture("tintn_valid_raster_3857.tif");
+    let o = d.run(&[
+        "mesh",
+        &dem,
+        "-o",
+        "m.obj",
+        "--max-error",
+        "1",
+        "-q",
+        "--report",
+        "r.json",
+    ]);
+    assert!(o.status.success());
+    assert_eq!(crate::util::stderr(&o), "");
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path("r.json")).unwrap()).unwrap();
+    for phase in [
+        "read",
+        "initial_mesh",
+        "decimate",
+        "verify",
+        "write",
+        "total",
+    ] {
+        assert!(r["seconds"][phase].as_f64().unwrap() >= 0.0, "{phase}");
+    }
+    assert_eq!(r["valid_samples"], 8000 - 970);
+    assert_eq!(r["max_error"], 1.0);
+    let pct = r["decimation_percent"].as_f64().unwrap();
+    let (before, after) = (
+        r["triangles_before"].as_f64().unwrap(),
+        r["triangles_after"].as_f64().unwrap(),
+    );
+    assert!((pct - 100.0 * (1.0 - after / before)).abs() < 1e-9);
+    assert_eq!(d.files(), vec!["m.obj", "r.json"]);
+}

@@ -57,6 +57,9 @@ pub struct MeshArgs {
     /// Write (column, row, value) instead of georeferenced coordinates.
     #[arg(long)]
     pub pixel_coords: bool,
+    /// No progress or summary on stderr (progress is shown only on a terminal anyway).
+    #[arg(short, long)]
+    pub quiet: bool,
     /// Write a JSON report of sizes, counts, measured error and timings.
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,

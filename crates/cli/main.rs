@@ -8,6 +8,7 @@ mod georef;
 mod info;
 mod mesh;
 mod output;
+mod progress;
 mod verify;
 
 use std::process::ExitCode;

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
-use tinsmith_core::{decimate, DecimationOptions, Tin};
+use tinsmith_core::{decimate_with_progress, DecimationOptions, Tin};
 use tinsmith_export::{MeshFormat, MeshRef};
 use tinsmith_verify::{GridRef, VerifyOptions};
 
@@ -68,7 +68,17 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     }
 
     let options = DecimationOptions::new(args.max_error).with_selection(args.selection.into());
-    let result = decimate(grid, &options).with_context(|| format!("{}", args.input.display()))?;
+    let mut bar = crate::progress::Progress::new(args.quiet);
+    let result = decimate_with_progress(grid, &options, &mut |p| {
+        bar.show(&format!(
+            "decimating: sweep {}, {:3.0}% of its vertices tried, {} removed",
+            p.sweep,
+            100.0 * p.sweep_fraction,
+            p.removed
+        ))
+    })
+    .with_context(|| format!("{}", args.input.display()))?;
+    bar.clear();
     let tin = &result.tin;
 
     // The promise is checked, independently, before anything is written.
@@ -137,15 +147,17 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             total: total.elapsed().as_secs_f64(),
         },
     };
-    eprintln!(
-        "{}: {} -> {} triangles ({:.1}% decimated), measured max error {} <= {}",
-        args.output.display(),
-        report.triangles_before,
-        report.triangles_after,
-        report.decimation_percent,
-        report.measured_max_error,
-        args.max_error
-    );
+    if !args.quiet {
+        eprintln!(
+            "{}: {} -> {} triangles ({:.1}% decimated), measured max error {} <= {}",
+            args.output.display(),
+            report.triangles_before,
+            report.triangles_after,
+            report.decimation_percent,
+            report.measured_max_error,
+            args.max_error
+        );
+    }
     if let Some(path) = &args.report {
         let json = serde_json::to_vec_pretty(&report)?;
         write_atomically(path, &json)?;

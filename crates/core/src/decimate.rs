@@ -66,6 +66,27 @@ pub struct DecimationReport {
 /// # Errors
 /// [`Error::InvalidMaxError`] when `max_error` is negative, NaN or infinite.
 pub fn decimate(grid: &Grid, options: &DecimationOptions) -> Result<Decimation> {
+    decimate_with_progress(grid, options, &mut |_| {})
+}
+
+/// Where a running decimation is, for progress displays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    /// The sweep under way (1-based).
+    pub sweep: usize,
+    /// Fraction of the vertices queued for this sweep already tried, in `[0, 1]`.
+    pub sweep_fraction: f64,
+    /// Vertices removed so far.
+    pub removed: usize,
+}
+
+/// [`decimate`], calling `progress` now and then (every 65,536 removal attempts and at
+/// each sweep's start). The result is the same as [`decimate`]'s.
+pub fn decimate_with_progress(
+    grid: &Grid,
+    options: &DecimationOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Decimation> {
     let max_error = options.max_error;
     if !(max_error.is_finite() && max_error >= 0.0) {
         return Err(Error::InvalidMaxError(max_error));
@@ -108,19 +129,37 @@ pub fn decimate(grid: &Grid, options: &DecimationOptions) -> Result<Decimation> 
             next_sweep.push(v);
         }
     }
-    let (mut sweeps, mut attempts) = (0, 0);
+    let (mut sweeps, mut attempts, mut removed) = (0, 0, 0);
     while !next_sweep.is_empty() {
         sweeps += 1;
         this_sweep.extend(next_sweep.drain(..).map(Reverse));
+        let mut sweep_size = this_sweep.len();
+        let mut tried = 0usize;
+        progress(Progress {
+            sweep: sweeps,
+            sweep_fraction: 0.0,
+            removed,
+        });
         while let Some(Reverse(v)) = this_sweep.pop() {
             queued[v as usize] = false;
             attempts += 1;
+            tried += 1;
+            if attempts % 65_536 == 0 {
+                let sweep_fraction = tried as f64 / sweep_size.max(tried) as f64;
+                progress(Progress {
+                    sweep: sweeps,
+                    sweep_fraction,
+                    removed,
+                });
+            }
             if remover.try_remove(&mut mesh, v) {
+                removed += 1;
                 for &u in &remover.star.ring {
                     if !queued[u as usize] {
                         queued[u as usize] = true;
                         if u > v {
                             this_sweep.push(Reverse(u));
+                            sweep_size += 1;
                         } else {
                             next_sweep.push(u);
                         }

@@ -37,7 +37,7 @@ mod options;
 mod predicates;
 mod tin;
 
-pub use decimate::{decimate, Decimation, DecimationReport};
+pub use decimate::{decimate, decimate_with_progress, Decimation, DecimationReport, Progress};
 pub use error::{Error, Result};
 pub use error_bound::ErrorBound;
 pub use geo_transform::GeoTransform;

@@ -189,3 +189,64 @@ fn quiet_mesh_prints_nothing_and_report_has_every_phase() {
     assert!((pct - 100.0 * (1.0 - after / before)).abs() < 1e-9);
     assert_eq!(d.files(), vec!["m.obj", "r.json"]);
 }
+
+#[test]
+fn every_model_order_and_retriangulation_from_the_cli() {
+    let ct = fixture("ct_brain_crop_128_i16.tif");
+    for model in ["bounds", "exact"] {
+        for order in ["sweep", "greedy"] {
+            for re in ["ears", "dp"] {
+                let extra = [
+                    "--error-model",
+                    model,
+                    "--order",
+                    order,
+                    "--retriangulate",
+                    re,
+                ];
+                let r = mesh_then_verify(&ct, 20.0, &extra, "ply");
+                assert_eq!(r["error_model"], model);
+                assert_eq!(r["order"], order);
+                assert_eq!(r["retriangulate"], re);
+            }
+        }
+    }
+}
+
+#[test]
+fn max_triangles_reports_the_verified_error() {
+    let d = Dir::new();
+    let dem = fixture("tintn_valid_raster_3857.tif");
+    let o = d.run(&[
+        "mesh",
+        &dem,
+        "-o",
+        "m.ply",
+        "--max-triangles",
+        "500",
+        "--error-model",
+        "exact",
+        "--report",
+        "r.json",
+    ]);
+    assert!(o.status.success(), "{}", crate::util::stderr(&o));
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path("r.json")).unwrap()).unwrap();
+    let after = r["triangles_after"].as_u64().unwrap();
+    assert!((490..=500).contains(&after), "{after}");
+    assert!(r["max_error"].is_null());
+    let measured = r["measured_max_error"].as_f64().unwrap();
+    // The file verifies at the measured error and not below it.
+    let m = measured.to_string();
+    assert!(d
+        .run(&["verify", &dem, "m.ply", "--max-error", &m])
+        .status
+        .success());
+    let below = (measured * 0.999).to_string();
+    assert_eq!(
+        d.run(&["verify", &dem, "m.ply", "--max-error", &below])
+            .status
+            .code(),
+        Some(1)
+    );
+}

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use tinsmith_core::EdgeSelection;
+use tinsmith_core::{EdgeSelection, ErrorModel, Order, Retriangulation};
 
 /// Turns DEMs and other 2D scalar grids into TINs whose error is guaranteed.
 #[derive(Debug, Parser)]
@@ -42,18 +42,33 @@ pub struct MeshArgs {
     /// Output mesh; the format follows the extension (.ply, .obj).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Largest allowed |sample - TIN| at any valid sample, in data units.
-    #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true)]
-    pub max_error: f64,
+    /// Largest allowed |sample - TIN| at any valid sample, in data units. Required unless
+    /// --max-triangles or --max-vertices is given.
+    #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true,
+          required_unless_present_any = ["max_triangles", "max_vertices"])]
+    pub max_error: Option<f64>,
+    /// Decimate until at most N triangles remain (greedy order), then report the verified
+    /// max error.
+    #[arg(long, value_name = "N")]
+    pub max_triangles: Option<usize>,
+    /// Decimate until at most N vertices remain (greedy order).
+    #[arg(long, value_name = "N")]
+    pub max_vertices: Option<usize>,
     /// Band to read (1-based).
     #[arg(long, default_value_t = 1)]
     pub band: usize,
     /// Error model.
     #[arg(long, value_enum, default_value_t = ErrorModelArg::Bounds)]
     pub error_model: ErrorModelArg,
-    /// Edge selection rule for retriangulating holes (paper §3.4).
+    /// Edge selection rule for retriangulating holes by ears (paper §3.4).
     #[arg(long, value_enum, default_value_t = SelectionArg::Hybrid)]
     pub selection: SelectionArg,
+    /// Removal order.
+    #[arg(long, value_enum, default_value_t = OrderArg::Sweep)]
+    pub order: OrderArg,
+    /// Hole retriangulation.
+    #[arg(long, value_enum, default_value_t = RetriangulateArg::Ears)]
+    pub retriangulate: RetriangulateArg,
     /// Write (column, row, value) instead of georeferenced coordinates.
     #[arg(long)]
     pub pixel_coords: bool,
@@ -89,6 +104,51 @@ pub struct VerifyArgs {
 pub enum ErrorModelArg {
     /// The paper's accumulated bounds above and below each triangle.
     Bounds,
+    /// The true max |sample - plane| over the samples a candidate triangle covers.
+    Exact,
+}
+
+impl From<ErrorModelArg> for ErrorModel {
+    fn from(m: ErrorModelArg) -> ErrorModel {
+        match m {
+            ErrorModelArg::Bounds => ErrorModel::Bounds,
+            ErrorModelArg::Exact => ErrorModel::Exact,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum OrderArg {
+    /// The paper's row-major sweeps, repeated until nothing can be removed.
+    Sweep,
+    /// Smallest-error removal first (priority queue).
+    Greedy,
+}
+
+impl From<OrderArg> for Order {
+    fn from(o: OrderArg) -> Order {
+        match o {
+            OrderArg::Sweep => Order::Sweep,
+            OrderArg::Greedy => Order::Greedy,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum RetriangulateArg {
+    /// The paper's greedy ear selection, with --selection.
+    Ears,
+    /// Min-max-error triangulation by dynamic programming (holes up to 16 vertices).
+    Dp,
+}
+
+impl From<RetriangulateArg> for Retriangulation {
+    fn from(r: RetriangulateArg) -> Retriangulation {
+        match r {
+            RetriangulateArg::Ears => Retriangulation::Ears,
+            RetriangulateArg::Dp => Retriangulation::Dp,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]

@@ -9,7 +9,7 @@ use tinsmith_core::{decimate_with_progress, DecimationOptions, Tin};
 use tinsmith_export::{MeshFormat, MeshRef};
 use tinsmith_verify::{GridRef, VerifyOptions};
 
-use crate::args::{ErrorModelArg, MeshArgs};
+use crate::args::MeshArgs;
 use crate::georef::Georef;
 use crate::output::{check_writable_target, write_atomically};
 
@@ -21,9 +21,13 @@ struct MeshReport<'a> {
     width: u32,
     height: u32,
     valid_samples: u64,
-    max_error: f64,
-    error_model: &'static str,
+    max_error: Option<f64>,
+    max_triangles: Option<usize>,
+    max_vertices: Option<usize>,
+    error_model: String,
     selection: String,
+    order: String,
+    retriangulate: String,
     triangles_before: usize,
     triangles_after: usize,
     vertices_before: usize,
@@ -67,7 +71,18 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         );
     }
 
-    let options = DecimationOptions::new(args.max_error).with_selection(args.selection.into());
+    let max_error = args.max_error.unwrap_or(f64::INFINITY);
+    let mut options = DecimationOptions::new(max_error)
+        .with_selection(args.selection.into())
+        .with_error_model(args.error_model.into())
+        .with_order(args.order.into())
+        .with_retriangulation(args.retriangulate.into());
+    if let Some(n) = args.max_triangles {
+        options = options.with_max_triangles(n);
+    }
+    if let Some(n) = args.max_vertices {
+        options = options.with_max_vertices(n);
+    }
     let mut bar = crate::progress::Progress::new(args.quiet);
     let result = decimate_with_progress(grid, &options, &mut |p| {
         bar.show(&format!(
@@ -93,7 +108,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let check = tinsmith_verify::verify(
         GridRef::new(grid.width(), grid.height(), grid.values()),
         tinsmith_verify::MeshRef::new(&positions, &heights, tin.triangles()),
-        &VerifyOptions::new().with_max_error(args.max_error),
+        &VerifyOptions::new().with_max_error(max_error),
     )?;
     let verify_seconds = t.elapsed().as_secs_f64();
     if !check.passed() {
@@ -126,10 +141,12 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         height: grid.height(),
         valid_samples: raster.info.valid_samples,
         max_error: args.max_error,
-        error_model: match args.error_model {
-            ErrorModelArg::Bounds => "bounds",
-        },
-        selection: format!("{:?}", args.selection).to_lowercase(),
+        max_triangles: args.max_triangles,
+        max_vertices: args.max_vertices,
+        error_model: value_name(args.error_model),
+        selection: value_name(args.selection),
+        order: value_name(args.order),
+        retriangulate: value_name(args.retriangulate),
         triangles_before: r.initial_triangles,
         triangles_after: r.final_triangles,
         vertices_before: r.initial_vertices,
@@ -155,7 +172,11 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             report.triangles_after,
             report.decimation_percent,
             report.measured_max_error,
-            args.max_error
+            if max_error.is_finite() {
+                max_error.to_string()
+            } else {
+                "(no bound asked)".into()
+            }
         );
     }
     if let Some(path) = &args.report {
@@ -163,6 +184,13 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         write_atomically(path, &json)?;
     }
     Ok(true)
+}
+
+/// The flag value clap shows for `v`.
+fn value_name(v: impl clap::ValueEnum) -> String {
+    v.to_possible_value()
+        .map(|p| p.get_name().to_owned())
+        .unwrap_or_default()
 }
 
 /// Vertices in file coordinates and triangles counter-clockwise in them (normals up).

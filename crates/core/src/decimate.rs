@@ -4,9 +4,10 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use std::time::Instant;
 
-use crate::hole::Retriangulator;
+use crate::hole::{Retriangulator, Rules};
 use crate::mesh::{Mesh, Star, VertexClass};
-use crate::{DecimationOptions, Error, ErrorBound, Grid, Result, Tin, TinVertex};
+use crate::predicates::Point;
+use crate::{DecimationOptions, Error, ErrorBound, Grid, Order, Result, Tin, TinVertex};
 
 /// Relative slack kept below the requested bound so that `f64` rounding in the bound
 /// arithmetic can never let a measured error exceed `max_error` (see [`decimate`]).
@@ -88,7 +89,8 @@ pub fn decimate_with_progress(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Decimation> {
     let max_error = options.max_error;
-    if !(max_error.is_finite() && max_error >= 0.0) {
+    let count_target = options.max_triangles.is_some() || options.max_vertices.is_some();
+    if max_error.is_nan() || max_error < 0.0 || (max_error.is_infinite() && !count_target) {
         return Err(Error::InvalidMaxError(max_error));
     }
     let started = Instant::now();
@@ -99,26 +101,75 @@ pub fn decimate_with_progress(
         .count();
     let seconds_initial_mesh = started.elapsed().as_secs_f64();
 
-    let slack = ROUNDING_SLACK * (max_error + grid.max_abs_value());
+    let slack = ROUNDING_SLACK * (max_error.min(f64::MAX) + grid.max_abs_value());
     let limit = if max_error > slack {
         max_error - slack
     } else {
         0.0
     };
     let started = Instant::now();
-    let mut remover = Remover {
-        star: Star::default(),
-        hole: Retriangulator::default(),
-        points: Vec::new(),
-        bounds: Vec::new(),
-        new_triangles: Vec::new(),
+    let rules = Rules {
+        grid,
+        model: options.error_model,
         selection: options.selection,
+        method: options.retriangulation,
+        dp_max_ring: options.dp_max_ring,
         limit,
     };
+    let mut remover = Remover::new(rules);
+    let mut stats = Stats::default();
+    match options.order {
+        Order::Sweep => sweep(&mut mesh, &mut remover, &mut stats, progress),
+        Order::Greedy => {
+            let target = Target {
+                triangles: options.max_triangles,
+                vertices: options.max_vertices,
+            };
+            greedy(
+                &mut mesh,
+                &mut remover,
+                &mut stats,
+                target,
+                initial_vertices,
+                progress,
+            )
+        }
+    }
+    #[cfg(debug_assertions)]
+    mesh.check_invariants();
+    let seconds_decimation = started.elapsed().as_secs_f64();
 
-    // The paper's sweep, made cheap: a vertex whose star did not change since it last
-    // failed would fail again, so each sweep visits only vertices whose star changed, in
-    // the same row-major order a full sweep would.
+    let (tin, max_bound) = extract(&mesh);
+    let report = DecimationReport {
+        initial_vertices,
+        initial_triangles,
+        final_vertices: tin.vertices.len(),
+        final_triangles: tin.triangles.len(),
+        max_bound,
+        sweeps: stats.sweeps,
+        attempts: stats.attempts,
+        seconds_initial_mesh,
+        seconds_decimation,
+    };
+    Ok(Decimation { tin, report })
+}
+
+#[derive(Debug, Default)]
+struct Stats {
+    sweeps: usize,
+    attempts: usize,
+    removed: usize,
+}
+
+/// The paper's sweep, made cheap: a vertex whose star did not change since it last failed
+/// would fail again, so each sweep visits only vertices whose star changed, in the same
+/// row-major order a full sweep would.
+fn sweep(
+    mesh: &mut Mesh<'_>,
+    remover: &mut Remover<'_>,
+    stats: &mut Stats,
+    progress: &mut dyn FnMut(Progress),
+) {
     let n = mesh.vertex_slots();
     let mut queued = vec![false; n];
     let mut this_sweep: BinaryHeap<Reverse<u32>> = BinaryHeap::new();
@@ -129,31 +180,31 @@ pub fn decimate_with_progress(
             next_sweep.push(v);
         }
     }
-    let (mut sweeps, mut attempts, mut removed) = (0, 0, 0);
     while !next_sweep.is_empty() {
-        sweeps += 1;
+        stats.sweeps += 1;
         this_sweep.extend(next_sweep.drain(..).map(Reverse));
         let mut sweep_size = this_sweep.len();
         let mut tried = 0usize;
         progress(Progress {
-            sweep: sweeps,
+            sweep: stats.sweeps,
             sweep_fraction: 0.0,
-            removed,
+            removed: stats.removed,
         });
         while let Some(Reverse(v)) = this_sweep.pop() {
             queued[v as usize] = false;
-            attempts += 1;
+            stats.attempts += 1;
             tried += 1;
-            if attempts % 65_536 == 0 {
+            if stats.attempts.is_multiple_of(65_536) {
                 let sweep_fraction = tried as f64 / sweep_size.max(tried) as f64;
                 progress(Progress {
-                    sweep: sweeps,
+                    sweep: stats.sweeps,
                     sweep_fraction,
-                    removed,
+                    removed: stats.removed,
                 });
             }
-            if remover.try_remove(&mut mesh, v) {
-                removed += 1;
+            if remover.plan(mesh, v).is_some() {
+                remover.apply(mesh, v);
+                stats.removed += 1;
                 for &u in &remover.star.ring {
                     if !queued[u as usize] {
                         queued[u as usize] = true;
@@ -168,75 +219,184 @@ pub fn decimate_with_progress(
             }
         }
     }
-    #[cfg(debug_assertions)]
-    mesh.check_invariants();
-    let seconds_decimation = started.elapsed().as_secs_f64();
-
-    let (tin, max_bound) = extract(&mesh);
-    let report = DecimationReport {
-        initial_vertices,
-        initial_triangles,
-        final_vertices: tin.vertices.len(),
-        final_triangles: tin.triangles.len(),
-        max_bound,
-        sweeps,
-        attempts,
-        seconds_initial_mesh,
-        seconds_decimation,
-    };
-    Ok(Decimation { tin, report })
 }
 
-/// Removes single vertices; holds the buffers reused across attempts.
-struct Remover {
-    star: Star,
-    hole: Retriangulator,
-    points: Vec<crate::predicates::Point>,
-    bounds: Vec<ErrorBound>,
-    new_triangles: Vec<(u32, [u32; 3], ErrorBound)>,
-    selection: crate::EdgeSelection,
-    limit: f64,
+/// When a count-driven decimation stops.
+#[derive(Debug, Clone, Copy)]
+struct Target {
+    triangles: Option<usize>,
+    vertices: Option<usize>,
 }
 
-impl Remover {
-    /// Removes `v` if it is interior or boundary and its hole can be retriangulated within
-    /// the limit; returns whether it did (then `self.star` holds its former star).
-    fn try_remove(&mut self, mesh: &mut Mesh<'_>, v: u32) -> bool {
-        if !mesh.contains_vertex(v) {
-            return false;
-        }
-        mesh.star(v, &mut self.star);
-        if mesh.classify(v, &self.star) == VertexClass::Corner {
-            return false;
-        }
-        self.points.clear();
-        self.points
-            .extend(self.star.ring.iter().map(|&u| mesh.point(u)));
-        let centre = mesh.point(v);
-        if self.limit == 0.0 && self.points.iter().any(|p| p.z != centre.z) {
-            // Below the rounding slack only exactly flat stars go: their bound arithmetic
-            // is exact (all differences are zero).
-            return false;
-        }
-        self.bounds.clear();
-        self.bounds
-            .extend(self.star.triangles.iter().map(|&t| mesh.bound(t)));
-        self.hole.load(centre, &self.points, &self.bounds);
-        let Some(triangles) = self.hole.retriangulate(self.selection, self.limit) else {
-            return false;
-        };
-        self.new_triangles.clear();
-        for (tri, &slot) in triangles.iter().zip(&self.star.triangles) {
-            let corners = tri.corners.map(|i| self.star.ring[i as usize]);
-            self.new_triangles.push((slot, corners, tri.bound));
-        }
-        mesh.replace_star(v, &self.star, &self.new_triangles);
-        #[cfg(test)]
-        mesh.check_invariants();
-        true
+/// A removal candidate: its cost, then the vertex, so ties go to the lower index.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Candidate {
+    cost: f64,
+    vertex: u32,
+    version: u32,
+}
+
+impl Eq for Candidate {}
+
+impl Ord for Candidate {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        // Reversed: BinaryHeap is a max-heap and we want the smallest cost first.
+        other
+            .cost
+            .total_cmp(&self.cost)
+            .then(other.vertex.cmp(&self.vertex))
     }
 }
 
+impl PartialOrd for Candidate {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+/// Greedy order: always remove the vertex whose best retriangulation has the smallest
+/// error. A key goes stale when a neighbour's removal changes the vertex's star; stale
+/// keys are recognised by a per-vertex version and recomputed when popped.
+fn greedy(
+    mesh: &mut Mesh<'_>,
+    remover: &mut Remover<'_>,
+    stats: &mut Stats,
+    target: Target,
+    initial_vertices: usize,
+    progress: &mut dyn FnMut(Progress),
+) {
+    let n = mesh.vertex_slots();
+    let mut version = vec![0u32; n];
+    let mut heap = BinaryHeap::new();
+    stats.sweeps = 1;
+    progress(Progress {
+        sweep: 1,
+        sweep_fraction: 0.0,
+        removed: 0,
+    });
+    for v in 0..n as u32 {
+        if mesh.contains_vertex(v) {
+            stats.attempts += 1;
+            if let Some(cost) = remover.plan(mesh, v) {
+                heap.push(Candidate {
+                    cost,
+                    vertex: v,
+                    version: 0,
+                });
+            }
+        }
+    }
+    let reached = |mesh: &Mesh<'_>, removed: usize| {
+        target.triangles.is_some_and(|t| mesh.triangle_count() <= t)
+            || target
+                .vertices
+                .is_some_and(|t| initial_vertices - removed <= t)
+    };
+    while let Some(c) = heap.pop() {
+        if reached(mesh, stats.removed) {
+            break;
+        }
+        let v = c.vertex;
+        if c.version != version[v as usize] || !mesh.contains_vertex(v) {
+            continue;
+        }
+        stats.attempts += 1;
+        let Some(cost) = remover.plan(mesh, v) else {
+            continue;
+        };
+        debug_assert_eq!(cost.to_bits(), c.cost.to_bits(), "a current key is exact");
+        remover.apply(mesh, v);
+        stats.removed += 1;
+        if stats.removed.is_multiple_of(65_536) {
+            let sweep_fraction = stats.removed as f64 / initial_vertices.max(1) as f64;
+            progress(Progress {
+                sweep: 1,
+                sweep_fraction,
+                removed: stats.removed,
+            });
+        }
+        for i in 0..remover.star.ring.len() {
+            let u = remover.star.ring[i];
+            version[u as usize] = version[u as usize].wrapping_add(1);
+            stats.attempts += 1;
+            if let Some(cost) = remover.plan(mesh, u) {
+                heap.push(Candidate {
+                    cost,
+                    vertex: u,
+                    version: version[u as usize],
+                });
+            }
+        }
+        // plan() for the neighbours replaced the star; restore nothing: apply() is done.
+    }
+}
+
+/// Removes single vertices; holds the buffers reused across attempts.
+struct Remover<'g> {
+    star: Star,
+    ring_star: Star,
+    hole: Retriangulator,
+    points: Vec<Point>,
+    bounds: Vec<ErrorBound>,
+    new_triangles: Vec<(u32, [u32; 3], ErrorBound)>,
+    rules: Rules<'g>,
+}
+
+impl<'g> Remover<'g> {
+    fn new(rules: Rules<'g>) -> Remover<'g> {
+        Remover {
+            star: Star::default(),
+            ring_star: Star::default(),
+            hole: Retriangulator::default(),
+            points: Vec::new(),
+            bounds: Vec::new(),
+            new_triangles: Vec::new(),
+            rules,
+        }
+    }
+
+    /// Plans the removal of `v`: if it is interior or boundary and its hole can be
+    /// retriangulated within the limit, returns the largest new bound and keeps the plan
+    /// for [`Remover::apply`]. Does not change the mesh.
+    fn plan(&mut self, mesh: &Mesh<'_>, v: u32) -> Option<f64> {
+        if !mesh.contains_vertex(v) {
+            return None;
+        }
+        let star = &mut self.ring_star;
+        mesh.star(v, star);
+        if mesh.classify(v, star) == VertexClass::Corner {
+            return None;
+        }
+        self.points.clear();
+        self.points.extend(star.ring.iter().map(|&u| mesh.point(u)));
+        let centre = mesh.point(v);
+        if self.rules.limit == 0.0 && self.points.iter().any(|p| p.z != centre.z) {
+            // Below the rounding slack only exactly flat stars go: their bound arithmetic
+            // is exact (all differences are zero).
+            return None;
+        }
+        self.bounds.clear();
+        self.bounds
+            .extend(star.triangles.iter().map(|&t| mesh.bound(t)));
+        self.hole.load(centre, &self.points, &self.bounds);
+        let (triangles, worst) = self.hole.retriangulate(&self.rules)?;
+        self.new_triangles.clear();
+        for (tri, &slot) in triangles.iter().zip(&star.triangles) {
+            let corners = tri.corners.map(|i| star.ring[i as usize]);
+            self.new_triangles.push((slot, corners, tri.bound));
+        }
+        Some(worst)
+    }
+
+    /// Carries out the last successful [`Remover::plan`], which must have been for `v`
+    /// with the mesh unchanged since; afterwards `self.star` holds `v`'s former star.
+    fn apply(&mut self, mesh: &mut Mesh<'_>, v: u32) {
+        std::mem::swap(&mut self.star, &mut self.ring_star);
+        mesh.replace_star(v, &self.star, &self.new_triangles);
+        #[cfg(test)]
+        mesh.check_invariants();
+    }
+}
 /// The mesh's live vertices (row-major) and triangles (slot order), and the largest bound.
 fn extract(mesh: &Mesh<'_>) -> (Tin, f64) {
     let mut index = vec![u32::MAX; mesh.vertex_slots()];

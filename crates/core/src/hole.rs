@@ -22,8 +22,9 @@
 //! bound a true bound; the paper's boundary rule (§3.3.2) is the special case of (a) and
 //! (b) on the new boundary edge, which passes through `c`.
 
+use crate::exact::triangle_error;
 use crate::predicates::{in_closed_triangle, orient, plane_gradient, Point};
-use crate::{EdgeSelection, ErrorBound};
+use crate::{EdgeSelection, ErrorBound, ErrorModel, Grid, Retriangulation};
 
 /// A triangle of the retriangulated hole: ring positions (counter-clockwise) and bound.
 #[derive(Debug, Clone, Copy)]
@@ -63,6 +64,23 @@ pub(crate) struct Retriangulator {
     edge: Vec<SegmentError>,
     ears: Vec<Option<Option<Ear>>>,
     triangles: Vec<HoleTriangle>,
+    // Dynamic programming tables, row-major m x m.
+    diagonal_ok: Vec<bool>,
+    segments: Vec<Option<SegmentError>>,
+    cost: Vec<f64>,
+    split: Vec<u32>,
+}
+
+/// What the retriangulation needs besides the hole: the rules and the grid.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Rules<'g> {
+    pub grid: &'g Grid,
+    pub model: ErrorModel,
+    pub selection: EdgeSelection,
+    pub method: Retriangulation,
+    /// Holes with more ring vertices than this use ears even when `method` is `Dp`.
+    pub dp_max_ring: usize,
+    pub limit: f64,
 }
 
 impl Retriangulator {
@@ -91,27 +109,32 @@ impl Retriangulator {
             .fold(f64::NEG_INFINITY, |m, b| m.max(b.below));
     }
 
-    /// Triangulates the loaded hole by ear clipping with `selection`, accepting only
-    /// triangles whose bound is at most `limit` on both sides. Returns the triangles
-    /// (corners index the ring) or `None` on a dead end (paper §3.4).
-    pub(crate) fn retriangulate(
-        &mut self,
-        selection: EdgeSelection,
-        limit: f64,
-    ) -> Option<&[HoleTriangle]> {
-        match selection {
-            EdgeSelection::Hybrid => {
-                if self.clip_ears(EdgeSelection::MinIntroduced, limit) {
-                    return Some(&self.triangles);
+    /// Triangulates the loaded hole under `rules`, accepting only triangles whose bound is
+    /// at most `rules.limit` on both sides. Returns the triangles (corners index the ring)
+    /// and the largest bound among them, or `None` on a dead end (paper §3.4).
+    pub(crate) fn retriangulate(&mut self, rules: &Rules<'_>) -> Option<(&[HoleTriangle], f64)> {
+        let found = if rules.method == Retriangulation::Dp && self.ring.len() <= rules.dp_max_ring {
+            self.dynamic_programming(rules)
+        } else {
+            match rules.selection {
+                EdgeSelection::Hybrid => {
+                    self.clip_ears(EdgeSelection::MinIntroduced, rules)
+                        || self.clip_ears(EdgeSelection::MinError, rules)
                 }
-                self.clip_ears(EdgeSelection::MinError, limit)
-                    .then_some(&self.triangles)
+                rule => self.clip_ears(rule, rules),
             }
-            rule => self.clip_ears(rule, limit).then_some(&self.triangles),
+        };
+        if !found {
+            return None;
         }
+        let worst = self
+            .triangles
+            .iter()
+            .fold(0.0f64, |w, t| w.max(t.bound.max()));
+        Some((&self.triangles, worst))
     }
 
-    fn clip_ears(&mut self, rule: EdgeSelection, limit: f64) -> bool {
+    fn clip_ears(&mut self, rule: EdgeSelection, rules: &Rules<'_>) -> bool {
         let m = self.ring.len();
         self.triangles.clear();
         self.prev.clear();
@@ -132,16 +155,17 @@ impl Retriangulator {
             let mut q = start;
             for _ in 0..remaining {
                 if self.ears[q].is_none() {
-                    let ear = self.ear(q, limit);
+                    let ear = self.ear(q, rules);
                     self.ears[q] = Some(ear);
                 }
                 // Geometric validity can change as other vertices leave the polygon, so it
                 // is re-tested every round; the error part is cached per ear.
                 if let Some(Some(ear)) = self.ears[q] {
                     if self.ear_is_empty(q) {
-                        let key = match rule {
-                            EdgeSelection::MinIntroduced => ear.diagonal.introduced,
-                            _ => ear.diagonal.bound.max(),
+                        let key = match (rule, rules.model) {
+                            (EdgeSelection::MinIntroduced, _) => ear.diagonal.introduced,
+                            (_, ErrorModel::Bounds) => ear.diagonal.bound.max(),
+                            (_, ErrorModel::Exact) => ear.triangle.max(),
                         };
                         if best.is_none_or(|(_, k)| key < k) {
                             best = Some((q, key));
@@ -175,10 +199,11 @@ impl Retriangulator {
         if orient(&self.ring[a], &self.ring[b], &self.ring[c]) <= 0 {
             return false;
         }
-        let bound = self.triangle_bound(a, b, c, [self.edge[a], self.edge[b], self.edge[c]]);
-        if !within(bound, limit) {
+        let Some(bound) =
+            self.triangle_cost(a, b, c, [self.edge[a], self.edge[b], self.edge[c]], rules)
+        else {
             return false;
-        }
+        };
         self.triangles.push(HoleTriangle {
             corners: [a as u32, b as u32, c as u32],
             bound,
@@ -186,15 +211,155 @@ impl Retriangulator {
         true
     }
 
-    /// The ear at `q` if it is convex and its triangle's bound is within `limit`.
-    fn ear(&self, q: usize, limit: f64) -> Option<Ear> {
+    /// The ear at `q` if it is convex and its triangle's bound is within the limit.
+    fn ear(&self, q: usize, rules: &Rules<'_>) -> Option<Ear> {
         let (p, r) = (self.prev[q] as usize, self.next[q] as usize);
         if orient(&self.ring[p], &self.ring[q], &self.ring[r]) <= 0 {
             return None;
         }
         let diagonal = self.segment_error(r, p);
-        let triangle = self.triangle_bound(p, q, r, [self.edge[p], self.edge[q], diagonal]);
-        within(triangle, limit).then_some(Ear { diagonal, triangle })
+        let triangle =
+            self.triangle_cost(p, q, r, [self.edge[p], self.edge[q], diagonal], rules)?;
+        Some(Ear { diagonal, triangle })
+    }
+
+    /// The bound of new triangle `abc` under the error model, if within the limit. For
+    /// `Bounds`, `edges` are the bounds of its three edges (paper §3.3.3).
+    fn triangle_cost(
+        &self,
+        a: usize,
+        b: usize,
+        c: usize,
+        edges: [SegmentError; 3],
+        rules: &Rules<'_>,
+    ) -> Option<ErrorBound> {
+        let (pa, pb, pc) = (&self.ring[a], &self.ring[b], &self.ring[c]);
+        let bound = match rules.model {
+            ErrorModel::Bounds => self.triangle_bound(a, b, c, edges),
+            ErrorModel::Exact => triangle_error(rules.grid, pa, pb, pc, rules.limit)?,
+        };
+        within(bound, rules.limit).then_some(bound)
+    }
+
+    /// Min-max-error triangulation of the hole by dynamic programming over ring intervals:
+    /// `cost(i, j) = min over k of max(cost(i, k), cost(k, j), error(i, k, j))`, optimal for
+    /// the error model. Ties go to the smallest `k`.
+    fn dynamic_programming(&mut self, rules: &Rules<'_>) -> bool {
+        let m = self.ring.len();
+        self.triangles.clear();
+        self.diagonal_ok.clear();
+        self.diagonal_ok.resize(m * m, false);
+        for i in 0..m {
+            for j in i + 1..m {
+                let ok = j == i + 1 || (i == 0 && j == m - 1) || self.is_diagonal(i, j);
+                self.diagonal_ok[i * m + j] = ok;
+            }
+        }
+        self.segments.clear();
+        self.segments.resize(m * m, None);
+        self.cost.clear();
+        self.cost.resize(m * m, f64::INFINITY);
+        self.split.clear();
+        self.split.resize(m * m, u32::MAX);
+        for i in 0..m - 1 {
+            self.cost[i * m + i + 1] = 0.0;
+        }
+        for len in 2..m {
+            for i in 0..m - len {
+                let j = i + len;
+                if !self.diagonal_ok[i * m + j] {
+                    continue;
+                }
+                let mut best = (f64::INFINITY, u32::MAX);
+                for k in i + 1..j {
+                    let sub = self.cost[i * m + k].max(self.cost[k * m + j]);
+                    if sub >= best.0 || !self.diagonal_ok[i * m + k] || !self.diagonal_ok[k * m + j]
+                    {
+                        continue;
+                    }
+                    if orient(&self.ring[i], &self.ring[k], &self.ring[j]) <= 0 {
+                        continue;
+                    }
+                    let edges = match rules.model {
+                        ErrorModel::Bounds => {
+                            [self.segment(i, k), self.segment(k, j), self.segment(i, j)]
+                        }
+                        ErrorModel::Exact => [SegmentError::default(); 3],
+                    };
+                    let Some(t) = self.triangle_cost(i, k, j, edges, rules) else {
+                        continue;
+                    };
+                    let c = sub.max(t.max());
+                    if c < best.0 {
+                        best = (c, k as u32);
+                    }
+                }
+                self.cost[i * m + j] = best.0;
+                self.split[i * m + j] = best.1;
+            }
+        }
+        if self.split[m - 1] == u32::MAX {
+            return false;
+        }
+        // Rebuild the triangles, recomputing each one's bound.
+        let mut stack = vec![(0usize, m - 1)];
+        while let Some((i, j)) = stack.pop() {
+            if j < i + 2 {
+                continue;
+            }
+            let k = self.split[i * m + j] as usize;
+            let edges = match rules.model {
+                ErrorModel::Bounds => [self.segment(i, k), self.segment(k, j), self.segment(i, j)],
+                ErrorModel::Exact => [SegmentError::default(); 3],
+            };
+            let bound = self
+                .triangle_cost(i, k, j, edges, rules)
+                .expect("chosen triangle is within the limit");
+            self.triangles.push(HoleTriangle {
+                corners: [i as u32, k as u32, j as u32],
+                bound,
+            });
+            stack.push((k, j));
+            stack.push((i, k));
+        }
+        true
+    }
+
+    /// The cached error of the segment between ring vertices `i < j` (a ring edge or a
+    /// diagonal).
+    fn segment(&mut self, i: usize, j: usize) -> SegmentError {
+        let m = self.ring.len();
+        if let Some(e) = self.segments[i * m + j] {
+            return e;
+        }
+        let e = if j == i + 1 {
+            self.ring_edge_error(i)
+        } else if i == 0 && j == m - 1 {
+            self.ring_edge_error(m - 1)
+        } else {
+            self.segment_error(j, i)
+        };
+        self.segments[i * m + j] = Some(e);
+        e
+    }
+
+    /// Whether the segment between ring vertices `i` and `j` (not neighbours) is a diagonal
+    /// of the hole polygon: inside it and touching its boundary only at its ends. Exact.
+    fn is_diagonal(&self, i: usize, j: usize) -> bool {
+        let m = self.ring.len();
+        let (a, b) = (&self.ring[i], &self.ring[j]);
+        for k in 0..m {
+            let k1 = (k + 1) % m;
+            if k == i || k == j || k1 == i || k1 == j {
+                continue;
+            }
+            if segments_meet(a, b, &self.ring[k], &self.ring[k1]) {
+                return false;
+            }
+        }
+        // Collinear with an edge at its end, or leaving the polygon at i.
+        in_cone(&self.ring[(i + m - 1) % m], a, &self.ring[(i + 1) % m], b)
+            && in_cone(&self.ring[(j + m - 1) % m], b, &self.ring[(j + 1) % m], a)
     }
 
     /// Whether no other vertex of the current polygon lies in the closed ear at `q`.
@@ -308,6 +473,34 @@ impl Retriangulator {
     }
 }
 
+/// Whether closed segments `ab` and `cd` share a point. Exact.
+fn segments_meet(a: &Point, b: &Point, c: &Point, d: &Point) -> bool {
+    let (d1, d2) = (orient(a, b, c), orient(a, b, d));
+    let (d3, d4) = (orient(c, d, a), orient(c, d, b));
+    if ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)) {
+        return true;
+    }
+    let on = |p: &Point, q: &Point, r: &Point| {
+        orient(p, q, r) == 0
+            && r.x >= p.x.min(q.x)
+            && r.x <= p.x.max(q.x)
+            && r.y >= p.y.min(q.y)
+            && r.y <= p.y.max(q.y)
+    };
+    on(a, b, c) || on(a, b, d) || on(c, d, a) || on(c, d, b)
+}
+
+/// Whether `b` lies strictly inside the interior angle at polygon vertex `a` (with
+/// neighbours `prev` and `next`, counter-clockwise polygon). Exact.
+fn in_cone(prev: &Point, a: &Point, next: &Point, b: &Point) -> bool {
+    if orient(prev, a, next) >= 0 {
+        // Convex (or straight) corner.
+        orient(a, next, b) > 0 && orient(a, b, prev) > 0
+    } else {
+        !(orient(a, next, b) <= 0 && orient(a, b, prev) <= 0)
+    }
+}
+
 fn within(bound: ErrorBound, limit: f64) -> bool {
     bound.above <= limit && bound.below <= limit
 }
@@ -360,6 +553,26 @@ mod tests {
         Point { x, y, z }
     }
 
+    fn rules(
+        grid: &Grid,
+        selection: EdgeSelection,
+        method: Retriangulation,
+        limit: f64,
+    ) -> Rules<'_> {
+        Rules {
+            grid,
+            model: ErrorModel::Bounds,
+            selection,
+            method,
+            dp_max_ring: 16,
+            limit,
+        }
+    }
+
+    fn unused_grid() -> Grid {
+        Grid::new(1, 1, vec![0.0]).unwrap()
+    }
+
     #[test]
     fn clipping_finds_entry_and_exit() {
         let tri = [pt(0, 0, 0.0), pt(4, 0, 0.0), pt(0, 4, 0.0)];
@@ -377,11 +590,17 @@ mod tests {
         let ring = [pt(0, 0, 0.0), pt(2, 0, 0.0), pt(2, 2, 0.0), pt(0, 2, 0.0)];
         let mut r = Retriangulator::default();
         r.load(pt(1, 1, 10.0), &ring, &[ErrorBound::default(); 4]);
-        assert!(r.retriangulate(EdgeSelection::Hybrid, 9.9).is_none());
-        let tris = r.retriangulate(EdgeSelection::Hybrid, 10.0).unwrap();
-        assert_eq!(tris.len(), 2);
-        let worst = tris.iter().map(|t| t.bound.above).fold(0.0, f64::max);
-        assert_eq!(worst, 10.0);
+        let g = unused_grid();
+        for method in [Retriangulation::Ears, Retriangulation::Dp] {
+            assert!(r
+                .retriangulate(&rules(&g, EdgeSelection::Hybrid, method, 9.9))
+                .is_none());
+            let (tris, worst) = r
+                .retriangulate(&rules(&g, EdgeSelection::Hybrid, method, 10.0))
+                .unwrap();
+            assert_eq!(tris.len(), 2);
+            assert_eq!(worst, 10.0);
+        }
     }
 
     #[test]
@@ -399,11 +618,16 @@ mod tests {
         ];
         let mut r = Retriangulator::default();
         r.load(f(1, 1), &ring, &[ErrorBound::default(); 8]);
-        let tris = r.retriangulate(EdgeSelection::MinError, 0.0).unwrap();
-        assert_eq!(tris.len(), 6);
-        for t in tris {
-            let [a, b, c] = t.corners.map(|i| ring[i as usize]);
-            assert!(orient(&a, &b, &c) > 0);
+        let g = unused_grid();
+        for method in [Retriangulation::Ears, Retriangulation::Dp] {
+            let (tris, worst) = r
+                .retriangulate(&rules(&g, EdgeSelection::MinError, method, 0.0))
+                .unwrap();
+            assert_eq!((tris.len(), worst), (6, 0.0));
+            for t in tris {
+                let [a, b, c] = t.corners.map(|i| ring[i as usize]);
+                assert!(orient(&a, &b, &c) > 0);
+            }
         }
     }
 
@@ -419,9 +643,82 @@ mod tests {
         ];
         let mut r = Retriangulator::default();
         r.load(pt(1, 0, 4.0), &ring, &[ErrorBound::default(); 4]);
-        assert!(r.retriangulate(EdgeSelection::Hybrid, 3.0).is_none());
-        let tris = r.retriangulate(EdgeSelection::Hybrid, 4.0).unwrap();
-        assert_eq!(tris.len(), 3);
-        assert!(tris.iter().any(|t| t.bound.above == 4.0));
+        let g = unused_grid();
+        for method in [Retriangulation::Ears, Retriangulation::Dp] {
+            assert!(r
+                .retriangulate(&rules(&g, EdgeSelection::Hybrid, method, 3.0))
+                .is_none());
+            let (tris, worst) = r
+                .retriangulate(&rules(&g, EdgeSelection::Hybrid, method, 4.0))
+                .unwrap();
+            assert_eq!((tris.len(), worst), (3, 4.0));
+        }
+    }
+
+    #[test]
+    fn dp_is_never_worse_than_ears() {
+        // DP minimizes the largest triangle bound over all triangulations; ears pick one.
+        let mut seed = 7u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 33) % 1000) as f64 / 100.0
+        };
+        let g = unused_grid();
+        for _ in 0..50 {
+            let ring: Vec<Point> = [
+                (0, 0),
+                (1, 0),
+                (2, 0),
+                (3, 1),
+                (2, 2),
+                (1, 3),
+                (0, 2),
+                (-1, 1),
+            ]
+            .iter()
+            .map(|&(x, y)| pt(x, y, rnd()))
+            .collect();
+            let bounds: Vec<ErrorBound> = (0..8)
+                .map(|_| ErrorBound {
+                    above: rnd() / 10.0,
+                    below: rnd() / 10.0,
+                })
+                .collect();
+            let mut r = Retriangulator::default();
+            r.load(pt(1, 1, rnd()), &ring, &bounds);
+            let (_, dp) = r
+                .retriangulate(&rules(
+                    &g,
+                    EdgeSelection::MinError,
+                    Retriangulation::Dp,
+                    1e9,
+                ))
+                .unwrap();
+            for sel in [EdgeSelection::MinError, EdgeSelection::MinIntroduced] {
+                let (_, ears) = r
+                    .retriangulate(&rules(&g, sel, Retriangulation::Ears, 1e9))
+                    .unwrap();
+                // Equal up to rounding: a segment's error is computed from either end.
+                assert!(dp <= ears + 1e-9 * (1.0 + ears), "dp {dp} > ears {ears}");
+            }
+        }
+    }
+
+    #[test]
+    fn diagonals_of_a_reflex_hole() {
+        // An arrow-shaped ring around (2, 2): the reflex vertex (2, 3) blocks (1,4)-(3,4).
+        let ring =
+            [(0, 0), (4, 0), (4, 4), (3, 4), (2, 3), (1, 4), (0, 4)].map(|(x, y)| pt(x, y, 0.0));
+        let mut r = Retriangulator::default();
+        r.load(pt(2, 2, 0.0), &ring, &[ErrorBound::default(); 7]);
+        assert!(r.is_diagonal(0, 2));
+        assert!(r.is_diagonal(0, 4));
+        assert!(!r.is_diagonal(3, 5), "passes outside at the reflex vertex");
+        assert!(
+            !r.is_diagonal(3, 6),
+            "passes through the reflex vertex's outside"
+        );
     }
 }

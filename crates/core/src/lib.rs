@@ -29,6 +29,7 @@
 mod decimate;
 mod error;
 mod error_bound;
+mod exact;
 mod geo_transform;
 mod grid;
 mod hole;
@@ -43,5 +44,5 @@ pub use error_bound::ErrorBound;
 pub use geo_transform::GeoTransform;
 pub use grid::Grid;
 pub use mesh::VertexClass;
-pub use options::{DecimationOptions, EdgeSelection, ErrorModel};
+pub use options::{DecimationOptions, EdgeSelection, ErrorModel, Order, Retriangulation};
 pub use tin::{Tin, TinVertex};

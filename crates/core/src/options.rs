@@ -7,6 +7,34 @@ pub enum ErrorModel {
     /// The paper's §3.3 model: two accumulated bounds per triangle, above and below.
     #[default]
     Bounds,
+    /// The true error: a candidate triangle's largest |sample - plane| over the original
+    /// samples it covers, measured on the grid. No accumulation.
+    Exact,
+}
+
+/// The order in which vertices are tried for removal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Order {
+    /// The paper's sweeps in row-major order, repeated until nothing can be removed.
+    #[default]
+    Sweep,
+    /// A priority queue: the vertex whose best retriangulation has the smallest error goes
+    /// first; neighbours' keys are refreshed after each removal.
+    Greedy,
+}
+
+/// How a hole is retriangulated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Retriangulation {
+    /// The paper's greedy ear selection (§3.4), with [`EdgeSelection`].
+    #[default]
+    Ears,
+    /// The min-max-error triangulation of the hole by dynamic programming (optimal for the
+    /// error model); holes with more than [`DecimationOptions::dp_max_ring`] vertices use
+    /// ears.
+    Dp,
 }
 
 /// Which candidate edge the hole retriangulation picks next (paper §3.4).
@@ -30,6 +58,17 @@ pub struct DecimationOptions {
     pub selection: EdgeSelection,
     /// Error model.
     pub error_model: ErrorModel,
+    /// Removal order.
+    pub order: Order,
+    /// Hole retriangulation.
+    pub retriangulation: Retriangulation,
+    /// Largest hole (ring vertices) that [`Retriangulation::Dp`] handles; larger ones use
+    /// ears. The dynamic program costs O(n^3) triangle evaluations.
+    pub dp_max_ring: usize,
+    /// Stop once the mesh has at most this many triangles (greedy order only).
+    pub max_triangles: Option<usize>,
+    /// Stop once the mesh has at most this many vertices (greedy order only).
+    pub max_vertices: Option<usize>,
 }
 
 impl DecimationOptions {
@@ -39,7 +78,39 @@ impl DecimationOptions {
             max_error,
             selection: EdgeSelection::default(),
             error_model: ErrorModel::default(),
+            order: Order::default(),
+            retriangulation: Retriangulation::default(),
+            dp_max_ring: 16,
+            max_triangles: None,
+            max_vertices: None,
         }
+    }
+
+    /// Options that decimate until at most `max_triangles` triangles remain, whatever the
+    /// error (greedy order: the smallest-error removals go first).
+    pub fn with_max_triangles(mut self, max_triangles: usize) -> DecimationOptions {
+        self.max_triangles = Some(max_triangles);
+        self.order = Order::Greedy;
+        self
+    }
+
+    /// Options that decimate until at most `max_vertices` vertices remain (greedy order).
+    pub fn with_max_vertices(mut self, max_vertices: usize) -> DecimationOptions {
+        self.max_vertices = Some(max_vertices);
+        self.order = Order::Greedy;
+        self
+    }
+
+    /// Sets the removal order.
+    pub fn with_order(mut self, order: Order) -> DecimationOptions {
+        self.order = order;
+        self
+    }
+
+    /// Sets the hole retriangulation.
+    pub fn with_retriangulation(mut self, retriangulation: Retriangulation) -> DecimationOptions {
+        self.retriangulation = retriangulation;
+        self
     }
 
     /// Sets the edge selection rule.

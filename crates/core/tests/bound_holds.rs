@@ -1,9 +1,11 @@
-//! Property tests: on random small grids, for every selection rule and bound, the
+//! Property tests: on random small grids, for every combination of options and bound, the
 //! independent verifier measures an error within the bound, the mesh is a valid tiling of
 //! the domain, and every domain corner is kept.
 
 use proptest::prelude::*;
-use tinsmith_core::{decimate, DecimationOptions, EdgeSelection, Grid, Tin};
+use tinsmith_core::{
+    decimate, DecimationOptions, EdgeSelection, ErrorModel, Grid, Order, Retriangulation, Tin,
+};
 use tinsmith_testkit::{max_error, small_grid, GridSpec};
 use tinsmith_verify::{verify, GridRef, MeshRef, Orientation, VerifyOptions};
 
@@ -13,13 +15,36 @@ const SELECTIONS: [EdgeSelection; 3] = [
     EdgeSelection::MinIntroduced,
 ];
 
+/// Every combination of error model, order, retriangulation and selection (selection
+/// matters only for ears).
+fn all_options(bound: f64) -> Vec<DecimationOptions> {
+    let mut all = Vec::new();
+    for model in [ErrorModel::Bounds, ErrorModel::Exact] {
+        for order in [Order::Sweep, Order::Greedy] {
+            let base = DecimationOptions::new(bound)
+                .with_error_model(model)
+                .with_order(order);
+            for selection in SELECTIONS {
+                all.push(base.clone().with_selection(selection));
+            }
+            all.push(base.with_retriangulation(Retriangulation::Dp));
+        }
+    }
+    all
+}
+
 fn check(spec: &GridSpec, bound: f64, selection: EdgeSelection) -> Result<Tin, TestCaseError> {
-    let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
-    let result = decimate(
-        &grid,
+    check_with(
+        spec,
         &DecimationOptions::new(bound).with_selection(selection),
     )
-    .unwrap();
+}
+
+/// Decimates `spec` with `options` and checks the result with the independent verifier.
+fn check_with(spec: &GridSpec, options: &DecimationOptions) -> Result<Tin, TestCaseError> {
+    let bound = options.max_error;
+    let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
+    let result = decimate(&grid, options).unwrap();
     let tin = result.tin;
     let positions: Vec<[i64; 2]> = tin
         .vertices()
@@ -35,11 +60,7 @@ fn check(spec: &GridSpec, bound: f64, selection: EdgeSelection) -> Result<Tin, T
             .with_orientation(Orientation::CounterClockwise),
     )
     .unwrap();
-    prop_assert!(
-        report.passed(),
-        "bound {bound} {selection:?}: {:?}",
-        report.problems
-    );
+    prop_assert!(report.passed(), "{options:?}: {:?}", report.problems);
     prop_assert!(report.max_error <= bound);
     prop_assert!(result.report.max_bound <= bound);
     prop_assert_eq!(result.report.final_triangles, tin.triangles().len());
@@ -92,9 +113,9 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(cases()))]
 
     #[test]
-    fn bound_holds_for_every_selection(spec in small_grid(), bound in max_error()) {
-        for selection in SELECTIONS {
-            check(&spec, bound, selection)?;
+    fn bound_holds_for_every_option(spec in small_grid(), bound in max_error()) {
+        for options in all_options(bound) {
+            check_with(&spec, &options)?;
         }
     }
 
@@ -158,8 +179,8 @@ fn rough_terrain_with_holes_stays_within_bound() {
         6.0,
     );
     for bound in [0.5, 2.0, 10.0] {
-        for selection in SELECTIONS {
-            check(&spec, bound, selection).unwrap();
+        for options in all_options(bound) {
+            check_with(&spec, &options).unwrap();
         }
     }
 }
@@ -173,4 +194,48 @@ fn empty_domain_gives_an_empty_tin() {
     };
     let tin = check(&spec, 1.0, EdgeSelection::Hybrid).unwrap();
     assert!(tin.triangles().is_empty() && tin.vertices().is_empty());
+}
+
+#[test]
+fn count_targets_stop_at_the_count() {
+    let spec = tinsmith_testkit::terrain(40, 30, 2.0, 3);
+    let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
+    for model in [ErrorModel::Bounds, ErrorModel::Exact] {
+        let options = DecimationOptions::new(f64::INFINITY)
+            .with_error_model(model)
+            .with_max_triangles(200);
+        let r = decimate(&grid, &options).unwrap();
+        assert!(r.tin.triangles().len() <= 200 && r.tin.triangles().len() >= 199);
+        let options = DecimationOptions::new(f64::INFINITY)
+            .with_error_model(model)
+            .with_max_vertices(50);
+        let r = decimate(&grid, &options).unwrap();
+        assert_eq!(r.tin.vertices().len(), 50);
+        // The reported bound really bounds the error.
+        let tin = check_with(
+            &spec,
+            &DecimationOptions::new(r.report.max_bound * (1.0 + 1e-9) + 1e-9)
+                .with_error_model(model)
+                .with_max_vertices(50),
+        )
+        .unwrap();
+        assert_eq!(tin.vertices().len(), 50);
+    }
+}
+
+#[test]
+fn exact_keeps_no_more_than_bounds_on_terrain() {
+    let spec = tinsmith_testkit::terrain(80, 60, 3.0, 11);
+    let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
+    for bound in [0.5, 2.0, 8.0] {
+        let count = |model| {
+            let o = DecimationOptions::new(bound).with_error_model(model);
+            decimate(&grid, &o).unwrap().tin.triangles().len()
+        };
+        let (bounds, exact) = (count(ErrorModel::Bounds), count(ErrorModel::Exact));
+        assert!(
+            exact <= bounds,
+            "at {bound}: exact {exact} > bounds {bounds}"
+        );
+    }
 }

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use tinsmith_core::{EdgeSelection, ErrorModel, Order, Retriangulation};
+use tinsmith_core::{EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation};
 
 /// Turns DEMs and other 2D scalar grids into TINs whose error is guaranteed.
 #[derive(Debug, Parser)]
@@ -69,6 +69,9 @@ pub struct MeshArgs {
     /// Hole retriangulation.
     #[arg(long, value_enum, default_value_t = RetriangulateArg::Ears)]
     pub retriangulate: RetriangulateArg,
+    /// The mesh decimation starts from.
+    #[arg(long, value_enum, default_value_t = InitialMeshArg::Full)]
+    pub initial_mesh: InitialMeshArg,
     /// Write (column, row, value) instead of georeferenced coordinates.
     #[arg(long)]
     pub pixel_coords: bool,
@@ -130,6 +133,23 @@ impl From<OrderArg> for Order {
         match o {
             OrderArg::Sweep => Order::Sweep,
             OrderArg::Greedy => Order::Greedy,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum InitialMeshArg {
+    /// Two triangles per valid cell (the paper's start).
+    Full,
+    /// The coarsest right-triangulated network within the bound (measured exactly).
+    Rtin,
+}
+
+impl From<InitialMeshArg> for InitialMesh {
+    fn from(m: InitialMeshArg) -> InitialMesh {
+        match m {
+            InitialMeshArg::Full => InitialMesh::Full,
+            InitialMeshArg::Rtin => InitialMesh::Rtin,
         }
     }
 }

@@ -28,6 +28,7 @@ struct MeshReport<'a> {
     selection: String,
     order: String,
     retriangulate: String,
+    initial_mesh: String,
     triangles_before: usize,
     triangles_after: usize,
     vertices_before: usize,
@@ -76,7 +77,8 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         .with_selection(args.selection.into())
         .with_error_model(args.error_model.into())
         .with_order(args.order.into())
-        .with_retriangulation(args.retriangulate.into());
+        .with_retriangulation(args.retriangulate.into())
+        .with_initial_mesh(args.initial_mesh.into());
     if let Some(n) = args.max_triangles {
         options = options.with_max_triangles(n);
     }
@@ -147,6 +149,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         selection: value_name(args.selection),
         order: value_name(args.order),
         retriangulate: value_name(args.retriangulate),
+        initial_mesh: value_name(args.initial_mesh),
         triangles_before: r.initial_triangles,
         triangles_after: r.final_triangles,
         vertices_before: r.initial_vertices,

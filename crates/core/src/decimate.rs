@@ -7,7 +7,10 @@ use std::time::Instant;
 use crate::hole::{Retriangulator, Rules};
 use crate::mesh::{Mesh, Star, VertexClass};
 use crate::predicates::Point;
-use crate::{DecimationOptions, Error, ErrorBound, Grid, Order, Result, Tin, TinVertex};
+use crate::rtin::rtin_triangles;
+use crate::{
+    DecimationOptions, Error, ErrorBound, Grid, InitialMesh, Order, Result, Tin, TinVertex,
+};
 
 /// Relative slack kept below the requested bound so that `f64` rounding in the bound
 /// arithmetic can never let a measured error exceed `max_error` (see [`decimate`]).
@@ -25,10 +28,13 @@ pub struct Decimation {
 /// What a decimation run reached.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct DecimationReport {
-    /// Vertices of the initial mesh (domain samples).
+    /// Vertices of the full mesh: the domain samples (corners of valid cells).
     pub initial_vertices: usize,
-    /// Triangles of the initial mesh (two per valid cell).
+    /// Triangles of the full mesh (two per valid cell).
     pub initial_triangles: usize,
+    /// Vertices of the mesh decimation started from (fewer than `initial_vertices` for
+    /// [`crate::InitialMesh::Rtin`]).
+    pub start_vertices: usize,
     /// Vertices kept.
     pub final_vertices: usize,
     /// Triangles kept.
@@ -93,20 +99,28 @@ pub fn decimate_with_progress(
     if max_error.is_nan() || max_error < 0.0 || (max_error.is_infinite() && !count_target) {
         return Err(Error::InvalidMaxError(max_error));
     }
-    let started = Instant::now();
-    let mut mesh = Mesh::from_grid(grid);
-    let initial_triangles = mesh.triangle_count();
-    let initial_vertices = (0..mesh.vertex_slots() as u32)
-        .filter(|&v| mesh.contains_vertex(v))
-        .count();
-    let seconds_initial_mesh = started.elapsed().as_secs_f64();
-
     let slack = ROUNDING_SLACK * (max_error.min(f64::MAX) + grid.max_abs_value());
     let limit = if max_error > slack {
         max_error - slack
     } else {
         0.0
     };
+
+    let started = Instant::now();
+    // Below the slack only exactly flat stars may go (see `Remover::plan`); the RTIN's
+    // measured errors are not exact enough for that, so it starts from the full grid.
+    let mut mesh = match options.initial_mesh {
+        InitialMesh::Rtin if limit > 0.0 => {
+            let (corners, bounds) = rtin_triangles(grid, limit);
+            Mesh::from_triangles(grid, corners, bounds)
+        }
+        _ => Mesh::from_grid(grid),
+    };
+    let start_vertices = (0..mesh.vertex_slots() as u32)
+        .filter(|&v| mesh.contains_vertex(v))
+        .count();
+    let seconds_initial_mesh = started.elapsed().as_secs_f64();
+
     let started = Instant::now();
     let rules = Rules {
         grid,
@@ -130,7 +144,7 @@ pub fn decimate_with_progress(
                 &mut remover,
                 &mut stats,
                 target,
-                initial_vertices,
+                start_vertices,
                 progress,
             )
         }
@@ -141,8 +155,9 @@ pub fn decimate_with_progress(
 
     let (tin, max_bound) = extract(&mesh);
     let report = DecimationReport {
-        initial_vertices,
-        initial_triangles,
+        initial_vertices: grid.domain_sample_count(),
+        initial_triangles: 2 * grid.valid_cell_count(),
+        start_vertices,
         final_vertices: tin.vertices.len(),
         final_triangles: tin.triangles.len(),
         max_bound,
@@ -373,6 +388,17 @@ impl<'g> Remover<'g> {
         if self.rules.limit == 0.0 && self.points.iter().any(|p| p.z != centre.z) {
             // Below the rounding slack only exactly flat stars go: their bound arithmetic
             // is exact (all differences are zero).
+            return None;
+        }
+        // Any retriangulation interpolates the centre from ring values, so a centre further
+        // than the limit outside their range can never go (a cheap exact rejection).
+        let (lo, hi) = self
+            .points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.z), hi.max(p.z))
+            });
+        if centre.z - hi > self.rules.limit || lo - centre.z > self.rules.limit {
             return None;
         }
         self.bounds.clear();

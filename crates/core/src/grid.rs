@@ -80,6 +80,24 @@ impl Grid {
         n
     }
 
+    /// Number of samples that are a corner of at least one valid cell: the vertices of
+    /// the full mesh.
+    pub fn domain_sample_count(&self) -> usize {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let cell = |x: usize, y: usize| x < w - 1 && y < h - 1 && self.cell_is_valid(x, y);
+        let mut n = 0;
+        for y in 0..h {
+            for x in 0..w {
+                let around = cell(x, y)
+                    || (x > 0 && cell(x - 1, y))
+                    || (y > 0 && cell(x, y - 1))
+                    || (x > 0 && y > 0 && cell(x - 1, y - 1));
+                n += usize::from(around);
+            }
+        }
+        n
+    }
+
     pub(crate) fn cell_is_valid(&self, x: usize, y: usize) -> bool {
         let w = self.width as usize;
         let i = y * w + x;

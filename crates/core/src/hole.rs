@@ -64,9 +64,13 @@ pub(crate) struct Retriangulator {
     edge: Vec<SegmentError>,
     ears: Vec<Option<Option<Ear>>>,
     triangles: Vec<HoleTriangle>,
+    /// Segment errors by ring index pair `i < j` (row-major m x m), for this hole.
+    segments: Vec<Option<SegmentError>>,
+    /// Exact errors of triangles tried in this hole, by sorted corner triple (`None`: over
+    /// the limit).
+    exact_errors: Vec<(u64, Option<ErrorBound>)>,
     // Dynamic programming tables, row-major m x m.
     diagonal_ok: Vec<bool>,
-    segments: Vec<Option<SegmentError>>,
     cost: Vec<f64>,
     split: Vec<u32>,
 }
@@ -97,6 +101,9 @@ impl Retriangulator {
         self.star_bounds.extend_from_slice(star_bounds);
         self.star_gradients.clear();
         let m = ring.len();
+        self.segments.clear();
+        self.segments.resize(m * m, None);
+        self.exact_errors.clear();
         for i in 0..star_bounds.len() {
             let g = plane_gradient(&centre, &ring[i], &ring[(i + 1) % m]);
             self.star_gradients.push(g);
@@ -113,6 +120,9 @@ impl Retriangulator {
     /// at most `rules.limit` on both sides. Returns the triangles (corners index the ring)
     /// and the largest bound among them, or `None` on a dead end (paper §3.4).
     pub(crate) fn retriangulate(&mut self, rules: &Rules<'_>) -> Option<(&[HoleTriangle], f64)> {
+        if !self.centre_can_fit(rules.limit) {
+            return None;
+        }
         let found = if rules.method == Retriangulation::Dp && self.ring.len() <= rules.dp_max_ring {
             self.dynamic_programming(rules)
         } else {
@@ -132,6 +142,33 @@ impl Retriangulator {
             .iter()
             .fold(0.0f64, |w, t| w.max(t.bound.max()));
         Some((&self.triangles, worst))
+    }
+
+    /// A necessary condition, cheap to test: whatever the triangulation, the removed vertex
+    /// lies in a triangle of ring vertices, and its own error there must be within the
+    /// limit (both error models count it). Tries every such triangle for small rings.
+    fn centre_can_fit(&self, limit: f64) -> bool {
+        let m = self.ring.len();
+        if m > 12 {
+            return true;
+        }
+        let centre = self.centre.expect("hole loaded");
+        for i in 0..m {
+            for j in i + 1..m {
+                for k in j + 1..m {
+                    let (a, b, c) = (&self.ring[i], &self.ring[j], &self.ring[k]);
+                    if orient(a, b, c) > 0 && in_closed_triangle(a, b, c, &centre) {
+                        let g = plane_gradient(a, b, c);
+                        let at =
+                            a.z + g[0] * (centre.x - a.x) as f64 + g[1] * (centre.y - a.y) as f64;
+                        if (at - centre.z).abs() <= limit {
+                            return true;
+                        }
+                    }
+                }
+            }
+        }
+        false
     }
 
     fn clip_ears(&mut self, rule: EdgeSelection, rules: &Rules<'_>) -> bool {
@@ -212,12 +249,19 @@ impl Retriangulator {
     }
 
     /// The ear at `q` if it is convex and its triangle's bound is within the limit.
-    fn ear(&self, q: usize, rules: &Rules<'_>) -> Option<Ear> {
+    fn ear(&mut self, q: usize, rules: &Rules<'_>) -> Option<Ear> {
         let (p, r) = (self.prev[q] as usize, self.next[q] as usize);
         if orient(&self.ring[p], &self.ring[q], &self.ring[r]) <= 0 {
             return None;
         }
-        let diagonal = self.segment_error(r, p);
+        // The exact model needs the diagonal only for its introduced error.
+        let needs_diagonal =
+            rules.model == ErrorModel::Bounds || rules.selection != EdgeSelection::MinError;
+        let diagonal = if needs_diagonal {
+            self.segment(p.min(r), p.max(r))
+        } else {
+            SegmentError::default()
+        };
         let triangle =
             self.triangle_cost(p, q, r, [self.edge[p], self.edge[q], diagonal], rules)?;
         Some(Ear { diagonal, triangle })
@@ -226,7 +270,7 @@ impl Retriangulator {
     /// The bound of new triangle `abc` under the error model, if within the limit. For
     /// `Bounds`, `edges` are the bounds of its three edges (paper §3.3.3).
     fn triangle_cost(
-        &self,
+        &mut self,
         a: usize,
         b: usize,
         c: usize,
@@ -236,7 +280,19 @@ impl Retriangulator {
         let (pa, pb, pc) = (&self.ring[a], &self.ring[b], &self.ring[c]);
         let bound = match rules.model {
             ErrorModel::Bounds => self.triangle_bound(a, b, c, edges),
-            ErrorModel::Exact => triangle_error(rules.grid, pa, pb, pc, rules.limit)?,
+            ErrorModel::Exact => {
+                let mut key = [a as u64, b as u64, c as u64];
+                key.sort_unstable();
+                let key = key[0] | key[1] << 21 | key[2] << 42;
+                match self.exact_errors.iter().find(|e| e.0 == key) {
+                    Some(&(_, cached)) => cached?,
+                    None => {
+                        let e = triangle_error(rules.grid, pa, pb, pc, rules.limit);
+                        self.exact_errors.push((key, e));
+                        e?
+                    }
+                }
+            }
         };
         within(bound, rules.limit).then_some(bound)
     }
@@ -255,8 +311,6 @@ impl Retriangulator {
                 self.diagonal_ok[i * m + j] = ok;
             }
         }
-        self.segments.clear();
-        self.segments.resize(m * m, None);
         self.cost.clear();
         self.cost.resize(m * m, f64::INFINITY);
         self.split.clear();

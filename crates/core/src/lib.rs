@@ -36,6 +36,7 @@ mod hole;
 mod mesh;
 mod options;
 mod predicates;
+mod rtin;
 mod tin;
 
 pub use decimate::{decimate, decimate_with_progress, Decimation, DecimationReport, Progress};
@@ -44,5 +45,7 @@ pub use error_bound::ErrorBound;
 pub use geo_transform::GeoTransform;
 pub use grid::Grid;
 pub use mesh::VertexClass;
-pub use options::{DecimationOptions, EdgeSelection, ErrorModel, Order, Retriangulation};
+pub use options::{
+    DecimationOptions, EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation,
+};
 pub use tin::{Tin, TinVertex};

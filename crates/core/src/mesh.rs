@@ -133,6 +133,56 @@ impl<'g> Mesh<'g> {
         mesh
     }
 
+    /// A mesh from counter-clockwise triangles over grid samples (vertex ids are sample
+    /// indices) that tile part of the grid's domain conformingly, with their bounds.
+    /// Neighbours are found by matching edges.
+    pub(crate) fn from_triangles(
+        grid: &'g Grid,
+        corners: Vec<[u32; 3]>,
+        bounds: Vec<ErrorBound>,
+    ) -> Mesh<'g> {
+        let n = grid.width() as usize * grid.height() as usize;
+        let mut vertex_triangle = vec![NONE; n];
+        let mut incident = vec![0u8; n];
+        let mut half_edges: Vec<(u64, u32)> = Vec::with_capacity(3 * corners.len());
+        for (t, c) in corners.iter().enumerate() {
+            for e in 0..3 {
+                let (a, b) = (c[e] as u64, c[(e + 1) % 3] as u64);
+                half_edges.push(((a.min(b) << 32) | a.max(b), (t as u32) << 2 | e as u32));
+                vertex_triangle[c[e] as usize] = t as u32;
+                incident[c[e] as usize] = incident[c[e] as usize].saturating_add(1);
+            }
+        }
+        half_edges.sort_unstable();
+        let mut neighbours = vec![[NONE; 3]; corners.len()];
+        for pair in half_edges.chunk_by(|x, y| x.0 == y.0) {
+            if let [(_, h1), (_, h2)] = pair {
+                neighbours[(h1 >> 2) as usize][(h1 & 3) as usize] = h2 >> 2;
+                neighbours[(h2 >> 2) as usize][(h2 & 3) as usize] = h1 >> 2;
+            } else {
+                debug_assert_eq!(pair.len(), 1, "an edge shared by more than two triangles");
+            }
+        }
+        let live = corners.len();
+        let mut mesh = Mesh {
+            grid,
+            corners,
+            bounds,
+            neighbours,
+            vertex_triangle,
+            pinched: vec![false; n],
+            live_triangles: live,
+        };
+        let mut star = Star::default();
+        for (v, &count) in incident.iter().enumerate() {
+            if count > 0 {
+                mesh.star(v as u32, &mut star);
+                mesh.pinched[v] = star.triangles.len() != count as usize;
+            }
+        }
+        mesh
+    }
+
     /// Number of live triangles.
     pub(crate) fn triangle_count(&self) -> usize {
         self.live_triangles

@@ -24,6 +24,19 @@ pub enum Order {
     Greedy,
 }
 
+/// The mesh decimation starts from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum InitialMesh {
+    /// Every valid cell split into two triangles (the paper's starting point).
+    #[default]
+    Full,
+    /// The coarsest right-triangulated irregular network (longest-edge bisection of a
+    /// power-of-two square) whose triangles are all within the bound, measured exactly;
+    /// much faster when the bound removes most samples. Same guarantee.
+    Rtin,
+}
+
 /// How a hole is retriangulated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
@@ -60,6 +73,8 @@ pub struct DecimationOptions {
     pub error_model: ErrorModel,
     /// Removal order.
     pub order: Order,
+    /// The mesh decimation starts from.
+    pub initial_mesh: InitialMesh,
     /// Hole retriangulation.
     pub retriangulation: Retriangulation,
     /// Largest hole (ring vertices) that [`Retriangulation::Dp`] handles; larger ones use
@@ -79,6 +94,7 @@ impl DecimationOptions {
             selection: EdgeSelection::default(),
             error_model: ErrorModel::default(),
             order: Order::default(),
+            initial_mesh: InitialMesh::default(),
             retriangulation: Retriangulation::default(),
             dp_max_ring: 16,
             max_triangles: None,
@@ -98,6 +114,12 @@ impl DecimationOptions {
     pub fn with_max_vertices(mut self, max_vertices: usize) -> DecimationOptions {
         self.max_vertices = Some(max_vertices);
         self.order = Order::Greedy;
+        self
+    }
+
+    /// Sets the initial mesh.
+    pub fn with_initial_mesh(mut self, initial_mesh: InitialMesh) -> DecimationOptions {
+        self.initial_mesh = initial_mesh;
         self
     }
 

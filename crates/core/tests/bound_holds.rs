@@ -4,7 +4,8 @@
 
 use proptest::prelude::*;
 use tinsmith_core::{
-    decimate, DecimationOptions, EdgeSelection, ErrorModel, Grid, Order, Retriangulation, Tin,
+    decimate, DecimationOptions, EdgeSelection, ErrorModel, Grid, InitialMesh, Order,
+    Retriangulation, Tin,
 };
 use tinsmith_testkit::{max_error, small_grid, GridSpec};
 use tinsmith_verify::{verify, GridRef, MeshRef, Orientation, VerifyOptions};
@@ -27,7 +28,8 @@ fn all_options(bound: f64) -> Vec<DecimationOptions> {
             for selection in SELECTIONS {
                 all.push(base.clone().with_selection(selection));
             }
-            all.push(base.with_retriangulation(Retriangulation::Dp));
+            all.push(base.clone().with_retriangulation(Retriangulation::Dp));
+            all.push(base.with_initial_mesh(InitialMesh::Rtin));
         }
     }
     all

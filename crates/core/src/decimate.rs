@@ -94,23 +94,70 @@ pub fn decimate_with_progress(
     options: &DecimationOptions,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Decimation> {
+    run(grid, options, None, progress)
+}
+
+/// Decimates a tile of a larger raster whose outer border is shared with neighbouring
+/// tiles and already decided: the TIN's vertices on the grid's outer rows and columns are
+/// exactly the valid border samples for which `keep_border(x, y)` is true, plus the grid's
+/// four corners.
+///
+/// The other valid border samples are removed first, each replaced by triangles within the
+/// strip of cells along the border, so the error there is the error of the straight border
+/// edge that skips them; the caller chooses the kept samples so that this 1-D error is
+/// within the bound (see [`effective_limit`]) and so that every sample next to an invalid
+/// cell of the border strip is kept. Kept border samples are never removed. The rest of the
+/// tile is decimated with `options` (the initial mesh is always the full grid).
+///
+/// # Errors
+/// [`Error::InvalidMaxError`] as [`decimate`]; [`Error::BorderSample`] when a sample to
+/// remove is a corner of the domain or its removal would exceed the bound.
+pub fn decimate_with_border(
+    grid: &Grid,
+    options: &DecimationOptions,
+    keep_border: &dyn Fn(u32, u32) -> bool,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Decimation> {
+    run(grid, options, Some(keep_border), progress)
+}
+
+/// The bound decimation actually enforces for `max_error` on data whose largest |value| is
+/// `max_abs_value`: `max_error` less a slack of `2^-40 (max_error + max_abs_value)` that
+/// covers the rounding of the error arithmetic, or 0 when `max_error` is below the slack.
+/// A caller that simplifies shared tile borders itself (see [`decimate_with_border`])
+/// keeps its 1-D errors within this limit, computed with
+/// [`DecimationOptions::max_abs_value`] set to the whole raster's value.
+pub fn effective_limit(max_error: f64, max_abs_value: f64) -> f64 {
+    let slack = ROUNDING_SLACK * (max_error.min(f64::MAX) + max_abs_value);
+    if max_error > slack {
+        max_error - slack
+    } else {
+        0.0
+    }
+}
+
+fn run(
+    grid: &Grid,
+    options: &DecimationOptions,
+    keep_border: Option<&dyn Fn(u32, u32) -> bool>,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Decimation> {
     let max_error = options.max_error;
     let count_target = options.max_triangles.is_some() || options.max_vertices.is_some();
     if max_error.is_nan() || max_error < 0.0 || (max_error.is_infinite() && !count_target) {
         return Err(Error::InvalidMaxError(max_error));
     }
-    let slack = ROUNDING_SLACK * (max_error.min(f64::MAX) + grid.max_abs_value());
-    let limit = if max_error > slack {
-        max_error - slack
-    } else {
-        0.0
-    };
+    let max_abs = options
+        .max_abs_value
+        .unwrap_or_else(|| grid.max_abs_value())
+        .max(grid.max_abs_value());
+    let limit = effective_limit(max_error, max_abs);
 
     let started = Instant::now();
     // Below the slack only exactly flat stars may go (see `Remover::plan`); the RTIN's
     // measured errors are not exact enough for that, so it starts from the full grid.
     let mut mesh = match options.initial_mesh {
-        InitialMesh::Rtin if limit > 0.0 => {
+        InitialMesh::Rtin if limit > 0.0 && keep_border.is_none() => {
             let (corners, bounds) = rtin_triangles(grid, limit);
             Mesh::from_triangles(grid, corners, bounds)
         }
@@ -132,6 +179,10 @@ pub fn decimate_with_progress(
     };
     let mut remover = Remover::new(rules);
     let mut stats = Stats::default();
+    if let Some(keep) = keep_border {
+        remove_border(&mut mesh, &mut remover, keep)?;
+        remover.locked_border = Some((grid.width(), grid.height()));
+    }
     match options.order {
         Order::Sweep => sweep(&mut mesh, &mut remover, &mut stats, progress),
         Order::Greedy => {
@@ -167,6 +218,44 @@ pub fn decimate_with_progress(
         seconds_decimation,
     };
     Ok(Decimation { tin, report })
+}
+
+/// Removes every valid border sample that `keep` rejects (grid corners are kept), in
+/// row-major order along each side, with triangles inside the border strip.
+fn remove_border(
+    mesh: &mut Mesh<'_>,
+    remover: &mut Remover<'_>,
+    keep: &dyn Fn(u32, u32) -> bool,
+) -> Result<()> {
+    let (w, h) = (mesh.width(), mesh.height());
+    if w >= 3 && h >= 2 {
+        // Corner cells get the diagonal through the grid corner, so that no triangle
+        // touches two sides and each side's strip is independent of the others.
+        mesh.flip_cell_diagonal(w as usize - 2, 0);
+        mesh.flip_cell_diagonal(0, h as usize - 2);
+    }
+    let mut border: Vec<(u32, u32)> = Vec::new();
+    for x in 1..w.saturating_sub(1) {
+        border.push((x, 0));
+        if h > 1 {
+            border.push((x, h - 1));
+        }
+    }
+    for y in 1..h.saturating_sub(1) {
+        border.push((0, y));
+        if w > 1 {
+            border.push((w - 1, y));
+        }
+    }
+    for (x, y) in border {
+        let v = y * w + x;
+        if mesh.contains_vertex(v) && !keep(x, y) {
+            remover
+                .force_remove(mesh, v)
+                .map_err(|problem| Error::BorderSample { x, y, problem })?;
+        }
+    }
+    Ok(())
 }
 
 #[derive(Debug, Default)]
@@ -355,6 +444,8 @@ struct Remover<'g> {
     bounds: Vec<ErrorBound>,
     new_triangles: Vec<(u32, [u32; 3], ErrorBound)>,
     rules: Rules<'g>,
+    /// In border mode, `(width, height)`: samples on the grid's outer border stay.
+    locked_border: Option<(u32, u32)>,
 }
 
 impl<'g> Remover<'g> {
@@ -367,6 +458,35 @@ impl<'g> Remover<'g> {
             bounds: Vec::new(),
             new_triangles: Vec::new(),
             rules,
+            locked_border: None,
+        }
+    }
+
+    /// Removes border sample `v` whatever the error, then checks the new triangles' exact
+    /// errors against the limit.
+    fn force_remove(
+        &mut self,
+        mesh: &mut Mesh<'_>,
+        v: u32,
+    ) -> std::result::Result<(), &'static str> {
+        let limit = self.rules.limit;
+        let saved = self.rules;
+        self.rules = Rules {
+            model: crate::ErrorModel::Exact,
+            selection: crate::EdgeSelection::MinError,
+            method: crate::Retriangulation::Ears,
+            limit: f64::INFINITY,
+            ..saved
+        };
+        let planned = self.plan(mesh, v);
+        self.rules = saved;
+        match planned {
+            None => Err("it is a corner of the domain, or its hole has no triangulation"),
+            Some(worst) if worst > limit => Err("skipping it exceeds the error bound"),
+            Some(_) => {
+                self.apply(mesh, v);
+                Ok(())
+            }
         }
     }
 
@@ -376,6 +496,12 @@ impl<'g> Remover<'g> {
     fn plan(&mut self, mesh: &Mesh<'_>, v: u32) -> Option<f64> {
         if !mesh.contains_vertex(v) {
             return None;
+        }
+        if let Some((w, h)) = self.locked_border {
+            let (x, y) = (v % w, v / w);
+            if x == 0 || y == 0 || x == w - 1 || y == h - 1 {
+                return None;
+            }
         }
         let star = &mut self.ring_star;
         mesh.star(v, star);

@@ -24,6 +24,16 @@ pub enum Error {
         /// Rows.
         height: u32,
     },
+    /// A border sample that [`crate::decimate_with_border`] was told to remove cannot be.
+    #[error("border sample ({x}, {y}) cannot be removed: {problem}")]
+    BorderSample {
+        /// Column.
+        x: u32,
+        /// Row.
+        y: u32,
+        /// Why.
+        problem: &'static str,
+    },
     /// The maximum error is negative, NaN or infinite.
     #[error("maximum error must be a finite number >= 0, got {0}")]
     InvalidMaxError(f64),

@@ -39,7 +39,10 @@ mod predicates;
 mod rtin;
 mod tin;
 
-pub use decimate::{decimate, decimate_with_progress, Decimation, DecimationReport, Progress};
+pub use decimate::{
+    decimate, decimate_with_border, decimate_with_progress, effective_limit, Decimation,
+    DecimationReport, Progress,
+};
 pub use error::{Error, Result};
 pub use error_bound::ErrorBound;
 pub use geo_transform::GeoTransform;

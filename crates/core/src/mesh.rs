@@ -183,6 +183,50 @@ impl<'g> Mesh<'g> {
         mesh
     }
 
+    /// Flips the diagonal of valid cell `(cx, cy)` of a mesh fresh from
+    /// [`Mesh::from_grid`], so that it runs from `(cx + 1, cy)` to `(cx, cy + 1)`.
+    pub(crate) fn flip_cell_diagonal(&mut self, cx: usize, cy: usize) {
+        let w = self.grid.width() as usize;
+        let (lower, upper) = (
+            (2 * (cy * (w - 1) + cx)) as u32,
+            (2 * (cy * (w - 1) + cx) + 1) as u32,
+        );
+        let [a, b, cc] = self.corners[lower as usize];
+        let [_, _, d] = self.corners[upper as usize];
+        if a == NONE {
+            return;
+        }
+        let [n0, n1, _] = self.neighbours[lower as usize];
+        let [_, m1, m2] = self.neighbours[upper as usize];
+        // lower becomes (a, b, d), upper becomes (b, cc, d).
+        self.corners[lower as usize] = [a, b, d];
+        self.corners[upper as usize] = [b, cc, d];
+        self.neighbours[lower as usize] = [n0, upper, m2];
+        self.neighbours[upper as usize] = [n1, m1, lower];
+        if n1 != NONE {
+            let k = self.edge_index(n1, cc, b);
+            self.neighbours[n1 as usize][k] = upper;
+        }
+        if m2 != NONE {
+            let k = self.edge_index(m2, a, d);
+            self.neighbours[m2 as usize][k] = lower;
+        }
+        self.vertex_triangle[cc as usize] = upper;
+        self.vertex_triangle[d as usize] = upper;
+        self.vertex_triangle[a as usize] = lower;
+        self.vertex_triangle[b as usize] = lower;
+    }
+
+    /// Grid columns.
+    pub(crate) fn width(&self) -> u32 {
+        self.grid.width()
+    }
+
+    /// Grid rows.
+    pub(crate) fn height(&self) -> u32 {
+        self.grid.height()
+    }
+
     /// Number of live triangles.
     pub(crate) fn triangle_count(&self) -> usize {
         self.live_triangles

@@ -80,6 +80,10 @@ pub struct DecimationOptions {
     /// Largest hole (ring vertices) that [`Retriangulation::Dp`] handles; larger ones use
     /// ears. The dynamic program costs O(n^3) triangle evaluations.
     pub dp_max_ring: usize,
+    /// The largest |value| the rounding slack is computed from (see
+    /// [`crate::effective_limit`]); `None` uses the grid's own. Tiles of one raster set the
+    /// raster's value so that they all enforce the same limit.
+    pub max_abs_value: Option<f64>,
     /// Stop once the mesh has at most this many triangles (greedy order only).
     pub max_triangles: Option<usize>,
     /// Stop once the mesh has at most this many vertices (greedy order only).
@@ -97,6 +101,7 @@ impl DecimationOptions {
             initial_mesh: InitialMesh::default(),
             retriangulation: Retriangulation::default(),
             dp_max_ring: 16,
+            max_abs_value: None,
             max_triangles: None,
             max_vertices: None,
         }

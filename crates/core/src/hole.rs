@@ -466,16 +466,50 @@ impl Retriangulator {
             },
             introduced: 0.0,
         };
-        // Which star triangles the segment can meet. A diagonal of the (star-shaped) hole
-        // splits it in two; it crosses the triangles of the chain on the far side from the
-        // centre and touches the two triangles beyond its ends at a shared corner. When
-        // the centre is on the segment, it touches every triangle.
+        // A diagonal of the (star-shaped) hole splits it in two; it crosses the spokes of
+        // the chain on the far side from the centre and touches the two star triangles
+        // beyond its ends at a shared corner. Walking it with the centre on its left, the
+        // introduced error is linear between consecutive spoke crossings, so each crossed
+        // triangle's extremes are at the crossings on its two spokes.
         let side = orient(&p, &q, &centre);
-        let (first, count) = match side.cmp(&0) {
-            std::cmp::Ordering::Greater => ((from + m - 1) % m, (to + m - from) % m + 2),
-            std::cmp::Ordering::Less => ((to + m - 1) % m, (from + m - to) % m + 2),
-            std::cmp::Ordering::Equal => (0, m),
-        };
+        if side != 0 {
+            let (a, b) = if side > 0 { (from, to) } else { (to, from) };
+            let (p, q) = (self.ring[a], self.ring[b]);
+            let side = side.abs() as f64;
+            let span = (b + m - a) % m;
+            let mut previous = 0.0f64; // introduced error at the last crossing (0 at p)
+            let fold = |i: usize, lo: f64, hi: f64, out: &mut SegmentError| {
+                if i < stars {
+                    let bound = &self.star_bounds[i];
+                    out.bound.above = out.bound.above.max(bound.above - lo);
+                    out.bound.below = out.bound.below.max(bound.below + hi);
+                }
+            };
+            fold((a + m - 1) % m, 0.0, 0.0, &mut out);
+            for step in 1..=span {
+                let k = (a + step) % m;
+                let current = if step == span {
+                    0.0
+                } else {
+                    let r = &self.ring[k];
+                    let (fp, fq) = (orient(&centre, r, &p) as f64, orient(&centre, r, &q) as f64);
+                    let t = fp / (fp - fq);
+                    let u = side / (side - orient(&p, &q, r) as f64);
+                    let new = p.z + t * (q.z - p.z);
+                    let old = centre.z + u * (r.z - centre.z);
+                    new - old
+                };
+                let i = (k + m - 1) % m;
+                fold(i, previous.min(current), previous.max(current), &mut out);
+                out.introduced = out.introduced.max(current.abs());
+                previous = current;
+            }
+            fold(b, 0.0, 0.0, &mut out);
+            debug_assert!(out.bound.above.is_finite(), "a ring segment meets its star");
+            return out;
+        }
+        // The centre is on the segment: it touches every star triangle there.
+        let (first, count) = (0, m);
         for k in 0..count.min(m) {
             let i = (first + k) % m;
             if i >= stars {

@@ -144,24 +144,45 @@ impl<'g> Mesh<'g> {
         let n = grid.width() as usize * grid.height() as usize;
         let mut vertex_triangle = vec![NONE; n];
         let mut incident = vec![0u8; n];
-        let mut half_edges: Vec<(u64, u32)> = Vec::with_capacity(3 * corners.len());
-        for (t, c) in corners.iter().enumerate() {
-            for e in 0..3 {
-                let (a, b) = (c[e] as u64, c[(e + 1) % 3] as u64);
-                half_edges.push(((a.min(b) << 32) | a.max(b), (t as u32) << 2 | e as u32));
-                vertex_triangle[c[e] as usize] = t as u32;
-                incident[c[e] as usize] = incident[c[e] as usize].saturating_add(1);
+
+        // Incident triangles per vertex (compressed rows), then each edge a -> b finds its
+        // twin b -> a among b's triangles.
+        let mut start = vec![0u32; n + 1];
+        for c in &corners {
+            for &v in c {
+                start[v as usize + 1] += 1;
             }
         }
-        half_edges.sort_unstable();
-        let mut neighbours = vec![[NONE; 3]; corners.len()];
-        for pair in half_edges.chunk_by(|x, y| x.0 == y.0) {
-            if let [(_, h1), (_, h2)] = pair {
-                neighbours[(h1 >> 2) as usize][(h1 & 3) as usize] = h2 >> 2;
-                neighbours[(h2 >> 2) as usize][(h2 & 3) as usize] = h1 >> 2;
-            } else {
-                debug_assert_eq!(pair.len(), 1, "an edge shared by more than two triangles");
+        for i in 0..n {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut incident_triangles = vec![0u32; 3 * corners.len()];
+        for (t, c) in corners.iter().enumerate() {
+            for &v in c {
+                incident_triangles[fill[v as usize] as usize] = t as u32;
+                fill[v as usize] += 1;
+                vertex_triangle[v as usize] = t as u32;
             }
+        }
+        drop(fill);
+        let mut neighbours = vec![[NONE; 3]; corners.len()];
+        for (t, c) in corners.iter().enumerate() {
+            for e in 0..3 {
+                let (a, b) = (c[e], c[(e + 1) % 3]);
+                let around_b =
+                    &incident_triangles[start[b as usize] as usize..start[b as usize + 1] as usize];
+                for &u in around_b {
+                    let cu = &corners[u as usize];
+                    if (0..3).any(|k| cu[k] == b && cu[(k + 1) % 3] == a) {
+                        neighbours[t][e] = u;
+                        break;
+                    }
+                }
+            }
+        }
+        for v in 0..n {
+            incident[v] = (start[v + 1] - start[v]).min(255) as u8;
         }
         let live = corners.len();
         let mut mesh = Mesh {

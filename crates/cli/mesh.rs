@@ -6,7 +6,6 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use tinsmith_core::{decimate_with_progress, DecimationOptions, Tin};
-use tinsmith_export::{MeshFormat, MeshRef};
 use tinsmith_verify::{GridRef, VerifyOptions};
 
 use crate::args::{ErrorModelArg, MeshArgs};
@@ -32,6 +31,8 @@ struct MeshReport<'a> {
     max_error_bound: f64,
     measured_max_error: f64,
     output: &'a Path,
+    #[serde(flatten)]
+    output_format: crate::export::PlanReport,
     seconds: Seconds,
 }
 
@@ -49,7 +50,7 @@ struct Seconds {
 /// independent verifier confirms the bound.
 pub fn run(args: &MeshArgs) -> Result<bool> {
     let total = Instant::now();
-    let format = MeshFormat::from_path(&args.output)?;
+    let format = crate::export::format(args)?;
     check_writable_target(&args.output)?;
     if let Some(report) = &args.report {
         check_writable_target(report)?;
@@ -67,7 +68,9 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         );
     }
 
-    let options = DecimationOptions::new(args.max_error).with_selection(args.selection.into());
+    let plan = crate::export::Plan::new(format, &raster, args)?;
+    let options =
+        DecimationOptions::new(plan.decimation_bound).with_selection(args.selection.into());
     let mut bar = crate::progress::Progress::new(args.quiet);
     let result = decimate_with_progress(grid, &options, &mut |p| {
         bar.show(&format!(
@@ -89,7 +92,12 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         .iter()
         .map(|v| [v.x as i64, v.y as i64])
         .collect();
-    let heights: Vec<f64> = tin.vertices().iter().map(|v| v.z).collect();
+    // The heights as the file will hold them (float32 formats round them).
+    let heights: Vec<f64> = tin
+        .vertices()
+        .iter()
+        .map(|v| plan.file_height(v.z))
+        .collect();
     let check = tinsmith_verify::verify(
         GridRef::new(grid.width(), grid.height(), grid.values()),
         tinsmith_verify::MeshRef::new(&positions, &heights, tin.triangles()),
@@ -106,16 +114,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
 
     let t = Instant::now();
     let (vertices, triangles) = file_mesh(tin, &georef);
-    let crs = if args.pixel_coords {
-        None
-    } else {
-        raster.info.crs_wkt.as_deref()
-    };
-    tinsmith_export::write_mesh(
-        &args.output,
-        format,
-        MeshRef::new(&vertices, &triangles).with_crs_wkt(crs),
-    )?;
+    crate::export::write(&plan, args, &raster, vertices, &triangles)?;
     let write_seconds = t.elapsed().as_secs_f64();
 
     let r = &result.report;
@@ -138,6 +137,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         max_error_bound: r.max_bound,
         measured_max_error: check.max_error,
         output: &args.output,
+        output_format: plan.report(),
         seconds: Seconds {
             read: read_seconds,
             initial_mesh: r.seconds_initial_mesh,
@@ -157,6 +157,15 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             report.measured_max_error,
             args.max_error
         );
+        if let Some(origin) = plan.origin {
+            let [x, y, z] = origin.offset();
+            eprintln!(
+                "{}: float32 positions relative to the local origin ({x}, {y}, {z}); \
+                 heights round by at most {}",
+                args.output.display(),
+                plan.height_rounding
+            );
+        }
     }
     if let Some(path) = &args.report {
         let json = serde_json::to_vec_pretty(&report)?;

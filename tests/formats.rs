@@ -566,3 +566,24 @@ fn flags_for_another_format_are_refused_and_format_overrides_the_extension() {
     );
     assert_eq!(ogr_field(&summary, "Geometry:"), "3D Triangle");
 }
+
+#[test]
+fn float32_formats_refuse_rasters_too_wide_for_float32_positions() {
+    let d = Dir::new();
+    // 40,000 samples across: half a float32 step at 20,000 pixels from the origin is more
+    // than the verifier's 1e-3 pixel.
+    let width = 40_000;
+    let row = vec!["1"; width].join(" ");
+    let text = format!(
+        "ncols {width}\nnrows 2\nxllcorner 500000\nyllcorner 5000000\ncellsize 1\n\
+         NODATA_value -9999\n{row}\n{row}\n"
+    );
+    let asc = d.write("wide.asc", &text).to_string_lossy().into_owned();
+    for name in ["w.stl", "w.glb"] {
+        let o = d.run(&["mesh", &asc, "-o", name, "--max-error", "1"]);
+        crate::util::assert_fails_naming(&o, &[name, "too large for float32"]);
+    }
+    // Double-precision formats are fine.
+    mesh(&d, &asc, "w.fgb", "1", &[]);
+    verify(&d, &asc, "w.fgb", "1", &[]);
+}

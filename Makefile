@@ -5,8 +5,12 @@ SHELL := /bin/bash
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 DEMO_DEM := data/becmodel_dem_bc_albers_50m.tif
 DEMO_ERROR := 5
+VENV := .venv
+TOOLS := .tools
+PY_ORACLES := trimesh==4.12.2 numpy==2.2.6
+NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps demo test bench-results
+.PHONY: deps oracles demo test bench-results
 
 ## Install Debian's GDAL (headers, tools) and pkg-config when missing.
 deps:
@@ -17,6 +21,26 @@ deps:
 	    libgdal-dev gdal-bin pkg-config build-essential ca-certificates curl; \
 	fi
 	@command -v cargo >/dev/null || { echo "Rust is missing: install it from https://rustup.rs"; exit 1; }
+	@$(MAKE) --no-print-directory oracles
+
+## The independent readers the format tests check our files with (tests/formats.rs):
+## trimesh in .venv (PyPI) and the Khronos glTF validator in .tools (npm). Idempotent.
+oracles: $(VENV)/.ok $(TOOLS)/node_modules/gltf-validator/package.json
+
+$(VENV)/.ok:
+	@python3 -m venv --help >/dev/null 2>&1 || { \
+	  $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends python3-venv; }
+	python3 -m venv $(VENV)
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check $(PY_ORACLES)
+	@touch $@
+
+$(TOOLS)/node_modules/gltf-validator/package.json:
+	@command -v npm >/dev/null || { \
+	  $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends nodejs npm; }
+	mkdir -p $(TOOLS)
+	npm install --prefix $(TOOLS) --no-audit --no-fund --silent $(NPM_ORACLES)
 
 ## Mesh the sample DEM at $(DEMO_ERROR) m, then prove the bound with the verifier.
 demo: deps

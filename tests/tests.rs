@@ -3,4 +3,5 @@
 mod util;
 
 mod bad_input;
+mod formats;
 mod mesh_and_verify;

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use tinsmith_core::{EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation};
+use tinsmith_export::MeshFormat;
 
 /// Turns DEMs and other 2D scalar grids into TINs whose error is guaranteed.
 #[derive(Debug, Parser)]
@@ -39,9 +40,12 @@ pub struct InfoArgs {
 pub struct MeshArgs {
     /// Any single-band raster GDAL can read (GeoTIFF, ESRI ASCII, HGT, VRT, PNG...).
     pub input: PathBuf,
-    /// Output mesh; the format follows the extension (.ply, .obj).
+    /// Output mesh; the format follows the extension (.ply, .obj, .stl, .glb, .geojson,
+    /// .fgb, .xml for LandXML) unless --format names it.
     #[arg(short, long)]
     pub output: PathBuf,
+    #[command(flatten)]
+    pub export: ExportArgs,
     /// Largest allowed |sample - TIN| at any valid sample, in data units. Required unless
     /// --max-triangles or --max-vertices is given.
     #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true,
@@ -83,11 +87,31 @@ pub struct MeshArgs {
     pub report: Option<PathBuf>,
 }
 
+/// Output format and format-specific options of `mesh`.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// Output format, whatever the extension: ply, obj, stl, glb, geojson, fgb, landxml.
+    #[arg(long, value_name = "NAME", value_parser = crate::export::parse_format)]
+    pub format: Option<MeshFormat>,
+    /// STL only: close the surface into a watertight solid, with walls along every
+    /// boundary down to z = Z and a bottom at Z (Z below every height).
+    #[arg(long, value_name = "Z", allow_negative_numbers = true)]
+    pub base: Option<f64>,
+    /// glTF only: write per-vertex normals.
+    #[arg(long)]
+    pub normals: bool,
+    /// GeoJSON only: keep the raster's CRS (with a "crs" member and a note) instead of
+    /// reprojecting to WGS84 longitude/latitude as RFC 7946 wants.
+    #[arg(long)]
+    pub geojson_source_crs: bool,
+}
+
 #[derive(Debug, Args)]
 pub struct VerifyArgs {
     /// The raster the mesh was made from.
     pub input: PathBuf,
-    /// The mesh to check (.ply, .obj).
+    /// The mesh to check (.ply, .obj, .stl, .glb, .geojson, .fgb, .xml); GeoJSON in WGS84
+    /// is transformed back to the raster's CRS.
     pub mesh: PathBuf,
     /// Fail (exit 1) when the measured error exceeds this.
     #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true)]

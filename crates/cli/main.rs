@@ -4,6 +4,7 @@
 //! 2 bad input or any other error (the message names the file and the problem).
 
 mod args;
+mod export;
 mod georef;
 mod info;
 mod mesh;

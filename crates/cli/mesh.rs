@@ -6,7 +6,6 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use tinsmith_core::{decimate_with_progress, DecimationOptions, Tin};
-use tinsmith_export::{MeshFormat, MeshRef};
 use tinsmith_verify::{GridRef, VerifyOptions};
 
 use crate::args::MeshArgs;
@@ -37,6 +36,8 @@ struct MeshReport<'a> {
     max_error_bound: f64,
     measured_max_error: f64,
     output: &'a Path,
+    #[serde(flatten)]
+    output_format: crate::export::PlanReport,
     seconds: Seconds,
 }
 
@@ -54,7 +55,7 @@ struct Seconds {
 /// independent verifier confirms the bound.
 pub fn run(args: &MeshArgs) -> Result<bool> {
     let total = Instant::now();
-    let format = MeshFormat::from_path(&args.output)?;
+    let format = crate::export::format(args)?;
     check_writable_target(&args.output)?;
     if let Some(report) = &args.report {
         check_writable_target(report)?;
@@ -73,7 +74,9 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     }
 
     let max_error = args.max_error.unwrap_or(f64::INFINITY);
-    let mut options = DecimationOptions::new(max_error)
+    let plan = crate::export::Plan::new(format, &raster, args)?;
+    // Float32 formats leave the decimator the bound less their height rounding.
+    let mut options = DecimationOptions::new(plan.decimation_bound)
         .with_selection(args.selection.into())
         .with_error_model(args.error_model.into())
         .with_order(args.order.into())
@@ -106,7 +109,12 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         .iter()
         .map(|v| [v.x as i64, v.y as i64])
         .collect();
-    let heights: Vec<f64> = tin.vertices().iter().map(|v| v.z).collect();
+    // The heights as the file will hold them (float32 formats round them).
+    let heights: Vec<f64> = tin
+        .vertices()
+        .iter()
+        .map(|v| plan.file_height(v.z))
+        .collect();
     let check = tinsmith_verify::verify(
         GridRef::new(grid.width(), grid.height(), grid.values()),
         tinsmith_verify::MeshRef::new(&positions, &heights, tin.triangles()),
@@ -123,16 +131,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
 
     let t = Instant::now();
     let (vertices, triangles) = file_mesh(tin, &georef);
-    let crs = if args.pixel_coords {
-        None
-    } else {
-        raster.info.crs_wkt.as_deref()
-    };
-    tinsmith_export::write_mesh(
-        &args.output,
-        format,
-        MeshRef::new(&vertices, &triangles).with_crs_wkt(crs),
-    )?;
+    crate::export::write(&plan, args, &raster, vertices, &triangles)?;
     let write_seconds = t.elapsed().as_secs_f64();
 
     let r = &result.report;
@@ -158,6 +157,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         max_error_bound: r.max_bound,
         measured_max_error: check.max_error,
         output: &args.output,
+        output_format: plan.report(),
         seconds: Seconds {
             read: read_seconds,
             initial_mesh: r.seconds_initial_mesh,
@@ -181,6 +181,15 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
                 "(no bound asked)".into()
             }
         );
+        if let Some(origin) = plan.origin {
+            let [x, y, z] = origin.offset();
+            eprintln!(
+                "{}: float32 positions relative to the local origin ({x}, {y}, {z}); \
+                 heights round by at most {}",
+                args.output.display(),
+                plan.height_rounding
+            );
+        }
     }
     if let Some(path) = &args.report {
         let json = serde_json::to_vec_pretty(&report)?;

@@ -9,8 +9,21 @@ use crate::georef::Georef;
 /// Runs the verifier; `Ok(false)` when the mesh is invalid or exceeds `--max-error`.
 pub fn run(args: &VerifyArgs) -> Result<bool> {
     let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
-    let mesh = tinsmith_export::read_mesh(&args.mesh)?;
+    let mut mesh = tinsmith_export::read_mesh(&args.mesh)?;
     let georef = Georef::new(raster.info.transform(), args.pixel_coords);
+    // RFC 7946 GeoJSON holds WGS84 longitude, latitude: back to the raster's CRS.
+    if let (Some(4326), Georef::World(_), Some(wkt)) =
+        (mesh.epsg, georef, raster.info.crs_wkt.as_deref())
+    {
+        if raster.info.epsg != Some(4326) {
+            tinsmith_raster::from_wgs84(wkt, &mut mesh.vertices).with_context(|| {
+                format!(
+                    "{}: cannot transform WGS84 back to the raster's CRS",
+                    args.mesh.display()
+                )
+            })?;
+        }
+    }
     let mut positions = Vec::with_capacity(mesh.vertices.len());
     for (i, v) in mesh.vertices.iter().enumerate() {
         let p = georef

@@ -18,6 +18,59 @@ pub(crate) fn write_atomically<F>(path: &Path, write: F) -> Result<()>
 where
     F: FnOnce(&mut BufWriter<&mut File>) -> io::Result<()>,
 {
+    stage(path, write)?.commit()
+}
+
+/// Writes `path` through `write` and, when given, a small `sidecar` file (path, bytes)
+/// beside it, both atomically: nothing is renamed into place before both are complete.
+///
+/// The sidecar is renamed first, then the main file. If the main file's rename fails, the
+/// new sidecar is removed again (a previous sidecar at that path is then gone too; the
+/// main file keeps its previous content).
+pub(crate) fn write_atomically_with_sidecar<F>(
+    path: &Path,
+    write: F,
+    sidecar: Option<(&Path, &[u8])>,
+) -> Result<()>
+where
+    F: FnOnce(&mut BufWriter<&mut File>) -> io::Result<()>,
+{
+    let main = stage(path, write)?;
+    let Some((sidecar_path, bytes)) = sidecar else {
+        return main.commit();
+    };
+    let side = stage(sidecar_path, |w| w.write_all(bytes))?;
+    side.commit()?;
+    main.commit().inspect_err(|_| {
+        let _ = std::fs::remove_file(sidecar_path);
+    })
+}
+
+/// A complete, synced temporary file waiting to be renamed over its target.
+pub(crate) struct Staged<'p> {
+    temp: tempfile::NamedTempFile,
+    path: &'p Path,
+}
+
+impl Staged<'_> {
+    /// Renames the temporary file over the target.
+    pub(crate) fn commit(self) -> Result<()> {
+        let path = self.path;
+        self.temp.persist(path).map_err(|error| Error::Io {
+            path: path.to_path_buf(),
+            action: "move the finished temporary file into place",
+            source: error.error,
+        })?;
+        Ok(())
+    }
+}
+
+/// Writes the content of `path` to a synced temporary file beside it; dropping the result
+/// without [`Staged::commit`] removes the temporary file.
+pub(crate) fn stage<F>(path: &Path, write: F) -> Result<Staged<'_>>
+where
+    F: FnOnce(&mut BufWriter<&mut File>) -> io::Result<()>,
+{
     let dir = match path.parent() {
         Some(dir) if !dir.as_os_str().is_empty() => dir,
         _ => Path::new("."),
@@ -58,9 +111,7 @@ where
         writer.flush().map_err(io_error("write"))?;
     }
     temp.as_file().sync_all().map_err(io_error("write"))?;
-    temp.persist(path)
-        .map_err(|error| io_error("move the finished temporary file into place")(error.error))?;
-    Ok(())
+    Ok(Staged { temp, path })
 }
 
 #[cfg(test)]
@@ -201,6 +252,30 @@ mod tests {
             .permissions()
             .mode();
         assert_eq!(mode & 0o777, expected & 0o777);
+        Ok(())
+    }
+
+    #[test]
+    fn sidecar_is_written_with_the_file_and_not_on_failure() -> Result<()> {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("out.stl");
+        let prj = dir.path().join("out.prj");
+        write_atomically_with_sidecar(&path, |w| w.write_all(b"mesh"), Some((&prj, b"WKT")))?;
+        assert_eq!(std::fs::read(&prj).expect("prj"), b"WKT");
+        assert_eq!(entries(dir.path()), vec![prj.clone(), path.clone()]);
+
+        let other = dir.path().join("other.stl");
+        let other_prj = dir.path().join("other.prj");
+        let result = write_atomically_with_sidecar(
+            &other,
+            |w| {
+                w.write_all(b"partial")?;
+                Err(io::Error::other("generator failed"))
+            },
+            Some((&other_prj, b"WKT")),
+        );
+        assert!(result.is_err());
+        assert_eq!(entries(dir.path()), vec![prj, path]);
         Ok(())
     }
 }

@@ -9,9 +9,10 @@ use crate::format::MeshFormat;
 /// What can go wrong while writing or reading a mesh file.
 ///
 /// Variants are split by what the caller does next: fix the arguments
-/// ([`Error::UnknownExtension`], [`Error::UnknownFormatName`], [`Error::MissingDirectory`]),
-/// fix the mesh ([`Error::IndexOutOfRange`], [`Error::NonFiniteVertex`],
-/// [`Error::TooManyVertices`]), look at the environment ([`Error::Io`]) or at the input file
+/// ([`Error::UnknownExtension`], [`Error::UnknownFormatName`], [`Error::MissingDirectory`],
+/// [`Error::BadOption`]), fix the mesh or pick another format ([`Error::IndexOutOfRange`],
+/// [`Error::NonFiniteVertex`], [`Error::TooManyVertices`], [`Error::TooManyTriangles`],
+/// [`Error::InvalidLine`]), look at the environment ([`Error::Io`]) or at the input file
 /// ([`Error::Malformed`], [`Error::Unsupported`]).
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -85,6 +86,41 @@ pub enum Error {
         count: usize,
         /// The most the format can index.
         max: usize,
+    },
+    /// The mesh has more triangles than the format can count.
+    #[error(
+        "{}: {count} triangles cannot be written to a {format} file (at most {max})",
+        .path.display()
+    )]
+    TooManyTriangles {
+        /// The output file.
+        path: PathBuf,
+        /// The format being written.
+        format: MeshFormat,
+        /// Number of triangles the file would hold.
+        count: u64,
+        /// The most the format can hold.
+        max: u64,
+    },
+    /// A [`crate::WriteOptions`] value cannot be used with this mesh, such as an STL base
+    /// that is not below every vertex, or an origin too long for the STL header.
+    #[error("{}: {reason}", .path.display())]
+    BadOption {
+        /// The output file.
+        path: PathBuf,
+        /// What is wrong, naming the option.
+        reason: String,
+    },
+    /// A line given to [`crate::write_lines`] cannot be written: fewer than two points, or
+    /// a non-finite coordinate or elevation.
+    #[error("{}: line {line}: {reason}", .path.display())]
+    InvalidLine {
+        /// The output file.
+        path: PathBuf,
+        /// Position of the line in the slice.
+        line: usize,
+        /// What is wrong.
+        reason: String,
     },
     /// An I/O operation on the file failed; the cause is the error's source.
     #[error("{}: cannot {action}", .path.display())]
@@ -203,7 +239,7 @@ mod tests {
         let message = error.to_string();
         assert!(message.starts_with("tin.xyz: "), "{message}");
         assert!(
-            message.contains(".ply") && message.contains(".obj"),
+            message.contains(".ply") && message.contains(".xml"),
             "{message}"
         );
     }

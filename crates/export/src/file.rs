@@ -2,36 +2,21 @@
 
 use std::fs::File;
 use std::io::BufReader;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use crate::atomic::write_atomically;
+use crate::atomic::write_atomically_with_sidecar;
 use crate::error::{Error, Problem, Result};
 use crate::format::MeshFormat;
 use crate::mesh::{Mesh, MeshRef};
-use crate::{obj, ply};
+use crate::options::WriteOptions;
+use crate::origin::LocalOrigin;
+use crate::{fgb, geojson, glb, landxml, obj, ply, stl};
 
 /// Size of the read buffer.
 const BUFFER_SIZE: usize = 1 << 16;
 
-/// Writes `mesh` to `path` in `format`, atomically.
-///
-/// The file is written to a temporary file in the same directory and renamed over `path`
-/// once complete, so readers never see a partial file. An existing file at `path` is
-/// replaced.
-///
-/// Reading the file back with [`read_mesh`] gives the same vertices (bit for bit), the same
-/// triangles in the same order and orientation, and the CRS as described in
-/// [`MeshRef::with_crs_wkt`].
-///
-/// # Errors
-/// - [`Error::MissingDirectory`] if `path`'s directory does not exist.
-/// - [`Error::IndexOutOfRange`], [`Error::NonFiniteVertex`], [`Error::TooManyVertices`] if
-///   the mesh cannot be written as a valid file; these are found before any file is created.
-/// - [`Error::Io`] if the directory is not writable, the disk is full, `path` is a
-///   directory, …; the I/O error is the source.
-///
-/// After an error, nothing new is left on disk: no file at `path` (or its previous content,
-/// untouched) and no temporary file.
+/// Writes `mesh` to `path` in `format` with the default [`WriteOptions`], atomically; see
+/// [`write_mesh_with`].
 ///
 /// # Example
 /// ```no_run
@@ -46,11 +31,145 @@ const BUFFER_SIZE: usize = 1 << 16;
 /// # }
 /// ```
 pub fn write_mesh(path: &Path, format: MeshFormat, mesh: MeshRef<'_>) -> Result<()> {
+    write_mesh_with(path, format, mesh, &WriteOptions::default())
+}
+
+/// The `.prj` sidecar of `path`: the same name with the extension `prj`.
+pub fn prj_path(path: &Path) -> PathBuf {
+    path.with_extension("prj")
+}
+
+/// Writes `mesh` to `path` in `format`, atomically, with format-specific `options`.
+///
+/// The file is written to a temporary file in the same directory and renamed over `path`
+/// once complete, so readers never see a partial file. An existing file at `path` is
+/// replaced. Every format is written as a stream from the slices: no second copy of the
+/// mesh is made (FlatGeobuf keeps one index entry per triangle; STL with a base keeps the
+/// list of edges to find the boundary; glTF with normals keeps one normal per vertex).
+///
+/// The CRS is recorded where the format holds one (see [`MeshFormat`]); for OBJ, STL and
+/// glTF the WKT is also written, verbatim, to the `.prj` sidecar ([`prj_path`]), renamed
+/// into place just before the mesh.
+///
+/// Reading the file back with [`read_mesh`] gives the same triangles in the same order and
+/// orientation, and the same vertices: bit for bit for the `f64` formats (PLY, OBJ,
+/// GeoJSON, FlatGeobuf, LandXML); [`LocalOrigin::quantize`] of them for the float32
+/// formats (STL, glTF), with the origin of `options` or [`LocalOrigin::of_points`].
+/// Formats that store corners by value (STL, GeoJSON, FlatGeobuf) give back each distinct
+/// position once, in order of first use by the triangles.
+///
+/// # Errors
+/// - [`Error::MissingDirectory`] if `path`'s directory does not exist.
+/// - [`Error::IndexOutOfRange`], [`Error::NonFiniteVertex`], [`Error::TooManyVertices`],
+///   [`Error::TooManyTriangles`] if the mesh cannot be written as a valid file, and
+///   [`Error::BadOption`] for an STL base not below every vertex; these are found before
+///   any file is created.
+/// - [`Error::Io`] if the directory is not writable, the disk is full, `path` is a
+///   directory, …; the I/O error is the source.
+///
+/// After an error, nothing new is left on disk: no file at `path` (or its previous content,
+/// untouched), no sidecar and no temporary file.
+pub fn write_mesh_with(
+    path: &Path,
+    format: MeshFormat,
+    mesh: MeshRef<'_>,
+    options: &WriteOptions,
+) -> Result<()> {
     mesh.check(path, format)?;
-    write_atomically(path, |w| match format {
-        MeshFormat::Ply => ply::write(w, mesh),
-        MeshFormat::Obj => obj::write(w, mesh),
-    })
+    let origin = options
+        .origin()
+        .unwrap_or_else(|| LocalOrigin::of_points(mesh.vertices));
+    if format.is_float32() {
+        check_float32(path, mesh, origin)?;
+    }
+    let base = match format {
+        MeshFormat::Stl => check_stl(path, mesh, origin, options.base())?,
+        _ => None,
+    };
+    let prj = prj_path(path);
+    let wkt = mesh.crs_wkt.filter(|w| !w.trim().is_empty());
+    let sidecar = match wkt {
+        Some(wkt) if format.uses_prj_sidecar() => Some((prj.as_path(), wkt.as_bytes())),
+        _ => None,
+    };
+    write_atomically_with_sidecar(
+        path,
+        |w| match format {
+            MeshFormat::Ply => ply::write(w, mesh),
+            MeshFormat::Obj => obj::write(w, mesh),
+            MeshFormat::Stl => stl::write(w, mesh, origin, base),
+            MeshFormat::Glb => glb::write(w, mesh, origin, options.normals()),
+            MeshFormat::GeoJson => geojson::write(w, mesh),
+            MeshFormat::FlatGeobuf => fgb::write(w, mesh),
+            MeshFormat::LandXml => landxml::write(w, mesh),
+        },
+        sidecar,
+    )
+}
+
+/// Checks that every vertex is finite relative to `origin` in float32.
+fn check_float32(path: &Path, mesh: MeshRef<'_>, origin: LocalOrigin) -> Result<()> {
+    if let Some(vertex) = mesh
+        .vertices
+        .iter()
+        .position(|&p| !origin.to_local(p).iter().all(|c| c.is_finite()))
+    {
+        return Err(Error::BadOption {
+            path: path.to_path_buf(),
+            reason: format!(
+                "vertex {vertex} {:?} is too far from the origin {:?} for float32",
+                mesh.vertices[vertex],
+                origin.offset()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Checks what the STL writer needs: a facet count that fits a `u32`, a header that fits,
+/// a base below every vertex after float32 rounding. Returns the base.
+fn check_stl(
+    path: &Path,
+    mesh: MeshRef<'_>,
+    origin: LocalOrigin,
+    base: Option<f64>,
+) -> Result<Option<f64>> {
+    let count = match base {
+        Some(_) => stl::solid_facet_count(mesh.triangles),
+        None => mesh.triangles.len() as u64,
+    };
+    if count > u64::from(u32::MAX) {
+        return Err(Error::TooManyTriangles {
+            path: path.to_path_buf(),
+            format: MeshFormat::Stl,
+            count,
+            max: u64::from(u32::MAX),
+        });
+    }
+    if stl::header_text(origin, base).is_none() {
+        return Err(Error::BadOption {
+            path: path.to_path_buf(),
+            reason: format!(
+                "the origin {:?} does not fit in the 80-byte STL header",
+                origin.offset()
+            ),
+        });
+    }
+    if let Some(base) = base {
+        let local = |z: f64| origin.to_local([0.0, 0.0, z])[2];
+        let lowest = mesh.vertices.iter().map(|v| v[2]).reduce(f64::min);
+        let ok = base.is_finite() && lowest.is_none_or(|low| local(base) < local(low));
+        if !ok {
+            return Err(Error::BadOption {
+                path: path.to_path_buf(),
+                reason: format!(
+                    "the STL base {base} must be below the lowest vertex ({}), also in float32",
+                    lowest.unwrap_or(f64::NAN)
+                ),
+            });
+        }
+    }
+    Ok(base)
 }
 
 /// Reads the mesh file at `path`, choosing the format by its extension (see
@@ -58,8 +177,8 @@ pub fn write_mesh(path: &Path, format: MeshFormat, mesh: MeshRef<'_>) -> Result<
 ///
 /// PLY files may be ASCII or binary (either byte order), with `x`, `y`, `z` vertex
 /// properties of any numeric type in any order among other properties, and a face list
-/// named `vertex_indices` or `vertex_index` with integer count and index types. OBJ files
-/// are read as described in [`MeshFormat::Obj`]; see [`read_mesh_as`] for both.
+/// named `vertex_indices` or `vertex_index` with integer count and index types. See
+/// [`read_mesh_as`] for every format.
 ///
 /// The returned mesh has finite coordinates only and every index is below the vertex count.
 ///
@@ -81,10 +200,25 @@ pub fn read_mesh(path: &Path) -> Result<Mesh> {
 
 /// Reads the mesh file at `path` as `format`, whatever its extension.
 ///
-/// Only triangle faces are read. Other PLY elements (edges, materials) and OBJ statements
-/// that carry no vertex or triangle (`vt`, `vn`, `g`, `usemtl`, …) are skipped; data after
-/// the last PLY element is ignored. The CRS comes from the first `comment crs <wkt>` (PLY)
-/// or `# crs: <wkt>` (OBJ) line, trimmed.
+/// Only triangles are read:
+/// - PLY: other elements (edges, materials) are skipped; data after the last element is
+///   ignored. OBJ: statements that carry no vertex or triangle (`vt`, `vn`, `g`, `usemtl`,
+///   …) are skipped. The CRS comes from the first `comment crs <wkt>` (PLY) or
+///   `# crs: <wkt>` (OBJ) line, trimmed.
+/// - STL: binary only. Positions are the header's `tinsmith origin X Y Z` (zero when the
+///   header has none) plus the float32 corners; facets with a corner at the header's
+///   `base` height (walls and bottom of a solid) are skipped.
+/// - glTF (`.glb`): nodes with a translation only, triangle primitives, glTF axes mapped
+///   back to world axes as the writer maps them (see [`MeshFormat::Glb`]).
+/// - GeoJSON: `Polygon` Z features with a closed ring of 4 positions. Without a `crs`
+///   member the coordinates are RFC 7946 longitude, latitude and [`Mesh::epsg`] is 4326.
+/// - FlatGeobuf: `Triangle`, one-ring `Polygon` or `TIN` Z features, put back in `id`
+///   order when every feature has one.
+/// - LandXML: the first `Surface`'s points (northing easting elevation, any ids) and
+///   visible faces.
+///
+/// For OBJ, STL and glTF files that record no CRS themselves, the CRS is read from the
+/// `.prj` sidecar ([`prj_path`]) when there is one, on one line.
 ///
 /// # Errors
 /// Every error names `path`:
@@ -92,7 +226,8 @@ pub fn read_mesh(path: &Path) -> Result<Mesh> {
 /// - [`Error::Malformed`] for an empty file, a bad header, truncated data, text where a
 ///   number belongs, an index out of range or a non-finite coordinate; the reason says
 ///   where.
-/// - [`Error::Unsupported`] for a face that is not a triangle or an unknown PLY encoding.
+/// - [`Error::Unsupported`] for faces that are not triangles, 2D coordinates, an ASCII
+///   STL, glTF nodes with rotation or scale, and the like.
 ///
 /// Malformed input gives an error, never a panic, and header counts are checked against the
 /// file size before memory is reserved for them.
@@ -107,8 +242,19 @@ pub fn read_mesh_as(path: &Path, format: MeshFormat) -> Result<Mesh> {
     let result: std::result::Result<Mesh, Problem> = match format {
         MeshFormat::Ply => ply::read(reader, file_len),
         MeshFormat::Obj => obj::read(reader),
+        MeshFormat::Stl => stl::read(reader, file_len),
+        MeshFormat::Glb => glb::read(reader, file_len),
+        MeshFormat::GeoJson => geojson::read(reader),
+        MeshFormat::FlatGeobuf => fgb::read(reader),
+        MeshFormat::LandXml => landxml::read(reader),
     };
-    result.map_err(|problem| problem.at(path, format))
+    let mut mesh = result.map_err(|problem| problem.at(path, format))?;
+    if mesh.crs_wkt.is_none() && format.uses_prj_sidecar() {
+        if let Ok(wkt) = std::fs::read_to_string(prj_path(path)) {
+            mesh.crs_wkt = MeshRef::new(&[], &[]).with_crs_wkt(wkt.as_str()).crs_line();
+        }
+    }
+    Ok(mesh)
 }
 
 #[cfg(test)]
@@ -138,13 +284,20 @@ mod tests {
         [512_345.678_9, 5_123_456.789_012_3, 2_962.125],
     ];
     const TRIANGLES: [[u32; 3]; 3] = [[0, 1, 2], [2, 3, 0], [4, 3, 2]];
+    /// Values float32 can hold relative to an origin.
+    const MODERATE: [[f64; 3]; 4] = [
+        [500_000.0, 4_649_776.25, 312.5],
+        [0.1 + 0.2 + 500_000.0, 4_649_776.1, 1.0 / 3.0],
+        [512_345.678_9, 4_653_456.789_012_3, 2_962.125],
+        [501_000.0, 4_650_000.0, -0.0],
+    ];
     const WKT: &str = "PROJCS[\"WGS 84 / UTM zone 33N\",GEOGCS[\"WGS 84\"],\
                        AUTHORITY[\"EPSG\",\"32633\"]]";
 
     #[test]
-    fn round_trip_is_bit_exact_in_every_format() -> Result<()> {
+    fn round_trip_is_bit_exact_in_every_f64_format() -> Result<()> {
         let dir = tempfile::tempdir().expect("temp dir");
-        for format in MeshFormat::ALL {
+        for format in MeshFormat::ALL.into_iter().filter(|f| !f.is_float32()) {
             let path = dir.path().join(format!("tile.{}", format.extension()));
             let mesh = MeshRef::new(&VERTICES, &TRIANGLES).with_crs_wkt(WKT);
             write_mesh(&path, format, mesh)?;
@@ -165,6 +318,74 @@ mod tests {
     }
 
     #[test]
+    fn float32_formats_give_back_the_quantized_positions() -> Result<()> {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let vertices = &MODERATE;
+        let triangles = [[0, 1, 2], [1, 3, 2]];
+        let origin = LocalOrigin::new([500_000.0, 4_649_776.0, 312.5]);
+        let expected: Vec<[f64; 3]> = vertices.iter().map(|&p| origin.quantize(p)).collect();
+        for format in [MeshFormat::Stl, MeshFormat::Glb] {
+            let path = dir.path().join(format!("tile.{}", format.extension()));
+            let mesh = MeshRef::new(vertices, &triangles).with_crs_wkt(WKT);
+            let options = WriteOptions::new().with_origin(origin);
+            write_mesh_with(&path, format, mesh, &options)?;
+            let back = read_mesh(&path)?;
+            assert_eq!(bits(&back.vertices), bits(&expected), "{format}");
+            assert_eq!(back.triangles, triangles, "{format}");
+            assert_eq!(back.crs_wkt.as_deref(), Some(WKT), "{format}");
+            assert_eq!(
+                std::fs::read_to_string(prj_path(&path)).ok().as_deref(),
+                Some(WKT)
+            );
+            let again = dir.path().join(format!("again.{}", format.extension()));
+            write_mesh_with(&again, format, back.as_mesh_ref(), &options)?;
+            assert_eq!(
+                std::fs::read(&path).ok(),
+                std::fs::read(&again).ok(),
+                "{format}"
+            );
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn float32_formats_refuse_what_float32_cannot_hold() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        for format in [MeshFormat::Stl, MeshFormat::Glb] {
+            let path = dir.path().join(format!("tile.{}", format.extension()));
+            let result = write_mesh(&path, format, MeshRef::new(&VERTICES, &TRIANGLES));
+            assert!(
+                matches!(result, Err(Error::BadOption { .. })),
+                "{format}: {result:?}"
+            );
+        }
+        assert!(entries(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn stl_base_must_be_below_every_vertex() -> Result<()> {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("solid.stl");
+        let vertices = [[0.0, 0.0, 10.0], [1.0, 0.0, 11.0], [0.0, 1.0, 12.0]];
+        let mesh = MeshRef::new(&vertices, &[[0, 1, 2]]);
+        for base in [10.0, 10.000_000_000_1, f64::NAN] {
+            let options = WriteOptions::new().with_base(base);
+            let result = write_mesh_with(&path, MeshFormat::Stl, mesh, &options);
+            let message = result.err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(message.contains("STL base"), "{base}: {message}");
+        }
+        assert!(entries(dir.path()).is_empty());
+        write_mesh_with(
+            &path,
+            MeshFormat::Stl,
+            mesh,
+            &WriteOptions::new().with_base(0.0),
+        )?;
+        assert_eq!(read_mesh(&path)?.triangles, vec![[0, 1, 2]]);
+        Ok(())
+    }
+
+    #[test]
     fn multi_line_crs_comes_back_on_one_line() -> Result<()> {
         let dir = tempfile::tempdir().expect("temp dir");
         let wkt = "GEOGCS[\"WGS 84\",\n    DATUM[\"WGS_1984\"],\r\n    UNIT[\"degree\",0.01]]\n";
@@ -173,7 +394,7 @@ mod tests {
             write_mesh(
                 &path,
                 format,
-                MeshRef::new(&VERTICES, &[]).with_crs_wkt(wkt),
+                MeshRef::new(&MODERATE, &[]).with_crs_wkt(wkt),
             )?;
             let back = read_mesh(&path)?;
             assert_eq!(
@@ -181,7 +402,8 @@ mod tests {
                 Some("GEOGCS[\"WGS 84\",     DATUM[\"WGS_1984\"],     UNIT[\"degree\",0.01]]"),
                 "{format}"
             );
-            write_mesh(&path, format, MeshRef::new(&VERTICES, &[]))?;
+            std::fs::remove_file(prj_path(&path)).ok();
+            write_mesh(&path, format, MeshRef::new(&MODERATE, &[]))?;
             assert_eq!(read_mesh(&path)?.crs_wkt, None, "{format}");
         }
         Ok(())
@@ -259,11 +481,11 @@ mod tests {
         );
         assert!(error.to_string().contains("nope.ply"));
 
-        let unknown = dir.path().join("tile.stl");
-        std::fs::write(&unknown, b"solid").expect("seed");
+        let unknown = dir.path().join("tile.dxf");
+        std::fs::write(&unknown, b"0\nSECTION").expect("seed");
         let error = read_mesh(&unknown).expect_err("unknown extension");
         assert!(matches!(error, Error::UnknownExtension { .. }), "{error:?}");
-        assert!(error.to_string().contains("tile.stl"));
+        assert!(error.to_string().contains("tile.dxf"));
 
         let empty = dir.path().join("empty.obj");
         std::fs::write(&empty, b"").expect("seed");

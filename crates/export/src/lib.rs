@@ -51,13 +51,25 @@
 
 mod atomic;
 mod error;
+mod fgb;
 mod file;
 mod format;
+mod geojson;
+mod glb;
+mod landxml;
+mod lines;
 mod mesh;
 mod obj;
+mod options;
+mod origin;
 mod ply;
+mod stl;
+mod weld;
 
 pub use error::{Error, Result};
-pub use file::{read_mesh, read_mesh_as, write_mesh};
+pub use file::{prj_path, read_mesh, read_mesh_as, write_mesh, write_mesh_with};
 pub use format::MeshFormat;
+pub use lines::{write_lines, CrsRef, LineFormat, LinePoint};
 pub use mesh::{Mesh, MeshRef};
+pub use options::WriteOptions;
+pub use origin::LocalOrigin;

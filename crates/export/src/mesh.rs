@@ -17,8 +17,13 @@ pub struct MeshRef<'a> {
     pub vertices: &'a [[f64; 3]],
     /// Triangles as 0-based indices into `vertices`.
     pub triangles: &'a [[u32; 3]],
-    /// The coordinate reference system as WKT, written as a header comment if given.
+    /// The coordinate reference system as WKT, recorded in the file (or its `.prj`
+    /// sidecar, see [`crate::MeshFormat::uses_prj_sidecar`]) if given.
     pub crs_wkt: Option<&'a str>,
+    /// The CRS's EPSG code, when known: recorded by the formats that hold one (FlatGeobuf,
+    /// LandXML, GeoJSON). `Some(4326)` means longitude, latitude in degrees (GeoJSON then
+    /// writes plain RFC 7946).
+    pub epsg: Option<u32>,
 }
 
 impl<'a> MeshRef<'a> {
@@ -28,7 +33,14 @@ impl<'a> MeshRef<'a> {
             vertices,
             triangles,
             crs_wkt: None,
+            epsg: None,
         }
+    }
+
+    /// Sets the CRS's EPSG code (see [`MeshRef::epsg`]).
+    pub fn with_epsg(mut self, epsg: impl Into<Option<u32>>) -> Self {
+        self.epsg = epsg.into();
+        self
     }
 
     /// Sets the CRS as WKT (or any other one-line text such as `EPSG:32633`).
@@ -100,8 +112,13 @@ pub struct Mesh {
     pub vertices: Vec<[f64; 3]>,
     /// Triangles as 0-based indices into `vertices`.
     pub triangles: Vec<[u32; 3]>,
-    /// The CRS from the file's header comment (`comment crs …` in PLY, `# crs: …` in OBJ).
+    /// The CRS the file records: `comment crs …` in PLY, `# crs: …` in OBJ, the header's
+    /// WKT in FlatGeobuf, `ogcWktCode` in LandXML, the `crs_wkt` member in GeoJSON (or the
+    /// `crs` member's name when it is not an EPSG code). `.prj` sidecars are not read.
     pub crs_wkt: Option<String>,
+    /// The EPSG code the file records (FlatGeobuf, LandXML, GeoJSON). A GeoJSON file
+    /// without a `crs` member is RFC 7946 longitude, latitude: `Some(4326)`.
+    pub epsg: Option<u32>,
 }
 
 impl Mesh {
@@ -111,6 +128,7 @@ impl Mesh {
             vertices,
             triangles,
             crs_wkt: None,
+            epsg: None,
         }
     }
 
@@ -120,6 +138,7 @@ impl Mesh {
             vertices: &self.vertices,
             triangles: &self.triangles,
             crs_wkt: self.crs_wkt.as_deref(),
+            epsg: self.epsg,
         }
     }
 }

@@ -2,12 +2,14 @@
 
 use std::path::{Path, PathBuf};
 
-/// What can go wrong while reading a raster; every message starts with the file's path.
+/// What can go wrong while reading a raster or transforming coordinates; every message
+/// about a raster starts with the file's path.
 ///
 /// The variants are split by what the caller does next: fix the path ([`Error::NotFound`]),
 /// pick another file ([`Error::NotARaster`], [`Error::UnsupportedType`], [`Error::Read`]),
 /// pick another band ([`Error::BandOutOfRange`], [`Error::AllNodata`]) or tile the input
-/// ([`Error::TooLarge`]).
+/// ([`Error::TooLarge`]). [`Error::Crs`] and [`Error::Untransformable`] come from
+/// reprojection, which has no file of its own: the caller names the file.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
@@ -85,6 +87,25 @@ pub enum Error {
         path: PathBuf,
         /// The 1-based band.
         band: usize,
+    },
+    /// Reprojection ([`crate::to_wgs84`], [`crate::from_wgs84`]): GDAL cannot read a CRS, or PROJ cannot transform between
+    /// two. Not about a file: the caller names the file the coordinates belong to.
+    #[error("{reason}")]
+    Crs {
+        /// What failed.
+        reason: String,
+        /// The error GDAL returned (boxed: it is large).
+        #[source]
+        source: Box<gdal::errors::GdalError>,
+    },
+    /// Reprojection: PROJ maps a point to no finite position (outside the area
+    /// the projection is defined on).
+    #[error("point {point} at {position:?} cannot be transformed")]
+    Untransformable {
+        /// Position of the point in the slice.
+        point: usize,
+        /// Its coordinates before the transformation.
+        position: [f64; 3],
     },
     /// The core refused the grid (a dimension of zero, or too many samples).
     #[error("{}: band {band} cannot become a grid", path.display())]

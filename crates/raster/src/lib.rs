@@ -3,6 +3,8 @@
 //! [`read_grid`] returns the grid (nodata as NaN) with a [`RasterInfo`]: driver, size, data
 //! type, nodata value, CRS (WKT and EPSG code), geotransform and statistics of the samples.
 //! [`open_info`] gives the same [`RasterInfo`] without keeping the samples.
+//! [`to_wgs84`] and [`from_wgs84`] transform coordinates between a CRS and WGS84
+//! longitude, latitude (for RFC 7946 GeoJSON), so that no other crate links GDAL.
 //!
 //! # What callers can rely on
 //! - **Nodata.** A sample is nodata exactly when it is NaN or infinite, or equals the band's
@@ -50,8 +52,10 @@ mod error;
 mod info;
 mod quiet;
 mod read;
+mod reproject;
 
 pub use error::{Error, Result};
 pub use info::{Raster, RasterInfo};
 pub use quiet::silence_gdal_errors;
 pub use read::{open_info, read_grid};
+pub use reproject::{from_wgs84, to_wgs84};

@@ -1,0 +1,276 @@
+//! How `tinsmith mesh` writes each format: the format and its flags, the float32 origin
+//! and the tighter bound that keeps the promise in float32 files, WGS84 for GeoJSON.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+use tinsmith_core::Grid;
+use tinsmith_export::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
+use tinsmith_raster::Raster;
+
+use crate::args::MeshArgs;
+use crate::georef::Georef;
+
+/// Largest rounding of a float32 position, in pixels, accepted before decimating: 90 % of
+/// the 1e-3 pixel within which the verifier maps file positions to samples. Half a float32
+/// step is 2^-24 of the offset, so rasters up to about 30,000 samples across pass.
+const MAX_POSITION_ROUNDING_PX: f64 = 9e-4;
+
+/// The format `mesh` writes: `--format` or the extension; fails when a format-specific
+/// flag is given for another format.
+pub fn format(args: &MeshArgs) -> Result<MeshFormat> {
+    let format = match args.export.format {
+        Some(format) => format,
+        None => MeshFormat::from_path(&args.output)?,
+    };
+    let e = &args.export;
+    let misplaced = [
+        (e.base.is_some(), "--base", MeshFormat::Stl),
+        (e.normals, "--normals", MeshFormat::Glb),
+        (
+            e.geojson_source_crs,
+            "--geojson-source-crs",
+            MeshFormat::GeoJson,
+        ),
+    ];
+    for (given, flag, only) in misplaced {
+        if given && format != only {
+            bail!(
+                "{}: {flag} applies to {only} output only, not {format}",
+                args.output.display()
+            );
+        }
+    }
+    if let Some(base) = e.base {
+        if !base.is_finite() {
+            bail!("--base must be a finite number, got {base}");
+        }
+    }
+    Ok(format)
+}
+
+/// What the output format needs decided before decimation.
+#[derive(Debug, Clone, Copy)]
+pub struct Plan {
+    pub format: MeshFormat,
+    /// The float32 formats' origin.
+    pub origin: Option<LocalOrigin>,
+    /// max |z - stored z| over every valid sample (0 for `f64` formats).
+    pub height_rounding: f64,
+    /// The bound given to the decimator: `--max-error` less `height_rounding`, so that
+    /// the heights as stored are within `--max-error` of every sample.
+    pub decimation_bound: f64,
+}
+
+/// The float32 part of the `--report` JSON.
+#[derive(Debug, Serialize)]
+pub struct PlanReport {
+    format: &'static str,
+    local_origin: Option<[f64; 3]>,
+    float32_height_rounding: f64,
+    decimation_max_error: f64,
+}
+
+impl Plan {
+    /// For STL and glTF: the origin in the middle of the grid's file coordinates and
+    /// heights, the largest float32 rounding of a height, and the bound left for the
+    /// decimator; fails when float32 cannot hold the positions to a sample or the heights
+    /// within `max_error`.
+    pub fn new(format: MeshFormat, raster: &Raster, args: &MeshArgs) -> Result<Plan> {
+        let max_error = args.max_error.unwrap_or(f64::INFINITY);
+        if !format.is_float32() {
+            return Ok(Plan {
+                format,
+                origin: None,
+                height_rounding: 0.0,
+                decimation_bound: max_error,
+            });
+        }
+        let grid = &raster.grid;
+        if let (Some(base), Some(min)) = (args.export.base, raster.info.min) {
+            if base >= min {
+                bail!(
+                    "{}: --base {base} must be below the lowest height ({min})",
+                    args.output.display()
+                );
+            }
+        }
+        let georef = Georef::new(raster.info.transform(), args.pixel_coords);
+        let (min, max) = extent(grid, &georef);
+        let origin = LocalOrigin::around(min, max);
+        check_position_rounding(grid, &georef, origin, min, max, &args.output)?;
+
+        let mut height_rounding = 0.0f64;
+        for &z in grid.values().iter().filter(|z| z.is_finite()) {
+            let stored = origin.quantize([0.0, 0.0, z])[2];
+            height_rounding = height_rounding.max((stored - z).abs());
+        }
+        let decimation_bound = max_error - height_rounding;
+        if decimation_bound < 0.0 {
+            bail!(
+                "{}: --max-error {max_error} is smaller than the float32 rounding of the \
+                 heights ({height_rounding}) in {format}; use a larger bound or a \
+                 double-precision format (.ply, .obj, .fgb, .geojson, .xml)",
+                args.output.display()
+            );
+        }
+        Ok(Plan {
+            format,
+            origin: Some(origin),
+            height_rounding,
+            decimation_bound,
+        })
+    }
+
+    /// The height the file will give back for `z`.
+    pub fn file_height(&self, z: f64) -> f64 {
+        match self.origin {
+            Some(origin) => origin.quantize([0.0, 0.0, z])[2],
+            None => z,
+        }
+    }
+
+    /// What goes into the `--report` JSON.
+    pub fn report(&self) -> PlanReport {
+        PlanReport {
+            format: self.format.name(),
+            local_origin: self.origin.map(|o| o.offset()),
+            float32_height_rounding: self.height_rounding,
+            decimation_max_error: self.decimation_bound,
+        }
+    }
+}
+
+/// Min and max of the grid's file coordinates (sample centres) and valid heights.
+fn extent(grid: &Grid, georef: &Georef) -> ([f64; 3], [f64; 3]) {
+    let (w, h) = (
+        grid.width().saturating_sub(1),
+        grid.height().saturating_sub(1),
+    );
+    let mut min = [f64::INFINITY; 3];
+    let mut max = [f64::NEG_INFINITY; 3];
+    for (x, y) in [(0, 0), (w, 0), (0, h), (w, h)] {
+        let p = georef.file_position(x, y);
+        for axis in 0..2 {
+            min[axis] = min[axis].min(p[axis]);
+            max[axis] = max[axis].max(p[axis]);
+        }
+    }
+    for &z in grid.values().iter().filter(|z| z.is_finite()) {
+        min[2] = min[2].min(z);
+        max[2] = max[2].max(z);
+    }
+    (min, max)
+}
+
+/// Fails when float32 offsets from `origin` cannot place every sample within
+/// [`MAX_POSITION_ROUNDING_PX`] of its centre (a bound: half a float32 step at the largest
+/// offset, plus the `f64` roundings, in pixels through the inverse geotransform).
+fn check_position_rounding(
+    grid: &Grid,
+    georef: &Georef,
+    origin: LocalOrigin,
+    min: [f64; 3],
+    max: [f64; 3],
+    output: &Path,
+) -> Result<()> {
+    let o = origin.offset();
+    let mut world = 0.0f64;
+    for axis in 0..2 {
+        let offset = (max[axis] - o[axis]).abs().max((min[axis] - o[axis]).abs());
+        let magnitude = max[axis].abs().max(min[axis].abs());
+        world = world.max(offset * 2f64.powi(-24) + magnitude * 2f64.powi(-51));
+    }
+    // Pixels per world unit: the inverse geotransform's largest row sum.
+    let per_unit = match georef {
+        Georef::Pixel => 1.0,
+        Georef::World(t) => {
+            let c = &t.0;
+            let det = (c[1] * c[5] - c[2] * c[4]).abs();
+            ((c[5].abs() + c[2].abs()).max(c[4].abs() + c[1].abs())) / det
+        }
+    };
+    let pixels = world * per_unit;
+    if !pixels.is_finite() || pixels > MAX_POSITION_ROUNDING_PX {
+        bail!(
+            "{}: a {}x{} raster is too large for float32 positions relative to one origin \
+             (rounding up to {pixels:.2e} pixel); use a double-precision format (.ply, \
+             .obj, .fgb, .geojson, .xml)",
+            output.display(),
+            grid.width(),
+            grid.height()
+        );
+    }
+    Ok(())
+}
+
+/// Writes the mesh (`vertices` in file coordinates, counter-clockwise `triangles`) as the
+/// plan's format with the raster's CRS: reprojected to WGS84 for GeoJSON unless
+/// `--geojson-source-crs`; a `.prj` sidecar for OBJ, STL and glTF.
+pub fn write(
+    plan: &Plan,
+    args: &MeshArgs,
+    raster: &Raster,
+    mut vertices: Vec<[f64; 3]>,
+    triangles: &[[u32; 3]],
+) -> Result<()> {
+    let path = &args.output;
+    let info = &raster.info;
+    let (mut crs, mut epsg) = match args.pixel_coords || info.transform().is_none() {
+        true => (None, None),
+        false => (info.crs_wkt.as_deref(), info.epsg),
+    };
+    if plan.format == MeshFormat::GeoJson && !args.export.geojson_source_crs {
+        match crs {
+            Some(wkt) => {
+                tinsmith_raster::to_wgs84(wkt, &mut vertices)
+                    .with_context(|| format!("{}: cannot reproject to WGS84", path.display()))?;
+                (crs, epsg) = (None, Some(4326));
+            }
+            None if !args.quiet => eprintln!(
+                "{}: no CRS, so the coordinates are written as they are, with \"crs\": null",
+                path.display()
+            ),
+            None => {}
+        }
+    }
+    if let Some(origin) = plan.origin {
+        check_positions_map_back(&vertices, origin, raster, args)?;
+    }
+    let options = WriteOptions::new()
+        .with_origin(plan.origin)
+        .with_base(args.export.base)
+        .with_normals(args.export.normals);
+    let mesh = MeshRef::new(&vertices, triangles)
+        .with_crs_wkt(crs)
+        .with_epsg(epsg);
+    tinsmith_export::write_mesh_with(path, plan.format, mesh, &options)?;
+    Ok(())
+}
+
+/// The last gate for float32 files: every stored position maps back to a sample centre
+/// as `tinsmith verify` will map it.
+fn check_positions_map_back(
+    vertices: &[[f64; 3]],
+    origin: LocalOrigin,
+    raster: &Raster,
+    args: &MeshArgs,
+) -> Result<()> {
+    let georef = Georef::new(raster.info.transform(), args.pixel_coords);
+    for (i, &v) in vertices.iter().enumerate() {
+        let q = origin.quantize(v);
+        georef.sample_at([q[0], q[1]]).with_context(|| {
+            format!(
+                "{}: vertex {i} would not map back to its sample in float32; nothing written",
+                args.output.display()
+            )
+        })?;
+    }
+    Ok(())
+}
+
+/// `--format NAME`.
+pub fn parse_format(name: &str) -> std::result::Result<MeshFormat, String> {
+    MeshFormat::from_name(name).map_err(|e| e.to_string())
+}

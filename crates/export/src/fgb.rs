@@ -1,0 +1,223 @@
+//! FlatGeobuf through the `flatgeobuf` crate: one `Triangle` Z feature per triangle, an `id`
+//! column, the CRS in the header, a packed Hilbert R-tree index.
+//!
+//! With the index, the writer sorts features along a Hilbert curve, so the file's feature
+//! order is not the mesh's; the `id` column (`Long`: GDAL reads unsigned 64-bit columns as
+//! reals) holds each triangle's position and the reader puts them back in that order.
+//! `Triangle` rather than `PolyhedralSurface` or `TIN`: GDAL 3.6 reads it.
+
+use std::io::{self, Read, Write};
+
+use flatgeobuf::geozero::{ColumnValue, FeatureProcessor, GeomProcessor, PropertyProcessor};
+use flatgeobuf::{
+    ColumnType, FallibleStreamingIterator, FeatureProperties, FgbCrs, FgbReader, FgbWriter,
+    FgbWriterOptions, Geometry, GeometryType,
+};
+
+use crate::error::Problem;
+use crate::mesh::{Mesh, MeshRef};
+use crate::weld::Welder;
+
+/// Name of the triangle-position column.
+const ID: &str = "id";
+
+/// The header CRS for a WKT and EPSG code.
+pub(crate) fn crs<'a>(wkt: Option<&'a str>, epsg: Option<u32>) -> FgbCrs<'a> {
+    FgbCrs {
+        org: epsg.map(|_| "EPSG"),
+        code: epsg.and_then(|c| i32::try_from(c).ok()).unwrap_or(0),
+        wkt,
+        ..FgbCrs::default()
+    }
+}
+
+/// A flatgeobuf or geozero error as an I/O error for the atomic writer.
+pub(crate) fn io_error(error: impl std::fmt::Display) -> io::Error {
+    io::Error::other(error.to_string())
+}
+
+/// Writes `mesh` as FlatGeobuf. The writer keeps the features in an anonymous temporary
+/// file until the index is built, so memory holds only one index entry per triangle.
+pub(crate) fn write<W: Write>(w: W, mesh: MeshRef<'_>) -> io::Result<()> {
+    let wkt = mesh.crs_line();
+    let options = FgbWriterOptions {
+        write_index: true,
+        detect_type: false,
+        promote_to_multi: false,
+        has_z: true,
+        crs: crs(wkt.as_deref(), mesh.epsg),
+        description: Some("TIN triangles written by tinsmith; id = triangle position"),
+        ..FgbWriterOptions::default()
+    };
+    let mut fgb =
+        FgbWriter::create_with_options("tin", GeometryType::Triangle, options).map_err(io_error)?;
+    fgb.add_column(ID, ColumnType::Long, |_, _| {});
+    for (id, &[a, b, c]) in mesh.triangles.iter().enumerate() {
+        let id64 = id as u64;
+        fgb.property(0, ID, &ColumnValue::Long(id as i64))
+            .map_err(io_error)?;
+        fgb.triangle_begin(true, 1, 0).map_err(io_error)?;
+        fgb.linestring_begin(false, 4, 0).map_err(io_error)?;
+        for (k, i) in [a, b, c, a].into_iter().enumerate() {
+            let [x, y, z] = mesh.vertices[i as usize];
+            fgb.coordinate(x, y, Some(z), None, None, None, k)
+                .map_err(io_error)?;
+        }
+        fgb.linestring_end(false, 0).map_err(io_error)?;
+        fgb.triangle_end(true, 0).map_err(io_error)?;
+        fgb.feature_end(id64).map_err(io_error)?;
+    }
+    fgb.write(w).map_err(io_error)
+}
+
+/// The first three corners of a triangle geometry's single ring.
+fn corners(geometry: &Geometry<'_>, feature: usize) -> Result<[[f64; 3]; 3], Problem> {
+    let bad = |what: &str| Problem::malformed(format_args!("feature {feature}: {what}"));
+    let xy = geometry.xy().ok_or_else(|| bad("no coordinates"))?;
+    let z = geometry
+        .z()
+        .ok_or_else(|| Problem::unsupported(format_args!("feature {feature} has no heights")))?;
+    let points = xy.len() / 2;
+    if !(points == 3 || points == 4)
+        || z.len() != points
+        || geometry.ends().is_some_and(|e| e.len() > 1)
+    {
+        return Err(Problem::unsupported(format_args!(
+            "feature {feature} is not a triangle (one ring of 3 or 4 positions): only \
+             triangles are read"
+        )));
+    }
+    let mut out = [[0.0; 3]; 3];
+    for (k, p) in out.iter_mut().enumerate() {
+        *p = [xy.get(2 * k), xy.get(2 * k + 1), z.get(k)];
+        if !p.iter().all(|c| c.is_finite()) {
+            return Err(bad("a non-finite coordinate"));
+        }
+    }
+    Ok(out)
+}
+
+/// Reads a FlatGeobuf file of `Triangle`, `Polygon` (one ring) or `TIN` features with Z,
+/// welding equal positions into shared vertices; when every feature has an `id`, the
+/// triangles are put in `id` order.
+pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
+    let reader = FgbReader::open(r).map_err(Problem::malformed)?;
+    let header = reader.header();
+    let mut mesh = Mesh::default();
+    if let Some(crs) = header.crs() {
+        mesh.epsg = u32::try_from(crs.code()).ok().filter(|&c| c > 0);
+        mesh.crs_wkt = crs.wkt().map(str::to_owned).filter(|w| !w.is_empty());
+    }
+    let kind = header.geometry_type();
+    if !matches!(
+        kind,
+        GeometryType::Triangle | GeometryType::Polygon | GeometryType::TIN | GeometryType::Unknown
+    ) {
+        return Err(Problem::unsupported(format_args!(
+            "{kind:?} geometries; only Triangle, Polygon and TIN are read"
+        )));
+    }
+    let mut features = reader.select_all_seq().map_err(Problem::malformed)?;
+    let mut welder = Welder::default();
+    let mut ids: Vec<Option<i64>> = Vec::new();
+    let mut feature_number = 0usize;
+    while let Some(feature) = features.next().map_err(Problem::malformed)? {
+        let geometry = feature.geometry().ok_or_else(|| {
+            Problem::malformed(format_args!("feature {feature_number} has no geometry"))
+        })?;
+        let id = feature.property::<i64>(ID).ok();
+        let mut triangles = Vec::new();
+        match geometry.parts() {
+            Some(parts) => {
+                for part in parts.iter() {
+                    triangles.push(corners(&part, feature_number)?);
+                }
+            }
+            None => triangles.push(corners(&geometry, feature_number)?),
+        }
+        for corners in triangles {
+            let mut triangle = [0u32; 3];
+            for (index, p) in triangle.iter_mut().zip(corners) {
+                *index = welder
+                    .vertex(p)
+                    .ok_or_else(|| Problem::unsupported("more than 2^32 vertices"))?;
+            }
+            mesh.triangles.push(triangle);
+            ids.push(id);
+        }
+        feature_number += 1;
+    }
+    mesh.vertices = welder.into_vertices();
+    if ids.iter().all(Option::is_some) {
+        let mut order: Vec<usize> = (0..mesh.triangles.len()).collect();
+        order.sort_by_key(|&i| ids[i]);
+        mesh.triangles = order.into_iter().map(|i| mesh.triangles[i]).collect();
+        // Vertices follow the triangles' order, as the other readers give them.
+        let mut welder = Welder::default();
+        let vertices = std::mem::take(&mut mesh.vertices);
+        for triangle in &mut mesh.triangles {
+            for index in triangle.iter_mut() {
+                *index = welder
+                    .vertex(vertices[*index as usize])
+                    .ok_or_else(|| Problem::unsupported("more than 2^32 vertices"))?;
+            }
+        }
+        mesh.vertices = welder.into_vertices();
+    }
+    Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write_to_vec(mesh: MeshRef<'_>) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        write(&mut bytes, mesh).expect("writing to a Vec");
+        bytes
+    }
+
+    #[test]
+    fn round_trip_restores_order_and_crs() -> Result<(), Problem> {
+        // A strip of triangles far apart, so the Hilbert sort reorders them.
+        let mut vertices = Vec::new();
+        let mut triangles = Vec::new();
+        for i in 0..50u32 {
+            let x = f64::from((i * 37) % 50) * 100.0 + 500_000.123_456_789;
+            vertices.extend([
+                [x, 0.5, 1.0 / 3.0],
+                [x + 1.0, 0.5, 2.0],
+                [x, 1.5, f64::from(i)],
+            ]);
+            triangles.push([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        let bytes = write_to_vec(
+            MeshRef::new(&vertices, &triangles)
+                .with_crs_wkt("PROJCS[\"x\"]")
+                .with_epsg(32610),
+        );
+        let mesh = read(bytes.as_slice())?;
+        assert_eq!(mesh.vertices, vertices);
+        assert_eq!(mesh.triangles, triangles);
+        assert_eq!(mesh.epsg, Some(32610));
+        assert_eq!(mesh.crs_wkt.as_deref(), Some("PROJCS[\"x\"]"));
+        Ok(())
+    }
+
+    #[test]
+    fn empty_mesh_and_garbage() -> Result<(), Problem> {
+        let bytes = write_to_vec(MeshRef::new(&[], &[]));
+        let mesh = read(bytes.as_slice())?;
+        assert!(mesh.triangles.is_empty() && mesh.vertices.is_empty());
+        assert!(read(&b""[..]).is_err());
+        assert!(read(&b"fgb\x03fgb\x00garbage"[..]).is_err());
+        let good = write_to_vec(MeshRef::new(
+            &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 1.0]],
+            &[[0, 1, 2]],
+        ));
+        for cut in 0..good.len() {
+            let _ = read(&good[..cut]);
+        }
+        Ok(())
+    }
+}

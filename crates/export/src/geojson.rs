@@ -1,0 +1,340 @@
+//! GeoJSON: a `FeatureCollection` with one `Polygon` Z feature (a closed ring of four
+//! positions) per triangle, written as a stream of text and read back with serde.
+//!
+//! RFC 7946 coordinates are WGS84 longitude, latitude. A mesh whose EPSG code is 4326 is
+//! written that way, with no `crs` member. Any other CRS is not RFC 7946: the collection then
+//! gets the `crs` member of the 2008 GeoJSON specification (which GDAL and QGIS read), a
+//! `crs_wkt` member with the full WKT and a `tinsmith_note` saying so. A mesh without a CRS
+//! gets `"crs": null`, which the 2008 specification defines as "no CRS".
+
+use std::io::{self, Read, Write};
+
+use serde::{Deserialize, Deserializer};
+use serde_json::Value;
+
+use crate::error::Problem;
+use crate::mesh::{Mesh, MeshRef};
+use crate::weld::Welder;
+
+/// The note written beside a non-WGS84 `crs` member.
+const NOTE_SOURCE_CRS: &str = "coordinates are in the CRS named by the crs member (see \
+                               crs_wkt), not WGS84 longitude/latitude as RFC 7946 requires";
+/// The note written beside `"crs": null`.
+const NOTE_NO_CRS: &str =
+    "coordinates have no CRS (pixel coordinates, or a raster without a CRS); not RFC 7946";
+
+/// Writes the opening of a `FeatureCollection` up to and including `"features":[`, with
+/// the members describing the CRS as explained in the module docs.
+pub(crate) fn write_collection_start<W: Write>(
+    w: &mut W,
+    crs_wkt: Option<&str>,
+    epsg: Option<u32>,
+) -> io::Result<()> {
+    let quote = |text: &str| serde_json::to_string(text).map_err(io::Error::other);
+    w.write_all(b"{\"type\":\"FeatureCollection\",\n")?;
+    if epsg != Some(4326) {
+        let name = match (epsg, crs_wkt) {
+            (Some(code), _) => Some(format!("urn:ogc:def:crs:EPSG::{code}")),
+            (None, Some(wkt)) => Some(wkt.to_owned()),
+            (None, None) => None,
+        };
+        match name {
+            Some(name) => {
+                writeln!(
+                    w,
+                    "\"crs\":{{\"type\":\"name\",\"properties\":{{\"name\":{}}}}},",
+                    quote(&name)?
+                )?;
+                writeln!(w, "\"tinsmith_note\":{},", quote(NOTE_SOURCE_CRS)?)?;
+            }
+            None => {
+                writeln!(w, "\"crs\":null,")?;
+                writeln!(w, "\"tinsmith_note\":{},", quote(NOTE_NO_CRS)?)?;
+            }
+        }
+    }
+    if let Some(wkt) = crs_wkt {
+        writeln!(w, "\"crs_wkt\":{},", quote(wkt)?)?;
+    }
+    w.write_all(b"\"features\":[\n")
+}
+
+/// Writes one position: `[x,y,z]` with the shortest decimals that parse back exactly.
+pub(crate) fn write_position<W: Write>(w: &mut W, p: &[f64]) -> io::Result<()> {
+    w.write_all(b"[")?;
+    for (i, c) in p.iter().enumerate() {
+        if i > 0 {
+            w.write_all(b",")?;
+        }
+        write!(w, "{c:?}")?;
+    }
+    w.write_all(b"]")
+}
+
+/// Writes `mesh` as a GeoJSON `FeatureCollection`; each feature has its triangle's
+/// position as the `id` property. The caller has checked the mesh.
+pub(crate) fn write<W: Write>(mut w: W, mesh: MeshRef<'_>) -> io::Result<()> {
+    let crs = mesh.crs_line();
+    write_collection_start(&mut w, crs.as_deref(), mesh.epsg)?;
+    for (id, &[a, b, c]) in mesh.triangles.iter().enumerate() {
+        if id > 0 {
+            w.write_all(b",\n")?;
+        }
+        write!(
+            w,
+            "{{\"type\":\"Feature\",\"properties\":{{\"id\":{id}}},\
+             \"geometry\":{{\"type\":\"Polygon\",\"coordinates\":[["
+        )?;
+        for (k, i) in [a, b, c, a].into_iter().enumerate() {
+            if k > 0 {
+                w.write_all(b",")?;
+            }
+            write_position(&mut w, &mesh.vertices[i as usize])?;
+        }
+        w.write_all(b"]]}}")?;
+    }
+    w.write_all(b"\n]}\n")
+}
+
+/// Deserializes a member that may be absent (`None`) or `null` (`Some(Value::Null)`).
+fn present<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Value>, D::Error> {
+    Value::deserialize(d).map(Some)
+}
+
+#[derive(Deserialize)]
+struct Collection {
+    #[serde(rename = "type")]
+    kind: String,
+    #[serde(default, deserialize_with = "present")]
+    crs: Option<Value>,
+    #[serde(default)]
+    crs_wkt: Option<String>,
+    #[serde(default)]
+    features: Vec<Feature>,
+}
+
+#[derive(Deserialize)]
+struct Feature {
+    geometry: Option<Geometry>,
+}
+
+#[derive(Deserialize)]
+struct Geometry {
+    #[serde(rename = "type")]
+    kind: String,
+    #[serde(default)]
+    coordinates: Vec<Vec<Vec<f64>>>,
+}
+
+/// The EPSG code in a CRS name such as `urn:ogc:def:crs:EPSG::3005` or `EPSG:3005`, or
+/// 4326 for OGC's CRS84.
+fn epsg_of_name(name: &str) -> Option<u32> {
+    if name.ends_with("CRS84") {
+        return Some(4326);
+    }
+    let upper = name.to_ascii_uppercase();
+    let code = upper.strip_prefix("EPSG:").or_else(|| {
+        upper
+            .strip_prefix("URN:OGC:DEF:CRS:EPSG:")
+            .map(|rest| rest.rsplit(':').next().unwrap_or(rest))
+    })?;
+    code.trim().parse().ok()
+}
+
+/// Reads a GeoJSON `FeatureCollection` of triangle `Polygon` Z features (closed rings of
+/// four positions), welding equal positions into shared vertices in order of appearance.
+pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
+    let collection: Collection = serde_json::from_reader(r).map_err(|e| {
+        if e.is_eof() && e.line() == 1 && e.column() == 0 {
+            Problem::malformed("the file is empty")
+        } else {
+            Problem::malformed(e)
+        }
+    })?;
+    if collection.kind != "FeatureCollection" {
+        return Err(Problem::unsupported(format_args!(
+            "a {} at the top level; only a FeatureCollection is read",
+            collection.kind
+        )));
+    }
+    let mut mesh = Mesh::default();
+    match &collection.crs {
+        // RFC 7946: WGS84 longitude, latitude.
+        None => mesh.epsg = Some(4326),
+        Some(Value::Null) => {}
+        Some(crs) => {
+            let name = crs["properties"]["name"]
+                .as_str()
+                .ok_or_else(|| Problem::unsupported("a crs member that is not of type `name`"))?;
+            mesh.epsg = epsg_of_name(name);
+            if mesh.epsg.is_none() {
+                mesh.crs_wkt = Some(name.to_owned());
+            }
+        }
+    }
+    if collection.crs_wkt.is_some() {
+        mesh.crs_wkt = collection.crs_wkt;
+    }
+    let mut welder = Welder::default();
+    for (f, feature) in collection.features.iter().enumerate() {
+        let Some(geometry) = &feature.geometry else {
+            return Err(Problem::malformed(format_args!(
+                "feature {f} has no geometry"
+            )));
+        };
+        if geometry.kind != "Polygon" {
+            return Err(Problem::unsupported(format_args!(
+                "feature {f} is a {}; only Polygon triangles are read",
+                geometry.kind
+            )));
+        }
+        let ring = match geometry.coordinates.as_slice() {
+            [ring] => ring,
+            rings => {
+                return Err(Problem::unsupported(format_args!(
+                    "feature {f} has {} rings; only triangles (one ring) are read",
+                    rings.len()
+                )))
+            }
+        };
+        if ring.len() != 4 || ring[0] != ring[3] {
+            return Err(Problem::unsupported(format_args!(
+                "feature {f} is not a triangle (a closed ring of 4 positions): only triangles \
+                 are read"
+            )));
+        }
+        let mut triangle = [0u32; 3];
+        for (index, position) in triangle.iter_mut().zip(ring) {
+            let p = match position.as_slice() {
+                &[x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => [x, y, z],
+                [_, _] => {
+                    return Err(Problem::unsupported(format_args!(
+                        "feature {f} has no heights (2D positions)"
+                    )))
+                }
+                _ => {
+                    return Err(Problem::malformed(format_args!(
+                        "feature {f} has a position that is not 3 finite numbers"
+                    )))
+                }
+            };
+            *index = welder
+                .vertex(p)
+                .ok_or_else(|| Problem::unsupported("more than 2^32 vertices"))?;
+        }
+        mesh.triangles.push(triangle);
+    }
+    mesh.vertices = welder.into_vertices();
+    Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write_to_string(mesh: MeshRef<'_>) -> String {
+        let mut bytes = Vec::new();
+        write(&mut bytes, mesh).expect("writing to a Vec");
+        String::from_utf8(bytes).expect("GeoJSON is text")
+    }
+
+    const VERTICES: [[f64; 3]; 4] = [
+        [-123.123_456_789_012_34, 49.0, 10.25],
+        [-123.0, 49.000_000_000_000_01, 11.0],
+        [-123.0, 49.1, 0.1 + 0.2],
+        [-123.1, 49.1, -0.0],
+    ];
+    const TRIANGLES: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
+
+    #[test]
+    fn wgs84_is_plain_rfc7946_and_round_trips_exactly() -> Result<(), Problem> {
+        let text = write_to_string(MeshRef::new(&VERTICES, &TRIANGLES).with_epsg(4326));
+        let value: Value = serde_json::from_str(&text).expect("valid JSON");
+        assert!(value.get("crs").is_none());
+        assert_eq!(value["features"].as_array().map(Vec::len), Some(2));
+        assert_eq!(value["features"][1]["properties"]["id"], 1);
+        let mesh = read(text.as_bytes())?;
+        assert_eq!(mesh.vertices, VERTICES);
+        assert_eq!(mesh.triangles, TRIANGLES);
+        assert_eq!((mesh.epsg, mesh.crs_wkt), (Some(4326), None));
+        Ok(())
+    }
+
+    #[test]
+    fn source_crs_gets_a_crs_member_and_a_note() -> Result<(), Problem> {
+        let wkt = "PROJCS[\"NAD83 / BC Albers\",AUTHORITY[\"EPSG\",\"3005\"]]";
+        let text = write_to_string(
+            MeshRef::new(&VERTICES, &TRIANGLES)
+                .with_crs_wkt(wkt)
+                .with_epsg(3005),
+        );
+        let value: Value = serde_json::from_str(&text).expect("valid JSON");
+        assert_eq!(
+            value["crs"]["properties"]["name"],
+            "urn:ogc:def:crs:EPSG::3005"
+        );
+        assert!(value["tinsmith_note"].as_str().is_some());
+        let mesh = read(text.as_bytes())?;
+        assert_eq!(
+            (mesh.epsg, mesh.crs_wkt.as_deref()),
+            (Some(3005), Some(wkt))
+        );
+
+        let text =
+            write_to_string(MeshRef::new(&VERTICES, &TRIANGLES).with_crs_wkt("LOCAL_CS[\"x\"]"));
+        let mesh = read(text.as_bytes())?;
+        assert_eq!(
+            (mesh.epsg, mesh.crs_wkt.as_deref()),
+            (None, Some("LOCAL_CS[\"x\"]"))
+        );
+
+        let text = write_to_string(MeshRef::new(&VERTICES, &TRIANGLES));
+        assert!(text.contains("\"crs\":null"));
+        let mesh = read(text.as_bytes())?;
+        assert_eq!((mesh.epsg, mesh.crs_wkt), (None, None));
+        Ok(())
+    }
+
+    #[test]
+    fn crs_names() {
+        assert_eq!(epsg_of_name("urn:ogc:def:crs:EPSG::3005"), Some(3005));
+        assert_eq!(
+            epsg_of_name("urn:ogc:def:crs:EPSG:9.8.1:32633"),
+            Some(32633)
+        );
+        assert_eq!(epsg_of_name("EPSG:2056"), Some(2056));
+        assert_eq!(epsg_of_name("urn:ogc:def:crs:OGC:1.3:CRS84"), Some(4326));
+        assert_eq!(epsg_of_name("PROJCS[\"x\"]"), None);
+    }
+
+    #[test]
+    fn bad_files_are_reported() {
+        let cases: [(&str, &str); 8] = [
+            ("", "empty"),
+            ("{\"type\":\"Feature\"}", "only a FeatureCollection"),
+            ("{\"type\":\"FeatureCollection\",\"features\":[{\"geometry\":null}]}", "no geometry"),
+            (
+                "{\"type\":\"FeatureCollection\",\"features\":[{\"geometry\":{\"type\":\"Point\",\"coordinates\":[]}}]}",
+                "only Polygon",
+            ),
+            (
+                "{\"type\":\"FeatureCollection\",\"features\":[{\"geometry\":{\"type\":\"Polygon\",\"coordinates\":[[[0,0,0],[1,0,0],[1,1,0],[0,1,0],[0,0,0]]]}}]}",
+                "only triangles",
+            ),
+            (
+                "{\"type\":\"FeatureCollection\",\"features\":[{\"geometry\":{\"type\":\"Polygon\",\"coordinates\":[[[0,0],[1,0],[1,1],[0,0]]]}}]}",
+                "no heights",
+            ),
+            ("{\"type\":\"FeatureCollection\",\"features\":[", "EOF"),
+            ("{\"type\":\"FeatureCollection\",\"crs\":{\"type\":\"link\"}}", "type `name`"),
+        ];
+        for (text, expected) in cases {
+            match read(text.as_bytes()) {
+                Err(Problem::Malformed(reason) | Problem::Unsupported(reason)) => {
+                    assert!(reason.contains(expected), "{text}: {reason}");
+                }
+                other => panic!("{text}: {other:?}"),
+            }
+        }
+    }
+}

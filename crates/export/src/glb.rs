@@ -1,0 +1,556 @@
+//! glTF 2.0 binary (`.glb`): one node whose translation is the local origin, one indexed
+//! triangle primitive with float32 positions (and optionally normals) relative to it.
+//!
+//! glTF is Y-up and right-handed; tinsmith's world is (x east, y north, z up). The writer
+//! maps world `(x, y, z)` to glTF `(x, z, -y)`, a proper rotation (−90° about x) that keeps
+//! triangles counter-clockwise seen from above as glTF front faces. Both the node
+//! translation (f64, in the JSON) and the positions (f32) are in glTF axes, so a glTF
+//! viewer shows the terrain right side up in its true position, and the reader maps back:
+//! world `x = tx + px`, `y = -(tz + pz)`, `z = ty + py` — exactly
+//! [`LocalOrigin::quantize`] of the written vertex.
+
+use std::io::{self, Read, Write};
+
+use serde_json::{json, Value};
+
+use crate::error::Problem;
+use crate::mesh::{Mesh, MeshRef};
+use crate::origin::LocalOrigin;
+
+/// `glTF` in ASCII, little-endian.
+const MAGIC: u32 = 0x4654_6C67;
+/// Chunk type of the JSON chunk.
+const CHUNK_JSON: u32 = 0x4E4F_534A;
+/// Chunk type of the binary chunk.
+const CHUNK_BIN: u32 = 0x004E_4942;
+/// Component types.
+const FLOAT: u64 = 5126;
+const UNSIGNED_BYTE: u64 = 5121;
+const UNSIGNED_SHORT: u64 = 5123;
+const UNSIGNED_INT: u64 = 5125;
+/// Largest JSON chunk read.
+const MAX_JSON: u32 = 64 << 20;
+
+/// World `(x, y, z)` offsets to glTF axes.
+fn to_gltf(p: [f32; 3]) -> [f32; 3] {
+    [p[0], p[2], -p[1]]
+}
+
+/// Rounds `n` up to a multiple of 4.
+fn pad4(n: u64) -> u64 {
+    n.div_ceil(4) * 4
+}
+
+/// Per-vertex unit normals in world axes: the area-weighted mean of the incident triangles'
+/// normals, computed from the float32 positions; straight up for a vertex without area.
+fn vertex_normals(local: &[[f32; 3]], triangles: &[[u32; 3]]) -> Vec<[f32; 3]> {
+    let mut sums = vec![[0.0f64; 3]; local.len()];
+    for &[a, b, c] in triangles {
+        let p = [a, b, c].map(|i| local[i as usize].map(f64::from));
+        let u = [p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]];
+        let v = [p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]];
+        // Twice the area times the unit normal.
+        let n = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        for i in [a, b, c] {
+            for (sum, component) in sums[i as usize].iter_mut().zip(n) {
+                *sum += component;
+            }
+        }
+    }
+    sums.into_iter()
+        .map(|n| {
+            let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            if length > 0.0 && length.is_finite() {
+                n.map(|c| (c / length) as f32)
+            } else {
+                [0.0, 0.0, 1.0]
+            }
+        })
+        .collect()
+}
+
+/// Writes `mesh` as GLB relative to `origin`, with normals if asked. The caller has
+/// checked the mesh.
+pub(crate) fn write<W: Write>(
+    mut w: W,
+    mesh: MeshRef<'_>,
+    origin: LocalOrigin,
+    normals: bool,
+) -> io::Result<()> {
+    let [ox, oy, oz] = origin.offset();
+    let mut extras = json!({
+        "generator": "tinsmith",
+        "origin": [ox, oy, oz],
+        "axes": "glTF (x, y, z) = world (x east, z up, -y north)",
+    });
+    if let Some(crs) = mesh.crs_line() {
+        extras["crs_wkt"] = Value::from(crs);
+    }
+    if let Some(epsg) = mesh.epsg {
+        extras["epsg"] = Value::from(epsg);
+    }
+    let mut node = json!({
+        "name": "tin",
+        "translation": [ox, oz, -oy],
+        "extras": extras,
+    });
+    let mut root = json!({
+        "asset": { "version": "2.0", "generator": concat!("tinsmith ", env!("CARGO_PKG_VERSION")) },
+        "scene": 0,
+        "scenes": [{ "nodes": [0] }],
+    });
+
+    let has_mesh = !mesh.vertices.is_empty() && !mesh.triangles.is_empty();
+    let vertex_count = mesh.vertices.len() as u64;
+    // 65535 is the primitive restart value, which glTF forbids in indices.
+    let small = vertex_count <= 65_535;
+    let index_size: u64 = if small { 2 } else { 4 };
+    let positions_len = 12 * vertex_count;
+    let normals_len = if normals { positions_len } else { 0 };
+    let indices_len = index_size * 3 * mesh.triangles.len() as u64;
+    let total_len = pad4(positions_len + normals_len + indices_len);
+
+    let mut min = [f32::INFINITY; 3];
+    let mut max = [f32::NEG_INFINITY; 3];
+    if has_mesh {
+        for &p in mesh.vertices {
+            let g = to_gltf(origin.to_local(p));
+            for axis in 0..3 {
+                min[axis] = min[axis].min(g[axis]);
+                max[axis] = max[axis].max(g[axis]);
+            }
+        }
+        // Exact f32 values, written as the f64 they convert to.
+        let exact = |v: [f32; 3]| v.map(f64::from);
+        let mut attributes = json!({ "POSITION": 0 });
+        let mut accessors = vec![json!({
+            "bufferView": 0, "componentType": FLOAT, "count": vertex_count, "type": "VEC3",
+            "min": exact(min), "max": exact(max),
+        })];
+        let mut views = vec![json!({
+            "buffer": 0, "byteOffset": 0, "byteLength": positions_len, "target": 34962,
+        })];
+        if normals {
+            attributes["NORMAL"] = Value::from(1);
+            accessors.push(json!({
+                "bufferView": 1, "componentType": FLOAT, "count": vertex_count, "type": "VEC3",
+            }));
+            views.push(json!({
+                "buffer": 0, "byteOffset": positions_len, "byteLength": normals_len,
+                "target": 34962,
+            }));
+        }
+        accessors.push(json!({
+            "bufferView": views.len(),
+            "componentType": if small { UNSIGNED_SHORT } else { UNSIGNED_INT },
+            "count": 3 * mesh.triangles.len() as u64,
+            "type": "SCALAR",
+        }));
+        views.push(json!({
+            "buffer": 0, "byteOffset": positions_len + normals_len, "byteLength": indices_len,
+            "target": 34963,
+        }));
+        node["mesh"] = Value::from(0);
+        root["meshes"] = json!([{
+            "name": "tin",
+            "primitives": [{ "attributes": attributes, "indices": accessors.len() - 1, "mode": 4 }],
+        }]);
+        root["accessors"] = Value::from(accessors);
+        root["bufferViews"] = Value::from(views);
+        root["buffers"] = json!([{ "byteLength": total_len }]);
+    }
+    root["nodes"] = json!([node]);
+
+    let mut json_bytes = serde_json::to_vec(&root).map_err(io::Error::other)?;
+    while !json_bytes.len().is_multiple_of(4) {
+        json_bytes.push(b' ');
+    }
+    let mut length = 12 + 8 + json_bytes.len() as u64;
+    if has_mesh {
+        length += 8 + total_len;
+    }
+    let length = u32::try_from(length)
+        .map_err(|_| io::Error::new(io::ErrorKind::InvalidInput, "larger than 4 GiB"))?;
+    w.write_all(&MAGIC.to_le_bytes())?;
+    w.write_all(&2u32.to_le_bytes())?;
+    w.write_all(&length.to_le_bytes())?;
+    w.write_all(&(json_bytes.len() as u32).to_le_bytes())?;
+    w.write_all(&CHUNK_JSON.to_le_bytes())?;
+    w.write_all(&json_bytes)?;
+    if !has_mesh {
+        return Ok(());
+    }
+    w.write_all(&(total_len as u32).to_le_bytes())?;
+    w.write_all(&CHUNK_BIN.to_le_bytes())?;
+    let local: Vec<[f32; 3]> = if normals {
+        mesh.vertices.iter().map(|&p| origin.to_local(p)).collect()
+    } else {
+        Vec::new()
+    };
+    for &p in mesh.vertices {
+        for c in to_gltf(origin.to_local(p)) {
+            w.write_all(&c.to_le_bytes())?;
+        }
+    }
+    if normals {
+        for n in vertex_normals(&local, mesh.triangles) {
+            for c in to_gltf(n) {
+                w.write_all(&c.to_le_bytes())?;
+            }
+        }
+    }
+    for &index in mesh.triangles.iter().flatten() {
+        if small {
+            w.write_all(&(index as u16).to_le_bytes())?;
+        } else {
+            w.write_all(&index.to_le_bytes())?;
+        }
+    }
+    let written = positions_len + normals_len + indices_len;
+    w.write_all(&vec![0u8; (total_len - written) as usize])?;
+    Ok(())
+}
+
+/// A little-endian `u32` at `at`.
+fn u32_at(bytes: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])
+}
+
+/// Reads a GLB file: every node with a mesh (translation only; no rotation, scale or
+/// matrix), every triangle primitive, positions mapped back to world axes through the
+/// node's translation. Vertices of several primitives are concatenated.
+pub(crate) fn read<R: Read>(mut r: R, file_len: Option<u64>) -> Result<Mesh, Problem> {
+    let mut header = [0u8; 20];
+    r.read_exact(&mut header).map_err(|error| match file_len {
+        Some(0) => Problem::malformed("the file is empty"),
+        _ => Problem::from(error),
+    })?;
+    if u32_at(&header, 0) != MAGIC {
+        return Err(Problem::malformed(
+            "does not start with `glTF` (not a GLB file)",
+        ));
+    }
+    if u32_at(&header, 4) != 2 {
+        return Err(Problem::unsupported(format_args!(
+            "GLB version {}; only 2 is read",
+            u32_at(&header, 4)
+        )));
+    }
+    let length = u64::from(u32_at(&header, 8));
+    if file_len.is_some_and(|len| len < length) {
+        return Err(Problem::malformed(format_args!(
+            "the header announces {length} bytes, the file has fewer (truncated)"
+        )));
+    }
+    let (json_len, json_type) = (u32_at(&header, 12), u32_at(&header, 16));
+    if json_type != CHUNK_JSON || json_len > MAX_JSON || u64::from(json_len) + 20 > length {
+        return Err(Problem::malformed(
+            "the first chunk is not a valid JSON chunk",
+        ));
+    }
+    let mut json_bytes = vec![0u8; json_len as usize];
+    r.read_exact(&mut json_bytes)?;
+    let root: Value = serde_json::from_slice(&json_bytes)
+        .map_err(|e| Problem::malformed(format_args!("JSON chunk: {e}")))?;
+
+    let mut bin = Vec::new();
+    let rest = length - 20 - u64::from(json_len);
+    if rest >= 8 {
+        let mut chunk = [0u8; 8];
+        r.read_exact(&mut chunk)?;
+        let (bin_len, bin_type) = (u64::from(u32_at(&chunk, 0)), u32_at(&chunk, 4));
+        if bin_type != CHUNK_BIN || bin_len > rest - 8 {
+            return Err(Problem::malformed(
+                "the second chunk is not a valid BIN chunk",
+            ));
+        }
+        bin = vec![0u8; bin_len as usize];
+        r.read_exact(&mut bin)?;
+    }
+    Gltf {
+        root: &root,
+        bin: &bin,
+    }
+    .mesh()
+}
+
+/// The parsed JSON and the binary chunk.
+struct Gltf<'a> {
+    root: &'a Value,
+    bin: &'a [u8],
+}
+
+/// A JSON member as an index or count.
+fn usize_of(value: &Value, what: &str) -> Result<usize, Problem> {
+    value
+        .as_u64()
+        .and_then(|v| usize::try_from(v).ok())
+        .ok_or_else(|| Problem::malformed(format_args!("{what} is not a non-negative integer")))
+}
+
+impl Gltf<'_> {
+    fn mesh(&self) -> Result<Mesh, Problem> {
+        let mut mesh = Mesh::default();
+        let nodes = self.root["nodes"]
+            .as_array()
+            .map(Vec::as_slice)
+            .unwrap_or(&[]);
+        for (n, node) in nodes.iter().enumerate() {
+            if let Some(extras) = node["extras"].as_object() {
+                if mesh.crs_wkt.is_none() {
+                    mesh.crs_wkt = extras
+                        .get("crs_wkt")
+                        .and_then(Value::as_str)
+                        .map(str::to_owned);
+                }
+                if mesh.epsg.is_none() {
+                    mesh.epsg = extras
+                        .get("epsg")
+                        .and_then(Value::as_u64)
+                        .and_then(|e| u32::try_from(e).ok());
+                }
+            }
+            if node["mesh"].is_null() {
+                continue;
+            }
+            for key in ["rotation", "scale", "matrix"] {
+                if !node[key].is_null() {
+                    return Err(Problem::unsupported(format_args!(
+                        "node {n} has a {key}; only translations are read"
+                    )));
+                }
+            }
+            let mut t = [0.0f64; 3];
+            if let Some(values) = node["translation"].as_array() {
+                if values.len() != 3 {
+                    return Err(Problem::malformed(format_args!(
+                        "node {n}: bad translation"
+                    )));
+                }
+                for (c, v) in t.iter_mut().zip(values) {
+                    *c = v.as_f64().filter(|c| c.is_finite()).ok_or_else(|| {
+                        Problem::malformed(format_args!("node {n}: bad translation"))
+                    })?;
+                }
+            }
+            let m = usize_of(&node["mesh"], "a node's mesh")?;
+            let primitives = self.root["meshes"][m]["primitives"]
+                .as_array()
+                .ok_or_else(|| Problem::malformed(format_args!("mesh {m} has no primitives")))?;
+            for primitive in primitives {
+                self.primitive(primitive, t, &mut mesh)?;
+            }
+        }
+        Ok(mesh)
+    }
+
+    fn primitive(&self, primitive: &Value, t: [f64; 3], mesh: &mut Mesh) -> Result<(), Problem> {
+        let mode = primitive["mode"].as_u64().unwrap_or(4);
+        if mode != 4 {
+            return Err(Problem::unsupported(format_args!(
+                "primitive mode {mode}; only triangles (4) are read"
+            )));
+        }
+        let position = usize_of(&primitive["attributes"]["POSITION"], "POSITION")?;
+        let positions = self.accessor(position, FLOAT, "VEC3")?;
+        let first = mesh.vertices.len();
+        for p in positions.chunks_exact(3) {
+            let g = [0, 1, 2].map(|i| p[i] as f32);
+            if g.iter().any(|c| !c.is_finite()) {
+                return Err(Problem::malformed("a position is not finite"));
+            }
+            let (px, py, pz) = (f64::from(g[0]), f64::from(g[1]), f64::from(g[2]));
+            mesh.vertices.push([t[0] + px, -(t[2] + pz), t[1] + py]);
+        }
+        let count = positions.len() / 3;
+        let indices: Vec<f64> = if primitive["indices"].is_null() {
+            (0..count).map(|i| i as f64).collect()
+        } else {
+            let accessor = usize_of(&primitive["indices"], "indices")?;
+            self.accessor(accessor, 0, "SCALAR")?
+        };
+        if !indices.len().is_multiple_of(3) {
+            return Err(Problem::malformed("the index count is not a multiple of 3"));
+        }
+        for corners in indices.chunks_exact(3) {
+            let mut triangle = [0u32; 3];
+            for (index, &corner) in triangle.iter_mut().zip(corners) {
+                let i = corner as usize;
+                if i >= count {
+                    return Err(Problem::malformed(format_args!(
+                        "index {i} out of range: the primitive has {count} vertices"
+                    )));
+                }
+                *index = u32::try_from(first + i)
+                    .map_err(|_| Problem::unsupported("more than 2^32 vertices"))?;
+            }
+            mesh.triangles.push(triangle);
+        }
+        Ok(())
+    }
+
+    /// The values of accessor `index` (of `component` type, or any integer type when 0),
+    /// as `f64` (exact for every type read).
+    fn accessor(&self, index: usize, component: u64, kind: &str) -> Result<Vec<f64>, Problem> {
+        let accessor = &self.root["accessors"][index];
+        let bad = |what: &str| Problem::malformed(format_args!("accessor {index}: {what}"));
+        if accessor["type"].as_str() != Some(kind) {
+            return Err(bad(&format!("type is not {kind}")));
+        }
+        if !accessor["sparse"].is_null() {
+            return Err(Problem::unsupported("sparse accessors"));
+        }
+        let component_type = accessor["componentType"].as_u64().unwrap_or(0);
+        let size = match (component, component_type) {
+            (FLOAT, FLOAT) => 4,
+            (0, UNSIGNED_BYTE) => 1,
+            (0, UNSIGNED_SHORT) => 2,
+            (0, UNSIGNED_INT) => 4,
+            _ => return Err(bad(&format!("unexpected component type {component_type}"))),
+        };
+        let width = if kind == "VEC3" { 3 } else { 1 };
+        let count = usize_of(&accessor["count"], "an accessor's count")?;
+        let view = &self.root["bufferViews"][usize_of(&accessor["bufferView"], "bufferView")?];
+        if view["buffer"].as_u64() != Some(0) {
+            return Err(Problem::unsupported("buffers other than the GLB's own"));
+        }
+        let view_offset = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+        let view_len = usize_of(&view["byteLength"], "a bufferView's byteLength")?;
+        let offset = accessor["byteOffset"].as_u64().unwrap_or(0) as usize;
+        let element = size * width;
+        let stride = view["byteStride"].as_u64().map_or(element, |s| s as usize);
+        let end = view_offset
+            .checked_add(view_len)
+            .filter(|&end| end <= self.bin.len())
+            .ok_or_else(|| bad("its bufferView runs past the binary chunk"))?;
+        let needed = match count {
+            0 => 0,
+            n => (n - 1)
+                .checked_mul(stride)
+                .and_then(|v| v.checked_add(offset + element))
+                .ok_or_else(|| bad("too large"))?,
+        };
+        if stride < element || needed > view_len {
+            return Err(bad("runs past its bufferView"));
+        }
+        let data = &self.bin[view_offset..end];
+        let mut values = Vec::with_capacity(count * width);
+        for i in 0..count {
+            for k in 0..width {
+                let at = offset + i * stride + k * size;
+                let b = &data[at..at + size];
+                values.push(match (component_type, size) {
+                    (FLOAT, _) => f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+                    (_, 1) => f64::from(b[0]),
+                    (_, 2) => f64::from(u16::from_le_bytes([b[0], b[1]])),
+                    _ => f64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+                });
+            }
+        }
+        Ok(values)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write_to_vec(mesh: MeshRef<'_>, origin: LocalOrigin, normals: bool) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        write(&mut bytes, mesh, origin, normals).expect("writing to a Vec");
+        bytes
+    }
+
+    const VERTICES: [[f64; 3]; 4] = [
+        [1_200_000.0, 500_000.0, 812.25],
+        [1_200_050.0, 500_000.0, 820.0],
+        [1_200_050.0, 500_050.0, 799.5],
+        [1_200_000.0, 500_050.0, 805.0],
+    ];
+    const TRIANGLES: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
+
+    #[test]
+    fn round_trip_gives_the_quantized_positions() -> Result<(), Problem> {
+        for normals in [false, true] {
+            let origin = LocalOrigin::of_points(&VERTICES);
+            let mesh = MeshRef::new(&VERTICES, &TRIANGLES)
+                .with_crs_wkt("PROJCS[\"x\"]")
+                .with_epsg(3005);
+            let bytes = write_to_vec(mesh, origin, normals);
+            assert_eq!(bytes.len() % 4, 0);
+            assert_eq!(u32_at(&bytes, 8) as usize, bytes.len());
+            let back = read(bytes.as_slice(), Some(bytes.len() as u64))?;
+            let expected: Vec<[f64; 3]> = VERTICES.iter().map(|&p| origin.quantize(p)).collect();
+            assert_eq!(back.vertices, expected);
+            assert_eq!(back.triangles, TRIANGLES);
+            assert_eq!(back.crs_wkt.as_deref(), Some("PROJCS[\"x\"]"));
+            assert_eq!(back.epsg, Some(3005));
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn json_states_origin_axes_and_exact_bounds() -> Result<(), Problem> {
+        let origin = LocalOrigin::new([1_200_025.0, 500_025.0, 810.0]);
+        let bytes = write_to_vec(MeshRef::new(&VERTICES, &TRIANGLES), origin, false);
+        let json_len = u32_at(&bytes, 12) as usize;
+        let root: Value = serde_json::from_slice(&bytes[20..20 + json_len]).expect("JSON");
+        assert_eq!(
+            root["nodes"][0]["translation"],
+            json!([1_200_025.0, 810.0, -500_025.0])
+        );
+        assert_eq!(root["accessors"][0]["min"], json!([-25.0, -10.5, -25.0]));
+        assert_eq!(root["accessors"][0]["max"], json!([25.0, 10.0, 25.0]));
+        assert_eq!(root["accessors"][1]["componentType"], json!(UNSIGNED_SHORT));
+        Ok(())
+    }
+
+    #[test]
+    fn normals_point_up_for_a_gentle_surface() {
+        let local: Vec<[f32; 3]> = VERTICES
+            .iter()
+            .map(|&p| LocalOrigin::of_points(&VERTICES).to_local(p))
+            .collect();
+        for n in vertex_normals(&local, &TRIANGLES) {
+            let length = n.iter().map(|c| f64::from(*c).powi(2)).sum::<f64>().sqrt();
+            assert!((length - 1.0).abs() < 1e-6);
+            assert!(n[2] > 0.9, "{n:?}");
+        }
+    }
+
+    #[test]
+    fn empty_mesh_and_broken_files() -> Result<(), Problem> {
+        let bytes = write_to_vec(MeshRef::new(&[], &[]), LocalOrigin::new([0.0; 3]), true);
+        assert_eq!(
+            read(bytes.as_slice(), Some(bytes.len() as u64))?,
+            Mesh::default()
+        );
+        let good = write_to_vec(
+            MeshRef::new(&VERTICES, &TRIANGLES),
+            LocalOrigin::of_points(&VERTICES),
+            true,
+        );
+        for cut in [0, 10, 20, 40, good.len() - 4] {
+            assert!(
+                read(&good[..cut], Some(cut as u64)).is_err(),
+                "cut at {cut}"
+            );
+        }
+        let mut corrupt = good.clone();
+        corrupt[0] = b'x';
+        assert!(matches!(
+            read(corrupt.as_slice(), None),
+            Err(Problem::Malformed(_))
+        ));
+        for position in (0..good.len()).step_by(7) {
+            let mut corrupt = good.clone();
+            corrupt[position] ^= 0xA5;
+            let _ = read(corrupt.as_slice(), Some(corrupt.len() as u64));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,261 @@
+//! Line features (contours, breaklines): GeoJSON or FlatGeobuf `LineString`s with an
+//! `elev` attribute, streamed and written atomically.
+
+use std::io::{self, Write};
+use std::path::Path;
+
+use flatgeobuf::geozero::{ColumnValue, FeatureProcessor, GeomProcessor, PropertyProcessor};
+use flatgeobuf::{ColumnType, FgbWriter, FgbWriterOptions, GeometryType};
+
+use crate::atomic::write_atomically;
+use crate::error::{Error, Result};
+use crate::{fgb, geojson};
+
+/// The vector formats [`write_lines`] writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum LineFormat {
+    /// A GeoJSON `FeatureCollection` of `LineString` features; the CRS is described as for
+    /// [`crate::MeshFormat::GeoJson`] (plain RFC 7946 for EPSG 4326, otherwise a `crs`
+    /// member and a note).
+    GeoJson,
+    /// FlatGeobuf `LineString` features with a spatial index and the CRS in the header.
+    FlatGeobuf,
+}
+
+/// A point type of a line: 2D `[x, y]` or 3D `[x, y, z]`.
+pub trait LinePoint: Copy {
+    /// Whether the points carry a height (written as Z).
+    const HAS_Z: bool;
+    /// The coordinates: 2 or 3 values.
+    fn coordinates(&self) -> &[f64];
+}
+
+impl LinePoint for [f64; 2] {
+    const HAS_Z: bool = false;
+    fn coordinates(&self) -> &[f64] {
+        self
+    }
+}
+
+impl LinePoint for [f64; 3] {
+    const HAS_Z: bool = true;
+    fn coordinates(&self) -> &[f64] {
+        self
+    }
+}
+
+/// The coordinate reference system of features to write.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct CrsRef<'a> {
+    /// The CRS as WKT.
+    pub wkt: Option<&'a str>,
+    /// Its EPSG code, when known; `Some(4326)` means longitude, latitude.
+    pub epsg: Option<u32>,
+}
+
+impl<'a> CrsRef<'a> {
+    /// A CRS from its WKT and EPSG code (either may be absent).
+    pub fn new(wkt: Option<&'a str>, epsg: Option<u32>) -> CrsRef<'a> {
+        CrsRef { wkt, epsg }
+    }
+}
+
+/// Writes `lines` — each a polyline and its elevation — to `path` as `LineString`
+/// features with an `elev` (double) attribute, in the given order, atomically.
+///
+/// With `[f64; 3]` points the features are `LineString Z`; with `[f64; 2]` they are 2D.
+/// The CRS is recorded in the file (GeoJSON: as for [`crate::MeshFormat::GeoJson`];
+/// FlatGeobuf: header WKT and EPSG code). Features are streamed to a temporary file and
+/// renamed into place; FlatGeobuf's spatial index sorts the features, so the GeoJSON order
+/// is the slice's and the FlatGeobuf order is not.
+///
+/// # Errors
+/// - [`Error::InvalidLine`] for a line with fewer than two points or a non-finite
+///   coordinate or elevation, found before any file is created.
+/// - [`Error::MissingDirectory`], [`Error::Io`] as for [`crate::write_mesh`].
+///
+/// After an error nothing new is left on disk.
+///
+/// # Example
+/// ```
+/// use tinsmith_export::{write_lines, CrsRef, LineFormat};
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let dir = tempfile::tempdir()?;
+/// let contour: &[[f64; 2]] = &[[500_000.0, 5_000_000.0], [500_050.0, 5_000_020.0]];
+/// write_lines(
+///     &dir.path().join("contours.geojson"),
+///     LineFormat::GeoJson,
+///     &[(contour, 250.0)],
+///     CrsRef::new(None, Some(32610)),
+/// )?;
+/// # Ok(())
+/// # }
+/// ```
+pub fn write_lines<P: LinePoint>(
+    path: &Path,
+    format: LineFormat,
+    lines: &[(&[P], f64)],
+    crs: CrsRef<'_>,
+) -> Result<()> {
+    for (line, (points, elev)) in lines.iter().enumerate() {
+        let invalid = |reason: String| Error::InvalidLine {
+            path: path.to_path_buf(),
+            line,
+            reason,
+        };
+        if points.len() < 2 {
+            return Err(invalid(format!(
+                "{} point(s); a line needs at least 2",
+                points.len()
+            )));
+        }
+        if !elev.is_finite() {
+            return Err(invalid(format!("non-finite elevation {elev}")));
+        }
+        if let Some(k) = points
+            .iter()
+            .position(|p| !p.coordinates().iter().all(|c| c.is_finite()))
+        {
+            return Err(invalid(format!("point {k} has a non-finite coordinate")));
+        }
+    }
+    write_atomically(path, |w| match format {
+        LineFormat::GeoJson => write_geojson(w, lines, crs),
+        LineFormat::FlatGeobuf => write_fgb(w, lines, crs),
+    })
+}
+
+fn write_geojson<W: Write, P: LinePoint>(
+    mut w: W,
+    lines: &[(&[P], f64)],
+    crs: CrsRef<'_>,
+) -> io::Result<()> {
+    geojson::write_collection_start(&mut w, crs.wkt, crs.epsg)?;
+    for (i, (points, elev)) in lines.iter().enumerate() {
+        if i > 0 {
+            w.write_all(b",\n")?;
+        }
+        write!(
+            w,
+            "{{\"type\":\"Feature\",\"properties\":{{\"elev\":{elev:?}}},\
+             \"geometry\":{{\"type\":\"LineString\",\"coordinates\":["
+        )?;
+        for (k, p) in points.iter().enumerate() {
+            if k > 0 {
+                w.write_all(b",")?;
+            }
+            geojson::write_position(&mut w, p.coordinates())?;
+        }
+        w.write_all(b"]}}")?;
+    }
+    w.write_all(b"\n]}\n")
+}
+
+fn write_fgb<W: Write, P: LinePoint>(
+    w: W,
+    lines: &[(&[P], f64)],
+    crs: CrsRef<'_>,
+) -> io::Result<()> {
+    let options = FgbWriterOptions {
+        write_index: true,
+        detect_type: false,
+        promote_to_multi: false,
+        has_z: P::HAS_Z,
+        crs: fgb::crs(crs.wkt, crs.epsg),
+        ..FgbWriterOptions::default()
+    };
+    let mut out = FgbWriter::create_with_options("lines", GeometryType::LineString, options)
+        .map_err(fgb::io_error)?;
+    out.add_column("elev", ColumnType::Double, |_, _| {});
+    for (i, (points, elev)) in lines.iter().enumerate() {
+        out.property(0, "elev", &ColumnValue::Double(*elev))
+            .map_err(fgb::io_error)?;
+        out.linestring_begin(true, points.len(), 0)
+            .map_err(fgb::io_error)?;
+        for (k, p) in points.iter().enumerate() {
+            let c = p.coordinates();
+            out.coordinate(c[0], c[1], c.get(2).copied(), None, None, None, k)
+                .map_err(fgb::io_error)?;
+        }
+        out.linestring_end(true, 0).map_err(fgb::io_error)?;
+        out.feature_end(i as u64).map_err(fgb::io_error)?;
+    }
+    out.write(w).map_err(fgb::io_error)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use flatgeobuf::{FallibleStreamingIterator, FeatureProperties, FgbReader};
+
+    #[test]
+    fn geojson_lines_carry_elev_and_order() -> Result<()> {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("c.geojson");
+        let a: &[[f64; 3]] = &[[0.0, 0.0, 5.0], [1.0, 0.5, 5.0]];
+        let b: &[[f64; 3]] = &[[2.0, 2.0, 10.0], [3.0, 2.0, 10.0], [3.0, 3.0, 10.0]];
+        write_lines(
+            &path,
+            LineFormat::GeoJson,
+            &[(a, 5.0), (b, 10.0)],
+            CrsRef::new(None, Some(4326)),
+        )?;
+        let text = std::fs::read_to_string(&path).expect("read back");
+        let value: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+        assert!(value.get("crs").is_none());
+        assert_eq!(value["features"][1]["properties"]["elev"], 10.0);
+        assert_eq!(
+            value["features"][1]["geometry"]["coordinates"][2],
+            serde_json::json!([3.0, 3.0, 10.0])
+        );
+        Ok(())
+    }
+
+    #[test]
+    fn fgb_lines_read_back_with_flatgeobuf() -> Result<()> {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("c.fgb");
+        let a: &[[f64; 2]] = &[[0.0, 0.0], [1.0, 0.5]];
+        let b: &[[f64; 2]] = &[[2.0, 2.0], [3.0, 2.0], [3.0, 3.0]];
+        write_lines(
+            &path,
+            LineFormat::FlatGeobuf,
+            &[(a, 5.0), (b, 10.5)],
+            CrsRef::new(Some("PROJCS[\"x\"]"), Some(3005)),
+        )?;
+        let file = std::fs::File::open(&path).expect("open");
+        let reader = FgbReader::open(std::io::BufReader::new(file)).expect("fgb");
+        assert_eq!(reader.header().geometry_type(), GeometryType::LineString);
+        assert_eq!(reader.header().crs().map(|c| c.code()), Some(3005));
+        let mut features = reader.select_all_seq().expect("features");
+        let mut elevs = Vec::new();
+        while let Some(feature) = features.next().expect("feature") {
+            elevs.push(feature.property::<f64>("elev").expect("elev"));
+        }
+        elevs.sort_by(f64::total_cmp);
+        assert_eq!(elevs, vec![5.0, 10.5]);
+        Ok(())
+    }
+
+    #[test]
+    fn invalid_lines_are_refused_before_any_file() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("c.geojson");
+        let short: &[[f64; 2]] = &[[0.0, 0.0]];
+        let nan: &[[f64; 2]] = &[[0.0, 0.0], [f64::NAN, 1.0]];
+        let good: &[[f64; 2]] = &[[0.0, 0.0], [1.0, 1.0]];
+        for (lines, expected) in [
+            (vec![(good, 1.0), (short, 1.0)], "line 1: 1 point(s)"),
+            (vec![(nan, 1.0)], "line 0: point 1 has a non-finite"),
+            (vec![(good, f64::INFINITY)], "non-finite elevation"),
+        ] {
+            let error = write_lines(&path, LineFormat::GeoJson, &lines, CrsRef::default())
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
+            assert!(error.contains(expected), "{error}");
+        }
+        assert!(std::fs::read_dir(dir.path()).expect("dir").next().is_none());
+    }
+}

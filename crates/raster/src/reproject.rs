@@ -1,0 +1,130 @@
+//! Coordinate transformation between a raster's CRS and WGS84 longitude, latitude (GDAL's
+//! PROJ), for writers that need RFC 7946 GeoJSON and for reading it back.
+
+use gdal::spatial_ref::{AxisMappingStrategy, CoordTransform, SpatialRef};
+
+use crate::error::{Error, Result};
+
+/// Points transformed per PROJ call.
+const CHUNK: usize = 1 << 16;
+
+/// A CRS from WKT (or anything GDAL's `SetFromUserInput` takes), in x = easting /
+/// longitude, y = northing / latitude order.
+fn spatial_ref(text: &str) -> Result<SpatialRef> {
+    let mut srs = SpatialRef::from_definition(text).map_err(|source| Error::Crs {
+        reason: format!("GDAL cannot read the CRS `{}`", short(text)),
+        source: Box::new(source),
+    })?;
+    srs.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+    Ok(srs)
+}
+
+/// The start of a long CRS text, for messages.
+fn short(text: &str) -> String {
+    let mut out: String = text.chars().take(60).collect();
+    if out.len() < text.len() {
+        out.push('…');
+    }
+    out
+}
+
+/// WGS84 (EPSG:4326) in longitude, latitude order.
+fn wgs84() -> Result<SpatialRef> {
+    spatial_ref("EPSG:4326")
+}
+
+/// Transforms `points` in place from `source` to `target`: x and y change, heights are
+/// left as they are (no vertical transformation).
+fn transform(source: &SpatialRef, target: &SpatialRef, points: &mut [[f64; 3]]) -> Result<()> {
+    let transform = CoordTransform::new(source, target).map_err(|source| Error::Crs {
+        reason: "PROJ has no transformation between the two CRSs".to_owned(),
+        source: Box::new(source),
+    })?;
+    let mut xs = Vec::with_capacity(CHUNK.min(points.len()));
+    let mut ys = Vec::with_capacity(CHUNK.min(points.len()));
+    for (chunk_number, chunk) in points.chunks_mut(CHUNK).enumerate() {
+        xs.clear();
+        ys.clear();
+        xs.extend(chunk.iter().map(|p| p[0]));
+        ys.extend(chunk.iter().map(|p| p[1]));
+        transform
+            .transform_coords(&mut xs, &mut ys, &mut [])
+            .map_err(|source| Error::Crs {
+                reason: "PROJ failed to transform the coordinates".to_owned(),
+                source: Box::new(source),
+            })?;
+        for (k, (p, (x, y))) in chunk.iter_mut().zip(xs.iter().zip(&ys)).enumerate() {
+            if !(x.is_finite() && y.is_finite()) {
+                return Err(Error::Untransformable {
+                    point: chunk_number * CHUNK + k,
+                    position: *p,
+                });
+            }
+            p[0] = *x;
+            p[1] = *y;
+        }
+    }
+    Ok(())
+}
+
+/// Transforms `points` (x, y in the CRS given as WKT, heights) in place to WGS84
+/// longitude, latitude in degrees (EPSG:4326 in traditional GIS order, as RFC 7946 GeoJSON
+/// wants it). Heights are not changed.
+///
+/// # Errors
+/// [`Error::Crs`] when GDAL cannot read the CRS or PROJ cannot transform between them,
+/// [`Error::Untransformable`] for a point PROJ maps to no finite position. `points` may be
+/// partly transformed after an error.
+///
+/// # Example
+/// ```no_run
+/// # fn main() -> Result<(), tinsmith_raster::Error> {
+/// let mut points = [[1_200_000.0, 500_000.0, 812.5]];
+/// tinsmith_raster::to_wgs84("EPSG:3005", &mut points)?;
+/// assert!(points[0][0] < -114.0 && points[0][1] > 48.0);
+/// # Ok(())
+/// # }
+/// ```
+pub fn to_wgs84(source_wkt: &str, points: &mut [[f64; 3]]) -> Result<()> {
+    transform(&spatial_ref(source_wkt)?, &wgs84()?, points)
+}
+
+/// The inverse of [`to_wgs84`]: WGS84 longitude, latitude to the CRS given as WKT, in
+/// place; heights are not changed.
+///
+/// # Errors
+/// As [`to_wgs84`].
+pub fn from_wgs84(target_wkt: &str, points: &mut [[f64; 3]]) -> Result<()> {
+    transform(&wgs84()?, &spatial_ref(target_wkt)?, points)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn utm_to_wgs84_and_back() -> Result<()> {
+        // UTM 33N: the central meridian is 15 E; the false easting 500 000 is on it.
+        let original = [[500_000.0, 0.0, 5.0], [500_000.0, 5_540_000.0, -3.25]];
+        let mut points = original;
+        to_wgs84("EPSG:32633", &mut points)?;
+        assert!((points[0][0] - 15.0).abs() < 1e-9 && points[0][1].abs() < 1e-9);
+        assert!((points[1][0] - 15.0).abs() < 1e-9 && (points[1][1] - 50.0).abs() < 0.1);
+        assert_eq!([points[0][2], points[1][2]], [5.0, -3.25]);
+        from_wgs84("EPSG:32633", &mut points)?;
+        for (p, q) in points.iter().zip(&original) {
+            assert!(
+                (p[0] - q[0]).abs() < 1e-6 && (p[1] - q[1]).abs() < 1e-6,
+                "{p:?}"
+            );
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn bad_crs_is_an_error() {
+        let mut points = [[0.0; 3]];
+        let error = to_wgs84("not a crs", &mut points).expect_err("bad CRS");
+        assert!(error.to_string().contains("not a crs"), "{error}");
+    }
+}

@@ -1,0 +1,589 @@
+//! Issue 5: every output format, checked by independent readers — GDAL's `ogrinfo` and
+//! `gdaltransform`, trimesh (PyPI), the Khronos glTF validator (npm), Python's
+//! `xml.etree` — and by `tinsmith verify` reading each file back.
+//!
+//! The oracles are installed by `make deps` (`.venv/`, `.tools/`). A missing oracle fails
+//! the test with the command that installs it; set `TINSMITH_SKIP_ORACLES=1` to skip those
+//! checks on purpose (CI never does).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use serde_json::Value;
+
+use crate::util::{fixture, stderr, stdout, Dir};
+
+/// The small DEM most tests use: 100 x 80 Float32, EPSG:3857, nodata.
+const DEM: &str = "tintn_valid_raster_3857.tif";
+const E: &str = "0.5";
+
+fn repo() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The Python with trimesh, or `None` when skipping oracles was asked for.
+fn python() -> Option<PathBuf> {
+    let path = std::env::var_os("TINSMITH_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join(".venv/bin/python3"));
+    oracle_present(path.exists(), &path.display().to_string()).then_some(path)
+}
+
+/// Whether the glTF validator is installed (see [`python`]).
+fn gltf_validator() -> bool {
+    let modules = std::env::var_os("TINSMITH_NODE_MODULES")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join(".tools/node_modules"));
+    let present = modules.join("gltf-validator").exists();
+    oracle_present(present, "gltf-validator in .tools/node_modules")
+}
+
+/// Fails when an oracle is missing, unless `TINSMITH_SKIP_ORACLES=1`.
+fn oracle_present(present: bool, what: &str) -> bool {
+    if present {
+        return true;
+    }
+    if std::env::var("TINSMITH_SKIP_ORACLES").as_deref() == Ok("1") {
+        eprintln!("skipping the {what} checks (TINSMITH_SKIP_ORACLES=1)");
+        return false;
+    }
+    panic!("oracle missing: {what}; run `make deps` (or set TINSMITH_SKIP_ORACLES=1)");
+}
+
+/// Runs a program, asserting success; returns stdout.
+fn run(program: &str, args: &[&str]) -> String {
+    let out = Command::new(program)
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {program}: {e}"));
+    assert!(
+        out.status.success(),
+        "{program} {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Meshes `dem` into `name` (extra flags appended), asserting success; returns the
+/// `--report` JSON.
+fn mesh(d: &Dir, dem: &str, name: &str, e: &str, extra: &[&str]) -> Value {
+    let mut args = vec![
+        "mesh",
+        dem,
+        "-o",
+        name,
+        "--max-error",
+        e,
+        "--report",
+        "r.json",
+        "-q",
+    ];
+    args.extend_from_slice(extra);
+    let o = d.run(&args);
+    assert!(o.status.success(), "mesh {name} failed: {}", stderr(&o));
+    serde_json::from_slice(&std::fs::read(d.path("r.json")).expect("report")).expect("JSON")
+}
+
+/// `tinsmith verify` on a written file: must pass within `e`; returns the JSON report.
+fn verify(d: &Dir, dem: &str, name: &str, e: &str, extra: &[&str]) -> Value {
+    let mut args = vec!["verify", dem, name, "--max-error", e, "--json"];
+    args.extend_from_slice(extra);
+    let o = d.run(&args);
+    let report: Value = serde_json::from_str(&stdout(&o))
+        .unwrap_or_else(|_| panic!("verify {name}: {} {}", stdout(&o), stderr(&o)));
+    assert!(o.status.success(), "verify {name} failed: {report:#}");
+    assert!(report["max_error"].as_f64().expect("max_error") <= e.parse::<f64>().expect("E"));
+    assert_eq!(report["uncovered_samples"], 0, "{name}");
+    report
+}
+
+/// A mesh as an oracle read it: positions and triangles.
+#[derive(Debug)]
+struct Read {
+    vertices: Vec<[f64; 3]>,
+    faces: Vec<[usize; 3]>,
+    json: Value,
+}
+
+/// Reads a mesh file with trimesh.
+fn trimesh(python: &Path, path: &Path) -> Read {
+    let script = repo().join("tests/oracles/mesh_read.py");
+    let text = run(
+        &python.to_string_lossy(),
+        &[&script.to_string_lossy(), &path.to_string_lossy()],
+    );
+    let json: Value = serde_json::from_str(&text).expect("oracle JSON");
+    let vertices = json["vertices"]
+        .as_array()
+        .expect("vertices")
+        .iter()
+        .map(|v| [0, 1, 2].map(|i| v[i].as_f64().expect("coordinate")))
+        .collect();
+    let faces = json["faces"]
+        .as_array()
+        .expect("faces")
+        .iter()
+        .map(|f| [0, 1, 2].map(|i| f[i].as_u64().expect("index") as usize))
+        .collect();
+    Read {
+        vertices,
+        faces,
+        json,
+    }
+}
+
+/// Each triangle as its corners, rotated to start at the smallest corner (orientation
+/// kept), sorted: comparable across formats whatever their vertex and triangle order.
+fn canonical(vertices: &[[f64; 3]], faces: &[[usize; 3]]) -> Vec<[[f64; 3]; 3]> {
+    let mut triangles: Vec<[[f64; 3]; 3]> = faces
+        .iter()
+        .map(|f| {
+            let c = f.map(|i| vertices[i]);
+            let first = (0..3)
+                .min_by(|&a, &b| c[a].partial_cmp(&c[b]).expect("finite"))
+                .expect("three corners");
+            [c[first], c[(first + 1) % 3], c[(first + 2) % 3]]
+        })
+        .collect();
+    triangles.sort_by(|a, b| a.partial_cmp(b).expect("finite"));
+    triangles
+}
+
+/// Asserts two canonical triangle lists are equal within `tolerance` per coordinate.
+fn assert_same_triangles(a: &[[[f64; 3]; 3]], b: &[[[f64; 3]; 3]], tolerance: f64, what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}: triangle counts");
+    let mut worst = 0.0f64;
+    for (s, t) in a.iter().zip(b) {
+        for (p, q) in s.iter().zip(t) {
+            for (x, y) in p.iter().zip(q) {
+                worst = worst.max((x - y).abs());
+            }
+        }
+    }
+    assert!(worst <= tolerance, "{what}: coordinates differ by {worst}");
+}
+
+/// The triangles in `ogrinfo -al` output: `TRIANGLE Z ((...))` or `POLYGON Z ((...))`
+/// lines, as corner triples.
+fn ogr_triangles(text: &str) -> Vec<[[f64; 3]; 3]> {
+    let mut triangles = Vec::new();
+    for line in text.lines().map(str::trim) {
+        let Some(ring) = line
+            .strip_prefix("TRIANGLE Z ((")
+            .or_else(|| line.strip_prefix("POLYGON Z (("))
+        else {
+            continue;
+        };
+        let ring = ring.trim_end_matches("))");
+        let points: Vec<[f64; 3]> = ring
+            .split(',')
+            .map(|p| {
+                let v: Vec<f64> = p
+                    .split_ascii_whitespace()
+                    .map(|c| c.parse().expect("number"))
+                    .collect();
+                [v[0], v[1], v[2]]
+            })
+            .collect();
+        assert_eq!(points.len(), 4, "{line}");
+        assert_eq!(points[0], points[3], "closed ring: {line}");
+        triangles.push([points[0], points[1], points[2]]);
+    }
+    triangles
+}
+
+/// `canonical` of triangles given by corners.
+fn canonical_corners(triangles: &[[[f64; 3]; 3]]) -> Vec<[[f64; 3]; 3]> {
+    let vertices: Vec<[f64; 3]> = triangles.iter().flatten().copied().collect();
+    let faces: Vec<[usize; 3]> = (0..triangles.len())
+        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+        .collect();
+    canonical(&vertices, &faces)
+}
+
+/// The value after `key:` on the line of `ogrinfo -so` output that starts with it.
+fn ogr_field<'a>(text: &'a str, key: &str) -> &'a str {
+    text.lines()
+        .find_map(|l| l.strip_prefix(key))
+        .map(str::trim)
+        .unwrap_or_else(|| panic!("no `{key}` in ogrinfo output:\n{text}"))
+}
+
+#[test]
+fn every_tin_format_reads_back_and_verifies() {
+    let d = Dir::new();
+    let dem = fixture(DEM);
+    for ext in ["ply", "obj", "stl", "glb", "geojson", "fgb", "xml"] {
+        let name = format!("m.{ext}");
+        let report = mesh(&d, &dem, &name, E, &[]);
+        let verified = verify(&d, &dem, &name, E, &[]);
+        assert_eq!(verified["triangles"], report["triangles_after"], "{ext}");
+        assert_eq!(verified["vertices"], report["vertices_after"], "{ext}");
+        assert_eq!(
+            report["format"],
+            if ext == "xml" {
+                "landxml"
+            } else if ext == "fgb" {
+                "fgb"
+            } else {
+                ext
+            }
+        );
+    }
+    // The CRS goes into a .prj sidecar for the formats that cannot hold it.
+    let srs = run(
+        "gdalsrsinfo",
+        &["-o", "epsg", &d.path("m.prj").to_string_lossy()],
+    );
+    assert!(srs.contains("EPSG:3857"), "{srs}");
+}
+
+#[test]
+fn trimesh_reads_ply_obj_stl_and_glb_with_the_same_triangles() {
+    let Some(python) = python() else { return };
+    let d = Dir::new();
+    let dem = fixture(DEM);
+    let report = mesh(&d, &dem, "m.ply", E, &[]);
+    let ply = trimesh(&python, &d.path("m.ply"));
+    assert_eq!(
+        ply.vertices.len() as u64,
+        report["vertices_after"].as_u64().expect("count")
+    );
+    assert_eq!(
+        ply.faces.len() as u64,
+        report["triangles_after"].as_u64().expect("count")
+    );
+    let reference = canonical(&ply.vertices, &ply.faces);
+
+    mesh(&d, &dem, "m.obj", E, &[]);
+    let obj = trimesh(&python, &d.path("m.obj"));
+    assert_eq!(obj.vertices, ply.vertices, "OBJ keeps every f64 exactly");
+    assert_eq!(obj.faces, ply.faces);
+
+    for ext in ["stl", "glb"] {
+        let name = format!("m.{ext}");
+        let report = mesh(&d, &dem, &name, E, &[]);
+        let origin: Vec<f64> = report["local_origin"]
+            .as_array()
+            .expect("local_origin in the report")
+            .iter()
+            .map(|c| c.as_f64().expect("number"))
+            .collect();
+        let read = trimesh(&python, &d.path(&name));
+        assert_eq!(read.vertices.len(), ply.vertices.len(), "{ext}");
+        assert_eq!(read.faces.len(), ply.faces.len(), "{ext}");
+        // STL has lost the origin (it is in our header, which trimesh ignores); glTF
+        // holds it in the node translation, which trimesh applies.
+        let vertices: Vec<[f64; 3]> = read
+            .vertices
+            .iter()
+            .map(|v| match ext {
+                "stl" => [0, 1, 2].map(|i| v[i] + origin[i]),
+                _ => *v,
+            })
+            .collect();
+        // float32 offsets from an origin mid-extent: well below a millimetre here.
+        assert_same_triangles(&canonical(&vertices, &read.faces), &reference, 1e-3, ext);
+    }
+}
+
+#[test]
+fn stl_base_makes_a_watertight_solid_over_holes_and_components() {
+    let d = Dir::new();
+    // Half the grid is nodata: an irregular outline.
+    let dem = fixture("landlab_hugo_site.asc");
+    let report = mesh(&d, &dem, "solid.stl", E, &["--base", "-10"]);
+    // The reader drops the walls and the bottom: the top verifies.
+    verify(&d, &dem, "solid.stl", E, &[]);
+    let Some(python) = python() else { return };
+    let read = trimesh(&python, &d.path("solid.stl"));
+    assert_eq!(
+        read.json["watertight"], true,
+        "every edge used exactly twice"
+    );
+    assert_eq!(read.json["winding_consistent"], true);
+    assert!(read.json["volume"].as_f64().expect("volume") > 0.0);
+    let top = report["triangles_after"].as_u64().expect("count") as usize;
+    assert!(read.faces.len() > 2 * top, "walls and a bottom were added");
+}
+
+#[test]
+fn gltf_validator_finds_no_errors() {
+    if !gltf_validator() {
+        return;
+    }
+    let d = Dir::new();
+    let small = fixture(DEM);
+    // The sample DEM keeps > 65535 vertices: 32-bit indices.
+    let large = fixture("becmodel_dem_bc_albers_50m.tif");
+    let script = repo().join("tests/oracles/gltf_validate.js");
+    for (dem, name, extra) in [
+        (&small, "u16.glb", &[][..]),
+        (&small, "normals.glb", &["--normals"][..]),
+        (&large, "u32.glb", &["--normals"][..]),
+    ] {
+        mesh(&d, dem, name, "5", extra);
+        let text = run(
+            "node",
+            &[&script.to_string_lossy(), &d.path(name).to_string_lossy()],
+        );
+        let report: Value = serde_json::from_str(&text).expect("validator JSON");
+        assert_eq!(report["issues"]["numErrors"], 0, "{name}: {report:#}");
+        assert_eq!(report["issues"]["numWarnings"], 0, "{name}: {report:#}");
+        if name == "u32.glb" {
+            let vertices = report["info"]["totalVertexCount"].as_u64().expect("count");
+            assert!(vertices > 65_535, "{vertices}");
+        }
+        verify(&d, dem, name, "5", &[]);
+    }
+}
+
+#[test]
+fn ogrinfo_reads_flatgeobuf_triangles_equal_to_the_ply() {
+    let Some(python) = python() else { return };
+    let d = Dir::new();
+    let dem = fixture(DEM);
+    let report = mesh(&d, &dem, "m.ply", E, &[]);
+    let ply = trimesh(&python, &d.path("m.ply"));
+    mesh(&d, &dem, "m.fgb", E, &[]);
+    let fgb = d.path("m.fgb").to_string_lossy().into_owned();
+    let summary = run("ogrinfo", &["-so", "-al", &fgb]);
+    assert_eq!(ogr_field(&summary, "Geometry:"), "3D Triangle");
+    assert_eq!(
+        ogr_field(&summary, "Feature Count:"),
+        report["triangles_after"].to_string()
+    );
+    assert!(summary.contains("ID[\"EPSG\",3857]"), "{summary}");
+    let all = run("ogrinfo", &["-al", "-q", &fgb]);
+    assert_same_triangles(
+        &canonical_corners(&ogr_triangles(&all)),
+        &canonical(&ply.vertices, &ply.faces),
+        1e-6,
+        "FlatGeobuf",
+    );
+}
+
+#[test]
+fn ogrinfo_reads_geojson_in_wgs84_and_in_the_source_crs() {
+    let Some(python) = python() else { return };
+    let d = Dir::new();
+    let dem = fixture(DEM);
+    let report = mesh(&d, &dem, "m.ply", E, &[]);
+    let ply = trimesh(&python, &d.path("m.ply"));
+
+    // Default: RFC 7946, WGS84 longitude/latitude, compared with GDAL's own transform of
+    // the PLY's vertices.
+    mesh(&d, &dem, "wgs84.geojson", E, &[]);
+    let path = d.path("wgs84.geojson").to_string_lossy().into_owned();
+    let summary = run("ogrinfo", &["-so", "-al", &path]);
+    assert_eq!(ogr_field(&summary, "Geometry:"), "3D Polygon");
+    assert_eq!(
+        ogr_field(&summary, "Feature Count:"),
+        report["triangles_after"].to_string()
+    );
+    assert!(summary.contains("GEOGCRS[\"WGS 84\""), "{summary}");
+    let points: String = ply
+        .vertices
+        .iter()
+        .map(|v| format!("{:?} {:?} {:?}\n", v[0], v[1], v[2]))
+        .collect();
+    let mut child = Command::new("gdaltransform")
+        .args(["-s_srs", "EPSG:3857", "-t_srs", "EPSG:4326"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("gdaltransform");
+    std::io::Write::write_all(child.stdin.as_mut().expect("stdin"), points.as_bytes())
+        .expect("feed gdaltransform");
+    let out = child.wait_with_output().expect("gdaltransform output");
+    let lonlat: Vec<[f64; 3]> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| {
+            let v: Vec<f64> = l
+                .split_ascii_whitespace()
+                .map(|c| c.parse().expect("number"))
+                .collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    assert_eq!(lonlat.len(), ply.vertices.len());
+    let all = run("ogrinfo", &["-al", "-q", &path]);
+    assert_same_triangles(
+        &canonical_corners(&ogr_triangles(&all)),
+        &canonical(&lonlat, &ply.faces),
+        1e-9,
+        "GeoJSON (WGS84)",
+    );
+    // verify transforms back to the raster's CRS.
+    verify(&d, &dem, "wgs84.geojson", E, &[]);
+
+    // Asked for: the source CRS with a crs member and a note.
+    mesh(&d, &dem, "src.geojson", E, &["--geojson-source-crs"]);
+    let path = d.path("src.geojson").to_string_lossy().into_owned();
+    let json: Value =
+        serde_json::from_slice(&std::fs::read(&path).expect("read")).expect("GeoJSON");
+    assert_eq!(
+        json["crs"]["properties"]["name"],
+        "urn:ogc:def:crs:EPSG::3857"
+    );
+    assert!(json["tinsmith_note"].as_str().is_some());
+    let summary = run("ogrinfo", &["-so", "-al", &path]);
+    assert!(summary.contains("ID[\"EPSG\",3857]"), "{summary}");
+    let all = run("ogrinfo", &["-al", "-q", &path]);
+    assert_same_triangles(
+        &canonical_corners(&ogr_triangles(&all)),
+        &canonical(&ply.vertices, &ply.faces),
+        1e-6,
+        "GeoJSON (source CRS)",
+    );
+    verify(&d, &dem, "src.geojson", E, &[]);
+}
+
+#[test]
+fn landxml_parses_as_xml_with_northing_easting_points() {
+    let Some(python) = python() else { return };
+    let d = Dir::new();
+    let dem = fixture(DEM);
+    let report = mesh(&d, &dem, "m.ply", E, &[]);
+    let ply = trimesh(&python, &d.path("m.ply"));
+    mesh(&d, &dem, "m.xml", E, &[]);
+    let script = repo().join("tests/oracles/landxml_read.py");
+    let text = run(
+        &python.to_string_lossy(),
+        &[
+            &script.to_string_lossy(),
+            &d.path("m.xml").to_string_lossy(),
+        ],
+    );
+    let xml: Value = serde_json::from_str(&text).expect("oracle JSON");
+    assert_eq!(xml["points"], report["vertices_after"]);
+    assert_eq!(xml["faces"], report["triangles_after"]);
+    assert_eq!(xml["surf_type"], "TIN");
+    assert_eq!(xml["epsg"], "3857");
+    assert_eq!(xml["linear_unit"], "meter");
+    assert!(xml["application"].as_str().is_some());
+    // Point 1 is the PLY's vertex 0, as northing easting elevation.
+    let [x, y, z] = ply.vertices[0];
+    assert_eq!(xml["first_point"], serde_json::json!([y, x, z]));
+    // The first face, 1-based, is the PLY's first triangle.
+    let f = ply.faces[0].map(|i| i + 1);
+    assert_eq!(xml["first_face"], serde_json::json!(f));
+}
+
+#[test]
+fn float32_formats_keep_the_bound_when_heights_do_not_fit_float32() {
+    let d = Dir::new();
+    // Heights around 100 km (a synthetic field) with digits float32 cannot hold.
+    let mut text = String::from(
+        "ncols 40\nnrows 30\nxllcorner 500000\nyllcorner 5000000\ncellsize 1\nNODATA_value -9999\n",
+    );
+    for row in 0..30 {
+        let line: Vec<String> = (0..40)
+            .map(|col| {
+                let z = 100_000.0
+                    + f64::from(row * 7 + col * 3) * 1.234_567_89
+                    + f64::from((row * col) % 5) * 0.001_234_5;
+                format!("{z:.7}")
+            })
+            .collect();
+        text.push_str(&line.join(" "));
+        text.push('\n');
+    }
+    d.write("high.asc", &text);
+    // GDAL reads an ASCII grid with decimals as Float32 unless told otherwise.
+    let tif = d.path("high.tif").to_string_lossy().into_owned();
+    let asc_path = d.path("high.asc").to_string_lossy().into_owned();
+    run(
+        "gdal_translate",
+        &[
+            "-q",
+            "-oo",
+            "DATATYPE=Float64",
+            "-ot",
+            "Float64",
+            "-a_srs",
+            "EPSG:32610",
+            &asc_path,
+            &tif,
+        ],
+    );
+    let asc = tif;
+    for ext in ["stl", "glb"] {
+        let name = format!("m.{ext}");
+        let report = mesh(&d, &asc, &name, "0.001", &[]);
+        let rounding = report["float32_height_rounding"]
+            .as_f64()
+            .expect("rounding");
+        assert!(rounding > 0.0, "{ext}: the heights do round");
+        assert_eq!(
+            report["decimation_max_error"].as_f64().expect("bound"),
+            0.001 - rounding
+        );
+        assert!(report["measured_max_error"].as_f64().expect("measured") <= 0.001);
+        // What the file holds, read back, is within the bound.
+        verify(&d, &asc, &name, "0.001", &[]);
+        // A bound below the rounding cannot be kept in float32: refused, nothing written.
+        let o = d.run(&["mesh", &asc, "-o", "tight.stl", "--max-error", "1e-7"]);
+        crate::util::assert_fails_naming(&o, &["tight.stl", "float32"]);
+        assert!(!d.path("tight.stl").exists());
+    }
+}
+
+#[test]
+fn flags_for_another_format_are_refused_and_format_overrides_the_extension() {
+    let d = Dir::new();
+    let dem = fixture(DEM);
+    for (name, flag) in [
+        ("m.ply", "--base"),
+        ("m.stl", "--normals"),
+        ("m.fgb", "--geojson-source-crs"),
+    ] {
+        let mut args = vec!["mesh", &dem, "-o", name, "--max-error", E, flag];
+        if flag == "--base" {
+            args.push("0");
+        }
+        let o = d.run(&args);
+        crate::util::assert_fails_naming(&o, &[name, flag]);
+    }
+    // A base that is not below the lowest height: refused before any work is written.
+    let o = d.run(&[
+        "mesh",
+        &dem,
+        "-o",
+        "m.stl",
+        "--max-error",
+        E,
+        "--base",
+        "1e6",
+    ]);
+    crate::util::assert_fails_naming(&o, &["m.stl", "base"]);
+    assert_eq!(d.files(), Vec::<String>::new(), "nothing written");
+
+    mesh(&d, &dem, "tin.dat", E, &["--format", "fgb"]);
+    let summary = run(
+        "ogrinfo",
+        &["-so", "-al", &d.path("tin.dat").to_string_lossy()],
+    );
+    assert_eq!(ogr_field(&summary, "Geometry:"), "3D Triangle");
+}
+
+#[test]
+fn float32_formats_refuse_rasters_too_wide_for_float32_positions() {
+    let d = Dir::new();
+    // 40,000 samples across: half a float32 step at 20,000 pixels from the origin is more
+    // than the verifier's 1e-3 pixel.
+    let width = 40_000;
+    let row = vec!["1"; width].join(" ");
+    let text = format!(
+        "ncols {width}\nnrows 2\nxllcorner 500000\nyllcorner 5000000\ncellsize 1\n\
+         NODATA_value -9999\n{row}\n{row}\n"
+    );
+    let asc = d.write("wide.asc", &text).to_string_lossy().into_owned();
+    for name in ["w.stl", "w.glb"] {
+        let o = d.run(&["mesh", &asc, "-o", name, "--max-error", "1"]);
+        crate::util::assert_fails_naming(&o, &[name, "too large for float32"]);
+    }
+    // Double-precision formats are fine.
+    mesh(&d, &asc, "w.fgb", "1", &[]);
+    verify(&d, &asc, "w.fgb", "1", &[]);
+}

@@ -72,6 +72,7 @@ pub(crate) struct Retriangulator {
     // Dynamic programming tables, row-major m x m.
     diagonal_ok: Vec<bool>,
     cost: Vec<f64>,
+    cost_sum: Vec<f64>,
     split: Vec<u32>,
 }
 
@@ -313,6 +314,8 @@ impl Retriangulator {
         }
         self.cost.clear();
         self.cost.resize(m * m, f64::INFINITY);
+        self.cost_sum.clear();
+        self.cost_sum.resize(m * m, 0.0);
         self.split.clear();
         self.split.resize(m * m, u32::MAX);
         for i in 0..m - 1 {
@@ -324,11 +327,12 @@ impl Retriangulator {
                 if !self.diagonal_ok[i * m + j] {
                     continue;
                 }
-                let mut best = (f64::INFINITY, u32::MAX);
+                // Lexicographic: the largest error, then the sum of the triangles' errors
+                // (less error spent now leaves more room for later removals).
+                let mut best = (f64::INFINITY, f64::INFINITY, u32::MAX);
                 for k in i + 1..j {
                     let sub = self.cost[i * m + k].max(self.cost[k * m + j]);
-                    if sub >= best.0 || !self.diagonal_ok[i * m + k] || !self.diagonal_ok[k * m + j]
-                    {
+                    if sub > best.0 || !self.diagonal_ok[i * m + k] || !self.diagonal_ok[k * m + j] {
                         continue;
                     }
                     if orient(&self.ring[i], &self.ring[k], &self.ring[j]) <= 0 {
@@ -344,12 +348,14 @@ impl Retriangulator {
                         continue;
                     };
                     let c = sub.max(t.max());
-                    if c < best.0 {
-                        best = (c, k as u32);
+                    let sum = self.cost_sum[i * m + k] + self.cost_sum[k * m + j] + t.max();
+                    if c < best.0 || (c == best.0 && sum < best.1) {
+                        best = (c, sum, k as u32);
                     }
                 }
                 self.cost[i * m + j] = best.0;
-                self.split[i * m + j] = best.1;
+                self.cost_sum[i * m + j] = best.1;
+                self.split[i * m + j] = best.2;
             }
         }
         if self.split[m - 1] == u32::MAX {

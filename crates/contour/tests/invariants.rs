@@ -149,7 +149,7 @@ fn check(mesh: &ContourMesh, levels: &[f64]) -> Result<(), TestCaseError> {
     let mut sorted = levels.to_vec();
     sorted.sort_by(f64::total_cmp);
     sorted.dedup();
-    for (&(a, b), _) in &uses {
+    for &(a, b) in uses.keys() {
         let (pa, pb) = (vs[a as usize], vs[b as usize]);
         for &level in &sorted {
             let straddles = (pa[2] < level) != (pb[2] < level);

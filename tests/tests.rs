@@ -3,4 +3,5 @@
 mod util;
 
 mod bad_input;
+mod contour;
 mod mesh_and_verify;

@@ -83,11 +83,11 @@ fn ogrinfo_reads_geojson_and_fgb_with_count_and_crs() {
         "3005",
         &["--interval", "100", "--offset", "50", "--max-error", "10"],
     );
-    // The full grid (the default) and explicit levels.
+    // The full grid (the default) and explicit levels, negative ones too.
     check_read_by_gdal(
         &fixture("becmodel_dem_bc_albers_50m.tif"),
         "3005",
-        &["--levels", "1000,1500,2000"],
+        &["--levels", "-5,1000,1500,2000"],
     );
 }
 

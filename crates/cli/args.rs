@@ -99,10 +99,11 @@ pub struct ContourArgs {
     #[arg(long, value_parser = parse_interval)]
     pub interval: Option<f64>,
     /// Shift of the --interval levels: levels are offset + k * interval.
-    #[arg(long, default_value_t = 0.0, requires = "interval", value_parser = parse_finite, allow_negative_numbers = true)]
-    pub offset: f64,
-    /// Explicit levels, comma-separated.
-    #[arg(long, value_delimiter = ',', num_args = 1.., value_parser = parse_finite, allow_negative_numbers = true, conflicts_with = "interval")]
+    /// (Default 0.)
+    #[arg(long, requires = "interval", value_parser = parse_finite, allow_negative_numbers = true)]
+    pub offset: Option<f64>,
+    /// Explicit levels, comma-separated (negative ones too: --levels -100,0,100).
+    #[arg(long, value_delimiter = ',', value_parser = parse_finite, allow_hyphen_values = true, conflicts_with = "interval")]
     pub levels: Vec<f64>,
     /// Contour the TIN decimated within this error of every sample; 0 (default) contours
     /// the full grid.

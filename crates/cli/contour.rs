@@ -25,6 +25,9 @@ use crate::output::check_writable_target;
 /// Builds the TIN, contours it and writes the lines; `Ok(true)` on success.
 pub fn run(args: &ContourArgs) -> Result<bool> {
     let started = Instant::now();
+    if args.offset.is_some() && args.interval.is_none() {
+        bail!("--offset shifts --interval levels; with --levels, give the levels themselves");
+    }
     let format = ContourFormat::from_path(&args.output)?;
     check_writable_target(&args.output)?;
     let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
@@ -64,7 +67,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
 
     let levels = match args.interval {
         Some(interval) => match mesh.height_range() {
-            Some((lo, hi)) => interval_levels(interval, args.offset, lo, hi)
+            Some((lo, hi)) => interval_levels(interval, args.offset.unwrap_or(0.0), lo, hi)
                 .with_context(|| format!("{}", args.input.display()))?,
             None => Vec::new(),
         },

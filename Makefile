@@ -6,7 +6,7 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 DEMO_DEM := data/becmodel_dem_bc_albers_50m.tif
 DEMO_ERROR := 5
 
-.PHONY: deps demo test bench-results
+.PHONY: deps demo test bench-results bench-contour
 
 ## Install Debian's GDAL (headers, tools) and pkg-config when missing.
 deps:
@@ -37,3 +37,8 @@ test: deps
 bench-results:
 	cargo build --release --quiet
 	python3 bench/paper_table.py
+
+## Contours on the TIN vs gdal_contour on the full grid (docs/results.md, "Contours").
+bench-contour: deps
+	cargo build --release --quiet
+	python3 bench/contour_compare.py --shared ../shared

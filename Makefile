@@ -10,7 +10,7 @@ TOOLS := .tools
 PY_ORACLES := trimesh==4.12.2 numpy==2.2.6
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps oracles demo test bench-results
+.PHONY: deps oracles demo test bench-results bench-contour
 
 ## Install Debian's GDAL (headers, tools) and pkg-config when missing.
 deps:
@@ -61,3 +61,8 @@ test: deps
 bench-results:
 	cargo build --release --quiet
 	python3 bench/paper_table.py
+
+## Contours on the TIN vs gdal_contour on the full grid (docs/results.md, "Contours").
+bench-contour: deps
+	cargo build --release --quiet
+	python3 bench/contour_compare.py --shared ../shared

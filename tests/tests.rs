@@ -3,5 +3,6 @@
 mod util;
 
 mod bad_input;
+mod contour;
 mod formats;
 mod mesh_and_verify;

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
 use tinsmith_core::{EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation};
 use tinsmith_export::MeshFormat;
 
@@ -22,6 +22,8 @@ pub enum Command {
     Mesh(MeshArgs),
     /// Measure a TIN's true error against its raster at every valid sample.
     Verify(VerifyArgs),
+    /// Contour lines of the raster's TIN (decimated within --max-error, or given).
+    Contour(ContourArgs),
 }
 
 #[derive(Debug, Args)]
@@ -127,6 +129,42 @@ pub struct VerifyArgs {
     pub json: bool,
 }
 
+#[derive(Debug, Args)]
+#[command(group(ArgGroup::new("which_levels").required(true).args(["interval", "levels"])))]
+pub struct ContourArgs {
+    /// Any single-band raster GDAL can read.
+    pub input: PathBuf,
+    /// Output lines; the format follows the extension (.geojson, .json, .fgb).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Contour every multiple of this (plus --offset) within the TIN's height range.
+    #[arg(long, value_parser = parse_interval)]
+    pub interval: Option<f64>,
+    /// Shift of the --interval levels: levels are offset + k * interval.
+    /// (Default 0.)
+    #[arg(long, requires = "interval", value_parser = parse_finite, allow_negative_numbers = true)]
+    pub offset: Option<f64>,
+    /// Explicit levels, comma-separated (negative ones too: --levels -100,0,100).
+    #[arg(long, value_delimiter = ',', value_parser = parse_finite, allow_hyphen_values = true, conflicts_with = "interval")]
+    pub levels: Vec<f64>,
+    /// Contour the TIN decimated within this error of every sample; 0 (default) contours
+    /// the full grid.
+    #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true, conflicts_with = "mesh")]
+    pub max_error: Option<f64>,
+    /// Contour this TIN (.ply, .obj, as written by `tinsmith mesh` from INPUT) instead.
+    #[arg(long, value_name = "MESH")]
+    pub mesh: Option<PathBuf>,
+    /// Band to read (1-based).
+    #[arg(long, default_value_t = 1)]
+    pub band: usize,
+    /// Write (column, row) coordinates; read --mesh as written with --pixel-coords.
+    #[arg(long)]
+    pub pixel_coords: bool,
+    /// No summary on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum ErrorModelArg {
     /// The paper's accumulated bounds above and below each triangle.
@@ -222,6 +260,25 @@ fn parse_max_error(s: &str) -> Result<f64, String> {
         .map_err(|_| format!("'{s}' is not a number"))?;
     if !v.is_finite() || v < 0.0 {
         return Err(format!("must be a finite number >= 0, got {s}"));
+    }
+    Ok(v)
+}
+
+fn parse_interval(s: &str) -> Result<f64, String> {
+    let v = parse_finite(s)?;
+    if v <= 0.0 {
+        return Err(format!("must be a finite number > 0, got {s}"));
+    }
+    Ok(v)
+}
+
+fn parse_finite(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number"))?;
+    if !v.is_finite() {
+        return Err(format!("must be a finite number, got {s}"));
     }
     Ok(v)
 }

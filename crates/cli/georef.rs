@@ -30,6 +30,15 @@ impl Georef {
         }
     }
 
+    /// File coordinates of the grid position `p` (fractional column, row), by the same
+    /// map as [`Georef::file_position`]: an integer position gives the same bits.
+    pub fn file_point(self, p: [f64; 2]) -> [f64; 2] {
+        match self {
+            Georef::Pixel => p,
+            Georef::World(t) => t.sample_centre(p[0], p[1]),
+        }
+    }
+
     /// The sample whose file coordinates are `p`; fails when `p` is not (within a
     /// thousandth of a pixel) on a sample centre.
     pub fn sample_at(self, p: [f64; 2]) -> Result<[i64; 2]> {

@@ -4,6 +4,8 @@
 //! 2 bad input or any other error (the message names the file and the problem).
 
 mod args;
+mod contour;
+mod contour_output;
 mod export;
 mod georef;
 mod info;
@@ -31,6 +33,7 @@ fn main() -> ExitCode {
         Command::Info(a) => info::run(&a),
         Command::Mesh(a) => mesh::run(&a),
         Command::Verify(a) => verify::run(&a),
+        Command::Contour(a) => contour::run(&a),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

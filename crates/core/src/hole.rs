@@ -332,7 +332,8 @@ impl Retriangulator {
                 let mut best = (f64::INFINITY, f64::INFINITY, u32::MAX);
                 for k in i + 1..j {
                     let sub = self.cost[i * m + k].max(self.cost[k * m + j]);
-                    if sub > best.0 || !self.diagonal_ok[i * m + k] || !self.diagonal_ok[k * m + j] {
+                    if sub > best.0 || !self.diagonal_ok[i * m + k] || !self.diagonal_ok[k * m + j]
+                    {
                         continue;
                     }
                     if orient(&self.ring[i], &self.ring[k], &self.ring[j]) <= 0 {

@@ -1,0 +1,148 @@
+//! `tinsmith contour`: contour lines of a raster's TIN (paper §5), written as GeoJSON or
+//! FlatGeobuf.
+//!
+//! The TIN is, in order of precedence: the mesh file given with `--mesh` (its vertices
+//! mapped back to grid samples as `tinsmith verify` does, its heights as written); the
+//! grid decimated within `--max-error E > 0` (`tinsmith_core::decimate`, whose bound is
+//! proved by the verifier in core's tests; it is not re-verified here); or, for
+//! `--max-error 0` (the default), the full grid, two triangles per valid cell, built
+//! directly ([`tinsmith_contour::ContourMesh::from_grid`]): the same surface decimation at
+//! 0 would give, without its cost. Lines are computed in grid coordinates and mapped to the
+//! world position of sample centres through the geotransform, as `tinsmith mesh` writes
+//! vertices, so a line through a vertex passes through the mesh file's vertex exactly.
+
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use tinsmith_contour::{contour, interval_levels, sorted_levels, ContourMesh};
+use tinsmith_core::{decimate, DecimationOptions, Grid};
+
+use crate::args::ContourArgs;
+use crate::contour_output::{write_contours, ContourFormat, ContourLine, Crs};
+use crate::georef::Georef;
+use crate::output::check_writable_target;
+
+/// Builds the TIN, contours it and writes the lines; `Ok(true)` on success.
+pub fn run(args: &ContourArgs) -> Result<bool> {
+    let started = Instant::now();
+    if args.offset.is_some() && args.interval.is_none() {
+        bail!("--offset shifts --interval levels; with --levels, give the levels themselves");
+    }
+    let format = ContourFormat::from_path(&args.output)?;
+    check_writable_target(&args.output)?;
+    let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
+    let grid = &raster.grid;
+    let georef = Georef::new(raster.info.transform(), args.pixel_coords);
+
+    let (mesh, source) = match &args.mesh {
+        Some(path) => (mesh_from_file(path, grid, &georef)?, "mesh file".to_owned()),
+        None => {
+            if grid.valid_cell_count() == 0 {
+                bail!(
+                    "{}: band {} has no 2x2 block of valid samples, so there is nothing to contour",
+                    args.input.display(),
+                    args.band
+                );
+            }
+            let e = args.max_error.unwrap_or(0.0);
+            if e == 0.0 {
+                let mesh = ContourMesh::from_grid(grid.width(), grid.height(), grid.values())
+                    .with_context(|| format!("{}", args.input.display()))?;
+                (mesh, "full grid".to_owned())
+            } else {
+                let tin = decimate(grid, &DecimationOptions::new(e))
+                    .with_context(|| format!("{}", args.input.display()))?
+                    .tin;
+                let vertices = tin
+                    .vertices()
+                    .iter()
+                    .map(|v| [v.x as f64, v.y as f64, v.z])
+                    .collect();
+                let mesh = ContourMesh::new(vertices, tin.triangles().to_vec())
+                    .with_context(|| format!("{}: decimated TIN", args.input.display()))?;
+                (mesh, format!("TIN within {e}"))
+            }
+        }
+    };
+
+    let levels = match args.interval {
+        Some(interval) => match mesh.height_range() {
+            Some((lo, hi)) => interval_levels(interval, args.offset.unwrap_or(0.0), lo, hi)
+                .with_context(|| format!("{}", args.input.display()))?,
+            None => Vec::new(),
+        },
+        None => sorted_levels(&args.levels)?,
+    };
+    let polylines = contour(&mesh, &levels)
+        .with_context(|| format!("{}: contouring failed", args.input.display()))?;
+
+    // Grid coordinates -> file coordinates. A north-up raster flips orientation; reverse
+    // so the high ground stays on the left in file coordinates.
+    let flip = georef.flips_orientation();
+    let lines: Vec<ContourLine> = polylines
+        .into_iter()
+        .map(|mut l| {
+            if flip {
+                l.reverse();
+            }
+            ContourLine {
+                elev: l.level(),
+                points: l.points().iter().map(|&p| georef.file_point(p)).collect(),
+            }
+        })
+        .collect();
+    let crs = match georef {
+        Georef::Pixel => Crs::default(),
+        Georef::World(_) => Crs {
+            epsg: raster.info.epsg,
+            wkt: raster.info.crs_wkt.as_deref(),
+        },
+    };
+    write_contours(&args.output, format, &lines, crs)?;
+
+    if !args.quiet {
+        let segments: usize = lines.iter().map(|l| l.points.len() - 1).sum();
+        let closed = lines
+            .iter()
+            .filter(|l| l.points.first() == l.points.last())
+            .count();
+        eprintln!(
+            "{}: {} lines ({} closed), {} segments at {} levels from the {} ({} triangles) in {:.2} s",
+            args.output.display(),
+            lines.len(),
+            closed,
+            segments,
+            levels.len(),
+            source,
+            mesh.triangles().len(),
+            started.elapsed().as_secs_f64()
+        );
+    }
+    Ok(true)
+}
+
+/// Reads a mesh file and maps its vertices back to grid positions (as `tinsmith verify`
+/// does); heights are the file's.
+fn mesh_from_file(path: &std::path::Path, grid: &Grid, georef: &Georef) -> Result<ContourMesh> {
+    let file = tinsmith_export::read_mesh(path)?;
+    let mut vertices = Vec::with_capacity(file.vertices.len());
+    for (i, v) in file.vertices.iter().enumerate() {
+        let [x, y] = georef
+            .sample_at([v[0], v[1]])
+            .with_context(|| format!("{}: vertex {i}", path.display()))?;
+        if !(0..grid.width() as i64).contains(&x) || !(0..grid.height() as i64).contains(&y) {
+            bail!(
+                "{}: vertex {i} is at column {x}, row {y}, outside the {} x {} raster",
+                path.display(),
+                grid.width(),
+                grid.height()
+            );
+        }
+        vertices.push([x as f64, y as f64, v[2]]);
+    }
+    if file.triangles.is_empty() {
+        bail!("{}: the mesh has no triangles", path.display());
+    }
+    ContourMesh::new(vertices, file.triangles)
+        .with_context(|| format!("{}: cannot contour this mesh", path.display()))
+}

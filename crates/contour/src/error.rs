@@ -1,0 +1,102 @@
+//! The error type of the contouring crate.
+
+/// What can go wrong when building a [`crate::ContourMesh`] or choosing levels; each
+/// variant says what the caller should fix.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A triangle names a vertex that does not exist.
+    #[error("triangle {triangle} uses vertex {vertex}, but there are only {vertices} vertices")]
+    VertexOutOfRange {
+        /// Index of the triangle.
+        triangle: usize,
+        /// The vertex index it names.
+        vertex: u32,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// A triangle uses the same vertex twice.
+    #[error("triangle {triangle} uses vertex {vertex} twice")]
+    RepeatedVertex {
+        /// Index of the triangle.
+        triangle: usize,
+        /// The repeated vertex.
+        vertex: u32,
+    },
+    /// A vertex used by a triangle has a NaN or infinite coordinate or height.
+    #[error("vertex {vertex} has a non-finite coordinate or height")]
+    NonFiniteVertex {
+        /// The vertex index.
+        vertex: u32,
+    },
+    /// More than two triangles share one edge, so the surface is not a manifold and a
+    /// contour through that edge would have no unique continuation.
+    #[error("edge ({a}, {b}) is shared by {count} triangles (at most 2 allowed)")]
+    NonManifoldEdge {
+        /// Smaller vertex of the edge.
+        a: u32,
+        /// Larger vertex of the edge.
+        b: u32,
+        /// Number of triangles using it.
+        count: usize,
+    },
+    /// The mesh has more triangles than 32-bit edge handles can address.
+    #[error("{triangles} triangles are too many (at most {max})")]
+    TooManyTriangles {
+        /// Triangles given.
+        triangles: usize,
+        /// The largest supported count.
+        max: usize,
+    },
+    /// The grid's dimensions and its value count disagree, or it is too large.
+    #[error("grid of {width}x{height} needs {expected} values, got {actual} (or is too large)")]
+    GridSize {
+        /// Columns.
+        width: u32,
+        /// Rows.
+        height: u32,
+        /// width * height.
+        expected: usize,
+        /// Values supplied.
+        actual: usize,
+    },
+    /// A contour level is NaN or infinite.
+    #[error("contour level {0} is not a finite number")]
+    InvalidLevel(f64),
+    /// The contour interval is zero, negative, NaN or infinite, or the offset is not finite.
+    #[error("contour interval must be a finite number > 0 and the offset finite, got interval {interval}, offset {offset}")]
+    InvalidInterval {
+        /// The interval given.
+        interval: f64,
+        /// The offset given.
+        offset: f64,
+    },
+    /// The interval is so small for the height range that there would be too many levels.
+    #[error(
+        "interval {interval} over heights {min}..{max} gives {count} levels (at most {max_levels})"
+    )]
+    TooManyLevels {
+        /// The interval given.
+        interval: f64,
+        /// Lowest height.
+        min: f64,
+        /// Highest height.
+        max: f64,
+        /// Levels it would give.
+        count: f64,
+        /// The limit, [`crate::MAX_LEVELS`].
+        max_levels: usize,
+    },
+    /// The contour walk met a state a valid mesh cannot produce (a bug, reported instead of
+    /// looping or panicking).
+    #[error("internal error while joining contour segments at level {level}: {what}")]
+    Internal {
+        /// The level being joined.
+        level: f64,
+        /// What went wrong.
+        what: &'static str,
+    },
+}
+
+/// Result of the contouring crate's fallible functions.
+pub type Result<T> = std::result::Result<T, Error>;

@@ -54,6 +54,7 @@ def main():
                 rep = pathlib.Path(tmp) / "r.json"
                 code, _, err = run([args.bin, "mesh", str(src), "-o", str(out), "--max-error", str(eps),
                                     "--error-model", "bounds", "--selection", args.selection,
+                                    "--initial-mesh", "full", "--order", "sweep", "--retriangulate", "ears",
                                     "--report", str(rep)])
                 if code != 0:
                     sys.exit(f"mesh failed on {src} at {eps}: {err}")

@@ -106,7 +106,7 @@ fn lines_are_closed_or_end_on_the_domain_edge_in_world_coordinates() {
             "--interval",
             "5",
             "--max-error",
-            "1",
+            "0.5",
         ],
     );
     let f = features(&d.path("c.json"));
@@ -137,7 +137,7 @@ fn lines_are_closed_or_end_on_the_domain_edge_in_world_coordinates() {
             "--interval",
             "5",
             "--max-error",
-            "1",
+            "0.5",
         ],
     );
     assert_eq!(

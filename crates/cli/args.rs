@@ -64,7 +64,7 @@ pub struct MeshArgs {
     #[arg(long, default_value_t = 1)]
     pub band: usize,
     /// Error model.
-    #[arg(long, value_enum, default_value_t = ErrorModelArg::Bounds)]
+    #[arg(long, value_enum, default_value_t = ErrorModelArg::Exact)]
     pub error_model: ErrorModelArg,
     /// Edge selection rule for retriangulating holes by ears (paper §3.4).
     #[arg(long, value_enum, default_value_t = SelectionArg::Hybrid)]
@@ -73,10 +73,10 @@ pub struct MeshArgs {
     #[arg(long, value_enum, default_value_t = OrderArg::Sweep)]
     pub order: OrderArg,
     /// Hole retriangulation.
-    #[arg(long, value_enum, default_value_t = RetriangulateArg::Ears)]
+    #[arg(long, value_enum, default_value_t = RetriangulateArg::Dp)]
     pub retriangulate: RetriangulateArg,
     /// The mesh decimation starts from.
-    #[arg(long, value_enum, default_value_t = InitialMeshArg::Full)]
+    #[arg(long, value_enum, default_value_t = InitialMeshArg::Rtin)]
     pub initial_mesh: InitialMeshArg,
     /// Write (column, row, value) instead of georeferenced coordinates.
     #[arg(long)]

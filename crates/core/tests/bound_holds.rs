@@ -22,14 +22,16 @@ fn all_options(bound: f64) -> Vec<DecimationOptions> {
     let mut all = Vec::new();
     for model in [ErrorModel::Bounds, ErrorModel::Exact] {
         for order in [Order::Sweep, Order::Greedy] {
-            let base = DecimationOptions::new(bound)
-                .with_error_model(model)
-                .with_order(order);
-            for selection in SELECTIONS {
-                all.push(base.clone().with_selection(selection));
+            for start in [InitialMesh::Full, InitialMesh::Rtin] {
+                let base = DecimationOptions::paper(bound)
+                    .with_error_model(model)
+                    .with_order(order)
+                    .with_initial_mesh(start);
+                for selection in SELECTIONS {
+                    all.push(base.clone().with_selection(selection));
+                }
+                all.push(base.with_retriangulation(Retriangulation::Dp));
             }
-            all.push(base.clone().with_retriangulation(Retriangulation::Dp));
-            all.push(base.with_initial_mesh(InitialMesh::Rtin));
         }
     }
     all

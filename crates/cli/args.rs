@@ -75,6 +75,10 @@ pub struct MeshArgs {
     /// Hole retriangulation.
     #[arg(long, value_enum, default_value_t = RetriangulateArg::Dp)]
     pub retriangulate: RetriangulateArg,
+    /// Largest hole (ring vertices) that --retriangulate dp solves optimally; larger ones
+    /// use ears. DP costs O(n^3) triangle evaluations.
+    #[arg(long, value_name = "N", default_value_t = 8, value_parser = clap::value_parser!(u16).range(3..=64))]
+    pub dp_max_ring: u16,
     /// The mesh decimation starts from.
     #[arg(long, value_enum, default_value_t = InitialMeshArg::Rtin)]
     pub initial_mesh: InitialMeshArg,

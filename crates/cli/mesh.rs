@@ -82,6 +82,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         .with_order(args.order.into())
         .with_retriangulation(args.retriangulate.into())
         .with_initial_mesh(args.initial_mesh.into());
+    options.dp_max_ring = args.dp_max_ring as usize;
     if let Some(n) = args.max_triangles {
         options = options.with_max_triangles(n);
     }

@@ -24,6 +24,41 @@ pub enum VertexClass {
     Corner,
 }
 
+/// An [`ErrorBound`] in `f32`, each side rounded up so it still bounds the error.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct CompactBound {
+    above: f32,
+    below: f32,
+}
+
+impl From<ErrorBound> for CompactBound {
+    fn from(b: ErrorBound) -> CompactBound {
+        CompactBound {
+            above: round_up(b.above),
+            below: round_up(b.below),
+        }
+    }
+}
+
+impl From<CompactBound> for ErrorBound {
+    fn from(b: CompactBound) -> ErrorBound {
+        ErrorBound {
+            above: b.above as f64,
+            below: b.below as f64,
+        }
+    }
+}
+
+/// The smallest `f32` at or above `x`.
+fn round_up(x: f64) -> f32 {
+    let r = x as f32;
+    if (r as f64) < x {
+        r.next_up()
+    } else {
+        r
+    }
+}
+
 /// The star of a vertex: its neighbours counter-clockwise and the triangles between them.
 #[derive(Debug, Default)]
 pub(crate) struct Star {
@@ -42,7 +77,8 @@ pub(crate) struct Mesh<'g> {
     grid: &'g Grid,
     corners: Vec<[u32; 3]>,
     neighbours: Vec<[u32; 3]>,
-    bounds: Vec<ErrorBound>,
+    /// Bounds stored as `f32` rounded up (so still bounds), halving their memory.
+    bounds: Vec<CompactBound>,
     /// One live triangle incident to each vertex, or `NONE` if the vertex is not in the mesh.
     vertex_triangle: Vec<u32>,
     /// Vertices where the domain pinches: never removable.
@@ -60,7 +96,6 @@ impl<'g> Mesh<'g> {
         let mut corners = vec![[NONE; 3]; 2 * cells];
         let mut neighbours = vec![[NONE; 3]; 2 * cells];
         let mut vertex_triangle = vec![NONE; w * h];
-        let mut incident = vec![0u8; w * h];
         let mut live = 0;
         let valid = |cx: usize, cy: usize| cx < cells_w && cy < h - 1 && grid.cell_is_valid(cx, cy);
         for cy in 0..h.saturating_sub(1) {
@@ -105,11 +140,9 @@ impl<'g> Mesh<'g> {
                 ];
                 for v in [a, b, cc] {
                     vertex_triangle[v as usize] = lower as u32;
-                    incident[v as usize] += 1;
                 }
                 for v in [a, cc, d] {
                     vertex_triangle[v as usize] = upper as u32;
-                    incident[v as usize] += 1;
                 }
                 live += 2;
             }
@@ -117,19 +150,13 @@ impl<'g> Mesh<'g> {
         let mut mesh = Mesh {
             grid,
             corners,
-            bounds: vec![ErrorBound::default(); 2 * cells],
+            bounds: vec![CompactBound::default(); 2 * cells],
             neighbours,
             vertex_triangle,
             pinched: vec![false; w * h],
             live_triangles: live,
         };
-        let mut star = Star::default();
-        for (v, &count) in incident.iter().enumerate() {
-            if count > 0 {
-                mesh.star(v as u32, &mut star);
-                mesh.pinched[v] = star.triangles.len() != count as usize;
-            }
-        }
+        mesh.mark_pinched();
         mesh
     }
 
@@ -139,11 +166,10 @@ impl<'g> Mesh<'g> {
     pub(crate) fn from_triangles(
         grid: &'g Grid,
         corners: Vec<[u32; 3]>,
-        bounds: Vec<ErrorBound>,
+        bounds: Vec<CompactBound>,
     ) -> Mesh<'g> {
         let n = grid.width() as usize * grid.height() as usize;
         let mut vertex_triangle = vec![NONE; n];
-        let mut incident = vec![0u8; n];
 
         // Incident triangles per vertex (compressed rows), then each edge a -> b finds its
         // twin b -> a among b's triangles.
@@ -181,9 +207,6 @@ impl<'g> Mesh<'g> {
                 }
             }
         }
-        for v in 0..n {
-            incident[v] = (start[v + 1] - start[v]).min(255) as u8;
-        }
         let live = corners.len();
         let mut mesh = Mesh {
             grid,
@@ -194,13 +217,7 @@ impl<'g> Mesh<'g> {
             pinched: vec![false; n],
             live_triangles: live,
         };
-        let mut star = Star::default();
-        for (v, &count) in incident.iter().enumerate() {
-            if count > 0 {
-                mesh.star(v as u32, &mut star);
-                mesh.pinched[v] = star.triangles.len() != count as usize;
-            }
-        }
+        mesh.mark_pinched();
         mesh
     }
 
@@ -236,6 +253,27 @@ impl<'g> Mesh<'g> {
         self.vertex_triangle[d as usize] = upper;
         self.vertex_triangle[a as usize] = lower;
         self.vertex_triangle[b as usize] = lower;
+    }
+
+    /// Marks the vertices where the domain pinches: a vertex on one fan of triangles has
+    /// zero or two domain-boundary edges, a vertex where several fans meet has more.
+    fn mark_pinched(&mut self) {
+        let mut boundary_edges = vec![0u8; self.vertex_triangle.len()];
+        for (t, c) in self.corners.iter().enumerate() {
+            if c[0] == NONE {
+                continue;
+            }
+            for e in 0..3 {
+                if self.neighbours[t][e] == NONE {
+                    for v in [c[e], c[(e + 1) % 3]] {
+                        boundary_edges[v as usize] = boundary_edges[v as usize].saturating_add(1);
+                    }
+                }
+            }
+        }
+        for (p, &count) in self.pinched.iter_mut().zip(&boundary_edges) {
+            *p = count > 2;
+        }
     }
 
     /// Grid columns.
@@ -276,7 +314,7 @@ impl<'g> Mesh<'g> {
 
     /// Bound of triangle `t`.
     pub(crate) fn bound(&self, t: u32) -> ErrorBound {
-        self.bounds[t as usize]
+        self.bounds[t as usize].into()
     }
 
     /// Live triangles in slot order, as corner triples.
@@ -383,7 +421,7 @@ impl<'g> Mesh<'g> {
         }
         for &(slot, c, bound) in new_triangles {
             self.corners[slot as usize] = c;
-            self.bounds[slot as usize] = bound;
+            self.bounds[slot as usize] = bound.into();
             for &x in &c {
                 self.vertex_triangle[x as usize] = slot;
             }

@@ -102,7 +102,7 @@ impl DecimationOptions {
             order: Order::default(),
             initial_mesh: InitialMesh::default(),
             retriangulation: Retriangulation::default(),
-            dp_max_ring: 16,
+            dp_max_ring: 8,
             max_abs_value: None,
             max_triangles: None,
             max_vertices: None,

@@ -21,14 +21,15 @@
 //! all four cells around it valid, or lies on a straight stretch of the grid's border).
 
 use crate::exact::triangle_error;
+use crate::mesh::CompactBound;
 use crate::predicates::{orient, Point};
-use crate::{ErrorBound, Grid};
+use crate::Grid;
 
 type Xy = (i64, i64);
 
 /// Triangles (counter-clockwise sample indices) of the coarsest conforming RTIN over the
 /// grid's domain whose triangles all have exact error at most `limit`, with those errors.
-pub(crate) fn rtin_triangles(grid: &Grid, limit: f64) -> (Vec<[u32; 3]>, Vec<ErrorBound>) {
+pub(crate) fn rtin_triangles(grid: &Grid, limit: f64) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
     let rtin = Rtin::new(grid, limit);
     let need = rtin.saturate();
     let mut out = (Vec::new(), Vec::new());
@@ -239,7 +240,14 @@ impl<'g> Rtin<'g> {
     }
 
     /// Emits triangle `(a, b, c)` (hypotenuse `ab`, right angle at `c`) or its children.
-    fn emit(&self, a: Xy, b: Xy, c: Xy, need: &[bool], out: &mut (Vec<[u32; 3]>, Vec<ErrorBound>)) {
+    fn emit(
+        &self,
+        a: Xy,
+        b: Xy,
+        c: Xy,
+        need: &[bool],
+        out: &mut (Vec<[u32; 3]>, Vec<CompactBound>),
+    ) {
         let t = [a, b, c];
         let extent = self.extent(t);
         if extent == Extent::Outside {
@@ -262,7 +270,7 @@ impl<'g> Rtin<'g> {
         }
     }
 
-    fn push(&self, t: [Xy; 3], out: &mut (Vec<[u32; 3]>, Vec<ErrorBound>)) {
+    fn push(&self, t: [Xy; 3], out: &mut (Vec<[u32; 3]>, Vec<CompactBound>)) {
         let [a, b, c] = self.points(t);
         let (b, c, tb, tc) = if orient(&a, &b, &c) > 0 {
             (b, c, t[1], t[2])
@@ -271,7 +279,7 @@ impl<'g> Rtin<'g> {
         };
         let bound = triangle_error(self.grid, &a, &b, &c, f64::INFINITY).expect("no limit");
         out.0.push([t[0], tb, tc].map(|p| self.index(p) as u32));
-        out.1.push(bound);
+        out.1.push(bound.into());
     }
 }
 

@@ -91,14 +91,7 @@ impl<'g> Rtin<'g> {
 
     /// Where triangle `abc` lies relative to the grid.
     fn extent(&self, t: [Xy; 3]) -> Extent {
-        let (x0, x1) = (
-            t[0].0.min(t[1].0).min(t[2].0),
-            t[0].0.max(t[1].0).max(t[2].0),
-        );
-        let (y0, y1) = (
-            t[0].1.min(t[1].1).min(t[2].1),
-            t[0].1.max(t[1].1).max(t[2].1),
-        );
+        let (x0, x1, y0, y1) = bbox(t);
         if x0 >= self.max_x || y0 >= self.max_y || x1 <= 0 || y1 <= 0 {
             Extent::Outside
         } else if x0 < 0 || y0 < 0 || x1 > self.max_x || y1 > self.max_y {
@@ -111,14 +104,7 @@ impl<'g> Rtin<'g> {
     /// Whether a triangle inside the grid must be split: it may cover an invalid cell (its
     /// bounding box holds one) or its exact error exceeds the limit.
     fn must_split(&self, t: [Xy; 3]) -> bool {
-        let (x0, x1) = (
-            t[0].0.min(t[1].0).min(t[2].0),
-            t[0].0.max(t[1].0).max(t[2].0),
-        );
-        let (y0, y1) = (
-            t[0].1.min(t[1].1).min(t[2].1),
-            t[0].1.max(t[1].1).max(t[2].1),
-        );
+        let (x0, x1, y0, y1) = bbox(t);
         if let Some(sat) = &self.invalid {
             let cw = self.max_x as usize + 1;
             let at = |x: i64, y: i64| sat[y as usize * cw + x as usize];
@@ -288,6 +274,18 @@ enum Extent {
     Inside,
     Partly,
     Outside,
+}
+
+/// `(x_min, x_max, y_min, y_max)` of a triangle.
+fn bbox(t: [Xy; 3]) -> (i64, i64, i64, i64) {
+    let xs = [t[0].0, t[1].0, t[2].0];
+    let ys = [t[0].1, t[1].1, t[2].1];
+    (
+        xs.into_iter().min().unwrap_or(0),
+        xs.into_iter().max().unwrap_or(0),
+        ys.into_iter().min().unwrap_or(0),
+        ys.into_iter().max().unwrap_or(0),
+    )
 }
 
 fn mid(a: Xy, b: Xy) -> Xy {

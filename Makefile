@@ -10,7 +10,7 @@ TOOLS := .tools
 PY_ORACLES := trimesh==4.12.2 numpy==2.2.6
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps oracles demo test bench-results bench-contour
+.PHONY: deps oracles demo test bench-results bench-contour bench-compare
 
 ## Install Debian's GDAL (headers, tools) and pkg-config when missing.
 deps:
@@ -28,10 +28,11 @@ deps:
 oracles: $(VENV)/.ok $(TOOLS)/node_modules/gltf-validator/package.json
 
 $(VENV)/.ok:
-	@python3 -m venv --help >/dev/null 2>&1 || { \
+	@# Debian's python3 needs python3-venv (ensurepip) to create a venv.
+	python3 -m venv $(VENV) 2>/dev/null || { rm -rf $(VENV); \
 	  $(SUDO) apt-get update -qq && \
-	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends python3-venv; }
-	python3 -m venv $(VENV)
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends python3-venv && \
+	  python3 -m venv $(VENV); }
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check $(PY_ORACLES)
 	@touch $@
 
@@ -66,3 +67,9 @@ bench-results:
 bench-contour: deps
 	cargo build --release --quiet
 	python3 bench/contour_compare.py --shared ../shared
+
+## tinsmith vs hmm (pydelatin) on real DEMs, both verified (docs/results.md, issue 3).
+bench-compare: deps
+	cargo build --release --quiet
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check pydelatin rasterio
+	$(VENV)/bin/python bench/compare.py --shared ../shared

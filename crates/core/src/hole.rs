@@ -278,6 +278,20 @@ impl Retriangulator {
         edges: [SegmentError; 3],
         rules: &Rules<'_>,
     ) -> Option<ErrorBound> {
+        self.triangle_cost_capped(a, b, c, edges, rules, rules.limit)
+    }
+
+    /// [`Retriangulator::triangle_cost`] within `cap <= rules.limit`: `None` as soon as the
+    /// error is known to exceed `cap` (the DP passes the best cost found so far).
+    fn triangle_cost_capped(
+        &mut self,
+        a: usize,
+        b: usize,
+        c: usize,
+        edges: [SegmentError; 3],
+        rules: &Rules<'_>,
+        cap: f64,
+    ) -> Option<ErrorBound> {
         let (pa, pb, pc) = (&self.ring[a], &self.ring[b], &self.ring[c]);
         let bound = match rules.model {
             ErrorModel::Bounds => self.triangle_bound(a, b, c, edges),
@@ -288,14 +302,17 @@ impl Retriangulator {
                 match self.exact_errors.iter().find(|e| e.0 == key) {
                     Some(&(_, cached)) => cached?,
                     None => {
-                        let e = triangle_error(rules.grid, pa, pb, pc, rules.limit);
-                        self.exact_errors.push((key, e));
+                        let e = triangle_error(rules.grid, pa, pb, pc, cap);
+                        // "Over the cap" is only worth keeping when the cap is the limit.
+                        if e.is_some() || cap >= rules.limit {
+                            self.exact_errors.push((key, e));
+                        }
                         e?
                     }
                 }
             }
         };
-        within(bound, rules.limit).then_some(bound)
+        within(bound, cap).then_some(bound)
     }
 
     /// Min-max-error triangulation of the hole by dynamic programming over ring intervals:
@@ -345,7 +362,8 @@ impl Retriangulator {
                         }
                         ErrorModel::Exact => [SegmentError::default(); 3],
                     };
-                    let Some(t) = self.triangle_cost(i, k, j, edges, rules) else {
+                    let cap = rules.limit.min(best.0);
+                    let Some(t) = self.triangle_cost_capped(i, k, j, edges, rules, cap) else {
                         continue;
                     };
                     let c = sub.max(t.max());
@@ -407,6 +425,31 @@ impl Retriangulator {
     /// Whether the segment between ring vertices `i` and `j` (not neighbours) is a diagonal
     /// of the hole polygon: inside it and touching its boundary only at its ends. Exact.
     fn is_diagonal(&self, i: usize, j: usize) -> bool {
+        // The hole is star-shaped from the removed vertex c, ring sorted around it. With c
+        // strictly left of r_i -> r_j, the segment crosses exactly the spokes of the ring
+        // vertices strictly between i and j (counter-clockwise), and lies in the hole iff
+        // it crosses each of them strictly between c and its ring vertex, that is iff those
+        // vertices lie strictly right of it. Through c, the segment is two half-spokes.
+        let m = self.ring.len();
+        let (i, j) = if i < j { (i, j) } else { (j, i) };
+        let centre = self.centre.expect("hole loaded");
+        let (a, b) = (&self.ring[i], &self.ring[j]);
+        match orient(a, b, &centre).cmp(&0) {
+            std::cmp::Ordering::Greater => (i + 1..j).all(|k| orient(a, b, &self.ring[k]) < 0),
+            std::cmp::Ordering::Less => {
+                !self.boundary
+                    && (j + 1..m)
+                        .chain(0..i)
+                        .all(|k| orient(a, b, &self.ring[k]) > 0)
+            }
+            std::cmp::Ordering::Equal => !self.boundary,
+        }
+    }
+
+    /// The general test, for any simple polygon: no crossing of a polygon edge, inside the
+    /// corner cones at both ends. Checks [`Retriangulator::is_diagonal`] in the tests.
+    #[cfg(test)]
+    fn is_diagonal_general(&self, i: usize, j: usize) -> bool {
         let m = self.ring.len();
         let (a, b) = (&self.ring[i], &self.ring[j]);
         for k in 0..m {
@@ -815,5 +858,76 @@ mod tests {
             !r.is_diagonal(3, 6),
             "passes through the reflex vertex's outside"
         );
+        for i in 0..7 {
+            for j in i + 2..7 {
+                if (i, j) != (0, 6) {
+                    assert_eq!(
+                        r.is_diagonal(i, j),
+                        r.is_diagonal_general(i, j),
+                        "({i}, {j})"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn star_diagonal_test_agrees_with_the_general_one() {
+        // Random star-shaped rings around the origin, interior and boundary.
+        let mut seed = 11u64;
+        let mut rnd = |n: i64| {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 33) as i64).rem_euclid(n)
+        };
+        let mut checked = 0;
+        for case in 0..2000 {
+            let boundary = case % 2 == 1;
+            let m = 3 + rnd(8) as usize;
+            let span = if boundary {
+                std::f64::consts::PI
+            } else {
+                2.0 * std::f64::consts::PI
+            };
+            let mut ring: Vec<Point> = Vec::new();
+            for k in 0..m {
+                // Angles spread over the full turn (interior) or the upper half (boundary).
+                let t = span * (k as f64 + 0.1 + 0.8 * rnd(100) as f64 / 100.0) / m as f64;
+                let t = match (boundary, k) {
+                    (true, 0) => 0.0,
+                    (true, k) if k == m - 1 => span,
+                    _ => t,
+                };
+                let r = 2.0 + rnd(6) as f64;
+                ring.push(pt(
+                    (r * t.cos()).round() as i64,
+                    (r * t.sin()).round() as i64,
+                    0.0,
+                ));
+            }
+            let centre = pt(0, 0, 0.0);
+            let stars = if boundary { m - 1 } else { m };
+            let star_ok = (0..stars).all(|i| orient(&centre, &ring[i], &ring[(i + 1) % m]) > 0)
+                && (!boundary || orient(&ring[m - 1], &centre, &ring[0]) == 0);
+            if !star_ok {
+                continue;
+            }
+            let mut r = Retriangulator::default();
+            r.load(centre, &ring, &vec![ErrorBound::default(); stars]);
+            for i in 0..m {
+                for j in i + 2..m {
+                    if (i, j) != (0, m - 1) {
+                        checked += 1;
+                        assert_eq!(
+                            r.is_diagonal(i, j),
+                            r.is_diagonal_general(i, j),
+                            "{ring:?} ({i}, {j})"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(checked > 1000, "only {checked} pairs checked");
     }
 }

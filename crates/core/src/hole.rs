@@ -612,6 +612,7 @@ impl Retriangulator {
 }
 
 /// Whether closed segments `ab` and `cd` share a point. Exact.
+#[cfg(test)]
 fn segments_meet(a: &Point, b: &Point, c: &Point, d: &Point) -> bool {
     let (d1, d2) = (orient(a, b, c), orient(a, b, d));
     let (d3, d4) = (orient(c, d, a), orient(c, d, b));
@@ -630,6 +631,7 @@ fn segments_meet(a: &Point, b: &Point, c: &Point, d: &Point) -> bool {
 
 /// Whether `b` lies strictly inside the interior angle at polygon vertex `a` (with
 /// neighbours `prev` and `next`, counter-clockwise polygon). Exact.
+#[cfg(test)]
 fn in_cone(prev: &Point, a: &Point, next: &Point, b: &Point) -> bool {
     if orient(prev, a, next) >= 0 {
         // Convex (or straight) corner.

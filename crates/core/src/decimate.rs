@@ -473,6 +473,17 @@ impl<'g> Remover<'g> {
         v: u32,
     ) -> std::result::Result<(), &'static str> {
         let limit = self.rules.limit;
+        if self.plan_border_fan(mesh, v) {
+            let worst = self
+                .new_triangles
+                .iter()
+                .fold(0.0f64, |w, t| w.max(t.2.max()));
+            if worst > limit {
+                return Err("skipping it exceeds the error bound");
+            }
+            self.apply(mesh, v);
+            return Ok(());
+        }
         let saved = self.rules;
         self.rules = Rules {
             model: crate::ErrorModel::Exact,
@@ -491,6 +502,41 @@ impl<'g> Remover<'g> {
                 Ok(())
             }
         }
+    }
+
+    /// Plans the removal of border vertex `v` as a fan from its border neighbour that comes
+    /// first along the border (already settled: kept, since border samples are removed in
+    /// order). The next border vertex then keeps a small star, so a long run of removals
+    /// stays linear. Returns false when `v` is not a boundary vertex or the fan is not a
+    /// valid triangulation of the hole; bounds are the exact errors.
+    fn plan_border_fan(&mut self, mesh: &Mesh<'_>, v: u32) -> bool {
+        let star = &mut self.ring_star;
+        mesh.star(v, star);
+        if mesh.classify(v, star) != VertexClass::Boundary {
+            return false;
+        }
+        self.points.clear();
+        self.points.extend(star.ring.iter().map(|&u| mesh.point(u)));
+        let m = self.points.len();
+        let (first, last) = (&self.points[0], &self.points[m - 1]);
+        let apex = if first.x + first.y <= last.x + last.y {
+            0
+        } else {
+            m - 1
+        };
+        let others: Vec<usize> = (0..m).filter(|&i| i != apex).collect();
+        self.new_triangles.clear();
+        for (pair, &slot) in others.windows(2).zip(&star.triangles) {
+            let [a, b, c] = [apex, pair[0], pair[1]].map(|i| self.points[i]);
+            if crate::predicates::orient(&a, &b, &c) <= 0 {
+                return false;
+            }
+            let bound = crate::exact::triangle_error(self.rules.grid, &a, &b, &c, f64::INFINITY)
+                .expect("no limit");
+            let corners = [apex, pair[0], pair[1]].map(|i| star.ring[i]);
+            self.new_triangles.push((slot, corners, bound));
+        }
+        true
     }
 
     /// Plans the removal of `v`: if it is interior or boundary and its hole can be

@@ -194,3 +194,47 @@ fn narrow_tiles() {
         check_two_tiles(&terrain(w, 12, 5.0, w as u64), 1.0, ErrorModel::Exact);
     }
 }
+
+#[test]
+fn whole_borders_skipped_on_a_plane() {
+    // Every border sample but the corners is skipped: the fans along the border keep this
+    // linear, and the plane decimates to two triangles.
+    let n = 120u32;
+    let values: Vec<f64> = (0..n * n)
+        .map(|i| 0.5 * (i % n) as f64 - 0.25 * (i / n) as f64)
+        .collect();
+    let grid = Grid::new(n, n, values.clone()).unwrap();
+    let options = DecimationOptions::new(0.01);
+    let tin = decimate_with_border(&grid, &options, &|_, _| false, &mut |_| {})
+        .unwrap()
+        .tin;
+    assert_eq!(tin.triangles().len(), 2);
+    let positions: Vec<[i64; 2]> = tin
+        .vertices()
+        .iter()
+        .map(|v| [v.x as i64, v.y as i64])
+        .collect();
+    let heights: Vec<f64> = tin.vertices().iter().map(|v| v.z).collect();
+    let report = verify(
+        GridRef::new(n, n, &values),
+        MeshRef::new(&positions, &heights, tin.triangles()),
+        &VerifyOptions::new().with_max_error(0.01),
+    )
+    .unwrap();
+    assert!(report.passed(), "{:?}", report.problems);
+}
+
+#[test]
+fn a_skipped_sample_that_breaks_the_bound_is_an_error() {
+    let mut spec = terrain(20, 20, 0.0, 3);
+    spec.values[10] += 50.0; // a spike on the top border
+    let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
+    let err = decimate_with_border(
+        &grid,
+        &DecimationOptions::new(1.0),
+        &|_, _| false,
+        &mut |_| {},
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("border sample"), "{err}");
+}

@@ -86,6 +86,29 @@ pub enum Error {
         /// The 1-based band.
         band: usize,
     },
+    /// A window asked of [`crate::WindowReader::read_window`] is empty or reaches past the
+    /// raster's edge.
+    #[error(
+        "{}: window of {width}x{height} samples at ({x0}, {y0}) is not inside the \
+         {raster_width}x{raster_height} raster",
+        path.display()
+    )]
+    WindowOutOfRange {
+        /// The file.
+        path: PathBuf,
+        /// First column of the window.
+        x0: u32,
+        /// First row of the window.
+        y0: u32,
+        /// Columns asked for.
+        width: u32,
+        /// Rows asked for.
+        height: u32,
+        /// Columns of the raster.
+        raster_width: u32,
+        /// Rows of the raster.
+        raster_height: u32,
+    },
     /// The core refused the grid (a dimension of zero, or too many samples).
     #[error("{}: band {band} cannot become a grid", path.display())]
     Grid {

@@ -5,8 +5,8 @@
 //! nothing about how the mesh was made; it depends on no other tinsmith crate.
 //!
 //! # Guarantees
-//! - **Atomic output.** [`write_mesh`] writes a temporary file next to the target and
-//!   renames it into place. After an error there is no partial file and no temporary file;
+//! - **Atomic output.** [`write_mesh`] (and [`MeshStreamWriter`], which takes the mesh in
+//!   pieces) writes a temporary file next to the target and renames it into place. After an error there is no partial file and no temporary file;
 //!   an existing file at the target keeps its content.
 //! - **Exact round trip.** [`read_mesh`] of a file written by [`write_mesh`] returns the
 //!   same coordinates bit for bit (PLY stores `double`s, OBJ the shortest decimal that parses
@@ -56,8 +56,10 @@ mod format;
 mod mesh;
 mod obj;
 mod ply;
+mod stream;
 
 pub use error::{Error, Result};
 pub use file::{read_mesh, read_mesh_as, write_mesh};
 pub use format::MeshFormat;
 pub use mesh::{Mesh, MeshRef};
+pub use stream::MeshStreamWriter;

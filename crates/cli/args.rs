@@ -40,8 +40,8 @@ pub struct MeshArgs {
     /// Any single-band raster GDAL can read (GeoTIFF, ESRI ASCII, HGT, VRT, PNG...).
     pub input: PathBuf,
     /// Output mesh; the format follows the extension (.ply, .obj).
-    #[arg(short, long)]
-    pub output: PathBuf,
+    #[arg(short, long, required_unless_present = "per_tile")]
+    pub output: Option<PathBuf>,
     /// Largest allowed |sample - TIN| at any valid sample, in data units. Required unless
     /// --max-triangles or --max-vertices is given.
     #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true,
@@ -81,6 +81,29 @@ pub struct MeshArgs {
     /// Write a JSON report of sizes, counts, measured error and timings.
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
+    /// Samples per tile side, shared row and column included: a raster wider or taller
+    /// than this is meshed tile by tile (in parallel, in bounded memory).
+    #[arg(long, value_name = "N", default_value_t = tinsmith_tile::DEFAULT_TILE_SIZE,
+          value_parser = clap::value_parser!(u32).range(2..))]
+    pub tile_size: u32,
+    /// Worker threads for tiles [default: one per core].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub threads: Option<u32>,
+    /// Write one mesh file per tile into DIR (which must not exist, or be empty) instead
+    /// of one welded mesh; always uses tiles.
+    #[arg(long, value_name = "DIR", conflicts_with = "output")]
+    pub per_tile: Option<PathBuf>,
+    /// Format of the --per-tile files.
+    #[arg(long, value_enum, default_value_t = TileFormatArg::Ply, requires = "per_tile")]
+    pub tile_format: TileFormatArg,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum TileFormatArg {
+    /// Binary PLY.
+    Ply,
+    /// Wavefront OBJ.
+    Obj,
 }
 
 #[derive(Debug, Args)]

@@ -9,6 +9,7 @@ mod info;
 mod mesh;
 mod output;
 mod progress;
+mod tiled;
 mod verify;
 
 use std::process::ExitCode;

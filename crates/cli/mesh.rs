@@ -53,9 +53,12 @@ struct Seconds {
 /// Reads, decimates, verifies in memory and writes; the mesh is written only if the
 /// independent verifier confirms the bound.
 pub fn run(args: &MeshArgs) -> Result<bool> {
+    let Some(output) = crate::tiled::untiled_output(args)? else {
+        return crate::tiled::run(args);
+    };
     let total = Instant::now();
-    let format = MeshFormat::from_path(&args.output)?;
-    check_writable_target(&args.output)?;
+    let format = MeshFormat::from_path(output)?;
+    check_writable_target(output)?;
     if let Some(report) = &args.report {
         check_writable_target(report)?;
     }
@@ -129,7 +132,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         raster.info.crs_wkt.as_deref()
     };
     tinsmith_export::write_mesh(
-        &args.output,
+        output,
         format,
         MeshRef::new(&vertices, &triangles).with_crs_wkt(crs),
     )?;
@@ -157,7 +160,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         decimation_percent: 100.0 * (1.0 - r.final_triangles as f64 / r.initial_triangles as f64),
         max_error_bound: r.max_bound,
         measured_max_error: check.max_error,
-        output: &args.output,
+        output,
         seconds: Seconds {
             read: read_seconds,
             initial_mesh: r.seconds_initial_mesh,
@@ -170,7 +173,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     if !args.quiet {
         eprintln!(
             "{}: {} -> {} triangles ({:.1}% decimated), measured max error {} <= {}",
-            args.output.display(),
+            output.display(),
             report.triangles_before,
             report.triangles_after,
             report.decimation_percent,

@@ -6,7 +6,7 @@ use std::time::Instant;
 use tinsmith_core::{decimate_with_border, DecimationOptions, DecimationReport, TinVertex};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
-use crate::edge::{edge_limit, EdgeProfile};
+use crate::edge::{edge_limit, EdgeProfile, MAX_EDGE_SPAN};
 use crate::error::{Error, Result};
 use crate::halo::{halo_window, TileInput};
 use crate::order::run_ordered;
@@ -282,7 +282,7 @@ impl TileJob {
 
         let keep = |edge: &EdgeProfile| {
             if self.edge_limit > 0.0 {
-                edge.simplify(self.edge_limit)
+                edge.simplify(self.edge_limit, MAX_EDGE_SPAN)
             } else {
                 // Below the rounding slack the core removes only exactly flat stars:
                 // keep every edge sample.

@@ -52,7 +52,7 @@ mod source;
 mod weld;
 mod welded;
 
-pub use edge::{edge_limit, EdgeProfile};
+pub use edge::{edge_limit, EdgeProfile, MAX_EDGE_SPAN};
 pub use engine::{mesh_tiles, TileOptions, TileProgress, TilesReport, DEFAULT_TILE_SIZE};
 pub use error::{Error, Result};
 pub use per_tile::PerTileWriter;

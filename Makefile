@@ -6,7 +6,7 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 DEMO_DEM := data/becmodel_dem_bc_albers_50m.tif
 DEMO_ERROR := 5
 
-.PHONY: deps demo test bench-results
+.PHONY: deps oracles demo test bench-results
 
 ## Install Debian's GDAL (headers, tools) and pkg-config when missing.
 deps:
@@ -17,6 +17,17 @@ deps:
 	    libgdal-dev gdal-bin pkg-config build-essential ca-certificates curl; \
 	fi
 	@command -v cargo >/dev/null || { echo "Rust is missing: install it from https://rustup.rs"; exit 1; }
+	$(MAKE) --no-print-directory oracles
+
+## Independent test oracles, pinned, in .tools/: the HERE quantized-mesh decoder (npm).
+## Tests that need an oracle fail (never skip) when it is missing under CI.
+oracles:
+	@command -v npm >/dev/null || { echo "installing nodejs npm"; $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends nodejs npm; }
+	@if [ ! -f .tools/node_modules/@here/quantized-mesh-decoder/package.json ]; then \
+	  mkdir -p .tools && npm install --silent --no-audit --no-fund --prefix .tools \
+	    @here/quantized-mesh-decoder@1.2.8; \
+	fi
 
 ## Mesh the sample DEM at $(DEMO_ERROR) m, then prove the bound with the verifier.
 demo: deps

@@ -56,10 +56,16 @@ mod format;
 mod mesh;
 mod obj;
 mod ply;
+mod quantized_mesh;
 mod stream;
 
 pub use error::{Error, Result};
 pub use file::{read_mesh, read_mesh_as, write_mesh};
 pub use format::MeshFormat;
 pub use mesh::{Mesh, MeshRef};
+pub use quantized_mesh::{
+    geodetic_to_ecef, gzip, oct_encode, surface_normal, EncodeError, GeoRectangle,
+    QuantizedMeshTile, EXTENSION_METADATA, EXTENSION_NORMALS, HEADER_BYTES, MAX_16BIT_VERTICES,
+    QUANTIZED_MAX, WGS84_A, WGS84_B,
+};
 pub use stream::MeshStreamWriter;

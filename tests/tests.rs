@@ -4,4 +4,5 @@ mod util;
 
 mod bad_input;
 mod mesh_and_verify;
+mod terrain;
 mod tiles;

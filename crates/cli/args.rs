@@ -21,6 +21,59 @@ pub enum Command {
     Mesh(MeshArgs),
     /// Measure a TIN's true error against its raster at every valid sample.
     Verify(VerifyArgs),
+    /// Build a Cesium quantized-mesh terrain pyramid (EPSG:4326 TMS) with layer.json.
+    Tiles(TilesArgs),
+    /// Serve a directory (a terrain pyramid) over HTTP on 127.0.0.1, for CesiumJS.
+    Serve(ServeArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct TilesArgs {
+    /// Any georeferenced raster GDAL can read, in any CRS (reprojected to EPSG:4326).
+    pub input: PathBuf,
+    /// Output directory: {z}/{x}/{y}.terrain and layer.json.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Band to read (1-based).
+    #[arg(long, default_value_t = 1)]
+    pub band: usize,
+    /// Coarsest level written.
+    #[arg(long, default_value_t = 0)]
+    pub min_zoom: u8,
+    /// Finest level (default: where the tile sample spacing reaches the input's).
+    #[arg(long)]
+    pub max_zoom: Option<u8>,
+    /// Bound per tile = Q x 77067.34 m / 2^level (Cesium's geometric error).
+    #[arg(long, default_value_t = 1.0)]
+    pub quality: f64,
+    /// Add oct-encoded vertex normals (octvertexnormals extension).
+    #[arg(long)]
+    pub normals: bool,
+    /// Add the metadata extension at levels 0, 10, 20 and metadataAvailability.
+    #[arg(long)]
+    pub metadata: bool,
+    /// Write tiles uncompressed (by default they are gzipped; serve them with
+    /// Content-Encoding: gzip).
+    #[arg(long)]
+    pub no_gzip: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Write the per-level report (bounds, measured error, tiles, bytes) as JSON.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct ServeArgs {
+    /// The directory to serve (made by `tinsmith tiles`).
+    pub dir: PathBuf,
+    /// Port on 127.0.0.1 (0 picks a free one; the address is printed).
+    #[arg(long, default_value_t = 8000)]
+    pub port: u16,
+    /// Stop after this many requests (for tests).
+    #[arg(long, hide = true)]
+    pub max_requests: Option<u64>,
 }
 
 #[derive(Debug, Args)]

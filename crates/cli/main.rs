@@ -9,6 +9,8 @@ mod info;
 mod mesh;
 mod output;
 mod progress;
+mod serve;
+mod terrain;
 mod tiled;
 mod verify;
 
@@ -31,6 +33,8 @@ fn main() -> ExitCode {
         Command::Info(a) => info::run(&a),
         Command::Mesh(a) => mesh::run(&a),
         Command::Verify(a) => verify::run(&a),
+        Command::Tiles(a) => terrain::run(&a),
+        Command::Serve(a) => serve::run(&a),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

@@ -109,6 +109,23 @@ pub enum Error {
         /// Rows of the raster.
         raster_height: u32,
     },
+    /// The raster has no CRS or no geotransform, so it cannot be placed on the globe.
+    #[error("{}: no CRS or geotransform, cannot reproject to EPSG:4326", path.display())]
+    NotGeoreferenced {
+        /// The file.
+        path: PathBuf,
+    },
+    /// GDAL failed to reproject the raster to EPSG:4326.
+    #[error("{}: reprojecting to EPSG:4326 failed ({reason})", path.display())]
+    Warp {
+        /// The file.
+        path: PathBuf,
+        /// GDAL's explanation.
+        reason: String,
+        /// The error GDAL returned (boxed: it is large).
+        #[source]
+        source: Box<gdal::errors::GdalError>,
+    },
     /// The core refused the grid (a dimension of zero, or too many samples).
     #[error("{}: band {band} cannot become a grid", path.display())]
     Grid {

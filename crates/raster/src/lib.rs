@@ -51,12 +51,14 @@
 
 mod decode;
 mod error;
+mod geographic;
 mod info;
 mod quiet;
 mod read;
 mod window;
 
 pub use error::{Error, Result};
+pub use geographic::{geographic_bounds, warp_to_geographic, GeoBounds, GeoLattice};
 pub use info::{Raster, RasterInfo};
 pub use quiet::silence_gdal_errors;
 pub use read::{open_info, read_grid};

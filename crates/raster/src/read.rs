@@ -172,6 +172,10 @@ impl OpenBand {
         })
     }
 
+    pub(crate) fn dataset(&self) -> &Dataset {
+        &self.dataset
+    }
+
     fn width(&self) -> usize {
         self.info.width as usize
     }

@@ -49,6 +49,7 @@ mod placement;
 mod plan;
 mod sink;
 mod source;
+mod terrain;
 mod weld;
 mod welded;
 
@@ -60,4 +61,8 @@ pub use placement::Placement;
 pub use plan::{TileIndex, TilePlan, TileWindow};
 pub use sink::{FinishedTile, SinkError, TileSink};
 pub use source::{GridSource, RasterSource, ReadError, TileSource, WindowRead};
+pub use terrain::{
+    build_terrain, tile_rectangle, LevelReport, TerrainError, TerrainOptions, TerrainReport,
+    TerrainResult, LEVEL_ZERO_ERROR, MAX_LEVEL, METADATA_AVAILABILITY, TILE_CELLS,
+};
 pub use welded::WeldedWriter;

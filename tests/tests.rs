@@ -4,5 +4,6 @@ mod util;
 
 mod bad_input;
 mod mesh_and_verify;
+mod serve;
 mod terrain;
 mod tiles;

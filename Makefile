@@ -19,14 +19,19 @@ deps:
 	@command -v cargo >/dev/null || { echo "Rust is missing: install it from https://rustup.rs"; exit 1; }
 	$(MAKE) --no-print-directory oracles
 
-## Independent test oracles, pinned, in .tools/: the HERE quantized-mesh decoder (npm).
-## Tests that need an oracle fail (never skip) when it is missing under CI.
+## Independent test oracles, pinned, in .tools/: the HERE quantized-mesh decoder (npm),
+## CesiumJS and playwright-core (npm) with Debian's Chromium for the real-client test.
+## Tests that need an oracle fail (never skip) when it is missing.
+ORACLES_NPM := @here/quantized-mesh-decoder@1.2.8 cesium@1.140.0 playwright-core@1.64.1
 oracles:
 	@command -v npm >/dev/null || { echo "installing nodejs npm"; $(SUDO) apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends nodejs npm; }
-	@if [ ! -f .tools/node_modules/@here/quantized-mesh-decoder/package.json ]; then \
-	  mkdir -p .tools && npm install --silent --no-audit --no-fund --prefix .tools \
-	    @here/quantized-mesh-decoder@1.2.8; \
+	@command -v chromium >/dev/null || { echo "installing chromium"; $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends chromium; }
+	@if [ ! -f .tools/node_modules/@here/quantized-mesh-decoder/package.json ] || \
+	    [ ! -f .tools/node_modules/cesium/Build/Cesium/Cesium.js ] || \
+	    [ ! -f .tools/node_modules/playwright-core/package.json ]; then \
+	  mkdir -p .tools && npm install --silent --no-audit --no-fund --prefix .tools $(ORACLES_NPM); \
 	fi
 
 ## Mesh the sample DEM at $(DEMO_ERROR) m, then prove the bound with the verifier.

@@ -251,7 +251,7 @@ fn max_error(t: &Tile, samples: &[Vec<f64>]) -> f64 {
 }
 
 /// The tile's lattice warped by the gdalwarp program (bilinear), row 0 the southernmost.
-fn gdal_samples(dir: &Dir, input: &str, z: u32, x: u32, y: u32) -> Vec<Vec<f64>> {
+pub(crate) fn gdal_samples(dir: &Dir, input: &str, z: u32, x: u32, y: u32) -> Vec<Vec<f64>> {
     let size = 180.0 / (1u64 << z) as f64;
     let d = size / CELLS as f64;
     let (west, south) = (-180.0 + x as f64 * size, -90.0 + y as f64 * size);

@@ -3,6 +3,7 @@
 mod util;
 
 mod bad_input;
+mod cesium;
 mod mesh_and_verify;
 mod serve;
 mod terrain;

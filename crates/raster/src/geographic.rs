@@ -63,6 +63,27 @@ fn warp_error(path: &Path, source: gdal::errors::GdalError) -> Error {
 /// [`Error::Warp`] when PROJ cannot transform the extent.
 pub fn geographic_bounds(path: &Path, band: usize) -> Result<GeoBounds> {
     let opened = OpenBand::open(path, band)?;
+    let b = raw_bounds(path, &opened)?;
+    let (w, h) = (f64::from(opened.info.width), f64::from(opened.info.height));
+    let resolution = ((b[2] - b[0]) / w).min((b[3] - b[1]) / h);
+    // A geographic raster in 0..360 (or -360..0) longitudes wraps around: it covers the
+    // whole circle of longitudes it spans modulo 360.
+    let (west, east) = if b[2] > 180.0 || b[0] < -180.0 {
+        (-180.0, 180.0)
+    } else {
+        (b[0], b[2])
+    };
+    Ok(GeoBounds {
+        west,
+        south: b[1].max(-90.0),
+        east,
+        north: b[3].min(90.0),
+        resolution,
+    })
+}
+
+/// The raster's extent in EPSG:4326 as PROJ gives it, longitudes not wrapped.
+fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
     let info = &opened.info;
     let (Some(gt), Some(_)) = (info.geo_transform, info.crs_wkt.as_ref()) else {
         return Err(Error::NotGeoreferenced {
@@ -78,7 +99,7 @@ pub fn geographic_bounds(path: &Path, band: usize) -> Result<GeoBounds> {
         .map_err(|e| warp_error(path, e))?;
     source.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
     let transform = CoordTransform::new(&source, &wgs84()?).map_err(|e| warp_error(path, e))?;
-    let b = transform
+    transform
         .transform_bounds(
             &[
                 xs[0].min(xs[1]),
@@ -88,16 +109,7 @@ pub fn geographic_bounds(path: &Path, band: usize) -> Result<GeoBounds> {
             ],
             21,
         )
-        .map_err(|e| warp_error(path, e))?;
-    let (west, south) = (b[0].max(-180.0), b[1].max(-90.0));
-    let (east, north) = (b[2].min(180.0), b[3].min(90.0));
-    Ok(GeoBounds {
-        west,
-        south,
-        east,
-        north,
-        resolution: ((east - west) / w).min((north - south) / h),
-    })
+        .map_err(|e| warp_error(path, e))
 }
 
 /// The band's samples at the lattice's positions, reprojected by GDAL's warper (bilinear,
@@ -108,12 +120,30 @@ pub fn geographic_bounds(path: &Path, band: usize) -> Result<GeoBounds> {
 /// As [`geographic_bounds`].
 pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Result<Vec<f32>> {
     let opened = OpenBand::open(path, band)?;
-    let info = opened.info.clone();
-    if info.geo_transform.is_none() || info.crs_wkt.is_none() {
-        return Err(Error::NotGeoreferenced {
-            path: path.to_path_buf(),
-        });
+    let b = raw_bounds(path, &opened)?;
+    let mut values = warp_pass(path, &opened, lattice, 0.0)?;
+    // Sources in 0..360 (or -360..0) longitudes: the part beyond the antimeridian is
+    // warped again with the lattice shifted by a full turn, filling what is still empty.
+    for shift in [360.0, -360.0] {
+        let beyond = if shift > 0.0 {
+            b[2] > 180.0
+        } else {
+            b[0] < -180.0
+        };
+        if beyond && values.iter().any(|v| v.is_nan()) {
+            let more = warp_pass(path, &opened, lattice, shift)?;
+            for (v, m) in values.iter_mut().zip(more) {
+                if v.is_nan() {
+                    *v = m;
+                }
+            }
+        }
     }
+    Ok(values)
+}
+
+fn warp_pass(path: &Path, opened: &OpenBand, lattice: &GeoLattice, shift: f64) -> Result<Vec<f32>> {
+    let info = &opened.info;
     let (width, height) = (lattice.width as usize, lattice.height as usize);
     let driver = DriverManager::get_driver_by_name("MEM").map_err(|e| warp_error(path, e))?;
     let mut target = driver
@@ -121,8 +151,9 @@ pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Res
         .map_err(|e| warp_error(path, e))?;
     let d = lattice.step;
     let north = lattice.south + (height as f64 - 1.0) * d;
+    let west = lattice.west + shift;
     target
-        .set_geo_transform(&[lattice.west - d / 2.0, d, 0.0, north + d / 2.0, 0.0, -d])
+        .set_geo_transform(&[west - d / 2.0, d, 0.0, north + d / 2.0, 0.0, -d])
         .map_err(|e| warp_error(path, e))?;
     target
         .set_spatial_ref(&wgs84()?)

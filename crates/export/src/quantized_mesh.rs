@@ -3,7 +3,7 @@
 //!
 //! Follows the CesiumGS/quantized-mesh README and CesiumJS's decoder
 //! (`CesiumTerrainProvider.js`, `createVerticesFromQuantizedTerrainMesh.js`); see
-//! `docs/quantized-mesh.md` for the choices made where they leave room.
+//! `docs/architecture.md` ("Terrain tiles") for the choices made where they leave room.
 
 use std::io::Write;
 

@@ -25,7 +25,7 @@ deps:
 
 ## The independent readers the format tests check our files with (tests/formats.rs):
 ## trimesh in .venv (PyPI) and the Khronos glTF validator in .tools (npm). Idempotent.
-oracles: $(VENV)/.ok $(TOOLS)/node_modules/gltf-validator/package.json
+oracles: $(VENV)/.ok $(TOOLS)/node_modules/gltf-validator/package.json qm-oracles
 
 $(VENV)/.ok:
 	@# Debian's python3 needs python3-venv (ensurepip) to create a venv.
@@ -42,6 +42,22 @@ $(TOOLS)/node_modules/gltf-validator/package.json:
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends nodejs npm; }
 	mkdir -p $(TOOLS)
 	npm install --prefix $(TOOLS) --no-audit --no-fund --silent $(NPM_ORACLES)
+
+## The quantized-mesh oracles, pinned, in .tools/: the HERE quantized-mesh decoder (npm),
+## CesiumJS and playwright-core (npm) with Debian's Chromium for the real-client test.
+## Tests that need an oracle fail (never skip) when it is missing.
+ORACLES_NPM := @here/quantized-mesh-decoder@1.2.8 cesium@1.140.0 playwright-core@1.64.1
+.PHONY: qm-oracles
+qm-oracles:
+	@command -v npm >/dev/null || { echo "installing nodejs npm"; $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends nodejs npm; }
+	@command -v chromium >/dev/null || { echo "installing chromium"; $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends chromium; }
+	@if [ ! -f .tools/node_modules/@here/quantized-mesh-decoder/package.json ] || \
+	    [ ! -f .tools/node_modules/cesium/Build/Cesium/Cesium.js ] || \
+	    [ ! -f .tools/node_modules/playwright-core/package.json ]; then \
+	  mkdir -p .tools && npm install --silent --no-audit --no-fund --prefix .tools $(ORACLES_NPM); \
+	fi
 
 ## Mesh the sample DEM at $(DEMO_ERROR) m, then prove the bound with the verifier.
 demo: deps

@@ -3,6 +3,10 @@
 mod util;
 
 mod bad_input;
+mod cesium;
 mod contour;
 mod formats;
 mod mesh_and_verify;
+mod serve;
+mod terrain;
+mod tiles;

@@ -24,6 +24,59 @@ pub enum Command {
     Verify(VerifyArgs),
     /// Contour lines of the raster's TIN (decimated within --max-error, or given).
     Contour(ContourArgs),
+    /// Build a Cesium quantized-mesh terrain pyramid (EPSG:4326 TMS) with layer.json.
+    Tiles(TilesArgs),
+    /// Serve a directory (a terrain pyramid) over HTTP on 127.0.0.1, for CesiumJS.
+    Serve(ServeArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct TilesArgs {
+    /// Any georeferenced raster GDAL can read, in any CRS (reprojected to EPSG:4326).
+    pub input: PathBuf,
+    /// Output directory: {z}/{x}/{y}.terrain and layer.json.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Band to read (1-based).
+    #[arg(long, default_value_t = 1)]
+    pub band: usize,
+    /// Coarsest level written.
+    #[arg(long, default_value_t = 0)]
+    pub min_zoom: u8,
+    /// Finest level (default: where the tile sample spacing reaches the input's).
+    #[arg(long)]
+    pub max_zoom: Option<u8>,
+    /// Bound per tile = Q x 77067.34 m / 2^level (Cesium's geometric error).
+    #[arg(long, default_value_t = 1.0)]
+    pub quality: f64,
+    /// Add oct-encoded vertex normals (octvertexnormals extension).
+    #[arg(long)]
+    pub normals: bool,
+    /// Add the metadata extension at levels 0, 10, 20 and metadataAvailability.
+    #[arg(long)]
+    pub metadata: bool,
+    /// Write tiles uncompressed (by default they are gzipped; serve them with
+    /// Content-Encoding: gzip).
+    #[arg(long)]
+    pub no_gzip: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Write the per-level report (bounds, measured error, tiles, bytes) as JSON.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct ServeArgs {
+    /// The directory to serve (made by `tinsmith tiles`).
+    pub dir: PathBuf,
+    /// Port on 127.0.0.1 (0 picks a free one; the address is printed).
+    #[arg(long, default_value_t = 8000)]
+    pub port: u16,
+    /// Stop after this many requests (for tests).
+    #[arg(long, hide = true)]
+    pub max_requests: Option<u64>,
 }
 
 #[derive(Debug, Args)]
@@ -43,9 +96,9 @@ pub struct MeshArgs {
     /// Any single-band raster GDAL can read (GeoTIFF, ESRI ASCII, HGT, VRT, PNG...).
     pub input: PathBuf,
     /// Output mesh; the format follows the extension (.ply, .obj, .stl, .glb, .geojson,
-    /// .fgb, .xml for LandXML) unless --format names it.
-    #[arg(short, long)]
-    pub output: PathBuf,
+    /// .fgb, .xml for LandXML) unless --format names it. Optional with --per-tile.
+    #[arg(short, long, required_unless_present = "per_tile")]
+    pub output: Option<PathBuf>,
     #[command(flatten)]
     pub export: ExportArgs,
     /// Largest allowed |sample - TIN| at any valid sample, in data units. Required unless
@@ -91,6 +144,29 @@ pub struct MeshArgs {
     /// Write a JSON report of sizes, counts, measured error and timings.
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
+    /// Samples per tile side, shared row and column included: a raster wider or taller
+    /// than this is meshed tile by tile (in parallel, in bounded memory).
+    #[arg(long, value_name = "N", default_value_t = tinsmith_tile::DEFAULT_TILE_SIZE,
+          value_parser = clap::value_parser!(u32).range(2..))]
+    pub tile_size: u32,
+    /// Worker threads for tiles [default: one per core].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub threads: Option<u32>,
+    /// Write one mesh file per tile into DIR (which must not exist, or be empty) instead
+    /// of one welded mesh; always uses tiles.
+    #[arg(long, value_name = "DIR", conflicts_with = "output")]
+    pub per_tile: Option<PathBuf>,
+    /// Format of the --per-tile files.
+    #[arg(long, value_enum, default_value_t = TileFormatArg::Ply, requires = "per_tile")]
+    pub tile_format: TileFormatArg,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum TileFormatArg {
+    /// Binary PLY.
+    Ply,
+    /// Wavefront OBJ.
+    Obj,
 }
 
 /// Output format and format-specific options of `mesh`.

@@ -22,7 +22,7 @@ const MAX_POSITION_ROUNDING_PX: f64 = 9e-4;
 pub fn format(args: &MeshArgs) -> Result<MeshFormat> {
     let format = match args.export.format {
         Some(format) => format,
-        None => MeshFormat::from_path(&args.output)?,
+        None => MeshFormat::from_path(out(args))?,
     };
     let e = &args.export;
     let misplaced = [
@@ -38,7 +38,7 @@ pub fn format(args: &MeshArgs) -> Result<MeshFormat> {
         if given && format != only {
             bail!(
                 "{}: {flag} applies to {only} output only, not {format}",
-                args.output.display()
+                out(args).display()
             );
         }
     }
@@ -92,14 +92,14 @@ impl Plan {
             if base >= min {
                 bail!(
                     "{}: --base {base} must be below the lowest height ({min})",
-                    args.output.display()
+                    out(args).display()
                 );
             }
         }
         let georef = Georef::new(raster.info.transform(), args.pixel_coords);
         let (min, max) = extent(grid, &georef);
         let origin = LocalOrigin::around(min, max);
-        check_position_rounding(grid, &georef, origin, min, max, &args.output)?;
+        check_position_rounding(grid, &georef, origin, min, max, out(args))?;
 
         let mut height_rounding = 0.0f64;
         for &z in grid.values().iter().filter(|z| z.is_finite()) {
@@ -112,7 +112,7 @@ impl Plan {
                 "{}: --max-error {max_error} is smaller than the float32 rounding of the \
                  heights ({height_rounding}) in {format}; use a larger bound or a \
                  double-precision format (.ply, .obj, .fgb, .geojson, .xml)",
-                args.output.display()
+                out(args).display()
             );
         }
         Ok(Plan {
@@ -215,7 +215,7 @@ pub fn write(
     mut vertices: Vec<[f64; 3]>,
     triangles: &[[u32; 3]],
 ) -> Result<()> {
-    let path = &args.output;
+    let path = out(args);
     let info = &raster.info;
     let (mut crs, mut epsg) = match args.pixel_coords || info.transform().is_none() {
         true => (None, None),
@@ -263,7 +263,7 @@ fn check_positions_map_back(
         georef.sample_at([q[0], q[1]]).with_context(|| {
             format!(
                 "{}: vertex {i} would not map back to its sample in float32; nothing written",
-                args.output.display()
+                out(args).display()
             )
         })?;
     }
@@ -273,4 +273,10 @@ fn check_positions_map_back(
 /// `--format NAME`.
 pub fn parse_format(name: &str) -> std::result::Result<MeshFormat, String> {
     MeshFormat::from_name(name).map_err(|e| e.to_string())
+}
+
+/// The output path of an untiled `mesh` run (where `--output` is always given; the tiled
+/// engine, which allows `--per-tile` alone, does not come here).
+fn out(args: &MeshArgs) -> &std::path::Path {
+    args.output.as_deref().unwrap_or(std::path::Path::new("-"))
 }

@@ -12,6 +12,9 @@ mod info;
 mod mesh;
 mod output;
 mod progress;
+mod serve;
+mod terrain;
+mod tiled;
 mod verify;
 
 use std::process::ExitCode;
@@ -34,6 +37,8 @@ fn main() -> ExitCode {
         Command::Mesh(a) => mesh::run(&a),
         Command::Verify(a) => verify::run(&a),
         Command::Contour(a) => contour::run(&a),
+        Command::Tiles(a) => terrain::run(&a),
+        Command::Serve(a) => serve::run(&a),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

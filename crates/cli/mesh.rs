@@ -54,9 +54,12 @@ struct Seconds {
 /// Reads, decimates, verifies in memory and writes; the mesh is written only if the
 /// independent verifier confirms the bound.
 pub fn run(args: &MeshArgs) -> Result<bool> {
+    let Some(output) = crate::tiled::untiled_output(args)? else {
+        return crate::tiled::run(args);
+    };
     let total = Instant::now();
     let format = crate::export::format(args)?;
-    check_writable_target(&args.output)?;
+    check_writable_target(output)?;
     if let Some(report) = &args.report {
         check_writable_target(report)?;
     }
@@ -157,7 +160,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         decimation_percent: 100.0 * (1.0 - r.final_triangles as f64 / r.initial_triangles as f64),
         max_error_bound: r.max_bound,
         measured_max_error: check.max_error,
-        output: &args.output,
+        output,
         output_format: plan.report(),
         seconds: Seconds {
             read: read_seconds,
@@ -171,7 +174,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     if !args.quiet {
         eprintln!(
             "{}: {} -> {} triangles ({:.1}% decimated), measured max error {} <= {}",
-            args.output.display(),
+            output.display(),
             report.triangles_before,
             report.triangles_after,
             report.decimation_percent,
@@ -187,7 +190,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             eprintln!(
                 "{}: float32 positions relative to the local origin ({x}, {y}, {z}); \
                  heights round by at most {}",
-                args.output.display(),
+                output.display(),
                 plan.height_rounding
             );
         }

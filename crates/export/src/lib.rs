@@ -5,8 +5,8 @@
 //! nothing about how the mesh was made; it depends on no other tinsmith crate.
 //!
 //! # Guarantees
-//! - **Atomic output.** [`write_mesh`] writes a temporary file next to the target and
-//!   renames it into place. After an error there is no partial file and no temporary file;
+//! - **Atomic output.** [`write_mesh`] (and [`MeshStreamWriter`], which takes the mesh in
+//!   pieces) writes a temporary file next to the target and renames it into place. After an error there is no partial file and no temporary file;
 //!   an existing file at the target keeps its content.
 //! - **Exact round trip.** [`read_mesh`] of a file written by [`write_mesh`] returns the
 //!   same coordinates bit for bit (PLY stores `double`s, OBJ the shortest decimal that parses
@@ -63,7 +63,9 @@ mod obj;
 mod options;
 mod origin;
 mod ply;
+mod quantized_mesh;
 mod stl;
+mod stream;
 mod weld;
 
 pub use error::{Error, Result};
@@ -73,3 +75,9 @@ pub use lines::{write_lines, CrsRef, LineFormat, LinePoint};
 pub use mesh::{Mesh, MeshRef};
 pub use options::WriteOptions;
 pub use origin::LocalOrigin;
+pub use quantized_mesh::{
+    geodetic_to_ecef, gzip, oct_encode, surface_normal, EncodeError, GeoRectangle,
+    QuantizedMeshTile, EXTENSION_METADATA, EXTENSION_NORMALS, HEADER_BYTES, MAX_16BIT_VERTICES,
+    QUANTIZED_MAX, WGS84_A, WGS84_B,
+};
+pub use stream::MeshStreamWriter;

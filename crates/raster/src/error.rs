@@ -98,6 +98,46 @@ pub enum Error {
         #[source]
         source: Box<gdal::errors::GdalError>,
     },
+    /// A window asked of [`crate::WindowReader::read_window`] is empty or reaches past the
+    /// raster's edge.
+    #[error(
+        "{}: window of {width}x{height} samples at ({x0}, {y0}) is not inside the \
+         {raster_width}x{raster_height} raster",
+        path.display()
+    )]
+    WindowOutOfRange {
+        /// The file.
+        path: PathBuf,
+        /// First column of the window.
+        x0: u32,
+        /// First row of the window.
+        y0: u32,
+        /// Columns asked for.
+        width: u32,
+        /// Rows asked for.
+        height: u32,
+        /// Columns of the raster.
+        raster_width: u32,
+        /// Rows of the raster.
+        raster_height: u32,
+    },
+    /// The raster has no CRS or no geotransform, so it cannot be placed on the globe.
+    #[error("{}: no CRS or geotransform, cannot reproject to EPSG:4326", path.display())]
+    NotGeoreferenced {
+        /// The file.
+        path: PathBuf,
+    },
+    /// GDAL failed to reproject the raster to EPSG:4326.
+    #[error("{}: reprojecting to EPSG:4326 failed ({reason})", path.display())]
+    Warp {
+        /// The file.
+        path: PathBuf,
+        /// GDAL's explanation.
+        reason: String,
+        /// The error GDAL returned (boxed: it is large).
+        #[source]
+        source: Box<gdal::errors::GdalError>,
+    },
     /// Reprojection: PROJ maps a point to no finite position (outside the area
     /// the projection is defined on).
     #[error("point {point} at {position:?} cannot be transformed")]

@@ -56,6 +56,17 @@ impl RasterInfo {
     pub fn transform(&self) -> Option<GeoTransform> {
         self.geo_transform.map(GeoTransform)
     }
+
+    /// The largest |height| of any valid sample, from [`RasterInfo::min`] and
+    /// [`RasterInfo::max`]; `None` when no sample is valid (or the statistics were not
+    /// computed, as for [`crate::WindowReader::info`]).
+    ///
+    /// Tiles of one raster decimated separately all use this value for the rounding slack
+    /// (`tinsmith_core::DecimationOptions::max_abs_value`), so that they enforce the same
+    /// limit.
+    pub fn max_abs_value(&self) -> Option<f64> {
+        Some(self.min?.abs().max(self.max?.abs()))
+    }
 }
 
 /// A band read into a [`Grid`] (nodata as NaN), with its [`RasterInfo`].

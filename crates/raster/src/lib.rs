@@ -5,6 +5,10 @@
 //! [`open_info`] gives the same [`RasterInfo`] without keeping the samples.
 //! [`to_wgs84`] and [`from_wgs84`] transform coordinates between a CRS and WGS84
 //! longitude, latitude (for RFC 7946 GeoJSON), so that no other crate links GDAL.
+//! [`open_info`] gives the same [`RasterInfo`] without keeping the samples. For rasters
+//! too large for one grid, [`WindowReader`] (or [`read_window`]) reads a rectangle at a
+//! time, decoded exactly as [`read_grid`] decodes the whole band, and
+//! [`RasterInfo::max_abs_value`] of [`open_info`] gives the raster-wide largest |height|.
 //!
 //! # What callers can rely on
 //! - **Nodata.** A sample is nodata exactly when it is NaN or infinite, or equals the band's
@@ -23,7 +27,8 @@
 //!   the message (without its repetition of the path), and GDAL's error is kept as the
 //!   [`std::error::Error::source`].
 //! - **Threads.** Each call opens its own GDAL dataset and closes it before returning, so
-//!   the functions can be called from several threads at once.
+//!   the functions can be called from several threads at once. A [`WindowReader`] keeps
+//!   its dataset open: it can move between threads but not be shared; open one per thread.
 //!
 //! GDAL also prints its errors to standard error by default; [`silence_gdal_errors`] stops
 //! that for the whole process (the messages stay in the returned errors).
@@ -49,13 +54,17 @@
 
 mod decode;
 mod error;
+mod geographic;
 mod info;
 mod quiet;
 mod read;
 mod reproject;
+mod window;
 
 pub use error::{Error, Result};
+pub use geographic::{geographic_bounds, warp_to_geographic, GeoBounds, GeoLattice};
 pub use info::{Raster, RasterInfo};
 pub use quiet::silence_gdal_errors;
 pub use read::{open_info, read_grid};
 pub use reproject::{from_wgs84, to_wgs84};
+pub use window::{read_window, WindowReader};

@@ -89,15 +89,15 @@ pub fn read_grid(path: &Path, band: usize) -> Result<Raster> {
 }
 
 /// An open dataset with a checked band and everything known before reading samples.
-struct OpenBand {
+pub(crate) struct OpenBand {
     dataset: Dataset,
     /// Metadata; the statistics are still zero.
-    info: RasterInfo,
+    pub(crate) info: RasterInfo,
     decoder: SampleDecoder,
 }
 
 impl OpenBand {
-    fn open(path: &Path, band: usize) -> Result<OpenBand> {
+    pub(crate) fn open(path: &Path, band: usize) -> Result<OpenBand> {
         let dataset = open_dataset(path)?;
         let count = dataset.raster_count();
         if band == 0 || band > count {
@@ -172,14 +172,41 @@ impl OpenBand {
         })
     }
 
+    pub(crate) fn dataset(&self) -> &Dataset {
+        &self.dataset
+    }
+
     fn width(&self) -> usize {
         self.info.width as usize
     }
 
-    fn band(&self) -> Result<RasterBand<'_>> {
+    pub(crate) fn band(&self) -> Result<RasterBand<'_>> {
         self.dataset
             .rasterband(self.info.band)
             .map_err(|e| self.read_error(e))
+    }
+
+    /// Reads the `size.0` x `size.1` window whose top-left sample is `origin` into `dst`
+    /// (row-major) and decodes it in place; the window must lie inside the raster.
+    pub(crate) fn read_window(
+        &self,
+        rb: &RasterBand<'_>,
+        origin: (usize, usize),
+        size: (usize, usize),
+        dst: &mut [f64],
+    ) -> Result<()> {
+        rb.read_into_slice::<f64>(
+            (origin.0 as isize, origin.1 as isize),
+            size,
+            size,
+            dst,
+            None,
+        )
+        .map_err(|e| self.read_error(e))?;
+        for v in dst.iter_mut() {
+            *v = self.decoder.decode(*v);
+        }
+        Ok(())
     }
 
     /// `(first row, row count)` of each strip, top to bottom; strips are whole rows of blocks.
@@ -201,13 +228,7 @@ impl OpenBand {
         rows: usize,
         dst: &mut [f64],
     ) -> Result<()> {
-        let size = (self.width(), rows);
-        rb.read_into_slice::<f64>((0, y0 as isize), size, size, dst, None)
-            .map_err(|e| self.read_error(e))?;
-        for v in dst.iter_mut() {
-            *v = self.decoder.decode(*v);
-        }
-        Ok(())
+        self.read_window(rb, (0, y0), (self.width(), rows), dst)
     }
 
     fn read_error(&self, source: gdal::errors::GdalError) -> Error {

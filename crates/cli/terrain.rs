@@ -1,0 +1,48 @@
+//! `tinsmith tiles`: a quantized-mesh terrain pyramid.
+
+use anyhow::{Context, Result};
+use tinsmith_tile::{build_terrain, TerrainOptions};
+
+use crate::args::TilesArgs;
+
+pub fn run(args: &TilesArgs) -> Result<bool> {
+    let options = TerrainOptions {
+        band: args.band,
+        min_zoom: args.min_zoom,
+        max_zoom: args.max_zoom,
+        quality: args.quality,
+        normals: args.normals,
+        metadata: args.metadata,
+        gzip: !args.no_gzip,
+        threads: args.threads,
+    };
+    let report = build_terrain(&args.input, &args.output, &options, &mut |level| {
+        eprintln!(
+            "level {:>2}: {} tiles, {} bytes, bound {:.3} m, measured {:.3} m, {:.2} s",
+            level.level,
+            level.tiles,
+            level.bytes,
+            level.achieved_bound,
+            level.measured_max_error,
+            level.seconds
+        );
+    })
+    .with_context(|| format!("{}", args.input.display()))?;
+    if let Some(path) = &args.report {
+        let text = serde_json::to_string_pretty(&report)?;
+        std::fs::write(path, text).with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    let tiles: u64 = report.levels.iter().map(|l| l.tiles).sum();
+    eprintln!(
+        "{tiles} tiles, levels {}..={}, in {}{}",
+        report.min_zoom,
+        report.max_zoom,
+        args.output.display(),
+        if args.no_gzip {
+            ""
+        } else {
+            " (gzipped: serve with Content-Encoding: gzip, e.g. `tinsmith serve`)"
+        }
+    );
+    Ok(true)
+}

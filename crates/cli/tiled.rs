@@ -1,0 +1,278 @@
+//! `tinsmith mesh` on rasters larger than one tile (or with `--per-tile`): the tiled
+//! engine of `tinsmith-tile`, with a progress bar and the same report as the untiled path
+//! plus the tile fields.
+
+use std::io::IsTerminal;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+use tinsmith_core::DecimationOptions;
+use tinsmith_export::MeshFormat;
+use tinsmith_tile::{
+    mesh_tiles, PerTileWriter, Placement, RasterSource, TileOptions, TilePlan, TileProgress,
+    TilesReport, WeldedWriter,
+};
+
+use crate::args::{MeshArgs, TileFormatArg};
+use crate::output::{check_writable_target, write_atomically};
+
+/// The output file when the untiled engine should run: no `--per-tile`, and the raster
+/// fits in one tile. `None` when the tiled engine should run.
+pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
+    let Some(output) = args.output.as_deref() else {
+        return Ok(None);
+    };
+    if args.per_tile.is_some() {
+        return Ok(None);
+    }
+    // Checks the untiled path makes first, so that errors come in the same order.
+    MeshFormat::from_path(output)?;
+    check_writable_target(output)?;
+    let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
+    let fits = reader.width() <= args.tile_size && reader.height() <= args.tile_size;
+    Ok(fits.then_some(output))
+}
+
+/// The `--report` JSON in tiled mode: the untiled report's fields (counts over the welded
+/// mesh; per-phase seconds summed over tiles, i.e. thread-seconds; `total` wall-clock),
+/// plus `tiles`.
+#[derive(Debug, Serialize)]
+struct TiledMeshReport<'a> {
+    input: &'a Path,
+    band: usize,
+    width: u32,
+    height: u32,
+    valid_samples: u64,
+    max_error: Option<f64>,
+    max_triangles: Option<usize>,
+    max_vertices: Option<usize>,
+    error_model: String,
+    selection: String,
+    order: String,
+    retriangulate: String,
+    initial_mesh: String,
+    triangles_before: u64,
+    triangles_after: u64,
+    vertices_before: u64,
+    vertices_after: u64,
+    decimation_percent: f64,
+    max_error_bound: f64,
+    measured_max_error: f64,
+    output: &'a Path,
+    seconds: Seconds,
+    tiles: Tiles,
+}
+
+#[derive(Debug, Serialize)]
+struct Seconds {
+    read: f64,
+    initial_mesh: f64,
+    decimate: f64,
+    verify: f64,
+    write: f64,
+    total: f64,
+}
+
+#[derive(Debug, Serialize)]
+struct Tiles {
+    /// Number of tiles.
+    count: usize,
+    /// `--tile-size`: samples per side, shared row and column included.
+    size: u32,
+    columns: u32,
+    rows: u32,
+    threads: usize,
+    /// `true` for one welded mesh, `false` for `--per-tile`.
+    welded: bool,
+    /// Wall-clock seconds of the statistics scan (the raster-wide max |value|).
+    scan_seconds: f64,
+    /// Wall-clock seconds from the first tile read to the last tile written.
+    tiles_seconds: f64,
+}
+
+/// Meshes the raster tile by tile into one welded mesh (`-o`) or one file per tile
+/// (`--per-tile`); every tile is verified before it is written.
+pub fn run(args: &MeshArgs) -> Result<bool> {
+    let total = Instant::now();
+    let input = args.input.display();
+    if args.max_triangles.is_some() || args.max_vertices.is_some() {
+        bail!(
+            "{input}: --max-triangles and --max-vertices need the whole raster at once, and it \
+             is larger than --tile-size {}; raise --tile-size or give --max-error",
+            args.tile_size
+        );
+    }
+    let Some(max_error) = args.max_error else {
+        bail!("{input}: tiles need --max-error");
+    };
+    let welded_format = match &args.output {
+        Some(output) => {
+            let format = MeshFormat::from_path(output)?;
+            check_writable_target(output)?;
+            Some(format)
+        }
+        None => None,
+    };
+    if let Some(report) = &args.report {
+        check_writable_target(report)?;
+    }
+
+    let bar = progress_bar(args.quiet);
+    bar.set_message("scanning the raster");
+    let t = Instant::now();
+    let info = tinsmith_raster::open_info(&args.input, args.band)?;
+    let source = RasterSource::new(&info)?;
+    let scan_seconds = t.elapsed().as_secs_f64();
+    let plan = TilePlan::new(info.width, info.height, args.tile_size)
+        .with_context(|| format!("{input}"))?;
+    bar.set_length(plan.len() as u64);
+    bar.set_message("tiles");
+    bar.reset_eta();
+
+    let mut decimation = DecimationOptions::new(max_error)
+        .with_selection(args.selection.into())
+        .with_error_model(args.error_model.into())
+        .with_order(args.order.into())
+        .with_retriangulation(args.retriangulate.into())
+        .with_initial_mesh(args.initial_mesh.into());
+    decimation.dp_max_ring = args.dp_max_ring as usize;
+    let options = TileOptions::new(decimation)
+        .with_tile_size(args.tile_size)
+        .with_threads(args.threads.map_or(0, |n| n as usize));
+    let placement = Placement::new(info.transform(), args.pixel_coords);
+    let crs = if args.pixel_coords {
+        None
+    } else {
+        info.crs_wkt.as_deref()
+    };
+    let mut progress = |p: TileProgress| bar.set_position(p.done as u64);
+    let nothing_to_triangulate = || {
+        anyhow::anyhow!(
+            "{input}: band {} has no 2x2 block of valid samples, so there is nothing to \
+             triangulate",
+            args.band
+        )
+    };
+
+    let (report, output, write_seconds) = match (&args.output, welded_format, &args.per_tile) {
+        (Some(output), Some(format), _) => {
+            let mut writer = WeldedWriter::create(output, format, crs, placement)?;
+            let report = mesh_tiles(&source, &options, &mut writer, &mut progress)
+                .with_context(|| format!("{input}"))?;
+            if report.final_triangles == 0 {
+                return Err(nothing_to_triangulate());
+            }
+            bar.set_message("writing");
+            let t = Instant::now();
+            writer.finish()?;
+            let write = report.seconds_sink + t.elapsed().as_secs_f64();
+            (report, output.as_path(), write)
+        }
+        (_, _, Some(dir)) => {
+            let format = match args.tile_format {
+                TileFormatArg::Ply => MeshFormat::Ply,
+                TileFormatArg::Obj => MeshFormat::Obj,
+            };
+            let mut writer = PerTileWriter::create(dir, format, crs, placement)?;
+            let report = mesh_tiles(&source, &options, &mut writer, &mut progress)
+                .with_context(|| format!("{input}"))?;
+            if report.final_triangles == 0 {
+                return Err(nothing_to_triangulate());
+            }
+            let t = Instant::now();
+            writer.finish()?;
+            let write = report.seconds_sink + t.elapsed().as_secs_f64();
+            (report, dir.as_path(), write)
+        }
+        _ => bail!("{input}: give -o OUT or --per-tile DIR"),
+    };
+    bar.finish_and_clear();
+
+    let r: &TilesReport = &report;
+    let json = TiledMeshReport {
+        input: &args.input,
+        band: args.band,
+        width: info.width,
+        height: info.height,
+        valid_samples: info.valid_samples,
+        max_error: args.max_error,
+        max_triangles: None,
+        max_vertices: None,
+        error_model: value_name(args.error_model),
+        selection: value_name(args.selection),
+        order: value_name(args.order),
+        retriangulate: value_name(args.retriangulate),
+        initial_mesh: value_name(args.initial_mesh),
+        triangles_before: r.initial_triangles,
+        triangles_after: r.final_triangles,
+        vertices_before: r.initial_vertices,
+        vertices_after: r.final_vertices,
+        decimation_percent: 100.0
+            * (1.0 - r.final_triangles as f64 / r.initial_triangles.max(1) as f64),
+        max_error_bound: r.max_bound,
+        measured_max_error: r.measured_max_error,
+        output,
+        seconds: Seconds {
+            read: scan_seconds + r.seconds_read,
+            initial_mesh: 0.0,
+            decimate: r.seconds_decimation,
+            verify: r.seconds_verify,
+            write: write_seconds,
+            total: total.elapsed().as_secs_f64(),
+        },
+        tiles: Tiles {
+            count: r.plan.len(),
+            size: r.plan.size(),
+            columns: r.plan.columns(),
+            rows: r.plan.rows(),
+            threads: r.threads,
+            welded: args.per_tile.is_none(),
+            scan_seconds,
+            tiles_seconds: r.seconds_total,
+        },
+    };
+    if !args.quiet {
+        eprintln!(
+            "{}: {} -> {} triangles ({:.1}% decimated) in {} tiles of {}, measured max error \
+             {} <= {}",
+            output.display(),
+            json.triangles_before,
+            json.triangles_after,
+            json.decimation_percent,
+            json.tiles.count,
+            json.tiles.size,
+            json.measured_max_error,
+            max_error
+        );
+    }
+    if let Some(path) = &args.report {
+        write_atomically(path, &serde_json::to_vec_pretty(&json)?)?;
+    }
+    Ok(true)
+}
+
+/// Tiles done / total with the ETA on stderr; hidden when quiet or when stderr is not a
+/// terminal.
+fn progress_bar(quiet: bool) -> ProgressBar {
+    if quiet || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(0);
+    if let Ok(style) = ProgressStyle::with_template(
+        "{msg:>8} [{bar:32}] {pos}/{len} tiles, {elapsed_precise} elapsed, ETA {eta}",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.enable_steady_tick(Duration::from_millis(200));
+    bar
+}
+
+/// The flag value clap shows for `v`.
+fn value_name(v: impl clap::ValueEnum) -> String {
+    v.to_possible_value()
+        .map(|p| p.get_name().to_owned())
+        .unwrap_or_default()
+}

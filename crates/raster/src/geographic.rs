@@ -1,0 +1,186 @@
+//! Reprojection to EPSG:4326: a raster's geographic bounds, and its samples on a regular
+//! longitude/latitude lattice through GDAL's warper.
+
+use std::path::Path;
+
+use gdal::raster::reproject;
+use gdal::spatial_ref::{AxisMappingStrategy, CoordTransform, SpatialRef};
+use gdal::DriverManager;
+
+use crate::error::{gdal_reason, Error, Result};
+use crate::read::OpenBand;
+
+/// Where a raster lies in EPSG:4326 (degrees), and how fine it is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GeoBounds {
+    /// West longitude.
+    pub west: f64,
+    /// South latitude.
+    pub south: f64,
+    /// East longitude.
+    pub east: f64,
+    /// North latitude.
+    pub north: f64,
+    /// The finer of the longitude and latitude spans per sample, in degrees.
+    pub resolution: f64,
+}
+
+/// A regular lattice of sample positions in EPSG:4326: column `i`, row `j` is at longitude
+/// `west + i * step`, latitude `south + j * step` (row 0 is the southernmost).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GeoLattice {
+    /// Longitude of column 0.
+    pub west: f64,
+    /// Latitude of row 0.
+    pub south: f64,
+    /// Spacing in degrees.
+    pub step: f64,
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+}
+
+fn wgs84() -> Result<SpatialRef> {
+    let mut srs = SpatialRef::from_epsg(4326).expect("PROJ knows EPSG:4326");
+    srs.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+    Ok(srs)
+}
+
+fn warp_error(path: &Path, source: gdal::errors::GdalError) -> Error {
+    Error::Warp {
+        path: path.to_path_buf(),
+        reason: gdal_reason(&source, path),
+        source: Box::new(source),
+    }
+}
+
+/// The raster's extent in EPSG:4326 (edges densified, so curved edges are covered) and its
+/// resolution in degrees.
+///
+/// # Errors
+/// As [`crate::open_info`], [`Error::NotGeoreferenced`] without a CRS or geotransform, and
+/// [`Error::Warp`] when PROJ cannot transform the extent.
+pub fn geographic_bounds(path: &Path, band: usize) -> Result<GeoBounds> {
+    let opened = OpenBand::open(path, band)?;
+    let b = raw_bounds(path, &opened)?;
+    let (w, h) = (f64::from(opened.info.width), f64::from(opened.info.height));
+    let resolution = ((b[2] - b[0]) / w).min((b[3] - b[1]) / h);
+    // A geographic raster in 0..360 (or -360..0) longitudes wraps around: it covers the
+    // whole circle of longitudes it spans modulo 360.
+    let (west, east) = if b[2] > 180.0 || b[0] < -180.0 {
+        (-180.0, 180.0)
+    } else {
+        (b[0], b[2])
+    };
+    Ok(GeoBounds {
+        west,
+        south: b[1].max(-90.0),
+        east,
+        north: b[3].min(90.0),
+        resolution,
+    })
+}
+
+/// The raster's extent in EPSG:4326 as PROJ gives it, longitudes not wrapped.
+fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
+    let info = &opened.info;
+    let (Some(gt), Some(_)) = (info.geo_transform, info.crs_wkt.as_ref()) else {
+        return Err(Error::NotGeoreferenced {
+            path: path.to_path_buf(),
+        });
+    };
+    let (w, h) = (f64::from(info.width), f64::from(info.height));
+    let xs = [gt[0], gt[0] + w * gt[1] + h * gt[2]];
+    let ys = [gt[3], gt[3] + w * gt[4] + h * gt[5]];
+    let mut source = opened
+        .dataset()
+        .spatial_ref()
+        .map_err(|e| warp_error(path, e))?;
+    source.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+    let transform = CoordTransform::new(&source, &wgs84()?).map_err(|e| warp_error(path, e))?;
+    transform
+        .transform_bounds(
+            &[
+                xs[0].min(xs[1]),
+                ys[0].min(ys[1]),
+                xs[0].max(xs[1]),
+                ys[0].max(ys[1]),
+            ],
+            21,
+        )
+        .map_err(|e| warp_error(path, e))
+}
+
+/// The band's samples at the lattice's positions, reprojected by GDAL's warper (bilinear,
+/// the band's nodata honoured), with the band's scale and offset applied: row-major, row 0
+/// the southernmost, NaN where there is no data.
+///
+/// # Errors
+/// As [`geographic_bounds`].
+pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Result<Vec<f32>> {
+    let opened = OpenBand::open(path, band)?;
+    let b = raw_bounds(path, &opened)?;
+    let mut values = warp_pass(path, &opened, lattice, 0.0)?;
+    // Sources in 0..360 (or -360..0) longitudes: the part beyond the antimeridian is
+    // warped again with the lattice shifted by a full turn, filling what is still empty.
+    for shift in [360.0, -360.0] {
+        let beyond = if shift > 0.0 {
+            b[2] > 180.0
+        } else {
+            b[0] < -180.0
+        };
+        if beyond && values.iter().any(|v| v.is_nan()) {
+            let more = warp_pass(path, &opened, lattice, shift)?;
+            for (v, m) in values.iter_mut().zip(more) {
+                if v.is_nan() {
+                    *v = m;
+                }
+            }
+        }
+    }
+    Ok(values)
+}
+
+fn warp_pass(path: &Path, opened: &OpenBand, lattice: &GeoLattice, shift: f64) -> Result<Vec<f32>> {
+    let info = &opened.info;
+    let (width, height) = (lattice.width as usize, lattice.height as usize);
+    let driver = DriverManager::get_driver_by_name("MEM").map_err(|e| warp_error(path, e))?;
+    let mut target = driver
+        .create_with_band_type::<f32, _>("", width, height, 1)
+        .map_err(|e| warp_error(path, e))?;
+    let d = lattice.step;
+    let north = lattice.south + (height as f64 - 1.0) * d;
+    let west = lattice.west + shift;
+    target
+        .set_geo_transform(&[west - d / 2.0, d, 0.0, north + d / 2.0, 0.0, -d])
+        .map_err(|e| warp_error(path, e))?;
+    target
+        .set_spatial_ref(&wgs84()?)
+        .map_err(|e| warp_error(path, e))?;
+    {
+        let mut rb = target.rasterband(1).map_err(|e| warp_error(path, e))?;
+        rb.set_no_data_value(Some(f64::NAN))
+            .map_err(|e| warp_error(path, e))?;
+        rb.fill(f64::NAN, None).map_err(|e| warp_error(path, e))?;
+    }
+    reproject(opened.dataset(), &target).map_err(|e| warp_error(path, e))?;
+    let rb = target.rasterband(1).map_err(|e| warp_error(path, e))?;
+    let buffer = rb
+        .read_as::<f32>((0, 0), (width, height), (width, height), None)
+        .map_err(|e| warp_error(path, e))?;
+    let data = buffer.data();
+    let (scale, offset) = (info.scale as f32, info.offset as f32);
+    let nodata = info.nodata.map(|v| v as f32);
+    let mut values = Vec::with_capacity(width * height);
+    for row in (0..height).rev() {
+        values.extend(data[row * width..(row + 1) * width].iter().map(|&v| {
+            if !v.is_finite() || Some(v) == nodata {
+                f32::NAN
+            } else {
+                v * scale + offset
+            }
+        }));
+    }
+    Ok(values)
+}

@@ -1,0 +1,140 @@
+//! Windowed reads: a rectangle of one band at a time, through a dataset kept open.
+
+use std::path::Path;
+
+use tinsmith_core::Grid;
+
+use crate::error::{Error, Result};
+use crate::info::RasterInfo;
+use crate::read::OpenBand;
+
+/// One band of a raster kept open for reading windows of it, one after another.
+///
+/// The samples of a window are decoded exactly as [`crate::read_grid`] decodes the whole
+/// band (the same nodata rule in the band's own type, NaN and infinities as nodata, scale
+/// and offset applied), so a window of the grid `read_grid` returns and the grid
+/// [`WindowReader::read_window`] returns for the same rectangle are equal sample for
+/// sample.
+///
+/// # Threads
+/// A reader owns a GDAL dataset, which may be moved to another thread but not shared
+/// between threads (`Send`, not `Sync`). Open one reader per worker thread, for example
+/// with rayon's `map_init`.
+///
+/// # Example
+/// ```no_run
+/// use std::path::Path;
+/// # fn main() -> Result<(), tinsmith_raster::Error> {
+/// let reader = tinsmith_raster::WindowReader::open(Path::new("data/becmodel_dem_bc_albers_50m.tif"), 1)?;
+/// let tile = reader.read_window(100, 200, 64, 64)?;
+/// assert_eq!((tile.width(), tile.height()), (64, 64));
+/// # Ok(())
+/// # }
+/// ```
+pub struct WindowReader {
+    opened: OpenBand,
+}
+
+impl std::fmt::Debug for WindowReader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("WindowReader")
+            .field("path", &self.opened.info.path)
+            .field("band", &self.opened.info.band)
+            .finish_non_exhaustive()
+    }
+}
+
+impl WindowReader {
+    /// Opens band `band` (1-based) of the raster at `path` without reading any sample.
+    ///
+    /// # Errors
+    /// [`Error::NotFound`], [`Error::NotARaster`], [`Error::BandOutOfRange`],
+    /// [`Error::UnsupportedType`] and [`Error::Read`], each naming `path`.
+    pub fn open(path: &Path, band: usize) -> Result<WindowReader> {
+        Ok(WindowReader {
+            opened: OpenBand::open(path, band)?,
+        })
+    }
+
+    /// The band's metadata. No sample has been read, so the statistics are those of an
+    /// empty band: `valid_samples` and `nodata_samples` are 0, `min` and `max` are `None`
+    /// (use [`crate::open_info`] for them).
+    pub fn info(&self) -> &RasterInfo {
+        &self.opened.info
+    }
+
+    /// Columns of the raster.
+    pub fn width(&self) -> u32 {
+        self.opened.info.width
+    }
+
+    /// Rows of the raster.
+    pub fn height(&self) -> u32 {
+        self.opened.info.height
+    }
+
+    /// Reads the `width` x `height` samples whose top-left sample is column `x0`, row `y0`
+    /// into a [`Grid`] (row 0 of the grid is row `y0` of the raster; nodata as NaN).
+    ///
+    /// A window without any valid sample is not an error: every sample is NaN.
+    ///
+    /// # Errors
+    /// [`Error::WindowOutOfRange`] when the window is empty or not inside the raster,
+    /// [`Error::TooLarge`] when it has 2^32 - 1 samples or more, [`Error::Read`] when GDAL
+    /// fails.
+    pub fn read_window(&self, x0: u32, y0: u32, width: u32, height: u32) -> Result<Grid> {
+        let info = &self.opened.info;
+        let inside = |start: u32, len: u32, total: u32| {
+            len > 0 && start.checked_add(len).is_some_and(|end| end <= total)
+        };
+        if !inside(x0, width, info.width) || !inside(y0, height, info.height) {
+            return Err(Error::WindowOutOfRange {
+                path: info.path.clone(),
+                x0,
+                y0,
+                width,
+                height,
+                raster_width: info.width,
+                raster_height: info.height,
+            });
+        }
+        let samples = width as u64 * height as u64;
+        if samples >= u32::MAX as u64 {
+            return Err(Error::TooLarge {
+                path: info.path.clone(),
+                width: width as usize,
+                height: height as usize,
+            });
+        }
+        let rb = self.opened.band()?;
+        let mut values = vec![0.0; samples as usize];
+        self.opened.read_window(
+            &rb,
+            (x0 as usize, y0 as usize),
+            (width as usize, height as usize),
+            &mut values,
+        )?;
+        Grid::new(width, height, values).map_err(|source| Error::Grid {
+            path: info.path.clone(),
+            band: info.band,
+            source,
+        })
+    }
+}
+
+/// Reads one window of band `band` (1-based) of the raster at `path`: opens the raster,
+/// reads as [`WindowReader::read_window`], closes it. To read many windows, keep a
+/// [`WindowReader`] open instead.
+///
+/// # Errors
+/// As [`WindowReader::open`] and [`WindowReader::read_window`].
+pub fn read_window(
+    path: &Path,
+    band: usize,
+    x0: u32,
+    y0: u32,
+    width: u32,
+    height: u32,
+) -> Result<Grid> {
+    WindowReader::open(path, band)?.read_window(x0, y0, width, height)
+}

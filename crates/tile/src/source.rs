@@ -1,0 +1,209 @@
+//! Where tiles' samples come from: a raster file through GDAL (one dataset per worker
+//! thread), or a grid in memory.
+
+use std::path::{Path, PathBuf};
+
+use tinsmith_core::Grid;
+use tinsmith_raster::{RasterInfo, WindowReader};
+
+use crate::error::{Error, Result};
+
+/// What reading a window may fail with: any error, boxed (the engine adds the tile).
+pub type ReadError = Box<dyn std::error::Error + Send + Sync>;
+
+/// A raster the engine cuts into tiles.
+///
+/// The engine asks each worker thread for its own [`TileSource::Reader`] (once per
+/// thread), so a reader may hold things that cannot be shared between threads, such as a
+/// GDAL dataset.
+pub trait TileSource: Sync {
+    /// Reads windows on one thread.
+    type Reader: WindowRead;
+
+    /// Columns of the raster.
+    fn width(&self) -> u32;
+
+    /// Rows of the raster.
+    fn height(&self) -> u32;
+
+    /// The largest |value| of any valid sample of the whole raster: every tile's rounding
+    /// slack is computed from it, so that all tiles and the shared edges enforce the same
+    /// limit.
+    fn max_abs_value(&self) -> f64;
+
+    /// A reader for the calling thread.
+    ///
+    /// # Errors
+    /// When the raster cannot be opened.
+    fn reader(&self) -> std::result::Result<Self::Reader, ReadError>;
+}
+
+/// Reads rectangles of a raster.
+pub trait WindowRead {
+    /// The `width` x `height` samples whose top-left sample is `(x0, y0)`, NaN = nodata.
+    /// The engine only asks for windows inside the raster.
+    ///
+    /// # Errors
+    /// When reading fails.
+    fn read_window(
+        &mut self,
+        x0: u32,
+        y0: u32,
+        width: u32,
+        height: u32,
+    ) -> std::result::Result<Grid, ReadError>;
+}
+
+/// One band of a raster file, read through GDAL, a window at a time.
+///
+/// Samples are decoded as `tinsmith_raster::read_grid` decodes them (nodata compared in
+/// the band's own type, NaN and infinities as nodata, scale and offset applied).
+#[derive(Debug, Clone)]
+pub struct RasterSource {
+    path: PathBuf,
+    band: usize,
+    width: u32,
+    height: u32,
+    max_abs_value: f64,
+}
+
+impl RasterSource {
+    /// The band described by `info`, which must come from `tinsmith_raster::open_info`
+    /// (it has the statistics the raster-wide max |value| comes from).
+    ///
+    /// # Errors
+    /// [`Error::AllNodata`] when the band has no valid sample.
+    pub fn new(info: &RasterInfo) -> Result<RasterSource> {
+        let max_abs_value = info.max_abs_value().ok_or_else(|| Error::AllNodata {
+            path: info.path.clone(),
+            band: info.band,
+        })?;
+        Ok(RasterSource {
+            path: info.path.clone(),
+            band: info.band,
+            width: info.width,
+            height: info.height,
+            max_abs_value,
+        })
+    }
+
+    /// Opens band `band` (1-based) of the raster at `path` and scans it once for its
+    /// statistics (`tinsmith_raster::open_info`), strip by strip: memory stays small.
+    ///
+    /// # Errors
+    /// [`Error::Raster`] as `open_info`; [`Error::AllNodata`].
+    pub fn open(path: &Path, band: usize) -> Result<RasterSource> {
+        RasterSource::new(&tinsmith_raster::open_info(path, band)?)
+    }
+
+    /// The raster file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The band (1-based).
+    pub fn band(&self) -> usize {
+        self.band
+    }
+}
+
+impl TileSource for RasterSource {
+    type Reader = WindowReader;
+
+    fn width(&self) -> u32 {
+        self.width
+    }
+
+    fn height(&self) -> u32 {
+        self.height
+    }
+
+    fn max_abs_value(&self) -> f64 {
+        self.max_abs_value
+    }
+
+    fn reader(&self) -> std::result::Result<WindowReader, ReadError> {
+        Ok(WindowReader::open(&self.path, self.band)?)
+    }
+}
+
+impl WindowRead for WindowReader {
+    fn read_window(
+        &mut self,
+        x0: u32,
+        y0: u32,
+        width: u32,
+        height: u32,
+    ) -> std::result::Result<Grid, ReadError> {
+        Ok(WindowReader::read_window(self, x0, y0, width, height)?)
+    }
+}
+
+/// A grid in memory, cut into tiles like a raster file (for tests, and for callers who
+/// want tiles of a grid they already hold).
+#[derive(Debug, Clone, Copy)]
+pub struct GridSource<'a> {
+    grid: &'a Grid,
+    max_abs_value: f64,
+}
+
+impl<'a> GridSource<'a> {
+    /// Tiles of `grid`.
+    pub fn new(grid: &'a Grid) -> GridSource<'a> {
+        let max_abs_value = grid
+            .values()
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0, |m: f64, v| m.max(v.abs()));
+        GridSource {
+            grid,
+            max_abs_value,
+        }
+    }
+}
+
+impl<'a> TileSource for GridSource<'a> {
+    type Reader = GridSource<'a>;
+
+    fn width(&self) -> u32 {
+        self.grid.width()
+    }
+
+    fn height(&self) -> u32 {
+        self.grid.height()
+    }
+
+    fn max_abs_value(&self) -> f64 {
+        self.max_abs_value
+    }
+
+    fn reader(&self) -> std::result::Result<GridSource<'a>, ReadError> {
+        Ok(*self)
+    }
+}
+
+impl WindowRead for GridSource<'_> {
+    fn read_window(
+        &mut self,
+        x0: u32,
+        y0: u32,
+        width: u32,
+        height: u32,
+    ) -> std::result::Result<Grid, ReadError> {
+        let w = self.grid.width();
+        if x0 + width > w || y0 + height > self.grid.height() {
+            return Err(
+                format!("window {width}x{height} at ({x0}, {y0}) is outside the grid").into(),
+            );
+        }
+        let values = (y0..y0 + height)
+            .flat_map(|y| {
+                let row = (y * w + x0) as usize;
+                self.grid.values()[row..row + width as usize]
+                    .iter()
+                    .copied()
+            })
+            .collect();
+        Ok(Grid::new(width, height, values)?)
+    }
+}

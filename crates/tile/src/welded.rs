@@ -1,0 +1,95 @@
+//! The sink that writes one welded mesh file: shared edge vertices once, global indices.
+
+use std::path::Path;
+
+use tinsmith_export::{MeshFormat, MeshStreamWriter};
+
+use crate::error::Result;
+use crate::placement::Placement;
+use crate::sink::{FinishedTile, SinkError, TileSink};
+
+/// Writes the tiles of a run as one mesh file (PLY or OBJ), streamed: each tile's new
+/// vertices and its triangles are appended as the tile arrives, so memory does not grow
+/// with the mesh.
+///
+/// Vertices are numbered as [`FinishedTile`] describes (tile order; a shared edge vertex
+/// once, by the first tile that has it). The file appears, complete, when
+/// [`WeldedWriter::finish`] succeeds; until then it is spooled in temporary files in the
+/// output directory, removed if the writer is dropped (see
+/// `tinsmith_export::MeshStreamWriter`).
+#[derive(Debug)]
+pub struct WeldedWriter {
+    stream: MeshStreamWriter,
+    placement: Placement,
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl WeldedWriter {
+    /// Starts the mesh file `path` in `format`, with the CRS (if any) in its header and
+    /// coordinates mapped by `placement`.
+    ///
+    /// # Errors
+    /// [`crate::Error::Write`] when the output directory is missing or not writable.
+    pub fn create(
+        path: &Path,
+        format: MeshFormat,
+        crs_wkt: Option<&str>,
+        placement: Placement,
+    ) -> Result<WeldedWriter> {
+        Ok(WeldedWriter {
+            stream: MeshStreamWriter::create(path, format, crs_wkt)?,
+            placement,
+            vertices: Vec::new(),
+            triangles: Vec::new(),
+        })
+    }
+
+    /// Vertices written so far.
+    pub fn vertex_count(&self) -> usize {
+        self.stream.vertex_count()
+    }
+
+    /// Triangles written so far.
+    pub fn triangle_count(&self) -> usize {
+        self.stream.triangle_count()
+    }
+
+    /// Completes the file and moves it into place.
+    ///
+    /// # Errors
+    /// [`crate::Error::Write`]; the target is then untouched.
+    pub fn finish(self) -> Result<()> {
+        Ok(self.stream.finish()?)
+    }
+}
+
+impl TileSink for WeldedWriter {
+    fn tile(&mut self, tile: &FinishedTile) -> std::result::Result<(), SinkError> {
+        if self.stream.vertex_count() != tile.first_new_id() as usize {
+            return Err(format!(
+                "tiles out of order: the file has {} vertices, the tile's first new one is {}",
+                self.stream.vertex_count(),
+                tile.first_new_id()
+            )
+            .into());
+        }
+        self.vertices.clear();
+        for (i, v) in tile.vertices().iter().enumerate() {
+            if tile.is_new(i) {
+                let [x, y] = self.placement.position(v.x, v.y);
+                self.vertices.push([x, y, v.z]);
+            }
+        }
+        self.stream.write_vertices(&self.vertices)?;
+        let ids = tile.ids();
+        self.triangles.clear();
+        self.triangles.extend(
+            tile.triangles()
+                .iter()
+                .map(|t| self.placement.orient(t.map(|local| ids[local as usize]))),
+        );
+        self.stream.write_triangles(&self.triangles)?;
+        Ok(())
+    }
+}

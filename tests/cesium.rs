@@ -1,0 +1,120 @@
+//! A real client: CesiumJS in headless Chromium loads a pyramid from `tinsmith serve`
+//! (`CesiumTerrainProvider.fromUrl`, `sampleTerrainMostDetailed`). Skipped only when
+//! Chromium cannot start; a missing CesiumJS or Chromium install fails.
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+use serde_json::Value;
+
+use crate::terrain::gdal_samples;
+use crate::util::{fixture, stderr, Dir};
+
+/// Kills the server when the test ends, however it ends.
+struct Server(std::process::Child);
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+#[test]
+fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let cesium = repo.join(".tools/node_modules/cesium/Build/Cesium");
+    assert!(
+        cesium.join("Cesium.js").exists() && Path::new("/usr/bin/chromium").exists(),
+        "CesiumJS or Chromium is missing: run `make oracles`"
+    );
+    let dir = Dir::new();
+    let input = fixture("tintn_valid_raster_3857.tif");
+    let o = dir.run(&["tiles", &input, "-o", "site/terrain", "--normals"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::os::unix::fs::symlink(&cesium, dir.path("site/cesium")).unwrap();
+    dir.write(
+        "site/index.html",
+        "<!doctype html><html><head><link rel=\"icon\" href=\"data:,\"><script>window.CESIUM_BASE_URL = '/cesium/';</script>\
+         <script src=\"/cesium/Cesium.js\"></script></head><body></body></html>\n",
+    );
+    let layer: Value =
+        serde_json::from_slice(&std::fs::read(dir.path("site/terrain/layer.json")).unwrap())
+            .unwrap();
+    let z = layer["maxzoom"].as_u64().unwrap() as u32;
+    let rect = &layer["available"][z as usize][0];
+    let (x, y) = (
+        rect["startX"].as_u64().unwrap() as u32,
+        rect["startY"].as_u64().unwrap() as u32,
+    );
+
+    // Points on the finest tile's sample lattice, away from its edges, where the tile's
+    // source samples are known (GDAL's warp of the same lattice).
+    let samples = gdal_samples(&dir, &input, z, x, y);
+    let size = 180.0 / (1u64 << z) as f64;
+    let d = size / 217.0;
+    let (west, south) = (-180.0 + x as f64 * size, -90.0 + y as f64 * size);
+    let mut points = Vec::new();
+    let mut expected = Vec::new();
+    let valid: Vec<(usize, usize)> = (3..215)
+        .flat_map(|j| (3..215).map(move |i| (i, j)))
+        .filter(|&(i, j)| samples[j][i].is_finite())
+        .collect();
+    for k in 0..6 {
+        let Some(&(i, j)) = valid.get(k * valid.len() / 6 + valid.len() / 12) else {
+            continue;
+        };
+        points.push([west + i as f64 * d, south + j as f64 * d]);
+        expected.push(samples[j][i]);
+    }
+    assert!(points.len() >= 3, "too few sample points with data");
+    let points_file = dir.write("points.json", &serde_json::to_string(&points).unwrap());
+
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+        .args(["serve", "site", "--port", "0"])
+        .current_dir(dir.tmp.path())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let _server = Server(child);
+    let base = line.trim().rsplit(' ').next().unwrap().to_string();
+
+    let out = Command::new("node")
+        .arg(repo.join("tests/oracle/cesium_sample.cjs"))
+        .arg(format!("{base}index.html"))
+        .arg(format!("{base}terrain/"))
+        .arg(&points_file)
+        .output()
+        .expect("node runs");
+    if out.status.code() == Some(3) {
+        eprintln!(
+            "SKIPPED: Chromium cannot start: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        return;
+    }
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let result: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
+    assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
+    let bound = 77_067.34 / (1u64 << z) as f64;
+    for (k, want) in expected.iter().enumerate() {
+        assert_eq!(result["levels"][k].as_u64(), Some(z as u64), "{result}");
+        let got = result["heights"][k]
+            .as_f64()
+            .unwrap_or_else(|| panic!("point {k} has no height: {result}"));
+        assert!(
+            (got - want).abs() <= bound + 1e-3,
+            "point {k}: CesiumJS {got}, DEM {want}, bound {bound}"
+        );
+    }
+}

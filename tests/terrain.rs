@@ -1,0 +1,413 @@
+//! `tinsmith tiles`: every tile of small pyramids decoded by an independent decoder (npm
+//! `@here/quantized-mesh-decoder`, `make oracles`), checked against the spec, against its
+//! neighbours, and at the finest level against GDAL's own warp of the tile's lattice.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use serde_json::Value;
+
+use crate::util::{fixture, stderr, Dir};
+
+const CELLS: i64 = 217;
+const U_STEP: i64 = 151;
+const E0: f64 = 77_067.34;
+
+struct Tile {
+    u: Vec<i64>,
+    v: Vec<i64>,
+    /// Decoded heights.
+    h: Vec<f64>,
+    triangles: Vec<[usize; 3]>,
+    edges: [Vec<usize>; 4],
+    normals: Option<Vec<u64>>,
+    metadata: Value,
+}
+
+fn numbers(v: &Value) -> Vec<i64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_i64().unwrap())
+        .collect()
+}
+
+/// Every `z/x/y.terrain` under `dir`, decoded by the oracle.
+fn decode_pyramid(dir: &Path) -> BTreeMap<(u32, u32, u32), Tile> {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    assert!(
+        repo.join(".tools/node_modules/@here/quantized-mesh-decoder/package.json")
+            .exists(),
+        "the quantized-mesh oracle is missing: run `make oracles` (needs node and npm)"
+    );
+    let mut files: Vec<(PathBuf, (u32, u32, u32))> = Vec::new();
+    for z in std::fs::read_dir(dir).unwrap() {
+        let z = z.unwrap().path();
+        if !z.is_dir() {
+            continue;
+        }
+        for x in std::fs::read_dir(&z).unwrap() {
+            let x = x.unwrap().path();
+            for y in std::fs::read_dir(&x).unwrap() {
+                let y = y.unwrap().path();
+                let name =
+                    |p: &Path| -> u32 { p.file_stem().unwrap().to_str().unwrap().parse().unwrap() };
+                files.push((y.clone(), (name(&z), name(&x), name(&y))));
+            }
+        }
+    }
+    let out = Command::new("node")
+        .arg(repo.join("tests/oracle/qm_decode.cjs"))
+        .args(files.iter().map(|f| &f.0))
+        .output()
+        .expect("node runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut tiles = BTreeMap::new();
+    for (line, (_, key)) in text.lines().zip(&files) {
+        let t: Value = serde_json::from_str(line).unwrap();
+        assert_eq!(t["gzipped"], true);
+        let (min, max) = (
+            t["header"]["minHeight"].as_f64().unwrap(),
+            t["header"]["maxHeight"].as_f64().unwrap(),
+        );
+        let h = numbers(&t["h"])
+            .iter()
+            .map(|&q| min + q as f64 / 32767.0 * (max - min))
+            .collect();
+        let idx = numbers(&t["triangles"]);
+        let tile = Tile {
+            u: numbers(&t["u"]),
+            v: numbers(&t["v"]),
+            h,
+            triangles: idx
+                .chunks(3)
+                .map(|c| [c[0] as usize, c[1] as usize, c[2] as usize])
+                .collect(),
+            edges: ["west", "south", "east", "north"]
+                .map(|k| numbers(&t[k]).iter().map(|&i| i as usize).collect()),
+            normals: t["normals"]
+                .as_array()
+                .map(|a| a.iter().map(|x| x.as_u64().unwrap()).collect()),
+            metadata: t["metadata"].clone(),
+        };
+        tiles.insert(*key, tile);
+    }
+    assert_eq!(tiles.len(), files.len());
+    tiles
+}
+
+/// Spec checks on one tile: ranges, counter-clockwise triangles, vertices on the tile's
+/// sample lattice, edge lists = border vertices.
+fn check_tile(key: (u32, u32, u32), t: &Tile) {
+    let n = t.u.len();
+    assert!(n >= 3 && !t.triangles.is_empty(), "{key:?} is empty");
+    for i in 0..n {
+        for q in [t.u[i], t.v[i]] {
+            assert!((0..=32767).contains(&q), "{key:?}");
+            assert_eq!(q % U_STEP, 0, "{key:?}: vertex off the sample lattice");
+        }
+    }
+    for tri in &t.triangles {
+        let [a, b, c] = *tri;
+        assert!(a < n && b < n && c < n);
+        let orient = (t.u[b] - t.u[a]) * (t.v[c] - t.v[a]) - (t.v[b] - t.v[a]) * (t.u[c] - t.u[a]);
+        assert!(
+            orient > 0,
+            "{key:?}: triangle {tri:?} is not counter-clockwise"
+        );
+    }
+    let border = |f: &dyn Fn(usize) -> bool| -> Vec<usize> { (0..n).filter(|&i| f(i)).collect() };
+    let want = [
+        border(&|i| t.u[i] == 0),
+        border(&|i| t.v[i] == 0),
+        border(&|i| t.u[i] == 32767),
+        border(&|i| t.v[i] == 32767),
+    ];
+    for (k, list) in t.edges.iter().enumerate() {
+        let mut got = list.clone();
+        got.sort();
+        assert_eq!(got, want[k], "{key:?}: edge list {k}");
+    }
+}
+
+/// The vertices along one edge of a tile as (position along the edge, decoded height).
+fn edge(t: &Tile, side: usize) -> Vec<(i64, f64)> {
+    let mut e: Vec<(i64, f64)> = t.edges[side]
+        .iter()
+        .map(|&i| {
+            (
+                if side.is_multiple_of(2) {
+                    t.v[i]
+                } else {
+                    t.u[i]
+                },
+                t.h[i],
+            )
+        })
+        .collect();
+    e.sort_by_key(|p| p.0);
+    e
+}
+
+/// The segments of one edge that triangles cover: pairs of positions along the edge.
+fn edge_segments(t: &Tile, side: usize) -> Vec<(i64, i64)> {
+    let on: std::collections::BTreeSet<usize> = t.edges[side].iter().copied().collect();
+    let pos = |i: usize| {
+        if side.is_multiple_of(2) {
+            t.v[i]
+        } else {
+            t.u[i]
+        }
+    };
+    let mut segments = Vec::new();
+    for tri in &t.triangles {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            if on.contains(&a) && on.contains(&b) {
+                segments.push((pos(a).min(pos(b)), pos(a).max(pos(b))));
+            }
+        }
+    }
+    segments.sort();
+    segments
+}
+
+/// Same-level neighbours share their edge: where both have an edge vertex, positions and
+/// heights agree; where their triangles both reach the edge, they end at the same
+/// vertices (no T-junction: no vertex of one inside a border segment of the other). A
+/// vertex only one side has lies where the other has no data.
+fn check_shared_edges(tiles: &BTreeMap<(u32, u32, u32), Tile>) -> usize {
+    let mut shared = 0;
+    for (&(z, x, y), t) in tiles {
+        for (dx, dy, mine, theirs) in [(1, 0, 2, 0), (0, 1, 3, 1)] {
+            let Some(other) = tiles.get(&(z, x + dx, y + dy)) else {
+                continue;
+            };
+            let (a, b) = (edge(t, mine), edge(other, theirs));
+            let b_at: BTreeMap<i64, f64> = b.iter().copied().collect();
+            for (p, h) in &a {
+                if let Some(hb) = b_at.get(p) {
+                    assert!(
+                        (h - hb).abs() < 1e-6,
+                        "{z}/{x}/{y}: edge heights {h} vs {hb}"
+                    );
+                    shared += 1;
+                }
+            }
+            for (one, other_edge) in [
+                (&a, edge_segments(other, theirs)),
+                (&b, edge_segments(t, mine)),
+            ] {
+                for (p, _) in one.iter() {
+                    assert!(
+                        !other_edge.iter().any(|&(s, e)| s < *p && *p < e),
+                        "{z}/{x}/{y}: T-junction at {p} on its edge with the neighbour"
+                    );
+                }
+            }
+        }
+    }
+    shared
+}
+
+/// The largest |decoded mesh - sample| over the tile's lattice (`samples[j][i]`, row 0
+/// the southernmost, NaN = nodata) and whether every valid sample of a valid cell is
+/// covered.
+fn max_error(t: &Tile, samples: &[Vec<f64>]) -> f64 {
+    let mut err: BTreeMap<(i64, i64), f64> = BTreeMap::new();
+    for tri in &t.triangles {
+        let p = tri.map(|k| (t.u[k], t.v[k], t.h[k]));
+        let det =
+            ((p[1].0 - p[0].0) * (p[2].1 - p[0].1) - (p[1].1 - p[0].1) * (p[2].0 - p[0].0)) as f64;
+        let lo_i = p.iter().map(|q| q.0).min().unwrap() / U_STEP;
+        let hi_i = p.iter().map(|q| q.0).max().unwrap() / U_STEP;
+        let lo_j = p.iter().map(|q| q.1).min().unwrap() / U_STEP;
+        let hi_j = p.iter().map(|q| q.1).max().unwrap() / U_STEP;
+        for j in lo_j..=hi_j {
+            for i in lo_i..=hi_i {
+                let (u, v) = (i * U_STEP, j * U_STEP);
+                let w = |a: (i64, i64, f64), b: (i64, i64, f64)| {
+                    ((b.0 - a.0) * (v - a.1) - (b.1 - a.1) * (u - a.0)) as f64
+                };
+                let (w0, w1, w2) = (w(p[1], p[2]), w(p[2], p[0]), w(p[0], p[1]));
+                if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
+                    continue;
+                }
+                let z = (w0 * p[0].2 + w1 * p[1].2 + w2 * p[2].2) / det;
+                let s = samples[j as usize][i as usize];
+                if s.is_finite() {
+                    err.insert((i, j), (z - s).abs());
+                }
+            }
+        }
+    }
+    err.values().fold(0.0, |m, &e| m.max(e))
+}
+
+/// The tile's lattice warped by the gdalwarp program (bilinear), row 0 the southernmost.
+pub(crate) fn gdal_samples(dir: &Dir, input: &str, z: u32, x: u32, y: u32) -> Vec<Vec<f64>> {
+    let size = 180.0 / (1u64 << z) as f64;
+    let d = size / CELLS as f64;
+    let (west, south) = (-180.0 + x as f64 * size, -90.0 + y as f64 * size);
+    let out = dir.path(&format!("warp_{z}_{x}_{y}.asc"));
+    let status = Command::new("gdalwarp")
+        .args([
+            "-q",
+            "-overwrite",
+            "-et",
+            "0",
+            "-t_srs",
+            "EPSG:4326",
+            "-r",
+            "bilinear",
+            "-ot",
+            "Float64",
+        ])
+        .args(["-of", "AAIGrid", "-dstnodata", "-99999", "-te"])
+        .args(
+            [
+                west - d / 2.0,
+                south - d / 2.0,
+                west + size + d / 2.0,
+                south + size + d / 2.0,
+            ]
+            .map(|v| format!("{v:.17}")),
+        )
+        .args(["-ts", "218", "218", input])
+        .arg(&out)
+        .status()
+        .expect("gdalwarp runs");
+    assert!(status.success());
+    let text = std::fs::read_to_string(&out).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip_while(|l| {
+            l.split_whitespace()
+                .next()
+                .is_some_and(|w| w.chars().next().unwrap().is_alphabetic())
+        })
+        .map(|l| {
+            l.split_whitespace()
+                .map(|w| {
+                    let v: f64 = w.parse().unwrap();
+                    if v == -99999.0 {
+                        f64::NAN
+                    } else {
+                        v
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    assert_eq!(rows.len(), 218);
+    rows.into_iter().rev().collect()
+}
+
+fn pyramid(dir: &Dir, input: &str, out: &str, extra: &[&str]) {
+    let mut args = vec!["tiles", input, "-o", out];
+    args.extend_from_slice(extra);
+    let o = dir.run(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+fn all_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(p) = stack.pop() {
+        for e in std::fs::read_dir(&p).unwrap() {
+            let e = e.unwrap().path();
+            if e.is_dir() {
+                stack.push(e);
+            } else {
+                out.insert(
+                    e.strip_prefix(root).unwrap().to_path_buf(),
+                    std::fs::read(&e).unwrap(),
+                );
+            }
+        }
+    }
+    out
+}
+
+fn check_pyramid(input: &str, quality: f64) {
+    let dir = Dir::new();
+    let q = quality.to_string();
+    pyramid(
+        &dir,
+        input,
+        "one",
+        &["--quality", &q, "--normals", "--metadata", "--threads", "1"],
+    );
+    pyramid(
+        &dir,
+        input,
+        "two",
+        &["--quality", &q, "--normals", "--metadata", "--threads", "2"],
+    );
+    let (one, two) = (all_files(&dir.path("one")), all_files(&dir.path("two")));
+    assert!(one == two, "1 and 2 threads wrote different bytes");
+
+    let layer: Value = serde_json::from_slice(&one[Path::new("layer.json")]).unwrap();
+    assert_eq!(layer["format"], "quantized-mesh-1.0");
+    assert_eq!(layer["scheme"], "tms");
+    assert_eq!(layer["metadataAvailability"], 10);
+    let max_zoom = layer["maxzoom"].as_u64().unwrap() as u32;
+
+    let tiles = decode_pyramid(&dir.path("one"));
+    // Availability lists exactly the tiles written.
+    let available = layer["available"].as_array().unwrap();
+    let mut listed = 0;
+    for (z, rects) in available.iter().enumerate() {
+        for r in rects.as_array().unwrap() {
+            let c = |k: &str| r[k].as_u64().unwrap() as u32;
+            for x in c("startX")..=c("endX") {
+                for y in c("startY")..=c("endY") {
+                    assert!(
+                        tiles.contains_key(&(z as u32, x, y)),
+                        "{z}/{x}/{y} listed, missing"
+                    );
+                    listed += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(listed, tiles.len());
+
+    for (&key, t) in &tiles {
+        check_tile(key, t);
+        assert_eq!(t.normals.as_ref().map(|n| n.len()), Some(2 * t.u.len()));
+        if key.0.is_multiple_of(10) {
+            assert!(t.metadata["available"].is_array(), "{key:?}: no metadata");
+        } else {
+            assert!(t.metadata.is_null());
+        }
+    }
+    assert!(check_shared_edges(&tiles) > 0, "no shared edges tested");
+
+    // The finest level against GDAL's own warp of each tile's lattice.
+    let mut checked = 0;
+    for (&(z, x, y), t) in tiles.range((max_zoom, 0, 0)..) {
+        let bound = quality * E0 / (1u64 << z) as f64;
+        let samples = gdal_samples(&dir, input, z, x, y);
+        let e = max_error(t, &samples);
+        assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
+        checked += 1;
+    }
+    assert!(checked > 0);
+}
+
+#[test]
+fn a_mercator_pyramid_decodes_stitches_and_keeps_its_bound() {
+    check_pyramid(&fixture("tintn_valid_raster_3857.tif"), 1.0);
+}
+
+#[test]
+fn an_albers_pyramid_decodes_stitches_and_keeps_its_bound() {
+    check_pyramid(&fixture("becmodel_dem_bc_albers_50m.tif"), 0.5);
+}

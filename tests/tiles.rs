@@ -1,0 +1,420 @@
+//! Issue 4: the tiled engine from the command line. Small `--tile-size` values force many
+//! tiles on the committed fixtures; the welded file is checked by `tinsmith verify` (which
+//! reads the whole raster untiled), for cracks by edge-use counts computed here from the
+//! file and the raster's cells, and for byte-identical output across thread counts.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use crate::util::{assert_fails_naming, fixture, stderr, stdout, Dir};
+
+/// `tinsmith mesh` with `args`, which must succeed; returns the `--report` JSON.
+fn mesh(d: &Dir, args: &[&str]) -> serde_json::Value {
+    let mut all = vec!["mesh", "--report", "r.json"];
+    all.extend_from_slice(args);
+    let o = d.run(&all);
+    assert!(o.status.success(), "mesh {args:?} failed: {}", stderr(&o));
+    serde_json::from_slice(&std::fs::read(d.path("r.json")).expect("report")).expect("json")
+}
+
+/// `tinsmith verify` on the written file at `e`, which must pass; returns its JSON.
+fn verify(d: &Dir, input: &str, mesh: &str, e: &str, pixel: bool) -> serde_json::Value {
+    let mut args = vec!["verify", input, mesh, "--max-error", e, "--json"];
+    if pixel {
+        args.push("--pixel-coords");
+    }
+    let o = d.run(&args);
+    let json: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("verify --json");
+    assert!(o.status.success(), "verify failed: {json:#}");
+    assert_eq!(json["uncovered_samples"], 0);
+    json
+}
+
+/// Every edge of the mesh (written with `--pixel-coords`) is used by at most two
+/// triangles, and an edge used once lies on the outline of the raster's domain: along
+/// cell sides, with no valid cell on the side away from its triangle.
+fn assert_crack_free(input: &str, mesh: &Path) {
+    let raster = tinsmith_raster::read_grid(Path::new(input), 1).expect("raster");
+    let grid = &raster.grid;
+    let (w, h) = (grid.width() as i64, grid.height() as i64);
+    let valid_cell = |cx: i64, cy: i64| {
+        cx >= 0
+            && cy >= 0
+            && cx + 1 < w
+            && cy + 1 < h
+            && [(cx, cy), (cx + 1, cy), (cx, cy + 1), (cx + 1, cy + 1)]
+                .iter()
+                .all(|&(x, y)| grid.get(x as u32, y as u32).is_some())
+    };
+    let file = tinsmith_export::read_mesh(mesh).expect("mesh");
+    let p: Vec<[i64; 2]> = file
+        .vertices
+        .iter()
+        .map(|v| [v[0] as i64, v[1] as i64])
+        .collect();
+    let mut uses: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    for t in &file.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            uses.entry((a.min(b), a.max(b)))
+                .or_default()
+                .push(t[(k + 2) % 3]);
+        }
+    }
+    let mut outline = 0;
+    for (&(a, b), thirds) in &uses {
+        let (pa, pb) = (p[a as usize], p[b as usize]);
+        assert!(
+            thirds.len() <= 2,
+            "edge {pa:?}-{pb:?} used {} times",
+            thirds.len()
+        );
+        if thirds.len() == 2 {
+            continue;
+        }
+        outline += 1;
+        let pc = p[thirds[0] as usize];
+        let cells: Vec<(i64, i64)> = if pa[1] == pb[1] {
+            let cy = if pc[1] > pa[1] { pa[1] - 1 } else { pa[1] };
+            (pa[0].min(pb[0])..pa[0].max(pb[0]))
+                .map(|x| (x, cy))
+                .collect()
+        } else if pa[0] == pb[0] {
+            let cx = if pc[0] > pa[0] { pa[0] - 1 } else { pa[0] };
+            (pa[1].min(pb[1])..pa[1].max(pb[1]))
+                .map(|y| (cx, y))
+                .collect()
+        } else {
+            panic!("edge {pa:?}-{pb:?} used once but not along cell sides: a crack");
+        };
+        for (cx, cy) in cells {
+            assert!(
+                !valid_cell(cx, cy),
+                "edge {pa:?}-{pb:?} used once beside valid cell ({cx}, {cy}): a crack"
+            );
+        }
+    }
+    assert!(outline > 0);
+}
+
+#[test]
+fn welded_mesh_keeps_the_bound_and_has_no_cracks() {
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    for (size, e) in [("64", "5"), ("17", "2"), ("108", "0.5")] {
+        let d = Dir::new();
+        let r = mesh(
+            &d,
+            &[
+                &dem,
+                "-o",
+                "t.ply",
+                "--max-error",
+                e,
+                "--tile-size",
+                size,
+                "--pixel-coords",
+                "-q",
+            ],
+        );
+        let v = verify(&d, &dem, "t.ply", e, true);
+        assert_eq!(r["triangles_after"], v["triangles"]);
+        assert_eq!(r["vertices_after"], v["vertices"]);
+        assert_eq!(r["measured_max_error"], v["max_error"]);
+        assert_eq!(r["tiles"]["size"], size.parse::<u64>().unwrap());
+        assert!(r["tiles"]["count"].as_u64().unwrap() > 4);
+        assert_crack_free(&dem, &d.path("t.ply"));
+    }
+}
+
+#[test]
+fn raster_not_a_multiple_of_the_tile_size() {
+    // 430 x 516: with 108 the last tile column is 2 samples wide; with 100 neither
+    // dimension is a multiple.
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    for (size, columns, rows) in [("108", 5, 5), ("100", 5, 6)] {
+        let d = Dir::new();
+        let r = mesh(
+            &d,
+            &[&dem, "-o", "t.obj", "--max-error", "3", "--tile-size", size],
+        );
+        assert_eq!(r["tiles"]["columns"], columns);
+        assert_eq!(r["tiles"]["rows"], rows);
+        verify(&d, &dem, "t.obj", "3", false);
+    }
+}
+
+#[test]
+fn nodata_across_tile_edges() {
+    // tin-terrain's Float32 tile (-FLT_MAX nodata) and the Hugo site (-9999 nodata, an
+    // irregular outline): small tiles put nodata on many tile edges.
+    for (name, size, e) in [
+        ("tintn_valid_raster_3857.tif", "9", "0.5"),
+        ("landlab_hugo_site.asc", "7", "1"),
+        ("landlab_west_bijou_gully.asc", "12", "0.25"),
+    ] {
+        let dem = fixture(name);
+        let d = Dir::new();
+        mesh(
+            &d,
+            &[
+                &dem,
+                "-o",
+                "t.ply",
+                "--max-error",
+                e,
+                "--tile-size",
+                size,
+                "--pixel-coords",
+            ],
+        );
+        verify(&d, &dem, "t.ply", e, true);
+        assert_crack_free(&dem, &d.path("t.ply"));
+    }
+}
+
+#[test]
+fn tiles_of_two_by_two_samples() {
+    let dem = fixture("landlab_hugo_site.asc");
+    let d = Dir::new();
+    let r = mesh(
+        &d,
+        &[
+            &dem,
+            "-o",
+            "t.ply",
+            "--max-error",
+            "100",
+            "--tile-size",
+            "2",
+            "--pixel-coords",
+        ],
+    );
+    assert_eq!(r["tiles"]["count"], 75 * 54);
+    // One cell per tile: nothing can be removed.
+    assert_eq!(r["triangles_after"], r["triangles_before"]);
+    verify(&d, &dem, "t.ply", "100", true);
+    assert_crack_free(&dem, &d.path("t.ply"));
+}
+
+#[test]
+fn same_bytes_for_one_and_two_threads_and_run_to_run() {
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let d = Dir::new();
+    for ext in ["ply", "obj"] {
+        let mut files = Vec::new();
+        for (i, threads) in ["1", "2", "2", "1"].iter().enumerate() {
+            let out = format!("t{i}.{ext}");
+            mesh(
+                &d,
+                &[
+                    &dem,
+                    "-o",
+                    &out,
+                    "--max-error",
+                    "2",
+                    "--tile-size",
+                    "33",
+                    "--threads",
+                    threads,
+                ],
+            );
+            files.push(std::fs::read(d.path(&out)).expect("output"));
+        }
+        assert!(
+            files.windows(2).all(|w| w[0] == w[1]),
+            "{ext} output differs"
+        );
+    }
+}
+
+#[test]
+fn per_tile_directory_has_one_file_per_tile() {
+    let dem = fixture("tintn_valid_raster_3857.tif");
+    let d = Dir::new();
+    let r = mesh(
+        &d,
+        &[
+            &dem,
+            "--per-tile",
+            "tiles",
+            "--max-error",
+            "0.5",
+            "--tile-size",
+            "40",
+            "--tile-format",
+            "obj",
+        ],
+    );
+    // 100 x 80 samples, 39 cells per tile: 3 x 3 tiles.
+    assert_eq!(r["tiles"]["count"], 9);
+    assert_eq!(r["tiles"]["welded"], false);
+    let mut names: Vec<String> = std::fs::read_dir(d.path("tiles"))
+        .expect("tiles dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names.len(), 9);
+    assert_eq!(names[0], "tile_r0_c0.obj");
+    assert_eq!(names[8], "tile_r2_c2.obj");
+    let (mut triangles, mut vertices) = (0, 0);
+    for n in &names {
+        let m = tinsmith_export::read_mesh(&d.path("tiles").join(n)).expect("tile mesh");
+        assert!(m.crs_wkt.is_some());
+        triangles += m.triangles.len() as u64;
+        vertices += m.vertices.len() as u64;
+    }
+    assert_eq!(triangles, r["triangles_after"].as_u64().unwrap());
+    // Welded, the same tiles have the same triangles and fewer vertices: each shared edge
+    // vertex once.
+    let w = mesh(
+        &d,
+        &[
+            &dem,
+            "-o",
+            "w.ply",
+            "--max-error",
+            "0.5",
+            "--tile-size",
+            "40",
+        ],
+    );
+    assert_eq!(w["triangles_after"], r["triangles_after"]);
+    assert_eq!(w["vertices_after"], r["vertices_after"]);
+    assert!(w["vertices_after"].as_u64().unwrap() < vertices);
+}
+
+#[test]
+fn per_tile_refuses_a_non_empty_directory_and_leaves_nothing() {
+    let dem = fixture("tintn_valid_raster_3857.tif");
+    let d = Dir::new();
+    std::fs::create_dir(d.path("tiles")).expect("mkdir");
+    d.write("tiles/keep.txt", "mine");
+    let o = d.run(&[
+        "mesh",
+        &dem,
+        "--per-tile",
+        "tiles",
+        "--max-error",
+        "1",
+        "--tile-size",
+        "40",
+    ]);
+    assert_fails_naming(&o, &["tiles", "not an empty directory"]);
+    assert_eq!(d.files(), vec!["tiles"]);
+}
+
+#[test]
+fn count_targets_need_the_untiled_engine() {
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let d = Dir::new();
+    let o = d.run(&[
+        "mesh",
+        &dem,
+        "-o",
+        "t.ply",
+        "--max-triangles",
+        "1000",
+        "--tile-size",
+        "64",
+    ]);
+    assert_fails_naming(&o, &["becmodel_dem_bc_albers_50m.tif", "--tile-size"]);
+    assert!(d.files().is_empty());
+}
+
+#[test]
+fn all_nodata_and_no_valid_cell_fail_cleanly_in_tiled_mode() {
+    let d = Dir::new();
+    d.write(
+        "empty.asc",
+        "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n-9999 -9999 -9999\n-9999 -9999 -9999\n",
+    );
+    let o = d.run(&[
+        "mesh",
+        "empty.asc",
+        "-o",
+        "out.ply",
+        "--max-error",
+        "1",
+        "--tile-size",
+        "2",
+    ]);
+    assert_fails_naming(&o, &["empty.asc", "nodata"]);
+    d.write(
+        "row.asc",
+        "ncols 4\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n1 2 3 4\n-9999 -9999 -9999 -9999\n",
+    );
+    let o = d.run(&[
+        "mesh",
+        "row.asc",
+        "-o",
+        "out.ply",
+        "--max-error",
+        "1",
+        "--tile-size",
+        "2",
+    ]);
+    assert_fails_naming(&o, &["row.asc", "2x2"]);
+    assert_eq!(d.files(), vec!["empty.asc", "row.asc"]);
+}
+
+#[test]
+fn small_rasters_stay_untiled_and_unchanged() {
+    // Below the tile size the untiled engine runs: same bytes as before tiling existed
+    // (the report has no tile fields).
+    let dem = fixture("tintn_valid_raster_3857.tif");
+    let d = Dir::new();
+    let r = mesh(&d, &[&dem, "-o", "a.ply", "--max-error", "0.5"]);
+    assert!(r.get("tiles").is_none());
+    let r = mesh(
+        &d,
+        &[
+            &dem,
+            "-o",
+            "b.ply",
+            "--max-error",
+            "0.5",
+            "--tile-size",
+            "100",
+            "--threads",
+            "1",
+        ],
+    );
+    assert!(r.get("tiles").is_none());
+    assert_eq!(
+        std::fs::read(d.path("a.ply")).unwrap(),
+        std::fs::read(d.path("b.ply")).unwrap()
+    );
+}
+
+#[test]
+fn quiet_and_piped_runs_print_no_progress() {
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let d = Dir::new();
+    let o = d.run(&[
+        "mesh",
+        &dem,
+        "-o",
+        "t.ply",
+        "--max-error",
+        "5",
+        "--tile-size",
+        "64",
+        "-q",
+    ]);
+    assert!(o.status.success());
+    assert_eq!(stderr(&o), "");
+    // stderr is a pipe here: no progress bar, only the summary line.
+    let o = d.run(&[
+        "mesh",
+        &dem,
+        "-o",
+        "t.ply",
+        "--max-error",
+        "5",
+        "--tile-size",
+        "64",
+    ]);
+    let err = stderr(&o);
+    assert_eq!(err.lines().count(), 1, "{err:?}");
+    assert!(err.contains("in 63 tiles of 64"), "{err}");
+}

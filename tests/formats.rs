@@ -579,11 +579,24 @@ fn float32_formats_refuse_rasters_too_wide_for_float32_positions() {
          NODATA_value -9999\n{row}\n{row}\n"
     );
     let asc = d.write("wide.asc", &text).to_string_lossy().into_owned();
+    // One tile, so that the float32 check (not the tiled engine's format rule) answers.
     for name in ["w.stl", "w.glb"] {
-        let o = d.run(&["mesh", &asc, "-o", name, "--max-error", "1"]);
+        let o = d.run(&[
+            "mesh",
+            &asc,
+            "-o",
+            name,
+            "--max-error",
+            "1",
+            "--tile-size",
+            "40000",
+        ]);
         crate::util::assert_fails_naming(&o, &[name, "too large for float32"]);
     }
+    // The tiled engine writes PLY/OBJ only, and says so.
+    let o = d.run(&["mesh", &asc, "-o", "w.stl", "--max-error", "1"]);
+    crate::util::assert_fails_naming(&o, &["w.stl", "tile-size"]);
     // Double-precision formats are fine.
-    mesh(&d, &asc, "w.fgb", "1", &[]);
+    mesh(&d, &asc, "w.fgb", "1", &["--tile-size", "40000"]);
     verify(&d, &asc, "w.fgb", "1", &[]);
 }

@@ -251,6 +251,7 @@ fn per_tile_directory_has_one_file_per_tile() {
     let mut names: Vec<String> = std::fs::read_dir(d.path("tiles"))
         .expect("tiles dir")
         .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".obj")) // each tile also gets its .prj sidecar
         .collect();
     names.sort();
     assert_eq!(names.len(), 9);

@@ -29,10 +29,19 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
         return Ok(None);
     }
     // Checks the untiled path makes first, so that errors come in the same order.
-    MeshFormat::from_path(output)?;
+    let format = crate::export::format(args)?;
     check_writable_target(output)?;
     let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
     let fits = reader.width() <= args.tile_size && reader.height() <= args.tile_size;
+    if !fits && !matches!(format, MeshFormat::Ply | MeshFormat::Obj) {
+        anyhow::bail!(
+            "{}: the raster ({} x {}) is larger than --tile-size {}, and tiled output is              written as .ply or .obj only; choose one of those or a larger --tile-size",
+            output.display(),
+            reader.width(),
+            reader.height(),
+            args.tile_size
+        );
+    }
     Ok(fits.then_some(output))
 }
 

@@ -49,6 +49,7 @@
 #![deny(rustdoc::broken_intra_doc_links)]
 #![forbid(unsafe_code)]
 
+mod cache;
 mod decode;
 mod error;
 mod info;
@@ -56,6 +57,7 @@ mod quiet;
 mod read;
 mod window;
 
+pub use cache::limit_block_cache;
 pub use error::{Error, Result};
 pub use info::{Raster, RasterInfo};
 pub use quiet::silence_gdal_errors;

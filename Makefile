@@ -6,7 +6,7 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 DEMO_DEM := data/becmodel_dem_bc_albers_50m.tif
 DEMO_ERROR := 5
 
-.PHONY: deps demo test bench-results
+.PHONY: deps demo test bench-results bench-tiles
 
 ## Install Debian's GDAL (headers, tools) and pkg-config when missing.
 deps:
@@ -37,3 +37,8 @@ test: deps
 bench-results:
 	cargo build --release --quiet
 	python3 bench/paper_table.py
+
+## Benchmark the tiled engine on a 16384^2 DEM built from ../shared/data (about an hour).
+bench-tiles:
+	cargo build --release --quiet
+	python3 bench/tiles.py --out /tmp/tinsmith-bench/results.md

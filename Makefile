@@ -10,7 +10,7 @@ TOOLS := .tools
 PY_ORACLES := trimesh==4.12.2 numpy==2.2.6
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps oracles demo test bench-results bench-contour bench-compare
+.PHONY: deps oracles demo test bench-results bench-contour bench-compare bench-tiles
 
 ## Install Debian's GDAL (headers, tools) and pkg-config when missing.
 deps:
@@ -89,3 +89,8 @@ bench-compare: deps
 	cargo build --release --quiet
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check pydelatin rasterio
 	$(VENV)/bin/python bench/compare.py --shared ../shared
+
+## Benchmark the tiled engine on a 16384^2 DEM built from ../shared/data (about an hour).
+bench-tiles:
+	cargo build --release --quiet
+	python3 bench/tiles.py --out /tmp/tinsmith-bench/results.md

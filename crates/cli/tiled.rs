@@ -19,6 +19,10 @@ use tinsmith_tile::{
 use crate::args::{MeshArgs, TileFormatArg};
 use crate::output::{check_writable_target, write_atomically};
 
+/// GDAL block cache in tiled mode, in MB: several rows of tiles of a 16k-wide Float32
+/// raster, whether it is stored in strips or blocks.
+const TILED_BLOCK_CACHE_MB: u64 = 256;
+
 /// The output file when the untiled engine should run: no `--per-tile`, and the raster
 /// fits in one tile. `None` when the tiled engine should run.
 pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
@@ -129,6 +133,9 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         check_writable_target(report)?;
     }
 
+    // Tiles need only the blocks of the current row of tiles; GDAL's default (5 % of the
+    // machine's memory) would keep most of a large raster resident.
+    tinsmith_raster::limit_block_cache(TILED_BLOCK_CACHE_MB);
     let bar = progress_bar(args.quiet);
     bar.set_message("scanning the raster");
     let t = Instant::now();

@@ -52,6 +52,7 @@
 #![deny(rustdoc::broken_intra_doc_links)]
 #![forbid(unsafe_code)]
 
+mod cache;
 mod decode;
 mod error;
 mod geographic;
@@ -61,6 +62,7 @@ mod read;
 mod reproject;
 mod window;
 
+pub use cache::limit_block_cache;
 pub use error::{Error, Result};
 pub use geographic::{geographic_bounds, warp_to_geographic, GeoBounds, GeoLattice};
 pub use info::{Raster, RasterInfo};

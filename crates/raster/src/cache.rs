@@ -14,6 +14,5 @@ pub fn limit_block_cache(megabytes: u64) -> bool {
         return false;
     }
     // GDAL reads values below 100000 as megabytes.
-    gdal::config::set_config_option("GDAL_CACHEMAX", &megabytes.min(99_999).to_string())
-        .is_ok()
+    gdal::config::set_config_option("GDAL_CACHEMAX", &megabytes.min(99_999).to_string()).is_ok()
 }

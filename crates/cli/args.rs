@@ -138,7 +138,8 @@ pub struct VerifyArgs {
 pub struct ContourArgs {
     /// Any single-band raster GDAL can read.
     pub input: PathBuf,
-    /// Output lines; the format follows the extension (.geojson, .json, .fgb).
+    /// Output lines; the format follows the extension (.geojson, .json, .fgb). GeoJSON is
+    /// in WGS84 longitude/latitude unless --geojson-source-crs.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Contour every multiple of this (plus --offset) within the TIN's height range.
@@ -155,7 +156,7 @@ pub struct ContourArgs {
     /// the full grid.
     #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true, conflicts_with = "mesh")]
     pub max_error: Option<f64>,
-    /// Contour this TIN (.ply, .obj, as written by `tinsmith mesh` from INPUT) instead.
+    /// Contour this TIN (any format `tinsmith mesh` writes, written from INPUT) instead.
     #[arg(long, value_name = "MESH")]
     pub mesh: Option<PathBuf>,
     /// Band to read (1-based).
@@ -164,6 +165,10 @@ pub struct ContourArgs {
     /// Write (column, row) coordinates; read --mesh as written with --pixel-coords.
     #[arg(long)]
     pub pixel_coords: bool,
+    /// GeoJSON only: keep the raster's CRS (with a "crs" member and a note) instead of
+    /// reprojecting to WGS84 longitude/latitude as RFC 7946 wants.
+    #[arg(long)]
+    pub geojson_source_crs: bool,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,

@@ -300,6 +300,68 @@ fn decimated_contours_have_fewer_segments_than_the_full_grid() {
     );
 }
 
+/// Distance from `p` to the segment `a`-`b`.
+fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 == 0.0 {
+        0.0
+    } else {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+    };
+    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
+}
+
+#[test]
+fn simplify_keeps_a_subsequence_within_the_distance() {
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    let d = Dir::new();
+    let base = [
+        "contour",
+        &input,
+        "--interval",
+        "100",
+        "--max-error",
+        "10",
+        "--geojson-source-crs",
+    ];
+    let mut a = base.to_vec();
+    a.extend_from_slice(&["-o", "exact.geojson"]);
+    run_ok(&d, &a);
+    let mut b = base.to_vec();
+    b.extend_from_slice(&["-o", "simple.geojson", "--simplify", "25"]);
+    run_ok(&d, &b);
+    let (exact, simple) = (
+        features(&d.path("exact.geojson")),
+        features(&d.path("simple.geojson")),
+    );
+    assert_eq!(exact.len(), simple.len());
+    let count = |f: &[(f64, Vec<[f64; 2]>)]| f.iter().map(|(_, p)| p.len() - 1).sum::<usize>();
+    assert!(
+        count(&simple) * 2 < count(&exact),
+        "{} segments simplified vs {} exact",
+        count(&simple),
+        count(&exact)
+    );
+    for ((le, pe), (ls, ps)) in exact.iter().zip(&simple) {
+        assert_eq!(le, ls);
+        assert_eq!((pe.first(), pe.last()), (ps.first(), ps.last()));
+        assert!(ps.len() >= if pe.first() == pe.last() { 4 } else { 2 });
+        // A subsequence, and each run of dropped points within 25 m of its segment.
+        let mut k = 0;
+        for w in ps.windows(2) {
+            let start = k;
+            while pe[k] != w[1] || k == start {
+                k += 1;
+            }
+            assert_eq!(pe[start], w[0]);
+            for &p in &pe[start..=k] {
+                assert!(segment_distance(p, w[0], w[1]) <= 25.0);
+            }
+        }
+    }
+}
+
 #[test]
 fn contour_bad_input_fails_cleanly() {
     let dem = fixture("tintn_valid_raster_3857.tif");
@@ -315,6 +377,18 @@ fn contour_bad_input_fails_cleanly() {
             vec!["no/dir/c.fgb"],
         ),
         (vec![&dem, "-o", "c.geojson"], vec!["--interval"]),
+        (
+            vec![
+                &dem,
+                "-o",
+                "c.geojson",
+                "--interval",
+                "1",
+                "--simplify",
+                "0",
+            ],
+            vec!["--simplify"],
+        ),
         (
             vec![
                 &dem,

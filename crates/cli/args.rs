@@ -159,6 +159,11 @@ pub struct ContourArgs {
     /// Contour this TIN (any format `tinsmith mesh` writes, written from INPUT) instead.
     #[arg(long, value_name = "MESH")]
     pub mesh: Option<PathBuf>,
+    /// Simplify each line (Douglas-Peucker) within this distance, in the output's map
+    /// units (pixels with --pixel-coords): lines move up to D sideways and are no longer
+    /// exact contours of the TIN.
+    #[arg(long, value_name = "D", value_parser = parse_interval)]
+    pub simplify: Option<f64>,
     /// Band to read (1-based).
     #[arg(long, default_value_t = 1)]
     pub band: usize,

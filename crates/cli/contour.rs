@@ -10,14 +10,16 @@
 //! 0 would give, without its cost. Lines are computed in grid coordinates and mapped to the
 //! world position of sample centres through the geotransform, as `tinsmith mesh` writes
 //! vertices, so a line through a vertex passes through the mesh file's vertex exactly.
-//! GeoJSON is then reprojected to WGS84 unless `--geojson-source-crs`, as `tinsmith mesh`
-//! does ([`crate::export::file_crs`]).
+//! With `--simplify D` each line is then simplified by Douglas–Peucker within `D` in those
+//! file coordinates ([`tinsmith_contour::simplify_indices`]). GeoJSON is then reprojected
+//! to WGS84 unless `--geojson-source-crs`, as `tinsmith mesh` does
+//! ([`crate::export::file_crs`]).
 
 use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use tinsmith_contour::{contour, interval_levels, sorted_levels, ContourMesh};
+use tinsmith_contour::{contour, interval_levels, simplify_indices, sorted_levels, ContourMesh};
 use tinsmith_core::{decimate, DecimationOptions, Grid};
 use tinsmith_export::LineFormat;
 use tinsmith_raster::Raster;
@@ -91,9 +93,9 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     let polylines = contour(&mesh, &levels)
         .with_context(|| format!("{}: contouring failed", args.input.display()))?;
 
-    // Grid coordinates -> file coordinates, with the level as z for the reprojection. A
-    // north-up raster flips orientation; reverse so the high ground stays on the left in
-    // file coordinates.
+    // Grid coordinates -> file coordinates, with the level as z for the reprojection, then
+    // --simplify. A north-up raster flips orientation; reverse so the high ground stays on
+    // the left in file coordinates.
     let flip = georef.flips_orientation();
     let closed = polylines.iter().filter(|l| l.is_closed()).count();
     let mut points: Vec<[f64; 3]> =
@@ -104,10 +106,21 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             line.reverse();
         }
         let level = line.level();
+        let start = points.len();
         points.extend(line.points().iter().map(|&p| {
             let [x, y] = georef.file_point(p);
             [x, y, level]
         }));
+        if let Some(tolerance) = args.simplify {
+            let file: Vec<[f64; 2]> = points[start..].iter().map(|p| [p[0], p[1]]).collect();
+            let kept = simplify_indices(&file, tolerance);
+            let count = kept.len();
+            // Indices only grow, so the kept points move down in place.
+            for (k, i) in kept.into_iter().enumerate() {
+                points[start + k] = points[start + i];
+            }
+            points.truncate(start + count);
+        }
         ends.push((points.len(), level));
     }
     let wgs84 = format == LineFormat::GeoJson && !args.geojson_source_crs;
@@ -133,11 +146,14 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
 
     if !args.quiet {
         eprintln!(
-            "{}: {} lines ({} closed), {} segments at {} levels from the {} ({} triangles) in {:.2} s",
+            "{}: {} lines ({} closed), {} segments{} at {} levels from the {} ({} triangles) in {:.2} s",
             args.output.display(),
             lines.len(),
             closed,
             points.len() - lines.len(),
+            args.simplify
+                .map(|d| format!(" (simplified within {d})"))
+                .unwrap_or_default(),
             levels.len(),
             source,
             mesh.triangles().len(),

@@ -1,10 +1,11 @@
 //! `tinsmith contour` on real rasters: GDAL's `ogrinfo` reads the GeoJSON and FlatGeobuf
-//! output with the right feature count and CRS; a mesh file gives the same lines as
+//! output with the right feature count and CRS; GeoJSON is WGS84 unless
+//! `--geojson-source-crs`, as GDAL transforms it; a mesh file gives the same lines as
 //! decimating in place; bad input fails cleanly (issue 7).
 
 use std::process::Command;
 
-use crate::util::{assert_fails_naming, fixture, stderr, Dir};
+use crate::util::{assert_fails_naming, fixture, gdaltransform, stderr, Dir};
 
 /// `ogrinfo -so -al FILE` (summary of every layer). gdal-bin is installed by `make deps`.
 fn ogrinfo(path: &std::path::Path) -> String {
@@ -41,16 +42,26 @@ fn features(path: &std::path::Path) -> Vec<(f64, Vec<[f64; 2]>)> {
         .collect()
 }
 
+/// Runs `contour` to GeoJSON (default: WGS84), GeoJSON with `--geojson-source-crs` and
+/// FlatGeobuf, and checks what `ogrinfo` reads: the same feature count, line strings, the
+/// `id` and `elev` attributes, and the CRS (EPSG:4326 for the default GeoJSON, the
+/// raster's for the others). Returns the number of lines.
 fn check_read_by_gdal(input: &str, epsg: &str, args: &[&str]) -> usize {
     let d = Dir::new();
-    let mut a = vec!["contour", input, "-o", "c.geojson"];
-    a.extend_from_slice(args);
-    run_ok(&d, &a);
-    a[3] = "c.fgb";
-    run_ok(&d, &a);
+    let outputs = [
+        ("c.geojson", "4326", &[][..]),
+        ("src.geojson", epsg, &["--geojson-source-crs"][..]),
+        ("c.fgb", epsg, &[][..]),
+    ];
+    for (file, _, extra) in outputs {
+        let mut a = vec!["contour", input, "-o", file];
+        a.extend_from_slice(args);
+        a.extend_from_slice(extra);
+        run_ok(&d, &a);
+    }
     let n = features(&d.path("c.geojson")).len();
     assert!(n > 0);
-    for file in ["c.geojson", "c.fgb"] {
+    for (file, epsg, _) in outputs {
         let info = ogrinfo(&d.path(file));
         assert!(
             info.contains(&format!("Feature Count: {n}\n")),
@@ -58,6 +69,7 @@ fn check_read_by_gdal(input: &str, epsg: &str, args: &[&str]) -> usize {
         );
         assert!(info.contains("Geometry: Line String"), "{file}: {info}");
         assert!(info.contains("elev: Real"), "{file}: {info}");
+        assert!(info.contains("id: Integer"), "{file}: {info}");
         assert!(
             info.contains(&format!("ID[\"EPSG\",{epsg}]]\nData axis")),
             "{file} should be EPSG:{epsg}: {info}"
@@ -65,10 +77,60 @@ fn check_read_by_gdal(input: &str, epsg: &str, args: &[&str]) -> usize {
     }
     assert_eq!(
         d.files(),
-        vec!["c.fgb", "c.geojson"],
+        vec!["c.fgb", "c.geojson", "src.geojson"],
         "no temporary file left"
     );
     n
+}
+
+#[test]
+fn geojson_is_wgs84_by_default_like_mesh() {
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    let d = Dir::new();
+    let base = ["contour", &input, "--interval", "500", "--max-error", "10"];
+    let mut a = base.to_vec();
+    a.extend_from_slice(&["-o", "wgs84.geojson"]);
+    run_ok(&d, &a);
+    let mut b = base.to_vec();
+    b.extend_from_slice(&["-o", "src.geojson", "--geojson-source-crs"]);
+    run_ok(&d, &b);
+    let json = |name: &str| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(d.path(name)).unwrap()).unwrap()
+    };
+    // RFC 7946: no crs member; the source CRS file names it, with a note.
+    assert!(json("wgs84.geojson").get("crs").is_none());
+    let src = json("src.geojson");
+    assert_eq!(
+        src["crs"]["properties"]["name"],
+        "urn:ogc:def:crs:EPSG::3005"
+    );
+    assert!(src["tinsmith_note"].as_str().is_some());
+    // The same lines, point for point, as GDAL transforms them.
+    let (wgs84, src) = (
+        features(&d.path("wgs84.geojson")),
+        features(&d.path("src.geojson")),
+    );
+    assert_eq!(wgs84.len(), src.len());
+    let src_points: Vec<[f64; 3]> = src
+        .iter()
+        .flat_map(|(_, p)| p.iter().map(|q| [q[0], q[1], 0.0]))
+        .collect();
+    let expected = gdaltransform("EPSG:3005", "EPSG:4326", &src_points);
+    let got: Vec<[f64; 2]> = wgs84.iter().flat_map(|(_, p)| p.iter().copied()).collect();
+    assert_eq!(got.len(), expected.len());
+    for (g, e) in got.iter().zip(&expected) {
+        assert!(
+            (g[0] - e[0]).abs() < 1e-9 && (g[1] - e[1]).abs() < 1e-9,
+            "{g:?} vs {e:?}"
+        );
+    }
+    for ((ew, _), (es, _)) in wgs84.iter().zip(&src) {
+        assert_eq!(ew, es);
+    }
+    // Longitude, latitude: the DEM is in southern British Columbia.
+    assert!(got
+        .iter()
+        .all(|p| (-121.0..-119.0).contains(&p[0]) && (48.5..49.5).contains(&p[1])));
 }
 
 #[test]
@@ -112,7 +174,7 @@ fn lines_are_closed_or_end_on_the_domain_edge_in_world_coordinates() {
     let f = features(&d.path("c.json"));
     let v: serde_json::Value =
         serde_json::from_slice(&std::fs::read(d.path("c.json")).unwrap()).unwrap();
-    assert!(v.get("crs").is_none(), "no CRS to record");
+    assert!(v["crs"].is_null(), "no CRS to record: \"crs\": null");
     assert!(f.iter().any(|(_, p)| p.first() == p.last()));
     for (elev, pts) in &f {
         assert_eq!(elev % 5.0, 0.0);
@@ -146,18 +208,44 @@ fn lines_are_closed_or_end_on_the_domain_edge_in_world_coordinates() {
     );
 }
 
+/// Lines in an order independent of vertex numbering: rings start at their smallest
+/// point, lines are sorted. (Open lines keep their direction: high ground on the left.)
+fn canonical(mut lines: Vec<(f64, Vec<[f64; 2]>)>) -> Vec<(f64, Vec<[f64; 2]>)> {
+    let key = |p: &[f64; 2]| (p[0].to_bits(), p[1].to_bits());
+    for (_, points) in &mut lines {
+        if points.first() == points.last() {
+            points.pop();
+            let start = (0..points.len())
+                .min_by(|&i, &j| points[i].partial_cmp(&points[j]).unwrap())
+                .unwrap();
+            points.rotate_left(start);
+            points.push(points[0]);
+        }
+    }
+    lines.sort_by(|a, b| {
+        a.0.total_cmp(&b.0)
+            .then_with(|| a.1.iter().map(key).cmp(b.1.iter().map(key)))
+    });
+    lines
+}
+
 #[test]
 fn mesh_file_gives_the_same_lines_as_decimating() {
     let input = fixture("tintn_valid_raster_3857.tif");
-    for extra in [&[][..], &["--pixel-coords"][..]] {
+    // A GeoJSON mesh is in WGS84 and is transformed back, as `verify` does.
+    for (mesh, extra) in [
+        ("m.ply", &[][..]),
+        ("m.geojson", &[][..]),
+        ("m.ply", &["--pixel-coords"][..]),
+    ] {
         let d = Dir::new();
-        let mut m = vec!["mesh", &input, "-o", "m.ply", "--max-error", "0.5"];
+        let mut m = vec!["mesh", &input, "-o", mesh, "--max-error", "0.5"];
         m.extend_from_slice(extra);
         run_ok(&d, &m);
         let mut a = vec!["contour", &input, "-o", "a.geojson", "--interval", "1"];
         a.extend_from_slice(extra);
         let mut b = a.clone();
-        a.extend_from_slice(&["--mesh", "m.ply"]);
+        a.extend_from_slice(&["--mesh", mesh]);
         b[3] = "b.geojson";
         b.extend_from_slice(&["--max-error", "0.5"]);
         run_ok(&d, &a);
@@ -167,7 +255,13 @@ fn mesh_file_gives_the_same_lines_as_decimating() {
             features(&d.path("b.geojson")),
         );
         assert!(!fa.is_empty());
-        assert_eq!(fa, fb, "{extra:?}");
+        if mesh.ends_with(".ply") {
+            assert_eq!(fa, fb, "{mesh} {extra:?}");
+        } else {
+            // GeoJSON has no shared vertices: the reader welds them in its own order, and
+            // the line order and ring starts follow vertex numbers.
+            assert_eq!(canonical(fa), canonical(fb), "{mesh} {extra:?}");
+        }
     }
 }
 
@@ -206,6 +300,68 @@ fn decimated_contours_have_fewer_segments_than_the_full_grid() {
     );
 }
 
+/// Distance from `p` to the segment `a`-`b`.
+fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 == 0.0 {
+        0.0
+    } else {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+    };
+    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
+}
+
+#[test]
+fn simplify_keeps_a_subsequence_within_the_distance() {
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    let d = Dir::new();
+    let base = [
+        "contour",
+        &input,
+        "--interval",
+        "100",
+        "--max-error",
+        "10",
+        "--geojson-source-crs",
+    ];
+    let mut a = base.to_vec();
+    a.extend_from_slice(&["-o", "exact.geojson"]);
+    run_ok(&d, &a);
+    let mut b = base.to_vec();
+    b.extend_from_slice(&["-o", "simple.geojson", "--simplify", "25"]);
+    run_ok(&d, &b);
+    let (exact, simple) = (
+        features(&d.path("exact.geojson")),
+        features(&d.path("simple.geojson")),
+    );
+    assert_eq!(exact.len(), simple.len());
+    let count = |f: &[(f64, Vec<[f64; 2]>)]| f.iter().map(|(_, p)| p.len() - 1).sum::<usize>();
+    assert!(
+        count(&simple) * 2 < count(&exact),
+        "{} segments simplified vs {} exact",
+        count(&simple),
+        count(&exact)
+    );
+    for ((le, pe), (ls, ps)) in exact.iter().zip(&simple) {
+        assert_eq!(le, ls);
+        assert_eq!((pe.first(), pe.last()), (ps.first(), ps.last()));
+        assert!(ps.len() >= if pe.first() == pe.last() { 4 } else { 2 });
+        // A subsequence, and each run of dropped points within 25 m of its segment.
+        let mut k = 0;
+        for w in ps.windows(2) {
+            let start = k;
+            while pe[k] != w[1] || k == start {
+                k += 1;
+            }
+            assert_eq!(pe[start], w[0]);
+            for &p in &pe[start..=k] {
+                assert!(segment_distance(p, w[0], w[1]) <= 25.0);
+            }
+        }
+    }
+}
+
 #[test]
 fn contour_bad_input_fails_cleanly() {
     let dem = fixture("tintn_valid_raster_3857.tif");
@@ -221,6 +377,29 @@ fn contour_bad_input_fails_cleanly() {
             vec!["no/dir/c.fgb"],
         ),
         (vec![&dem, "-o", "c.geojson"], vec!["--interval"]),
+        (
+            vec![
+                &dem,
+                "-o",
+                "c.geojson",
+                "--interval",
+                "1",
+                "--simplify",
+                "0",
+            ],
+            vec!["--simplify"],
+        ),
+        (
+            vec![
+                &dem,
+                "-o",
+                "c.fgb",
+                "--interval",
+                "1",
+                "--geojson-source-crs",
+            ],
+            vec!["c.fgb", "--geojson-source-crs"],
+        ),
         (
             vec![&dem, "-o", "c.geojson", "--interval", "0"],
             vec!["--interval"],

@@ -11,7 +11,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
-use crate::util::{fixture, stderr, stdout, Dir};
+use crate::util::{fixture, gdaltransform, stderr, stdout, Dir};
 
 /// The small DEM most tests use: 100 x 80 Float32, EPSG:3857, nodata.
 const DEM: &str = "tintn_valid_raster_3857.tif";
@@ -382,31 +382,7 @@ fn ogrinfo_reads_geojson_in_wgs84_and_in_the_source_crs() {
         report["triangles_after"].to_string()
     );
     assert!(summary.contains("GEOGCRS[\"WGS 84\""), "{summary}");
-    let points: String = ply
-        .vertices
-        .iter()
-        .map(|v| format!("{:?} {:?} {:?}\n", v[0], v[1], v[2]))
-        .collect();
-    let mut child = Command::new("gdaltransform")
-        .args(["-s_srs", "EPSG:3857", "-t_srs", "EPSG:4326"])
-        .stdin(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .expect("gdaltransform");
-    std::io::Write::write_all(child.stdin.as_mut().expect("stdin"), points.as_bytes())
-        .expect("feed gdaltransform");
-    let out = child.wait_with_output().expect("gdaltransform output");
-    let lonlat: Vec<[f64; 3]> = String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .map(|l| {
-            let v: Vec<f64> = l
-                .split_ascii_whitespace()
-                .map(|c| c.parse().expect("number"))
-                .collect();
-            [v[0], v[1], v[2]]
-        })
-        .collect();
-    assert_eq!(lonlat.len(), ply.vertices.len());
+    let lonlat = gdaltransform("EPSG:3857", "EPSG:4326", &ply.vertices);
     let all = run("ogrinfo", &["-al", "-q", &path]);
     assert_same_triangles(
         &canonical_corners(&ogr_triangles(&all)),

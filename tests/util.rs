@@ -78,3 +78,36 @@ pub fn assert_fails_naming(o: &Output, names: &[&str]) {
     }
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// GDAL's `gdaltransform` (Debian gdal-bin, installed by `make deps`): `points` from the
+/// CRS `from` to `to` (e.g. "EPSG:4326", longitude, latitude), heights unchanged.
+pub fn gdaltransform(from: &str, to: &str, points: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    let text: String = points
+        .iter()
+        .map(|v| format!("{:?} {:?} {:?}\n", v[0], v[1], v[2]))
+        .collect();
+    let mut child = Command::new("gdaltransform")
+        .args(["-s_srs", from, "-t_srs", to])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("gdaltransform (Debian gdal-bin, installed by `make deps`) must be on PATH");
+    // Fed from a thread: gdaltransform answers line by line, so a large input written
+    // before reading would fill both pipes.
+    let mut stdin = child.stdin.take().expect("stdin");
+    let feeder = std::thread::spawn(move || std::io::Write::write_all(&mut stdin, text.as_bytes()));
+    let out = child.wait_with_output().expect("gdaltransform output");
+    feeder.join().expect("feeder").expect("feed gdaltransform");
+    let transformed: Vec<[f64; 3]> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| {
+            let v: Vec<f64> = l
+                .split_ascii_whitespace()
+                .map(|c| c.parse().expect("number"))
+                .collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    assert_eq!(transformed.len(), points.len(), "gdaltransform output");
+    transformed
+}

@@ -214,7 +214,8 @@ pub struct VerifyArgs {
 pub struct ContourArgs {
     /// Any single-band raster GDAL can read.
     pub input: PathBuf,
-    /// Output lines; the format follows the extension (.geojson, .json, .fgb).
+    /// Output lines; the format follows the extension (.geojson, .json, .fgb). GeoJSON is
+    /// in WGS84 longitude/latitude unless --geojson-source-crs.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Contour every multiple of this (plus --offset) within the TIN's height range.
@@ -231,15 +232,24 @@ pub struct ContourArgs {
     /// the full grid.
     #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true, conflicts_with = "mesh")]
     pub max_error: Option<f64>,
-    /// Contour this TIN (.ply, .obj, as written by `tinsmith mesh` from INPUT) instead.
+    /// Contour this TIN (any format `tinsmith mesh` writes, written from INPUT) instead.
     #[arg(long, value_name = "MESH")]
     pub mesh: Option<PathBuf>,
+    /// Simplify each line (Douglas-Peucker) within this distance, in the output's map
+    /// units (pixels with --pixel-coords): lines move up to D sideways and are no longer
+    /// exact contours of the TIN.
+    #[arg(long, value_name = "D", value_parser = parse_interval)]
+    pub simplify: Option<f64>,
     /// Band to read (1-based).
     #[arg(long, default_value_t = 1)]
     pub band: usize,
     /// Write (column, row) coordinates; read --mesh as written with --pixel-coords.
     #[arg(long)]
     pub pixel_coords: bool,
+    /// GeoJSON only: keep the raster's CRS (with a "crs" member and a note) instead of
+    /// reprojecting to WGS84 longitude/latitude as RFC 7946 wants.
+    #[arg(long)]
+    pub geojson_source_crs: bool,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,

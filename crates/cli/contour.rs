@@ -1,5 +1,5 @@
 //! `tinsmith contour`: contour lines of a raster's TIN (paper §5), written as GeoJSON or
-//! FlatGeobuf.
+//! FlatGeobuf by [`tinsmith_export::write_lines`].
 //!
 //! The TIN is, in order of precedence: the mesh file given with `--mesh` (its vertices
 //! mapped back to grid samples as `tinsmith verify` does, its heights as written); the
@@ -10,17 +10,25 @@
 //! 0 would give, without its cost. Lines are computed in grid coordinates and mapped to the
 //! world position of sample centres through the geotransform, as `tinsmith mesh` writes
 //! vertices, so a line through a vertex passes through the mesh file's vertex exactly.
+//! With `--simplify D` each line is then simplified by Douglas–Peucker within `D` in those
+//! file coordinates ([`tinsmith_contour::simplify_indices`]). GeoJSON is then reprojected
+//! to WGS84 unless `--geojson-source-crs`, as `tinsmith mesh` does
+//! ([`crate::export::file_crs`]).
 
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use tinsmith_contour::{contour, interval_levels, sorted_levels, ContourMesh};
+use tinsmith_contour::{contour, interval_levels, simplify_indices, sorted_levels, ContourMesh};
 use tinsmith_core::{decimate, DecimationOptions, Grid};
+use tinsmith_export::LineFormat;
+use tinsmith_raster::Raster;
 
 use crate::args::ContourArgs;
-use crate::contour_output::{write_contours, ContourFormat, ContourLine, Crs};
+use crate::export::file_crs;
 use crate::georef::Georef;
 use crate::output::check_writable_target;
+use crate::verify::read_mesh_file;
 
 /// Builds the TIN, contours it and writes the lines; `Ok(true)` on success.
 pub fn run(args: &ContourArgs) -> Result<bool> {
@@ -28,14 +36,23 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     if args.offset.is_some() && args.interval.is_none() {
         bail!("--offset shifts --interval levels; with --levels, give the levels themselves");
     }
-    let format = ContourFormat::from_path(&args.output)?;
+    let format = LineFormat::from_path(&args.output)?;
+    if args.geojson_source_crs && format != LineFormat::GeoJson {
+        bail!(
+            "{}: --geojson-source-crs applies to GeoJSON output only",
+            args.output.display()
+        );
+    }
     check_writable_target(&args.output)?;
     let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
     let grid = &raster.grid;
     let georef = Georef::new(raster.info.transform(), args.pixel_coords);
 
     let (mesh, source) = match &args.mesh {
-        Some(path) => (mesh_from_file(path, grid, &georef)?, "mesh file".to_owned()),
+        Some(path) => (
+            mesh_from_file(path, &raster, georef)?,
+            "mesh file".to_owned(),
+        ),
         None => {
             if grid.valid_cell_count() == 0 {
                 bail!(
@@ -76,42 +93,67 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     let polylines = contour(&mesh, &levels)
         .with_context(|| format!("{}: contouring failed", args.input.display()))?;
 
-    // Grid coordinates -> file coordinates. A north-up raster flips orientation; reverse
-    // so the high ground stays on the left in file coordinates.
+    // Grid coordinates -> file coordinates, with the level as z for the reprojection, then
+    // --simplify. A north-up raster flips orientation; reverse so the high ground stays on
+    // the left in file coordinates.
     let flip = georef.flips_orientation();
-    let lines: Vec<ContourLine> = polylines
-        .into_iter()
-        .map(|mut l| {
-            if flip {
-                l.reverse();
+    let closed = polylines.iter().filter(|l| l.is_closed()).count();
+    let mut points: Vec<[f64; 3]> =
+        Vec::with_capacity(polylines.iter().map(|l| l.points().len()).sum());
+    let mut ends = Vec::with_capacity(polylines.len());
+    for mut line in polylines {
+        if flip {
+            line.reverse();
+        }
+        let level = line.level();
+        let start = points.len();
+        points.extend(line.points().iter().map(|&p| {
+            let [x, y] = georef.file_point(p);
+            [x, y, level]
+        }));
+        if let Some(tolerance) = args.simplify {
+            let file: Vec<[f64; 2]> = points[start..].iter().map(|p| [p[0], p[1]]).collect();
+            let kept = simplify_indices(&file, tolerance);
+            let count = kept.len();
+            // Indices only grow, so the kept points move down in place.
+            for (k, i) in kept.into_iter().enumerate() {
+                points[start + k] = points[start + i];
             }
-            ContourLine {
-                elev: l.level(),
-                points: l.points().iter().map(|&p| georef.file_point(p)).collect(),
-            }
+            points.truncate(start + count);
+        }
+        ends.push((points.len(), level));
+    }
+    let wgs84 = format == LineFormat::GeoJson && !args.geojson_source_crs;
+    let crs = file_crs(
+        &raster,
+        args.pixel_coords,
+        wgs84,
+        &mut points,
+        &args.output,
+        args.quiet,
+    )?;
+    let points: Vec<[f64; 2]> = points.iter().map(|p| [p[0], p[1]]).collect();
+    let mut start = 0;
+    let lines: Vec<(&[[f64; 2]], f64)> = ends
+        .iter()
+        .map(|&(end, level)| {
+            let line = (&points[start..end], level);
+            start = end;
+            line
         })
         .collect();
-    let crs = match georef {
-        Georef::Pixel => Crs::default(),
-        Georef::World(_) => Crs {
-            epsg: raster.info.epsg,
-            wkt: raster.info.crs_wkt.as_deref(),
-        },
-    };
-    write_contours(&args.output, format, &lines, crs)?;
+    tinsmith_export::write_lines(&args.output, format, &lines, crs)?;
 
     if !args.quiet {
-        let segments: usize = lines.iter().map(|l| l.points.len() - 1).sum();
-        let closed = lines
-            .iter()
-            .filter(|l| l.points.first() == l.points.last())
-            .count();
         eprintln!(
-            "{}: {} lines ({} closed), {} segments at {} levels from the {} ({} triangles) in {:.2} s",
+            "{}: {} lines ({} closed), {} segments{} at {} levels from the {} ({} triangles) in {:.2} s",
             args.output.display(),
             lines.len(),
             closed,
-            segments,
+            points.len() - lines.len(),
+            args.simplify
+                .map(|d| format!(" (simplified within {d})"))
+                .unwrap_or_default(),
             levels.len(),
             source,
             mesh.triangles().len(),
@@ -121,10 +163,12 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     Ok(true)
 }
 
-/// Reads a mesh file and maps its vertices back to grid positions (as `tinsmith verify`
-/// does); heights are the file's.
-fn mesh_from_file(path: &std::path::Path, grid: &Grid, georef: &Georef) -> Result<ContourMesh> {
-    let file = tinsmith_export::read_mesh(path)?;
+/// Reads a mesh file written from `raster` (as `tinsmith verify` reads it: GeoJSON in
+/// WGS84 back to the raster's CRS) and maps its vertices back to grid positions; heights
+/// are the file's.
+fn mesh_from_file(path: &Path, raster: &Raster, georef: Georef) -> Result<ContourMesh> {
+    let grid: &Grid = &raster.grid;
+    let file = read_mesh_file(path, raster, georef)?;
     let mut vertices = Vec::with_capacity(file.vertices.len());
     for (i, v) in file.vertices.iter().enumerate() {
         let [x, y] = georef

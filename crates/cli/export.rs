@@ -1,12 +1,13 @@
 //! How `tinsmith mesh` writes each format: the format and its flags, the float32 origin
-//! and the tighter bound that keeps the promise in float32 files, WGS84 for GeoJSON.
+//! and the tighter bound that keeps the promise in float32 files; WGS84 for GeoJSON, for
+//! `mesh` and `contour` alike ([`file_crs`]).
 
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use tinsmith_core::Grid;
-use tinsmith_export::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
+use tinsmith_export::{CrsRef, LocalOrigin, MeshFormat, MeshRef, WriteOptions};
 use tinsmith_raster::Raster;
 
 use crate::args::MeshArgs;
@@ -216,25 +217,15 @@ pub fn write(
     triangles: &[[u32; 3]],
 ) -> Result<()> {
     let path = out(args);
-    let info = &raster.info;
-    let (mut crs, mut epsg) = match args.pixel_coords || info.transform().is_none() {
-        true => (None, None),
-        false => (info.crs_wkt.as_deref(), info.epsg),
-    };
-    if plan.format == MeshFormat::GeoJson && !args.export.geojson_source_crs {
-        match crs {
-            Some(wkt) => {
-                tinsmith_raster::to_wgs84(wkt, &mut vertices)
-                    .with_context(|| format!("{}: cannot reproject to WGS84", path.display()))?;
-                (crs, epsg) = (None, Some(4326));
-            }
-            None if !args.quiet => eprintln!(
-                "{}: no CRS, so the coordinates are written as they are, with \"crs\": null",
-                path.display()
-            ),
-            None => {}
-        }
-    }
+    let wgs84 = plan.format == MeshFormat::GeoJson && !args.export.geojson_source_crs;
+    let crs = file_crs(
+        raster,
+        args.pixel_coords,
+        wgs84,
+        &mut vertices,
+        path,
+        args.quiet,
+    )?;
     if let Some(origin) = plan.origin {
         check_positions_map_back(&vertices, origin, raster, args)?;
     }
@@ -243,10 +234,50 @@ pub fn write(
         .with_base(args.export.base)
         .with_normals(args.export.normals);
     let mesh = MeshRef::new(&vertices, triangles)
-        .with_crs_wkt(crs)
-        .with_epsg(epsg);
+        .with_crs_wkt(crs.wkt)
+        .with_epsg(crs.epsg);
     tinsmith_export::write_mesh_with(path, plan.format, mesh, &options)?;
     Ok(())
+}
+
+/// The CRS a file written from `raster` records: none with `--pixel-coords` or without a
+/// geotransform, else the raster's. With `wgs84` (GeoJSON without `--geojson-source-crs`,
+/// for `mesh` and `contour` alike) a raster with a CRS has `points` (file coordinates)
+/// reprojected in place to WGS84 longitude, latitude (RFC 7946), heights unchanged, and
+/// the file records EPSG 4326; without a CRS the points stay as they are, with a note on
+/// stderr unless `quiet`.
+pub fn file_crs<'r>(
+    raster: &'r Raster,
+    pixel_coords: bool,
+    wgs84: bool,
+    points: &mut [[f64; 3]],
+    path: &Path,
+    quiet: bool,
+) -> Result<CrsRef<'r>> {
+    let info = &raster.info;
+    let crs = match pixel_coords || info.transform().is_none() {
+        true => CrsRef::default(),
+        false => CrsRef::new(info.crs_wkt.as_deref(), info.epsg),
+    };
+    if !wgs84 {
+        return Ok(crs);
+    }
+    match crs.wkt {
+        Some(wkt) => {
+            tinsmith_raster::to_wgs84(wkt, points)
+                .with_context(|| format!("{}: cannot reproject to WGS84", path.display()))?;
+            Ok(CrsRef::new(None, Some(4326)))
+        }
+        None => {
+            if !quiet {
+                eprintln!(
+                    "{}: no CRS, so the coordinates are written as they are, with \"crs\": null",
+                    path.display()
+                );
+            }
+            Ok(crs)
+        }
+    }
 }
 
 /// The last gate for float32 files: every stored position maps back to a sample centre

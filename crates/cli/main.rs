@@ -5,7 +5,6 @@
 
 mod args;
 mod contour;
-mod contour_output;
 mod export;
 mod georef;
 mod info;

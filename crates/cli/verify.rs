@@ -1,6 +1,10 @@
 //! `tinsmith verify`: measure a mesh file's true error against its raster.
 
+use std::path::Path;
+
 use anyhow::{Context, Result};
+use tinsmith_export::Mesh;
+use tinsmith_raster::Raster;
 use tinsmith_verify::{GridRef, MeshRef, Orientation, Report, VerifyOptions};
 
 use crate::args::VerifyArgs;
@@ -9,21 +13,8 @@ use crate::georef::Georef;
 /// Runs the verifier; `Ok(false)` when the mesh is invalid or exceeds `--max-error`.
 pub fn run(args: &VerifyArgs) -> Result<bool> {
     let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
-    let mut mesh = tinsmith_export::read_mesh(&args.mesh)?;
     let georef = Georef::new(raster.info.transform(), args.pixel_coords);
-    // RFC 7946 GeoJSON holds WGS84 longitude, latitude: back to the raster's CRS.
-    if let (Some(4326), Georef::World(_), Some(wkt)) =
-        (mesh.epsg, georef, raster.info.crs_wkt.as_deref())
-    {
-        if raster.info.epsg != Some(4326) {
-            tinsmith_raster::from_wgs84(wkt, &mut mesh.vertices).with_context(|| {
-                format!(
-                    "{}: cannot transform WGS84 back to the raster's CRS",
-                    args.mesh.display()
-                )
-            })?;
-        }
-    }
+    let mesh = read_mesh_file(&args.mesh, &raster, georef)?;
     let mut positions = Vec::with_capacity(mesh.vertices.len());
     for (i, v) in mesh.vertices.iter().enumerate() {
         let p = georef
@@ -49,6 +40,25 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
         print_report(&report, args);
     }
     Ok(report.passed())
+}
+
+/// Reads a mesh file written from `raster` in its file coordinates: RFC 7946 GeoJSON
+/// (WGS84 longitude, latitude) is transformed back to the raster's CRS.
+pub fn read_mesh_file(path: &Path, raster: &Raster, georef: Georef) -> Result<Mesh> {
+    let mut mesh = tinsmith_export::read_mesh(path)?;
+    if let (Some(4326), Georef::World(_), Some(wkt)) =
+        (mesh.epsg, georef, raster.info.crs_wkt.as_deref())
+    {
+        if raster.info.epsg != Some(4326) {
+            tinsmith_raster::from_wgs84(wkt, &mut mesh.vertices).with_context(|| {
+                format!(
+                    "{}: cannot transform WGS84 back to the raster's CRS",
+                    path.display()
+                )
+            })?;
+        }
+    }
+    Ok(mesh)
 }
 
 /// Mesh files hold triangles counter-clockwise in file coordinates (normals up), which is

@@ -5,12 +5,13 @@ use std::io;
 use std::path::PathBuf;
 
 use crate::format::MeshFormat;
+use crate::lines::LineFormat;
 
 /// What can go wrong while writing or reading a mesh file.
 ///
 /// Variants are split by what the caller does next: fix the arguments
-/// ([`Error::UnknownExtension`], [`Error::UnknownFormatName`], [`Error::MissingDirectory`],
-/// [`Error::BadOption`]), fix the mesh or pick another format ([`Error::IndexOutOfRange`],
+/// ([`Error::UnknownExtension`], [`Error::UnknownLineExtension`],
+/// [`Error::UnknownFormatName`], [`Error::MissingDirectory`], [`Error::BadOption`]), fix the mesh or pick another format ([`Error::IndexOutOfRange`],
 /// [`Error::NonFiniteVertex`], [`Error::TooManyVertices`], [`Error::TooManyTriangles`],
 /// [`Error::InvalidLine`]), look at the environment ([`Error::Io`]) or at the input file
 /// ([`Error::Malformed`], [`Error::Unsupported`]).
@@ -24,6 +25,16 @@ pub enum Error {
         MeshFormat::supported_extensions()
     )]
     UnknownExtension {
+        /// The path whose extension is missing or unknown.
+        path: PathBuf,
+    },
+    /// The line format cannot be told from the path's extension.
+    #[error(
+        "{}: cannot tell the line format from the file extension (supported: {})",
+        .path.display(),
+        LineFormat::supported_extensions()
+    )]
+    UnknownLineExtension {
         /// The path whose extension is missing or unknown.
         path: PathBuf,
     },

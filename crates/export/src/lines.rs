@@ -11,6 +11,12 @@ use crate::atomic::write_atomically;
 use crate::error::{Error, Result};
 use crate::{fgb, geojson};
 
+/// Name of the line-position attribute (`Long` in FlatGeobuf: GDAL reads unsigned 64-bit
+/// columns as reals).
+const ID: &str = "id";
+/// Name of the elevation attribute.
+const ELEV: &str = "elev";
+
 /// The vector formats [`write_lines`] writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
@@ -21,6 +27,45 @@ pub enum LineFormat {
     GeoJson,
     /// FlatGeobuf `LineString` features with a spatial index and the CRS in the header.
     FlatGeobuf,
+}
+
+impl LineFormat {
+    /// The extensions [`LineFormat::from_path`] recognises, without the dot, and their
+    /// formats.
+    const EXTENSIONS: [(&'static str, LineFormat); 3] = [
+        ("geojson", LineFormat::GeoJson),
+        ("json", LineFormat::GeoJson),
+        ("fgb", LineFormat::FlatGeobuf),
+    ];
+
+    /// Picks the format from the path's extension, ignoring ASCII case: `.geojson` or
+    /// `.json` for GeoJSON, `.fgb` for FlatGeobuf.
+    ///
+    /// # Errors
+    /// [`Error::UnknownLineExtension`], naming the path and the supported extensions, if
+    /// the extension is missing, not UTF-8 or not one of these.
+    pub fn from_path(path: &Path) -> Result<LineFormat> {
+        path.extension()
+            .and_then(|extension| extension.to_str())
+            .and_then(|extension| {
+                Self::EXTENSIONS
+                    .into_iter()
+                    .find(|(known, _)| known.eq_ignore_ascii_case(extension))
+            })
+            .map(|(_, format)| format)
+            .ok_or_else(|| Error::UnknownLineExtension {
+                path: path.to_path_buf(),
+            })
+    }
+
+    /// `".geojson, .json, .fgb"`, for messages.
+    pub(crate) fn supported_extensions() -> String {
+        let list: Vec<String> = Self::EXTENSIONS
+            .iter()
+            .map(|(extension, _)| format!(".{extension}"))
+            .collect();
+        list.join(", ")
+    }
 }
 
 /// A point type of a line: 2D `[x, y]` or 3D `[x, y, z]`.
@@ -62,13 +107,16 @@ impl<'a> CrsRef<'a> {
 }
 
 /// Writes `lines` — each a polyline and its elevation — to `path` as `LineString`
-/// features with an `elev` (double) attribute, in the given order, atomically.
+/// features with an `id` (the line's position in `lines`, an integer) and an `elev`
+/// (double) attribute, in the given order, atomically.
 ///
 /// With `[f64; 3]` points the features are `LineString Z`; with `[f64; 2]` they are 2D.
-/// The CRS is recorded in the file (GeoJSON: as for [`crate::MeshFormat::GeoJson`];
-/// FlatGeobuf: header WKT and EPSG code). Features are streamed to a temporary file and
-/// renamed into place; FlatGeobuf's spatial index sorts the features, so the GeoJSON order
-/// is the slice's and the FlatGeobuf order is not.
+/// Coordinates are written as given, GeoJSON's with the shortest decimals that read back
+/// to the same `f64`. The CRS is recorded in the file (GeoJSON: as for
+/// [`crate::MeshFormat::GeoJson`]; FlatGeobuf: header WKT and EPSG code). Features are
+/// streamed to a temporary file and renamed into place. The GeoJSON order is the slice's;
+/// FlatGeobuf's spatial index sorts the features along a Hilbert curve, so there `id`
+/// gives the slice's order back. The same input gives the same bytes.
 ///
 /// # Errors
 /// - [`Error::InvalidLine`] for a line with fewer than two points or a non-finite
@@ -138,7 +186,7 @@ fn write_geojson<W: Write, P: LinePoint>(
         }
         write!(
             w,
-            "{{\"type\":\"Feature\",\"properties\":{{\"elev\":{elev:?}}},\
+            "{{\"type\":\"Feature\",\"properties\":{{\"id\":{i},\"elev\":{elev:?}}},\
              \"geometry\":{{\"type\":\"LineString\",\"coordinates\":["
         )?;
         for (k, p) in points.iter().enumerate() {
@@ -167,9 +215,12 @@ fn write_fgb<W: Write, P: LinePoint>(
     };
     let mut out = FgbWriter::create_with_options("lines", GeometryType::LineString, options)
         .map_err(fgb::io_error)?;
-    out.add_column("elev", ColumnType::Double, |_, _| {});
+    out.add_column(ID, ColumnType::Long, |_, _| {});
+    out.add_column(ELEV, ColumnType::Double, |_, _| {});
     for (i, (points, elev)) in lines.iter().enumerate() {
-        out.property(0, "elev", &ColumnValue::Double(*elev))
+        out.property(0, ID, &ColumnValue::Long(i as i64))
+            .map_err(fgb::io_error)?;
+        out.property(1, ELEV, &ColumnValue::Double(*elev))
             .map_err(fgb::io_error)?;
         out.linestring_begin(true, points.len(), 0)
             .map_err(fgb::io_error)?;
@@ -205,6 +256,7 @@ mod tests {
         let value: serde_json::Value = serde_json::from_str(&text).expect("JSON");
         assert!(value.get("crs").is_none());
         assert_eq!(value["features"][1]["properties"]["elev"], 10.0);
+        assert_eq!(value["features"][1]["properties"]["id"], 1);
         assert_eq!(
             value["features"][1]["geometry"]["coordinates"][2],
             serde_json::json!([3.0, 3.0, 10.0])
@@ -229,13 +281,33 @@ mod tests {
         assert_eq!(reader.header().geometry_type(), GeometryType::LineString);
         assert_eq!(reader.header().crs().map(|c| c.code()), Some(3005));
         let mut features = reader.select_all_seq().expect("features");
-        let mut elevs = Vec::new();
+        let mut read = Vec::new();
         while let Some(feature) = features.next().expect("feature") {
-            elevs.push(feature.property::<f64>("elev").expect("elev"));
+            let id = feature.property::<i64>("id").expect("id");
+            read.push((id, feature.property::<f64>("elev").expect("elev")));
         }
-        elevs.sort_by(f64::total_cmp);
-        assert_eq!(elevs, vec![5.0, 10.5]);
+        read.sort_by_key(|&(id, _)| id);
+        assert_eq!(read, vec![(0, 5.0), (1, 10.5)]);
         Ok(())
+    }
+
+    #[test]
+    fn formats_from_extensions() {
+        for (path, format) in [
+            ("a.geojson", LineFormat::GeoJson),
+            ("a.JSON", LineFormat::GeoJson),
+            ("dir/a.fgb", LineFormat::FlatGeobuf),
+        ] {
+            assert_eq!(LineFormat::from_path(Path::new(path)).ok(), Some(format));
+        }
+        for path in ["a.shp", "a", "a.ply"] {
+            let error = LineFormat::from_path(Path::new(path))
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
+            assert!(error.starts_with(path), "{error}");
+            assert!(error.contains(".geojson, .json, .fgb"), "{error}");
+        }
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! The line-feature writer, read back by GDAL's `ogrinfo` (Debian gdal-bin, installed by
-//! `make deps`): geometry type, feature count, the `elev` attribute, the CRS and the
-//! coordinates.
+//! `make deps`): geometry type, feature count, the `id` and `elev` attributes, the CRS and
+//! the coordinates.
 
 use std::path::Path;
 use std::process::Command;
@@ -56,6 +56,7 @@ fn ogrinfo_reads_3d_lines_with_elev_in_both_formats() -> tinsmith_export::Result
         assert!(so.contains("Feature Count: 2"), "{name}: {so}");
         assert!(so.contains("ID[\"EPSG\",3005]"), "{name}: {so}");
         assert!(so.contains("elev: Real"), "{name}: {so}");
+        assert!(so.contains("id: Integer"), "{name}: {so}");
         let all = ogrinfo(&path);
         assert!(all.contains("elev (Real) = 250"), "{name}: {all}");
         assert!(all.contains("elev (Real) = 300"), "{name}: {all}");

@@ -416,9 +416,9 @@ mod tests {
     fn other_formats_are_refused_up_front() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("m.stl");
-        let err = MeshStreamWriter::create(&path, MeshFormat::Stl, None)
-            .err()
-            .expect("refused");
+        let Err(err) = MeshStreamWriter::create(&path, MeshFormat::Stl, None) else {
+            panic!("STL accepted for streaming");
+        };
         assert!(err.to_string().contains("PLY or OBJ"), "{err}");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }

@@ -7,7 +7,8 @@ to `gdal_contour -fl ...` (Debian gdal-bin, marching squares on the full grid) a
 per cell; then decimated TINs), in the same run. Reported per run:
 
 - seconds: wall clock of the whole command (read, decimate, contour, write), median of
-  --repeat runs, writing FlatGeobuf (.fgb) and, separately, GeoJSON;
+  --repeat runs, writing FlatGeobuf (.fgb) and, separately, GeoJSON (both tools in the
+  raster's CRS: tinsmith with --geojson-source-crs);
 - lines, segments (points - 1 summed over lines) and total length, from the GeoJSON;
 - Hausdorff distance to gdal_contour's lines of the same level, maximized over levels,
   and the 99th percentile of the sampled distances (both directions, all levels).
@@ -22,11 +23,15 @@ only one output (a small feature one side missed) counts as the largest distance
 its lines to any point of the other set's lines at any level; such levels are listed.
 gdal_contour also writes microscopic rings (length below a thousandth of a pixel) around
 single samples exactly at a level (its 1e-6 nudge of such values); tinsmith drops lines
-that collapse to a point, so these are left out of gdal's lines, segments and Hausdorff
-distance and counted in a note.
+that collapse to a point, so these are left out of gdal's lines (simplified or not),
+segments and Hausdorff distance and counted in a note.
 
 Also reported: `tinsmith contour --mesh` on a TIN written beforehand by `tinsmith mesh`
-(decimation paid once, contouring many times: the paper's interactive use).
+(decimation paid once, contouring many times: the paper's interactive use); and, at
+ε = interval / 10, `tinsmith contour --simplify D` (Douglas-Peucker within D map units;
+no longer exact contours of the TIN) beside gdal_contour's lines simplified by
+`ogr2ogr -simplify D` (GEOS, topology-preserving per line), at D = 0.1 and 0.25 pixel;
+the ogr2ogr time is its own, written to GeoJSON from gdal_contour's FlatGeobuf.
 
 Usage (from the repository root, after `cargo build --release`):
 
@@ -45,9 +50,17 @@ import time
 CASES = [
     # (label, path under shared/data, interval, [max errors])
     ("Big Tujunga, SRTM 30 m, 1197x643", "dem/topotoolbox_bigtujunga_30m.tif", 50, None),
-    ("BC Robson, TRIM 50 m, 430x516", "dem/becmodel_dem_bc_albers_50m.tif", 100, None),
+    ("BC TRIM 50 m (becmodel), 430x516", "dem/becmodel_dem_bc_albers_50m.tif", 100, None),
     ("ETOPO5, 5', 4320x2161", "dem/etopo5_global_5arcmin.tif", 1000, [0, 100]),
 ]
+
+
+# tinsmith writes GeoJSON in WGS84 by default (RFC 7946); gdal_contour writes the raster's
+# CRS. Both in the raster's CRS: the same work, and distances in map units.
+SRC_CRS = ["--geojson-source-crs"]
+# `tinsmith contour --simplify D` at ε = interval / 10, with D these fractions of a pixel;
+# beside it, gdal_contour's lines simplified by `ogr2ogr -simplify D`.
+SIMPLIFY = [0.1, 0.25]
 
 
 def run(cmd):
@@ -75,6 +88,17 @@ def read_lines(path):
         pts = f["geometry"]["coordinates"]
         by_level.setdefault(float(f["properties"]["elev"]), []).append(pts)
     return by_level
+
+
+def without_microscopic_rings(by_level, cell):
+    """gdal_contour's lines without those shorter than cell / 2000, and how many."""
+    kept, micro = {}, 0
+    for level, lines in by_level.items():
+        keep = [p for p in lines if sum(math.dist(a, b) for a, b in zip(p, p[1:])) >= cell / 2000]
+        micro += len(lines) - len(keep)
+        if keep:
+            kept[level] = keep
+    return kept, micro
 
 
 def stats(by_level):
@@ -190,6 +214,7 @@ def main():
             levels = [k * interval for k in range(math.ceil(lo / interval), math.floor(hi / interval) + 1)]
             levels = [l for l in levels if lo < l <= hi]
             lv = ",".join(f"{l:g}" for l in levels)
+            pixel = abs(gt[1])
             cell = 2 * max(abs(gt[1]), abs(gt[5]))
 
             g_fgb, g_json = tmp / "g.fgb", tmp / "g.geojson"
@@ -198,14 +223,7 @@ def main():
                 f.unlink(missing_ok=True)
             t_fgb = statistics.median(run(gcmd + [str(g_fgb)])[0] for _ in range(args.repeat) if not g_fgb.unlink(missing_ok=True))
             t_json = statistics.median(run(gcmd + [str(g_json)])[0] for _ in range(args.repeat) if not g_json.unlink(missing_ok=True))
-            gdal = read_lines(g_json)
-            micro = 0
-            for level in list(gdal):
-                keep = [p for p in gdal[level] if sum(math.dist(a, b) for a, b in zip(p, p[1:])) >= cell / 2000]
-                micro += len(gdal[level]) - len(keep)
-                gdal[level] = keep
-                if not keep:
-                    del gdal[level]
+            gdal, micro = without_microscopic_rings(read_lines(g_json), cell)
             if micro:
                 notes.append(f"{label}: {micro} microscopic gdal_contour rings around single samples at a level left out")
             gl, gs, glen = stats(gdal)
@@ -215,8 +233,8 @@ def main():
                 t_out_fgb, t_out_json = tmp / "t.fgb", tmp / "t.geojson"
                 base = [args.bin, "contour", str(src), "--levels", lv, "--max-error", f"{e:g}", "-q"]
                 tf = timed(base + ["-o", str(t_out_fgb)], args.repeat)
-                tj = timed(base + ["-o", str(t_out_json)], args.repeat)
-                _, p = run([args.bin, "contour", str(src), "--levels", lv, "--max-error", f"{e:g}", "-o", str(t_out_json)])
+                tj = timed(base + ["-o", str(t_out_json), *SRC_CRS], args.repeat)
+                _, p = run([args.bin, "contour", str(src), "--levels", lv, "--max-error", f"{e:g}", "-o", str(t_out_json), *SRC_CRS])
                 tris = p.stderr.split("(")[-1].split(" triangles")[0]
                 tin = read_lines(t_out_json)
                 tl, ts, tlen = stats(tin)
@@ -229,8 +247,25 @@ def main():
                     mesh = tmp / "m.ply"
                     tm = timed([args.bin, "mesh", str(src), "-o", str(mesh), "--max-error", f"{e:g}", "-q"], 1)
                     tmf = timed([args.bin, "contour", str(src), "--levels", lv, "--mesh", str(mesh), "-q", "-o", str(t_out_fgb)], args.repeat)
-                    tmj = timed([args.bin, "contour", str(src), "--levels", lv, "--mesh", str(mesh), "-q", "-o", str(t_out_json)], args.repeat)
+                    tmj = timed([args.bin, "contour", str(src), "--levels", lv, "--mesh", str(mesh), "-q", "-o", str(t_out_json), *SRC_CRS], args.repeat)
                     emit(f"| {label} | {interval} | tinsmith --mesh (TIN made once by `tinsmith mesh` in {tm:.2f} s) | {e:g} | {tris} | {tmf:.2f} | {tmj:.2f} | {tl} | {ts} | {100 * (ts / gs - 1):+.0f} % | {tlen:.4g} | same lines |")
+                    for frac in SIMPLIFY:
+                        d = frac * pixel
+                        simp = ["--simplify", f"{d:g}"]
+                        tsf = timed(base + simp + ["-o", str(t_out_fgb)], args.repeat)
+                        tsj = timed(base + simp + ["-o", str(t_out_json), *SRC_CRS], args.repeat)
+                        sl, ss, slen = stats(read_lines(t_out_json))
+                        h, gap, _, p99 = hausdorff(read_lines(t_out_json), gdal, cell)
+                        emit(f"| {label} | {interval} | tinsmith --simplify {d:g} ({frac:g} pixel) | {e:g} | {tris} | {tsf:.2f} | {tsj:.2f} | {sl} | {ss} | {100 * (ss / gs - 1):+.0f} % | {slen:.4g} | {h:.4g} (gap ≤ {gap:.2g}); 99 %: {p99:.3g} |")
+                        # The same simplification (GEOS, topology-preserving per line) on
+                        # gdal_contour's lines: gdal_contour, then ogr2ogr.
+                        g_simp = tmp / "gs.geojson"
+                        ocmd = ["ogr2ogr", "-simplify", f"{d:g}", str(g_simp), str(g_fgb)]
+                        to = statistics.median(run(ocmd)[0] for _ in range(args.repeat) if not g_simp.unlink(missing_ok=True))
+                        gsimp, _ = without_microscopic_rings(read_lines(g_simp), cell)
+                        ol, os_, olen = stats(gsimp)
+                        h, gap, _, p99 = hausdorff(gsimp, gdal, cell)
+                        emit(f"| {label} | {interval} | gdal_contour + `ogr2ogr -simplify {d:g}` | – | – | {t_fgb:.2f} + {to:.2f} | – | {ol} | {os_} | {100 * (os_ / gs - 1):+.0f} % | {olen:.4g} | {h:.4g} (gap ≤ {gap:.2g}); 99 %: {p99:.3g} |")
     for n in notes:
         emit(f"- {n}")
     if args.out:

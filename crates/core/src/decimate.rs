@@ -107,7 +107,7 @@ pub fn decimate_with_progress(
 /// edge that skips them; the caller chooses the kept samples so that this 1-D error is
 /// within the bound (see [`effective_limit`]) and so that every sample next to an invalid
 /// cell of the border strip is kept. Kept border samples are never removed. The rest of the
-/// tile is decimated with `options` (the initial mesh is always the full grid).
+/// tile is decimated with `options` (an RTIN initial mesh keeps half cells along the border).
 ///
 /// # Errors
 /// [`Error::InvalidMaxError`] as [`decimate`]; [`Error::BorderSample`] when a sample to
@@ -155,10 +155,11 @@ fn run(
 
     let started = Instant::now();
     // Below the slack only exactly flat stars may go (see `Remover::plan`); the RTIN's
-    // measured errors are not exact enough for that, so it starts from the full grid.
+    // measured errors are not exact enough for that, so it starts from the full grid. In
+    // border mode the RTIN keeps half cells along the border (see `remove_border`).
     let mut mesh = match options.initial_mesh {
-        InitialMesh::Rtin if limit > 0.0 && keep_border.is_none() => {
-            let (corners, bounds) = rtin_triangles(grid, limit);
+        InitialMesh::Rtin if limit > 0.0 => {
+            let (corners, bounds) = rtin_triangles(grid, limit, keep_border.is_some());
             Mesh::from_triangles(grid, corners, bounds)
         }
         _ => Mesh::from_grid(grid),
@@ -234,8 +235,9 @@ fn remove_border(
     if w >= 3 && h >= 2 {
         // Corner cells get the diagonal through the grid corner, so that no triangle
         // touches two sides and each side's strip is independent of the others.
-        mesh.flip_cell_diagonal(w as usize - 2, 0);
-        mesh.flip_cell_diagonal(0, h as usize - 2);
+        for corner in [0, w - 1, (h - 1) * w, h * w - 1] {
+            mesh.flip_into_corner(corner);
+        }
     }
     let mut border: Vec<(u32, u32)> = Vec::new();
     for x in 1..w.saturating_sub(1) {

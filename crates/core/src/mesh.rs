@@ -221,38 +221,63 @@ impl<'g> Mesh<'g> {
         mesh
     }
 
-    /// Flips the diagonal of valid cell `(cx, cy)` of a mesh fresh from
-    /// [`Mesh::from_grid`], so that it runs from `(cx + 1, cy)` to `(cx, cy + 1)`.
-    pub(crate) fn flip_cell_diagonal(&mut self, cx: usize, cy: usize) {
-        let w = self.grid.width() as usize;
-        let (lower, upper) = (
-            (2 * (cy * (w - 1) + cx)) as u32,
-            (2 * (cy * (w - 1) + cx) + 1) as u32,
-        );
-        let [a, b, cc] = self.corners[lower as usize];
-        let [_, _, d] = self.corners[upper as usize];
-        if a == NONE {
-            return;
+    /// If `v` is the corner of exactly one triangle, and that triangle's edge opposite `v`
+    /// is shared with a triangle that, with it, forms a convex quadrilateral, flips that
+    /// edge so that it runs through `v`; returns whether it flipped. The new triangles get
+    /// their exact errors as bounds.
+    pub(crate) fn flip_into_corner(&mut self, v: u32) -> bool {
+        let t = self.vertex_triangle[v as usize];
+        if t == NONE {
+            return false;
         }
-        let [n0, n1, _] = self.neighbours[lower as usize];
-        let [_, m1, m2] = self.neighbours[upper as usize];
-        // lower becomes (a, b, d), upper becomes (b, cc, d).
-        self.corners[lower as usize] = [a, b, d];
-        self.corners[upper as usize] = [b, cc, d];
-        self.neighbours[lower as usize] = [n0, upper, m2];
-        self.neighbours[upper as usize] = [n1, m1, lower];
-        if n1 != NONE {
-            let k = self.edge_index(n1, cc, b);
-            self.neighbours[n1 as usize][k] = upper;
+        let i = self.local(t, v);
+        let e = (i + 1) % 3;
+        // t = (c, a, b) with c = v; the edge a -> b is opposite v.
+        let [c, a, b] = [
+            v,
+            self.corners[t as usize][e],
+            self.corners[t as usize][(e + 1) % 3],
+        ];
+        if self.neighbours[t as usize][i] != NONE
+            || self.neighbours[t as usize][(i + 2) % 3] != NONE
+        {
+            return false; // v has more than one triangle
         }
-        if m2 != NONE {
-            let k = self.edge_index(m2, a, d);
-            self.neighbours[m2 as usize][k] = lower;
+        let u = self.neighbours[t as usize][e];
+        if u == NONE {
+            return false;
         }
-        self.vertex_triangle[cc as usize] = upper;
-        self.vertex_triangle[d as usize] = upper;
-        self.vertex_triangle[a as usize] = lower;
-        self.vertex_triangle[b as usize] = lower;
+        // u = (b, a, d): the quadrilateral is c, a, d, b counter-clockwise.
+        let k = self.edge_index(u, b, a);
+        let d = self.corners[u as usize][(k + 2) % 3];
+        let (pa, pb, pc, pd) = (self.point(a), self.point(b), self.point(c), self.point(d));
+        if orient(&pc, &pa, &pd) <= 0 || orient(&pd, &pb, &pc) <= 0 {
+            return false;
+        }
+        // Outer neighbours: t's edges b -> c and c -> a are boundary (checked above);
+        // u's edges a -> d and d -> b.
+        let u_ad = self.neighbours[u as usize][(k + 1) % 3];
+        let u_db = self.neighbours[u as usize][(k + 2) % 3];
+        // New t = (c, a, d): edges c -> a (boundary), a -> d (u_ad), d -> c (u).
+        // New u = (c, d, b): edges c -> d (t), d -> b (u_db), b -> c (boundary).
+        self.corners[t as usize] = [c, a, d];
+        self.neighbours[t as usize] = [NONE, u_ad, u];
+        self.corners[u as usize] = [c, d, b];
+        self.neighbours[u as usize] = [t, u_db, NONE];
+        if u_ad != NONE {
+            let j = self.edge_index(u_ad, d, a);
+            self.neighbours[u_ad as usize][j] = t;
+        }
+        for (slot, [p, q, r]) in [(t, [pc, pa, pd]), (u, [pc, pd, pb])] {
+            let bound = crate::exact::triangle_error(self.grid, &p, &q, &r, f64::INFINITY)
+                .expect("no limit");
+            self.bounds[slot as usize] = bound.into();
+        }
+        self.vertex_triangle[a as usize] = t;
+        self.vertex_triangle[b as usize] = u;
+        self.vertex_triangle[c as usize] = t;
+        self.vertex_triangle[d as usize] = u;
+        true
     }
 
     /// Marks the vertices where the domain pinches: a vertex on one fan of triangles has

@@ -29,8 +29,16 @@ type Xy = (i64, i64);
 
 /// Triangles (counter-clockwise sample indices) of the coarsest conforming RTIN over the
 /// grid's domain whose triangles all have exact error at most `limit`, with those errors.
-pub(crate) fn rtin_triangles(grid: &Grid, limit: f64) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
-    let rtin = Rtin::new(grid, limit);
+///
+/// With `full_border`, every triangle that reaches the grid's outer rows or columns is a
+/// half cell, so the strip of cells along the border is triangulated as in the full grid
+/// (what [`crate::decimate_with_border`] needs to remove border samples inside the strip).
+pub(crate) fn rtin_triangles(
+    grid: &Grid,
+    limit: f64,
+    full_border: bool,
+) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
+    let rtin = Rtin::new(grid, limit, full_border);
     let need = rtin.saturate();
     let mut out = (Vec::new(), Vec::new());
     let s = rtin.size;
@@ -50,10 +58,12 @@ struct Rtin<'g> {
     /// Invalid cells counted over `[0, x) x [0, y)` (summed-area table over cells), when
     /// the grid has any.
     invalid: Option<Vec<u32>>,
+    /// Whether triangles reaching the outer rows or columns always split (to half cells).
+    full_border: bool,
 }
 
 impl<'g> Rtin<'g> {
-    fn new(grid: &'g Grid, limit: f64) -> Rtin<'g> {
+    fn new(grid: &'g Grid, limit: f64, full_border: bool) -> Rtin<'g> {
         let (w, h) = (grid.width() as i64, grid.height() as i64);
         let mut size = 1;
         while size < (w - 1).max(h - 1) {
@@ -78,6 +88,7 @@ impl<'g> Rtin<'g> {
             max_y: h - 1,
             size,
             invalid,
+            full_border,
         }
     }
 
@@ -101,10 +112,14 @@ impl<'g> Rtin<'g> {
         }
     }
 
-    /// Whether a triangle inside the grid must be split: it may cover an invalid cell (its
-    /// bounding box holds one) or its exact error exceeds the limit.
+    /// Whether a triangle inside the grid (and larger than a half cell) must be split: it
+    /// may cover an invalid cell (its bounding box holds one), it reaches the outer border
+    /// in full-border mode, or its exact error exceeds the limit.
     fn must_split(&self, t: [Xy; 3]) -> bool {
         let (x0, x1, y0, y1) = bbox(t);
+        if self.full_border && (x0 == 0 || y0 == 0 || x1 == self.max_x || y1 == self.max_y) {
+            return true;
+        }
         if let Some(sat) = &self.invalid {
             let cw = self.max_x as usize + 1;
             let at = |x: i64, y: i64| sat[y as usize * cw + x as usize];

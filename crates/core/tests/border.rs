@@ -2,7 +2,7 @@
 //! weld into one valid TIN of the whole grid within the bound.
 
 use tinsmith_core::{
-    decimate_with_border, effective_limit, DecimationOptions, ErrorModel, Grid, Tin,
+    decimate_with_border, effective_limit, DecimationOptions, ErrorModel, Grid, InitialMesh, Tin,
 };
 use tinsmith_testkit::{terrain, with_nodata_disc, GridSpec};
 use tinsmith_verify::{verify, GridRef, MeshRef, VerifyOptions};
@@ -69,7 +69,7 @@ fn window(spec: &GridSpec, x0: u32, x1: u32) -> GridSpec {
     }
 }
 
-fn check_two_tiles(spec: &GridSpec, bound: f64, model: ErrorModel) {
+fn check_two_tiles(spec: &GridSpec, bound: f64, model: ErrorModel, initial: InitialMesh) {
     let split = spec.width / 2;
     let max_abs = spec
         .values
@@ -80,6 +80,7 @@ fn check_two_tiles(spec: &GridSpec, bound: f64, model: ErrorModel) {
     let shared = kept_rows(spec, split, limit);
     let options = DecimationOptions {
         max_abs_value: Some(max_abs),
+        initial_mesh: initial,
         ..DecimationOptions::new(bound).with_error_model(model)
     };
     let mut welded: Vec<([i64; 2], f64)> = Vec::new();
@@ -174,8 +175,12 @@ fn check_two_tiles(spec: &GridSpec, bound: f64, model: ErrorModel) {
 #[test]
 fn two_tiles_weld_within_the_bound() {
     for model in [ErrorModel::Bounds, ErrorModel::Exact] {
-        for bound in [0.5, 3.0, 20.0] {
-            check_two_tiles(&terrain(41, 30, 3.0, 5), bound, model);
+        for initial in [InitialMesh::Full, InitialMesh::Rtin] {
+            for bound in [0.5, 3.0, 20.0] {
+                check_two_tiles(&terrain(41, 30, 3.0, 5), bound, model, initial);
+                // Odd and even sizes put the RTIN's corner cells both ways.
+                check_two_tiles(&terrain(38, 27, 3.0, 6), bound, model, initial);
+            }
         }
     }
 }
@@ -184,14 +189,23 @@ fn two_tiles_weld_within_the_bound() {
 fn nodata_across_the_shared_border() {
     let spec = with_nodata_disc(terrain(40, 36, 2.0, 9), 20.0, 18.0, 5.0);
     for model in [ErrorModel::Bounds, ErrorModel::Exact] {
-        check_two_tiles(&spec, 2.0, model);
+        for initial in [InitialMesh::Full, InitialMesh::Rtin] {
+            check_two_tiles(&spec, 2.0, model, initial);
+        }
     }
 }
 
 #[test]
 fn narrow_tiles() {
     for w in [3, 4, 5] {
-        check_two_tiles(&terrain(w, 12, 5.0, w as u64), 1.0, ErrorModel::Exact);
+        for initial in [InitialMesh::Full, InitialMesh::Rtin] {
+            check_two_tiles(
+                &terrain(w, 12, 5.0, w as u64),
+                1.0,
+                ErrorModel::Exact,
+                initial,
+            );
+        }
     }
 }
 

@@ -251,3 +251,37 @@ fn max_triangles_reports_the_verified_error() {
         Some(1)
     );
 }
+
+#[test]
+fn max_edge_length_caps_every_edge_untiled_and_tiled() {
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    for tile_size in ["100000", "64"] {
+        let extra = [
+            "--pixel-coords",
+            "--max-edge-length",
+            "6",
+            "--tile-size",
+            tile_size,
+        ];
+        mesh_then_verify(&dem, 20.0, &extra, "ply");
+        let d = Dir::new();
+        let mut args = vec!["mesh", &dem, "-o", "m.ply", "--max-error", "20", "-q"];
+        args.extend_from_slice(&extra);
+        assert!(d.run(&args).status.success());
+        let mesh = tinsmith_export::read_mesh(&d.path("m.ply")).expect("mesh");
+        let longest = mesh
+            .triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+            .map(|(a, b)| {
+                let (p, q) = (mesh.vertices[a as usize], mesh.vertices[b as usize]);
+                (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)
+            })
+            .fold(0.0f64, f64::max);
+        assert!(
+            longest <= 36.0,
+            "--tile-size {tile_size}: an edge of squared length {longest}"
+        );
+        assert!(longest >= 16.0, "the cap should bind on this DEM at 20 m");
+    }
+}

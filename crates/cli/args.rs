@@ -3,7 +3,9 @@
 use std::path::PathBuf;
 
 use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
-use tinsmith_core::{EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation};
+use tinsmith_core::{
+    DecimationOptions, EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation,
+};
 use tinsmith_export::MeshFormat;
 
 /// Turns DEMs and other 2D scalar grids into TINs whose error is guaranteed.
@@ -135,6 +137,10 @@ pub struct MeshArgs {
     /// The mesh decimation starts from.
     #[arg(long, value_enum, default_value_t = InitialMeshArg::Rtin)]
     pub initial_mesh: InitialMeshArg,
+    /// Longest triangle edge allowed, in sample spacings (at least 2): no long slivers,
+    /// at the cost of more triangles. The error bound holds either way.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
+    pub max_edge_length: Option<u32>,
     /// Write (column, row, value) instead of georeferenced coordinates.
     #[arg(long)]
     pub pixel_coords: bool,
@@ -261,6 +267,28 @@ pub enum ErrorModelArg {
     Bounds,
     /// The true max |sample - plane| over the samples a candidate triangle covers.
     Exact,
+}
+
+impl MeshArgs {
+    /// The decimation options the flags ask for, with `max_error` as the bound (the
+    /// untiled path passes the bound less the output format's height rounding).
+    pub fn decimation_options(&self, max_error: f64) -> DecimationOptions {
+        let mut options = DecimationOptions::new(max_error)
+            .with_selection(self.selection.into())
+            .with_error_model(self.error_model.into())
+            .with_order(self.order.into())
+            .with_retriangulation(self.retriangulate.into())
+            .with_initial_mesh(self.initial_mesh.into());
+        options.dp_max_ring = self.dp_max_ring as usize;
+        options.max_edge_length = self.max_edge_length;
+        if let Some(n) = self.max_triangles {
+            options = options.with_max_triangles(n);
+        }
+        if let Some(n) = self.max_vertices {
+            options = options.with_max_vertices(n);
+        }
+        options
+    }
 }
 
 impl From<ErrorModelArg> for ErrorModel {

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
-use tinsmith_core::{decimate_with_progress, DecimationOptions, Tin};
+use tinsmith_core::{decimate_with_progress, Tin};
 use tinsmith_verify::{GridRef, VerifyOptions};
 
 use crate::args::MeshArgs;
@@ -79,19 +79,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let max_error = args.max_error.unwrap_or(f64::INFINITY);
     let plan = crate::export::Plan::new(format, &raster, args)?;
     // Float32 formats leave the decimator the bound less their height rounding.
-    let mut options = DecimationOptions::new(plan.decimation_bound)
-        .with_selection(args.selection.into())
-        .with_error_model(args.error_model.into())
-        .with_order(args.order.into())
-        .with_retriangulation(args.retriangulate.into())
-        .with_initial_mesh(args.initial_mesh.into());
-    options.dp_max_ring = args.dp_max_ring as usize;
-    if let Some(n) = args.max_triangles {
-        options = options.with_max_triangles(n);
-    }
-    if let Some(n) = args.max_vertices {
-        options = options.with_max_vertices(n);
-    }
+    let options = args.decimation_options(plan.decimation_bound);
     let mut bar = crate::progress::Progress::new(args.quiet);
     let result = decimate_with_progress(grid, &options, &mut |p| {
         bar.show(&format!(

@@ -9,7 +9,6 @@ use std::time::{Duration, Instant};
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
-use tinsmith_core::DecimationOptions;
 use tinsmith_export::MeshFormat;
 use tinsmith_tile::{
     mesh_tiles, PerTileWriter, Placement, RasterSource, TileOptions, TilePlan, TileProgress,
@@ -148,13 +147,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     bar.set_message("tiles");
     bar.reset_eta();
 
-    let mut decimation = DecimationOptions::new(max_error)
-        .with_selection(args.selection.into())
-        .with_error_model(args.error_model.into())
-        .with_order(args.order.into())
-        .with_retriangulation(args.retriangulate.into())
-        .with_initial_mesh(args.initial_mesh.into());
-    decimation.dp_max_ring = args.dp_max_ring as usize;
+    let decimation = args.decimation_options(max_error);
     let options = TileOptions::new(decimation)
         .with_tile_size(args.tile_size)
         .with_threads(args.threads.map_or(0, |n| n as usize));

@@ -147,6 +147,11 @@ fn run(
     if max_error.is_nan() || max_error < 0.0 || (max_error.is_infinite() && !count_target) {
         return Err(Error::InvalidMaxError(max_error));
     }
+    if let Some(length) = options.max_edge_length {
+        if length < 2 {
+            return Err(Error::InvalidMaxEdgeLength(length));
+        }
+    }
     let max_abs = options
         .max_abs_value
         .unwrap_or_else(|| grid.max_abs_value())
@@ -159,7 +164,12 @@ fn run(
     // border mode the RTIN keeps half cells along the border (see `remove_border`).
     let mut mesh = match options.initial_mesh {
         InitialMesh::Rtin if limit > 0.0 => {
-            let (corners, bounds) = rtin_triangles(grid, limit, keep_border.is_some());
+            let (corners, bounds) = rtin_triangles(
+                grid,
+                limit,
+                max_edge_squared(options),
+                keep_border.is_some(),
+            );
             Mesh::from_triangles(grid, corners, bounds)
         }
         _ => Mesh::from_grid(grid),
@@ -177,6 +187,7 @@ fn run(
         method: options.retriangulation,
         dp_max_ring: options.dp_max_ring,
         limit,
+        max_edge_squared: max_edge_squared(options),
     };
     let mut remover = Remover::new(rules);
     let mut stats = Stats::default();
@@ -222,6 +233,13 @@ fn run(
         seconds_decimation,
     };
     Ok(Decimation { tin, report })
+}
+
+/// The squared maximum edge length, `i64::MAX` when there is none.
+fn max_edge_squared(options: &DecimationOptions) -> i64 {
+    options
+        .max_edge_length
+        .map_or(i64::MAX, |l| i64::from(l) * i64::from(l))
 }
 
 /// Removes every valid border sample that `keep` rejects (grid corners are kept), in
@@ -492,6 +510,8 @@ impl<'g> Remover<'g> {
             selection: crate::EdgeSelection::MinError,
             method: crate::Retriangulation::Ears,
             limit: f64::INFINITY,
+            // The caller's 1-D rule already spaced the kept border samples.
+            max_edge_squared: i64::MAX,
             ..saved
         };
         let planned = self.plan(mesh, v);

@@ -34,6 +34,10 @@ pub enum Error {
         /// Why.
         problem: &'static str,
     },
+    /// The maximum edge length is below 2 sample spacings (the full grid's diagonals are
+    /// longer than 1).
+    #[error("maximum edge length must be at least 2 sample spacings, got {0}")]
+    InvalidMaxEdgeLength(u32),
     /// The maximum error is negative, NaN or infinite.
     #[error("maximum error must be a finite number >= 0, got {0}")]
     InvalidMaxError(f64),

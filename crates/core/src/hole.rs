@@ -86,6 +86,8 @@ pub(crate) struct Rules<'g> {
     /// Holes with more ring vertices than this use ears even when `method` is `Dp`.
     pub dp_max_ring: usize,
     pub limit: f64,
+    /// Largest squared edge length (in sample spacings) a new triangle may have.
+    pub max_edge_squared: i64,
 }
 
 impl Retriangulator {
@@ -293,6 +295,12 @@ impl Retriangulator {
         cap: f64,
     ) -> Option<ErrorBound> {
         let (pa, pb, pc) = (&self.ring[a], &self.ring[b], &self.ring[c]);
+        if [(pa, pb), (pb, pc), (pc, pa)]
+            .iter()
+            .any(|(p, q)| squared_length(p, q) > rules.max_edge_squared)
+        {
+            return None;
+        }
         let bound = match rules.model {
             ErrorModel::Bounds => self.triangle_bound(a, b, c, edges),
             ErrorModel::Exact => {
@@ -641,6 +649,12 @@ fn in_cone(prev: &Point, a: &Point, next: &Point, b: &Point) -> bool {
     }
 }
 
+/// Squared length of the segment `pq` in sample spacings.
+pub(crate) fn squared_length(p: &Point, q: &Point) -> i64 {
+    let (dx, dy) = (p.x - q.x, p.y - q.y);
+    dx * dx + dy * dy
+}
+
 fn within(bound: ErrorBound, limit: f64) -> bool {
     bound.above <= limit && bound.below <= limit
 }
@@ -706,6 +720,7 @@ mod tests {
             method,
             dp_max_ring: 16,
             limit,
+            max_edge_squared: i64::MAX,
         }
     }
 

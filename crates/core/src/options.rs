@@ -88,6 +88,10 @@ pub struct DecimationOptions {
     pub max_triangles: Option<usize>,
     /// Stop once the mesh has at most this many vertices (greedy order only).
     pub max_vertices: Option<usize>,
+    /// Longest edge allowed in the output, in sample spacings (at least 2): a removal that
+    /// would need a longer edge is refused. For renderers that interpolate in another space
+    /// than the grid's (e.g. terrain on a globe, where long edges cut below the surface).
+    pub max_edge_length: Option<u32>,
 }
 
 impl DecimationOptions {
@@ -106,6 +110,7 @@ impl DecimationOptions {
             max_abs_value: None,
             max_triangles: None,
             max_vertices: None,
+            max_edge_length: None,
         }
     }
 
@@ -134,6 +139,13 @@ impl DecimationOptions {
     pub fn with_max_vertices(mut self, max_vertices: usize) -> DecimationOptions {
         self.max_vertices = Some(max_vertices);
         self.order = Order::Greedy;
+        self
+    }
+
+    /// Sets the longest edge allowed, in sample spacings (see
+    /// [`DecimationOptions::max_edge_length`]).
+    pub fn with_max_edge_length(mut self, samples: u32) -> DecimationOptions {
+        self.max_edge_length = Some(samples);
         self
     }
 

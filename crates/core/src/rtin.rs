@@ -30,15 +30,17 @@ type Xy = (i64, i64);
 /// Triangles (counter-clockwise sample indices) of the coarsest conforming RTIN over the
 /// grid's domain whose triangles all have exact error at most `limit`, with those errors.
 ///
+/// Triangles with an edge longer than `sqrt(max_edge_squared)` sample spacings split too.
 /// With `full_border`, every triangle that reaches the grid's outer rows or columns is a
 /// half cell, so the strip of cells along the border is triangulated as in the full grid
 /// (what [`crate::decimate_with_border`] needs to remove border samples inside the strip).
 pub(crate) fn rtin_triangles(
     grid: &Grid,
     limit: f64,
+    max_edge_squared: i64,
     full_border: bool,
 ) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
-    let rtin = Rtin::new(grid, limit, full_border);
+    let rtin = Rtin::new(grid, limit, max_edge_squared, full_border);
     let need = rtin.saturate();
     let mut out = (Vec::new(), Vec::new());
     let s = rtin.size;
@@ -60,10 +62,12 @@ struct Rtin<'g> {
     invalid: Option<Vec<u32>>,
     /// Whether triangles reaching the outer rows or columns always split (to half cells).
     full_border: bool,
+    /// Triangles with a longer (squared) hypotenuse always split.
+    max_edge_squared: i64,
 }
 
 impl<'g> Rtin<'g> {
-    fn new(grid: &'g Grid, limit: f64, full_border: bool) -> Rtin<'g> {
+    fn new(grid: &'g Grid, limit: f64, max_edge_squared: i64, full_border: bool) -> Rtin<'g> {
         let (w, h) = (grid.width() as i64, grid.height() as i64);
         let mut size = 1;
         while size < (w - 1).max(h - 1) {
@@ -89,6 +93,7 @@ impl<'g> Rtin<'g> {
             size,
             invalid,
             full_border,
+            max_edge_squared,
         }
     }
 
@@ -114,10 +119,15 @@ impl<'g> Rtin<'g> {
 
     /// Whether a triangle inside the grid (and larger than a half cell) must be split: it
     /// may cover an invalid cell (its bounding box holds one), it reaches the outer border
-    /// in full-border mode, or its exact error exceeds the limit.
+    /// in full-border mode, its hypotenuse is too long, or its exact error exceeds the limit.
     fn must_split(&self, t: [Xy; 3]) -> bool {
         let (x0, x1, y0, y1) = bbox(t);
         if self.full_border && (x0 == 0 || y0 == 0 || x1 == self.max_x || y1 == self.max_y) {
+            return true;
+        }
+        // The hypotenuse (the longest edge) is the one between t[0] and t[1].
+        let (dx, dy) = (t[0].0 - t[1].0, t[0].1 - t[1].1);
+        if dx * dx + dy * dy > self.max_edge_squared {
             return true;
         }
         if let Some(sat) = &self.invalid {

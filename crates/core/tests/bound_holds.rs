@@ -77,6 +77,21 @@ fn check_with(spec: &GridSpec, options: &DecimationOptions) -> Result<Tin, TestC
     Ok(tin)
 }
 
+/// The longest edge of `tin`, squared, in sample spacings.
+fn longest_edge_squared(tin: &Tin) -> i64 {
+    let v = tin.vertices();
+    tin.triangles()
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .map(|(a, b)| {
+            let (p, q) = (&v[a as usize], &v[b as usize]);
+            let (dx, dy) = (p.x as i64 - q.x as i64, p.y as i64 - q.y as i64);
+            dx * dx + dy * dy
+        })
+        .max()
+        .unwrap_or(0)
+}
+
 /// Samples where the domain's outline turns or pinches, found from the cells alone: one or
 /// three of the four cells around the sample are valid, or two diagonal ones.
 fn domain_corners(spec: &GridSpec) -> Vec<[u32; 2]> {
@@ -124,11 +139,52 @@ proptest! {
     }
 
     #[test]
+    fn edges_stay_within_the_max_edge_length(
+        spec in small_grid(),
+        bound in max_error(),
+        length in 2u32..7,
+    ) {
+        for model in [ErrorModel::Bounds, ErrorModel::Exact] {
+            for start in [InitialMesh::Full, InitialMesh::Rtin] {
+                let options = DecimationOptions::new(bound)
+                    .with_error_model(model)
+                    .with_initial_mesh(start)
+                    .with_max_edge_length(length);
+                let tin = check_with(&spec, &options)?;
+                let longest = longest_edge_squared(&tin);
+                prop_assert!(
+                    longest <= i64::from(length * length),
+                    "{options:?}: an edge of squared length {longest}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn decimation_is_deterministic(spec in small_grid(), bound in max_error()) {
         let a = check(&spec, bound, EdgeSelection::Hybrid)?;
         let b = check(&spec, bound, EdgeSelection::Hybrid)?;
         prop_assert_eq!(a, b);
     }
+}
+
+#[test]
+fn a_plane_under_an_edge_cap_keeps_a_lattice() {
+    let n = 41u32;
+    let values: Vec<f64> = (0..n * n)
+        .map(|i| 0.5 * (i % n) as f64 - 0.25 * (i / n) as f64)
+        .collect();
+    let grid = Grid::new(n, n, values).unwrap();
+    let free = decimate(&grid, &DecimationOptions::new(0.1)).unwrap().tin;
+    assert_eq!(free.triangles().len(), 2);
+    let capped = decimate(&grid, &DecimationOptions::new(0.1).with_max_edge_length(10))
+        .unwrap()
+        .tin;
+    assert!(longest_edge_squared(&capped) <= 100);
+    // 40 spacings per side need at least 4 edges of length <= 10 along each side.
+    assert!(capped.vertices().len() >= 16, "{}", capped.vertices().len());
+    let err = decimate(&grid, &DecimationOptions::new(0.1).with_max_edge_length(1));
+    assert!(err.unwrap_err().to_string().contains("at least 2"));
 }
 
 #[test]

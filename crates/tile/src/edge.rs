@@ -8,16 +8,6 @@ use tinsmith_core::effective_limit;
 /// interpolation used here; 2^-40 of the data's magnitude is far above either rounding.
 const EDGE_MARGIN: f64 = 1.0 / (1u64 << 40) as f64;
 
-/// The longest step, in samples, between consecutive kept edge samples.
-///
-/// The core removes skipped edge samples one by one inside the border strip, and each
-/// removal retriangulates a hole that spans the whole run skipped so far: a run of n
-/// samples costs about n^3. Capping runs at 32 samples keeps that cost below the tile's own
-/// decimation, at a cost of at most one kept sample per 32 (measured on a 4096^2 DEM with
-/// 2048-sample tiles at 1 m: decimation 44 s uncapped, 18.5 s capped at 32, which is what
-/// keeping every edge sample costs; triangles +0.003 %).
-pub const MAX_EDGE_SPAN: usize = 32;
-
 /// The largest 1-D error [`EdgeProfile::simplify`] may accept so that the core's
 /// [`tinsmith_core::decimate_with_border`] accepts the same removals: the core's
 /// [`effective_limit`] less a further `2^-40 (max_error + max_abs_value)`, or 0.
@@ -32,6 +22,26 @@ pub fn edge_limit(max_error: f64, max_abs_value: f64) -> f64 {
         limit
     } else {
         0.0
+    }
+}
+
+/// The longest skip, in samples, between kept edge samples that keeps every new edge of
+/// the tile's border strip within `max_edge_length` sample spacings
+/// ([`tinsmith_core::DecimationOptions::max_edge_length`]): the fans that replace skipped
+/// border samples reach one row inwards, so a skip of `s` makes edges of length
+/// `sqrt(s^2 + 1)`. The result is `floor(sqrt(L^2 - 1))` (at least 1), or `usize::MAX`
+/// without a cap.
+pub fn edge_span(max_edge_length: Option<u32>) -> usize {
+    match max_edge_length {
+        None => usize::MAX,
+        Some(l) => {
+            let target = u64::from(l) * u64::from(l);
+            let mut s = 1u64;
+            while (s + 1) * (s + 1) < target {
+                s += 1;
+            }
+            s as usize
+        }
     }
 }
 
@@ -80,7 +90,8 @@ impl EdgeProfile {
     }
 
     /// Which samples the edge keeps at 1-D error `limit` (see [`edge_limit`]), skipping at
-    /// most `max_span - 1` samples at a time (see [`MAX_EDGE_SPAN`]).
+    /// most `max_span - 1` samples at a time (`usize::MAX`: no cap; the core removes
+    /// skipped samples as fans, in time linear in the run).
     ///
     /// Kept: both ends (the tile corners); both samples of every step that is not open
     /// (so the domain's outline along the edge is kept exactly, on both sides); and, along
@@ -98,7 +109,7 @@ impl EdgeProfile {
     /// The result depends only on the profile and `limit`.
     ///
     /// # Runtime
-    /// O(n * max_span) for n samples.
+    /// O(n * min(n, max_span)) for n samples.
     pub fn simplify(&self, limit: f64, max_span: usize) -> Vec<bool> {
         let v = &self.values;
         let n = v.len();
@@ -168,6 +179,18 @@ mod tests {
         let keep = edge.simplify(1.0, 4);
         let kept: Vec<usize> = (0..10).filter(|&i| keep[i]).collect();
         assert_eq!(kept, vec![0, 4, 8, 9]);
+    }
+
+    #[test]
+    fn spans_leave_room_for_the_strip_fans() {
+        assert_eq!(edge_span(None), usize::MAX);
+        assert_eq!(edge_span(Some(2)), 1);
+        assert_eq!(edge_span(Some(10)), 9);
+        for l in 2u32..200 {
+            let s = edge_span(Some(l)) as u64;
+            assert!(s * s + 1 <= u64::from(l * l));
+            assert!(s == 1 || (s + 1) * (s + 1) + 1 > u64::from(l * l));
+        }
     }
 
     #[test]

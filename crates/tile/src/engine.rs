@@ -6,7 +6,7 @@ use std::time::Instant;
 use tinsmith_core::{decimate_with_border, DecimationOptions, DecimationReport, TinVertex};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
-use crate::edge::{edge_limit, EdgeProfile, MAX_EDGE_SPAN};
+use crate::edge::{edge_limit, edge_span, EdgeProfile};
 use crate::error::{Error, Result};
 use crate::halo::{halo_window, TileInput};
 use crate::order::run_ordered;
@@ -171,6 +171,7 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
             ..d.clone()
         },
         edge_limit: edge_limit(d.max_error, max_abs_value),
+        edge_span: edge_span(d.max_edge_length),
     };
 
     let mut report = TilesReport {
@@ -238,6 +239,8 @@ struct TileJob {
     plan: TilePlan,
     options: DecimationOptions,
     edge_limit: f64,
+    /// Longest skip along a shared edge (see [`edge_span`]).
+    edge_span: usize,
 }
 
 /// A tile decimated and verified on a worker thread, not yet numbered.
@@ -282,7 +285,7 @@ impl TileJob {
 
         let keep = |edge: &EdgeProfile| {
             if self.edge_limit > 0.0 {
-                edge.simplify(self.edge_limit, MAX_EDGE_SPAN)
+                edge.simplify(self.edge_limit, self.edge_span)
             } else {
                 // Below the rounding slack the core removes only exactly flat stars:
                 // keep every edge sample.

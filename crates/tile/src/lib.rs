@@ -53,7 +53,7 @@ mod terrain;
 mod weld;
 mod welded;
 
-pub use edge::{edge_limit, EdgeProfile, MAX_EDGE_SPAN};
+pub use edge::{edge_limit, edge_span, EdgeProfile};
 pub use engine::{mesh_tiles, TileOptions, TileProgress, TilesReport, DEFAULT_TILE_SIZE};
 pub use error::{Error, Result};
 pub use per_tile::PerTileWriter;

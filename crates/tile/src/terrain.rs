@@ -13,7 +13,7 @@ use tinsmith_export::{gzip, surface_normal, GeoRectangle, QuantizedMeshTile, QUA
 use tinsmith_raster::{geographic_bounds, warp_to_geographic, GeoBounds, GeoLattice};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
-use crate::edge::{edge_limit, EdgeProfile, MAX_EDGE_SPAN};
+use crate::edge::{edge_limit, edge_span, EdgeProfile};
 
 /// Cesium's level-zero geometric error for the geographic scheme, in metres:
 /// `maximumRadius * 2 pi * 0.25 / (65 * 2)` (`TerrainProvider`
@@ -205,6 +205,26 @@ struct LevelRaster {
 /// Lattice spacing of a level, in degrees.
 fn step(level: u8) -> f64 {
     180.0 / (f64::from(TILE_CELLS) * (1u64 << level) as f64)
+}
+
+/// WGS84 semi-major axis, metres.
+const EARTH_RADIUS: f64 = 6_378_137.0;
+
+/// The longest triangle edge, in lattice spacings of `level`, whose chord sinks no deeper
+/// than `bound` metres below the ellipsoid: CesiumJS draws each triangle flat between its
+/// ECEF corners, so an edge spanning `t` radians of arc cuts `R (1 - cos(t / 2))` below the
+/// surface, an error the height check (made in longitude/latitude) does not see. Measured
+/// along the equator (where a lattice step spans the most arc); `None` when even the
+/// tile's diagonal is short enough.
+fn max_edge_length(level: u8, bound: f64) -> Option<u32> {
+    let arc = 2.0 * (1.0 - (bound / EARTH_RADIUS).min(1.0)).acos();
+    let spacing = step(level).to_radians();
+    let length = (arc / spacing).floor();
+    if length >= f64::from(TILE_CELLS) * std::f64::consts::SQRT_2 {
+        None
+    } else {
+        Some((length as u32).max(2))
+    }
 }
 
 /// The tile rectangle `z/x/y` (TMS y) in degrees.
@@ -400,6 +420,8 @@ impl LevelRaster {
 #[derive(Debug, Clone, Copy)]
 struct LevelBudget {
     step: f64,
+    /// Longest edge, in lattice spacings (see [`max_edge_length`]).
+    max_edge: Option<u32>,
     /// What decimation may use: the bound less the quantization error (half a step).
     decimation: f64,
     verify: f64,
@@ -559,6 +581,7 @@ fn build_level(
     let margin = (bound + max_abs) / (1u64 << 30) as f64;
     let budget = LevelBudget {
         step: height_step,
+        max_edge: max_edge_length(level, bound),
         decimation: (bound - half_step - margin).max(0.0),
         verify: bound.max(half_step + margin),
         max_abs,
@@ -649,7 +672,7 @@ fn build_tile(
     let limit = edge_limit(budget.decimation, budget.max_abs);
     let keep = |edge: EdgeProfile| {
         if limit > 0.0 {
-            edge.simplify(limit, MAX_EDGE_SPAN)
+            edge.simplify(limit, edge_span(budget.max_edge))
         } else {
             vec![true; n + 1]
         }
@@ -674,6 +697,7 @@ fn build_tile(
     };
     let mut decimation_options = DecimationOptions::new(budget.decimation);
     decimation_options.max_abs_value = Some(budget.max_abs);
+    decimation_options.max_edge_length = budget.max_edge;
     let tin = decimate_with_border(&grid, &decimation_options, &keep_border, &mut |_| {})
         .map_err(|source| TerrainError::Decimate { z, x, y, source })?
         .tin;
@@ -917,6 +941,19 @@ mod tests {
     #[test]
     fn u_lands_exactly_on_the_edges() {
         assert_eq!(U_PER_CELL * TILE_CELLS, u32::from(QUANTIZED_MAX));
+    }
+
+    #[test]
+    fn coarse_levels_cap_edges_by_the_ellipsoid_sag() {
+        // Level 0: bound 77 km allows an arc of 17.8 degrees; a lattice step is 0.83.
+        let l0 = max_edge_length(0, LEVEL_ZERO_ERROR).unwrap();
+        assert_eq!(l0, 21);
+        let arc = f64::from(l0) * step(0).to_radians();
+        assert!(EARTH_RADIUS * (1.0 - (arc / 2.0).cos()) <= LEVEL_ZERO_ERROR);
+        let arc = f64::from(l0 + 1) * step(0).to_radians();
+        assert!(EARTH_RADIUS * (1.0 - (arc / 2.0).cos()) > LEVEL_ZERO_ERROR);
+        // Deep levels: no cap.
+        assert_eq!(max_edge_length(12, LEVEL_ZERO_ERROR / 4096.0), None);
     }
 
     #[test]

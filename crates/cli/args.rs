@@ -67,6 +67,9 @@ pub struct TilesArgs {
     /// Write the per-level report (bounds, measured error, tiles, bytes) as JSON.
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// No per-level lines or summary on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Args)]

@@ -16,7 +16,13 @@ pub fn run(args: &TilesArgs) -> Result<bool> {
         gzip: !args.no_gzip,
         threads: args.threads,
     };
+    if let Some(report) = &args.report {
+        crate::output::check_writable_target(report)?;
+    }
     let report = build_terrain(&args.input, &args.output, &options, &mut |level| {
+        if args.quiet {
+            return;
+        }
         eprintln!(
             "level {:>2}: {} tiles, {} bytes, bound {:.3} m, measured {:.3} m, {:.2} s",
             level.level,
@@ -29,8 +35,10 @@ pub fn run(args: &TilesArgs) -> Result<bool> {
     })
     .with_context(|| format!("{}", args.input.display()))?;
     if let Some(path) = &args.report {
-        let text = serde_json::to_string_pretty(&report)?;
-        std::fs::write(path, text).with_context(|| format!("{}: cannot write", path.display()))?;
+        crate::output::write_atomically(path, &serde_json::to_vec_pretty(&report)?)?;
+    }
+    if args.quiet {
+        return Ok(true);
     }
     let tiles: u64 = report.levels.iter().map(|l| l.tiles).sum();
     eprintln!(

@@ -109,7 +109,7 @@ def main():
                 for _ in range(args.repeat):
                     out, rep = tmp / "t.ply", tmp / "t.json"
                     cmd = [args.bin, "mesh", str(raster), "-o", str(out), "--max-error", str(eps),
-                           "--pixel-coords", "-q", "--report", str(rep)] + shlex.split(args.tinsmith_args)
+                           "--pixel-coords", "-q", "--threads", "1", "--report", str(rep)] + shlex.split(args.tinsmith_args)
                     p = subprocess.run(cmd, capture_output=True, text=True)
                     if p.returncode != 0:
                         sys.exit(f"tinsmith failed: {p.stderr}")

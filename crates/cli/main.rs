@@ -11,6 +11,7 @@ mod info;
 mod mesh;
 mod output;
 mod progress;
+mod report;
 mod serve;
 mod terrain;
 mod tiled;

@@ -1,6 +1,5 @@
 //! `tinsmith mesh`: decimate a raster into a TIN, check it, write it.
 
-use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
@@ -11,44 +10,16 @@ use tinsmith_verify::{GridRef, VerifyOptions};
 use crate::args::MeshArgs;
 use crate::georef::Georef;
 use crate::output::{check_writable_target, write_atomically};
+use crate::report::{MeshSummary, Outcome, Seconds};
 
 /// The `--report` JSON.
 #[derive(Debug, Serialize)]
 struct MeshReport<'a> {
-    input: &'a Path,
-    band: usize,
-    width: u32,
-    height: u32,
-    valid_samples: u64,
-    max_error: Option<f64>,
-    max_triangles: Option<usize>,
-    max_vertices: Option<usize>,
-    error_model: String,
-    selection: String,
-    order: String,
-    retriangulate: String,
-    initial_mesh: String,
-    triangles_before: usize,
-    triangles_after: usize,
-    vertices_before: usize,
-    vertices_after: usize,
-    decimation_percent: f64,
-    max_error_bound: f64,
-    measured_max_error: f64,
-    output: &'a Path,
+    #[serde(flatten)]
+    summary: MeshSummary<'a>,
     #[serde(flatten)]
     output_format: crate::export::PlanReport,
     seconds: Seconds,
-}
-
-#[derive(Debug, Serialize)]
-struct Seconds {
-    read: f64,
-    initial_mesh: f64,
-    decimate: f64,
-    verify: f64,
-    write: f64,
-    total: f64,
 }
 
 /// Reads, decimates, verifies in memory and writes; the mesh is written only if the
@@ -127,28 +98,16 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let write_seconds = t.elapsed().as_secs_f64();
 
     let r = &result.report;
-    let report = MeshReport {
-        input: &args.input,
-        band: args.band,
-        width: grid.width(),
-        height: grid.height(),
+    let outcome = Outcome {
+        size: (grid.width(), grid.height()),
         valid_samples: raster.info.valid_samples,
-        max_error: args.max_error,
-        max_triangles: args.max_triangles,
-        max_vertices: args.max_vertices,
-        error_model: value_name(args.error_model),
-        selection: value_name(args.selection),
-        order: value_name(args.order),
-        retriangulate: value_name(args.retriangulate),
-        initial_mesh: value_name(args.initial_mesh),
-        triangles_before: r.initial_triangles,
-        triangles_after: r.final_triangles,
-        vertices_before: r.initial_vertices,
-        vertices_after: r.final_vertices,
-        decimation_percent: 100.0 * (1.0 - r.final_triangles as f64 / r.initial_triangles as f64),
+        before: (r.initial_triangles as u64, r.initial_vertices as u64),
+        after: (r.final_triangles as u64, r.final_vertices as u64),
         max_error_bound: r.max_bound,
         measured_max_error: check.max_error,
-        output,
+    };
+    let report = MeshReport {
+        summary: MeshSummary::new(args, output, outcome),
         output_format: plan.report(),
         seconds: Seconds {
             read: read_seconds,
@@ -160,19 +119,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         },
     };
     if !args.quiet {
-        eprintln!(
-            "{}: {} -> {} triangles ({:.1}% decimated), measured max error {} <= {}",
-            output.display(),
-            report.triangles_before,
-            report.triangles_after,
-            report.decimation_percent,
-            report.measured_max_error,
-            if max_error.is_finite() {
-                max_error.to_string()
-            } else {
-                "(no bound asked)".into()
-            }
-        );
+        report.summary.print("");
         if let Some(origin) = plan.origin {
             let [x, y, z] = origin.offset();
             eprintln!(
@@ -188,13 +135,6 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         write_atomically(path, &json)?;
     }
     Ok(true)
-}
-
-/// The flag value clap shows for `v`.
-fn value_name(v: impl clap::ValueEnum) -> String {
-    v.to_possible_value()
-        .map(|p| p.get_name().to_owned())
-        .unwrap_or_default()
 }
 
 /// Vertices in file coordinates and triangles counter-clockwise in them (normals up).

@@ -17,6 +17,7 @@ use tinsmith_tile::{
 
 use crate::args::{MeshArgs, TileFormatArg};
 use crate::output::{check_writable_target, write_atomically};
+use crate::report::{MeshSummary, Outcome, Seconds};
 
 /// GDAL block cache in tiled mode, in MB: several rows of tiles of a 16k-wide Float32
 /// raster, whether it is stored in strips or blocks.
@@ -53,39 +54,10 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
 /// plus `tiles`.
 #[derive(Debug, Serialize)]
 struct TiledMeshReport<'a> {
-    input: &'a Path,
-    band: usize,
-    width: u32,
-    height: u32,
-    valid_samples: u64,
-    max_error: Option<f64>,
-    max_triangles: Option<usize>,
-    max_vertices: Option<usize>,
-    error_model: String,
-    selection: String,
-    order: String,
-    retriangulate: String,
-    initial_mesh: String,
-    triangles_before: u64,
-    triangles_after: u64,
-    vertices_before: u64,
-    vertices_after: u64,
-    decimation_percent: f64,
-    max_error_bound: f64,
-    measured_max_error: f64,
-    output: &'a Path,
+    #[serde(flatten)]
+    summary: MeshSummary<'a>,
     seconds: Seconds,
     tiles: Tiles,
-}
-
-#[derive(Debug, Serialize)]
-struct Seconds {
-    read: f64,
-    initial_mesh: f64,
-    decimate: f64,
-    verify: f64,
-    write: f64,
-    total: f64,
 }
 
 #[derive(Debug, Serialize)]
@@ -201,29 +173,16 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     bar.finish_and_clear();
 
     let r: &TilesReport = &report;
-    let json = TiledMeshReport {
-        input: &args.input,
-        band: args.band,
-        width: info.width,
-        height: info.height,
+    let outcome = Outcome {
+        size: (info.width, info.height),
         valid_samples: info.valid_samples,
-        max_error: args.max_error,
-        max_triangles: None,
-        max_vertices: None,
-        error_model: value_name(args.error_model),
-        selection: value_name(args.selection),
-        order: value_name(args.order),
-        retriangulate: value_name(args.retriangulate),
-        initial_mesh: value_name(args.initial_mesh),
-        triangles_before: r.initial_triangles,
-        triangles_after: r.final_triangles,
-        vertices_before: r.initial_vertices,
-        vertices_after: r.final_vertices,
-        decimation_percent: 100.0
-            * (1.0 - r.final_triangles as f64 / r.initial_triangles.max(1) as f64),
+        before: (r.initial_triangles, r.initial_vertices),
+        after: (r.final_triangles, r.final_vertices),
         max_error_bound: r.max_bound,
         measured_max_error: r.measured_max_error,
-        output,
+    };
+    let json = TiledMeshReport {
+        summary: MeshSummary::new(args, output, outcome),
         seconds: Seconds {
             read: scan_seconds + r.seconds_read,
             initial_mesh: 0.0,
@@ -244,18 +203,10 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         },
     };
     if !args.quiet {
-        eprintln!(
-            "{}: {} -> {} triangles ({:.1}% decimated) in {} tiles of {}, measured max error \
-             {} <= {}",
-            output.display(),
-            json.triangles_before,
-            json.triangles_after,
-            json.decimation_percent,
-            json.tiles.count,
-            json.tiles.size,
-            json.measured_max_error,
-            max_error
-        );
+        json.summary.print(&format!(
+            " in {} tiles of {}",
+            json.tiles.count, json.tiles.size
+        ));
     }
     if let Some(path) = &args.report {
         write_atomically(path, &serde_json::to_vec_pretty(&json)?)?;
@@ -277,11 +228,4 @@ fn progress_bar(quiet: bool) -> ProgressBar {
     }
     bar.enable_steady_tick(Duration::from_millis(200));
     bar
-}
-
-/// The flag value clap shows for `v`.
-fn value_name(v: impl clap::ValueEnum) -> String {
-    v.to_possible_value()
-        .map(|p| p.get_name().to_owned())
-        .unwrap_or_default()
 }

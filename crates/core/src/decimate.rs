@@ -216,7 +216,7 @@ fn run(
     mesh.check_invariants();
     let seconds_decimation = started.elapsed().as_secs_f64();
 
-    let (tin, stored_max_bound) = extract(&mesh);
+    let (tin, stored_max_bound) = extract(mesh, grid);
     // Every live triangle's bound was at most `limit` when computed in f64; storage in f32
     // rounds it up, so the stored maximum may sit a hair above the limit.
     let max_bound = stored_max_bound.min(limit);
@@ -621,26 +621,20 @@ impl<'g> Remover<'g> {
     }
 }
 /// The mesh's live vertices (row-major) and triangles (slot order), and the largest bound.
-fn extract(mesh: &Mesh<'_>) -> (Tin, f64) {
-    let mut index = vec![u32::MAX; mesh.vertex_slots()];
-    let mut vertices = Vec::new();
-    for v in 0..mesh.vertex_slots() as u32 {
-        if mesh.contains_vertex(v) {
-            index[v as usize] = vertices.len() as u32;
-            let p = mesh.point(v);
-            vertices.push(TinVertex {
-                x: p.x as u32,
-                y: p.y as u32,
-                z: p.z,
-            });
-        }
-    }
-    let mut triangles = Vec::with_capacity(mesh.triangle_count());
-    let mut max_bound: f64 = 0.0;
-    for (t, c) in mesh.live_triangles() {
-        triangles.push(c.map(|v| index[v as usize]));
-        max_bound = max_bound.max(mesh.bound(t).max());
-    }
+fn extract(mesh: Mesh<'_>, grid: &Grid) -> (Tin, f64) {
+    let max_bound = mesh
+        .live_triangles()
+        .fold(0.0f64, |m, (t, _)| m.max(mesh.bound(t).max()));
+    let (kept, triangles) = mesh.into_numbered();
+    let width = grid.width();
+    let vertices = kept
+        .iter()
+        .map(|&v| TinVertex {
+            x: v % width,
+            y: v / width,
+            z: grid.values()[v as usize],
+        })
+        .collect();
     (
         Tin {
             vertices,

@@ -162,51 +162,40 @@ impl<'g> Mesh<'g> {
 
     /// A mesh from counter-clockwise triangles over grid samples (vertex ids are sample
     /// indices) that tile part of the grid's domain conformingly, with their bounds.
-    /// Neighbours are found by matching edges.
+    /// Neighbours are found by matching edges (by their midpoints).
     pub(crate) fn from_triangles(
         grid: &'g Grid,
         corners: Vec<[u32; 3]>,
         bounds: Vec<CompactBound>,
     ) -> Mesh<'g> {
-        let n = grid.width() as usize * grid.height() as usize;
+        let (w, h) = (grid.width() as usize, grid.height() as usize);
+        let n = w * h;
         let mut vertex_triangle = vec![NONE; n];
-
-        // Incident triangles per vertex (compressed rows), then each edge a -> b finds its
-        // twin b -> a among b's triangles.
-        let mut start = vec![0u32; n + 1];
-        for c in &corners {
-            for &v in c {
-                start[v as usize + 1] += 1;
-            }
-        }
-        for i in 0..n {
-            start[i + 1] += start[i];
-        }
-        let mut fill = start.clone();
-        let mut incident_triangles = vec![0u32; 3 * corners.len()];
-        for (t, c) in corners.iter().enumerate() {
-            for &v in c {
-                incident_triangles[fill[v as usize] as usize] = t as u32;
-                fill[v as usize] += 1;
-                vertex_triangle[v as usize] = t as u32;
-            }
-        }
-        drop(fill);
+        // In a conforming triangulation no two edges share a midpoint, so the midpoint
+        // (on the doubled lattice) names the edge: the first triangle to reach it waits
+        // there for its twin. 16 bytes per sample, less than per-vertex triangle lists.
+        let doubled_width = 2 * w - 1;
+        let mut waiting = vec![NONE; doubled_width * (2 * h - 1)];
         let mut neighbours = vec![[NONE; 3]; corners.len()];
         for (t, c) in corners.iter().enumerate() {
             for e in 0..3 {
-                let (a, b) = (c[e], c[(e + 1) % 3]);
-                let around_b =
-                    &incident_triangles[start[b as usize] as usize..start[b as usize + 1] as usize];
-                for &u in around_b {
-                    let cu = &corners[u as usize];
-                    if (0..3).any(|k| cu[k] == b && cu[(k + 1) % 3] == a) {
-                        neighbours[t][e] = u;
-                        break;
-                    }
+                let (a, b) = (c[e] as usize, c[(e + 1) % 3] as usize);
+                vertex_triangle[a] = t as u32;
+                let key = (a % w + b % w) + (a / w + b / w) * doubled_width;
+                let u = waiting[key];
+                if u == NONE {
+                    waiting[key] = t as u32;
+                    continue;
                 }
+                let cu = corners[u as usize];
+                let k = (0..3)
+                    .find(|&k| cu[k] as usize == b && cu[(k + 1) % 3] as usize == a)
+                    .expect("the triangles are conforming");
+                neighbours[t][e] = u;
+                neighbours[u as usize][k] = t as u32;
             }
         }
+        drop(waiting);
         let live = corners.len();
         let mut mesh = Mesh {
             grid,
@@ -351,29 +340,41 @@ impl<'g> Mesh<'g> {
             .map(|(t, c)| (t as u32, *c))
     }
 
+    /// Consumes the mesh: its live vertices (sample indices, increasing) and its live
+    /// triangles (slot order) with corners renumbered as positions in that list. The links
+    /// and bounds are freed first, so the result does not add to the mesh's peak memory.
+    pub(crate) fn into_numbered(self) -> (Vec<u32>, Vec<[u32; 3]>) {
+        let Mesh {
+            corners,
+            vertex_triangle,
+            ..
+        } = self;
+        let mut number = vertex_triangle;
+        let mut vertices = Vec::with_capacity(number.iter().filter(|&&t| t != NONE).count());
+        for (v, n) in number.iter_mut().enumerate() {
+            if *n != NONE {
+                *n = vertices.len() as u32;
+                vertices.push(v as u32);
+            }
+        }
+        // Filtering and mapping in place reuses the corners' allocation.
+        let mut triangles: Vec<[u32; 3]> = corners
+            .into_iter()
+            .filter(|c| c[0] != NONE)
+            .map(|c| c.map(|v| number[v as usize]))
+            .collect();
+        triangles.shrink_to_fit();
+        (vertices, triangles)
+    }
+
     /// Fills `star` with the fan around `v` (which must be in the mesh).
     pub(crate) fn star(&self, v: u32, star: &mut Star) {
         star.ring.clear();
         star.triangles.clear();
         let start = self.vertex_triangle[v as usize];
         debug_assert_ne!(start, NONE);
-        // Turn clockwise to the first triangle of an open fan, or back to `start`.
-        let mut first = start;
-        star.open = false;
-        loop {
-            let i = self.local(first, v);
-            let cw = self.neighbours[first as usize][i];
-            if cw == NONE {
-                star.open = true;
-                break;
-            }
-            if cw == start {
-                break;
-            }
-            first = cw;
-        }
-        // Walk counter-clockwise from `first`.
-        let mut t = first;
+        // Walk counter-clockwise from `start`; a closed fan comes back to it in one pass.
+        let mut t = start;
         loop {
             let i = self.local(t, v);
             let c = self.corners[t as usize];
@@ -384,10 +385,39 @@ impl<'g> Mesh<'g> {
                 star.ring.push(c[(i + 2) % 3]);
                 break;
             }
-            if ccw == first {
-                break;
+            if ccw == start {
+                // Begin at the triangle after `start`, as the decimation's tie-breaks
+                // were measured with.
+                star.open = false;
+                star.triangles.rotate_left(1);
+                star.ring.rotate_left(1);
+                return;
             }
             t = ccw;
+        }
+        // An open fan: the triangles clockwise of `start` come first.
+        star.open = true;
+        let ccw_triangles = star.triangles.len();
+        let mut t = start;
+        loop {
+            let i = self.local(t, v);
+            let cw = self.neighbours[t as usize][i];
+            if cw == NONE {
+                break;
+            }
+            let j = self.local(cw, v);
+            star.ring.push(self.corners[cw as usize][(j + 1) % 3]);
+            star.triangles.push(cw);
+            t = cw;
+        }
+        // The clockwise part was appended nearest-first: rotate it to the front, reversed.
+        let cw_triangles = star.triangles.len() - ccw_triangles;
+        if cw_triangles > 0 {
+            star.triangles[ccw_triangles..].reverse();
+            star.triangles.rotate_right(cw_triangles);
+            let ring_ccw = ccw_triangles + 1;
+            star.ring[ring_ccw..].reverse();
+            star.ring.rotate_right(cw_triangles);
         }
     }
 

@@ -42,10 +42,18 @@ pub(crate) fn rtin_triangles(
 ) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
     let rtin = Rtin::new(grid, limit, max_edge_squared, full_border);
     let need = rtin.saturate();
-    let mut out = (Vec::new(), Vec::new());
     let s = rtin.size;
-    rtin.emit((0, 0), (s, s), (s, 0), &need, &mut out);
-    rtin.emit((s, s), (0, 0), (0, s), &need, &mut out);
+    let halves = [((0, 0), (s, s), (s, 0)), ((s, s), (0, 0), (0, s))];
+    // Count first so that the arrays are allocated once, at their size: at small bounds
+    // they hold nearly two triangles per sample, and doubling growth would waste up to half.
+    let mut count = 0;
+    for (a, b, c) in halves {
+        rtin.emit(a, b, c, &need, &mut |_| count += 1);
+    }
+    let mut out = (Vec::with_capacity(count), Vec::with_capacity(count));
+    for (a, b, c) in halves {
+        rtin.emit(a, b, c, &need, &mut |t| rtin.push(t, &mut out));
+    }
     out
 }
 
@@ -250,15 +258,9 @@ impl<'g> Rtin<'g> {
         need
     }
 
-    /// Emits triangle `(a, b, c)` (hypotenuse `ab`, right angle at `c`) or its children.
-    fn emit(
-        &self,
-        a: Xy,
-        b: Xy,
-        c: Xy,
-        need: &[bool],
-        out: &mut (Vec<[u32; 3]>, Vec<CompactBound>),
-    ) {
+    /// Passes triangle `(a, b, c)` (hypotenuse `ab`, right angle at `c`) or its children
+    /// to `out`, in a fixed order.
+    fn emit(&self, a: Xy, b: Xy, c: Xy, need: &[bool], out: &mut dyn FnMut([Xy; 3])) {
         let t = [a, b, c];
         let extent = self.extent(t);
         if extent == Extent::Outside {
@@ -268,7 +270,7 @@ impl<'g> Rtin<'g> {
         if leaf {
             let (x, y) = (a.0.min(b.0), a.1.min(b.1));
             if extent == Extent::Inside && self.grid.cell_is_valid(x as usize, y as usize) {
-                self.push(t, out);
+                out(t);
             }
             return;
         }
@@ -277,7 +279,7 @@ impl<'g> Rtin<'g> {
             self.emit(c, a, m, need, out);
             self.emit(b, c, m, need, out);
         } else {
-            self.push(t, out);
+            out(t);
         }
     }
 

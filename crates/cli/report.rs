@@ -1,0 +1,120 @@
+//! The `--report` JSON of `tinsmith mesh`, shared by the untiled and the tiled paths.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::args::MeshArgs;
+
+/// What every mesh report says: the input, the options, the counts before and after, the
+/// bound and the independently measured error, and where the mesh went.
+#[derive(Debug, Serialize)]
+pub struct MeshSummary<'a> {
+    input: &'a Path,
+    band: usize,
+    width: u32,
+    height: u32,
+    valid_samples: u64,
+    max_error: Option<f64>,
+    max_triangles: Option<usize>,
+    max_vertices: Option<usize>,
+    error_model: String,
+    selection: String,
+    order: String,
+    retriangulate: String,
+    initial_mesh: String,
+    max_edge_length: Option<u32>,
+    triangles_before: u64,
+    triangles_after: u64,
+    vertices_before: u64,
+    vertices_after: u64,
+    decimation_percent: f64,
+    max_error_bound: f64,
+    measured_max_error: f64,
+    output: &'a Path,
+}
+
+/// Counts and errors of a finished run, for [`MeshSummary::new`].
+pub struct Outcome {
+    /// Raster columns and rows.
+    pub size: (u32, u32),
+    /// Valid samples of the band.
+    pub valid_samples: u64,
+    /// Full-grid triangles and domain samples.
+    pub before: (u64, u64),
+    /// Triangles and vertices written.
+    pub after: (u64, u64),
+    /// The largest bound the decimation kept.
+    pub max_error_bound: f64,
+    /// The error the verifier measured.
+    pub measured_max_error: f64,
+}
+
+impl<'a> MeshSummary<'a> {
+    /// The summary of a run of `args` that wrote `output`.
+    pub fn new(args: &'a MeshArgs, output: &'a Path, outcome: Outcome) -> MeshSummary<'a> {
+        let (triangles_before, vertices_before) = outcome.before;
+        let (triangles_after, vertices_after) = outcome.after;
+        MeshSummary {
+            input: &args.input,
+            band: args.band,
+            width: outcome.size.0,
+            height: outcome.size.1,
+            valid_samples: outcome.valid_samples,
+            max_error: args.max_error,
+            max_triangles: args.max_triangles,
+            max_vertices: args.max_vertices,
+            error_model: value_name(args.error_model),
+            selection: value_name(args.selection),
+            order: value_name(args.order),
+            retriangulate: value_name(args.retriangulate),
+            initial_mesh: value_name(args.initial_mesh),
+            max_edge_length: args.max_edge_length,
+            triangles_before,
+            triangles_after,
+            vertices_before,
+            vertices_after,
+            decimation_percent: 100.0
+                * (1.0 - triangles_after as f64 / triangles_before.max(1) as f64),
+            max_error_bound: outcome.max_error_bound,
+            measured_max_error: outcome.measured_max_error,
+            output,
+        }
+    }
+
+    /// The one-line summary on stderr: triangles before and after, measured error and bound,
+    /// with `how` (e.g. the tiling) after the percentage.
+    pub fn print(&self, how: &str) {
+        eprintln!(
+            "{}: {} -> {} triangles ({:.1}% decimated){how}, measured max error {} <= {}",
+            self.output.display(),
+            self.triangles_before,
+            self.triangles_after,
+            self.decimation_percent,
+            self.measured_max_error,
+            match self.max_error {
+                Some(e) => e.to_string(),
+                None => "(no bound asked)".into(),
+            }
+        );
+    }
+}
+
+/// Seconds per phase; in tiled mode the phases are summed over tiles (thread-seconds) and
+/// `total` is wall-clock.
+#[derive(Debug, Serialize)]
+pub struct Seconds {
+    pub read: f64,
+    pub initial_mesh: f64,
+    pub decimate: f64,
+    pub verify: f64,
+    pub write: f64,
+    pub total: f64,
+}
+
+/// The flag value clap shows for `v`.
+fn value_name(v: impl clap::ValueEnum) -> String {
+    v.to_possible_value()
+        .map(|p| p.get_name().to_owned())
+        .unwrap_or_default()
+}

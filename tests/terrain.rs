@@ -411,3 +411,51 @@ fn a_mercator_pyramid_decodes_stitches_and_keeps_its_bound() {
 fn an_albers_pyramid_decodes_stitches_and_keeps_its_bound() {
     check_pyramid(&fixture("becmodel_dem_bc_albers_50m.tif"), 0.5);
 }
+
+/// Great-circle angle, in radians, between two decoded vertices of tile `z/x/y`.
+fn arc(key: (u32, u32, u32), t: &Tile, a: usize, b: usize) -> f64 {
+    let (z, x, y) = key;
+    let size = 180.0 / f64::from(1u32 << z);
+    let lon_lat = |i: usize| {
+        let lon = -180.0 + size * (f64::from(x) + t.u[i] as f64 / 32767.0);
+        let lat = -90.0 + size * (f64::from(y) + t.v[i] as f64 / 32767.0);
+        (lon.to_radians(), lat.to_radians())
+    };
+    let ((l1, p1), (l2, p2)) = (lon_lat(a), lon_lat(b));
+    let h = ((p2 - p1) / 2.0).sin().powi(2) + p1.cos() * p2.cos() * ((l2 - l1) / 2.0).sin().powi(2);
+    2.0 * h.sqrt().min(1.0).asin()
+}
+
+#[test]
+fn a_global_pyramid_bends_with_the_globe() {
+    // A whole globe at 2 degrees: at levels 0 and 1 a bound of tens of kilometres lets a
+    // tile go nearly flat, but CesiumJS draws triangles as chords between ECEF corners,
+    // so no edge may span an arc whose chord sinks deeper than the level's bound.
+    let dir = Dir::new();
+    let input = fixture("etopo5_2deg_i16.tif");
+    pyramid(&dir, &input, "globe", &["--max-zoom", "1", "-q"]);
+    let tiles = decode_pyramid(&dir.path("globe"));
+    assert_eq!(tiles.len(), 2 + 8, "every tile of levels 0 and 1 has data");
+    const RADIUS: f64 = 6_378_137.0;
+    for (&key, t) in &tiles {
+        check_tile(key, t);
+        let bound = E0 / f64::from(1u32 << key.0);
+        let longest = t
+            .triangles
+            .iter()
+            .flat_map(|tri| (0..3).map(move |k| (tri[k], tri[(k + 1) % 3])))
+            .map(|(a, b)| arc(key, t, a, b))
+            .fold(0.0f64, f64::max);
+        let sag = RADIUS * (1.0 - (longest / 2.0).cos());
+        assert!(
+            sag <= bound,
+            "{key:?}: an edge of {:.1} degrees sinks {sag:.0} m below the ellipsoid (bound {bound:.0} m)",
+            longest.to_degrees()
+        );
+        // Edges of at most ~17 degrees across a 180-degree tile need many vertices.
+        if key.0 == 0 {
+            assert!(t.u.len() >= 100, "{key:?}: only {} vertices", t.u.len());
+        }
+    }
+    assert!(check_shared_edges(&tiles) > 0);
+}

@@ -19,6 +19,11 @@ struct MeshReport<'a> {
     summary: MeshSummary<'a>,
     #[serde(flatten)]
     output_format: crate::export::PlanReport,
+    /// Vertices of the initial mesh (the RTIN's, or every domain sample).
+    start_vertices: usize,
+    /// Sweeps until nothing could be removed, and removal attempts in all.
+    sweeps: usize,
+    removal_attempts: usize,
     seconds: Seconds,
 }
 
@@ -109,6 +114,9 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let report = MeshReport {
         summary: MeshSummary::new(args, output, outcome),
         output_format: plan.report(),
+        start_vertices: r.start_vertices,
+        sweeps: r.sweeps,
+        removal_attempts: r.attempts,
         seconds: Seconds {
             read: read_seconds,
             initial_mesh: r.seconds_initial_mesh,

@@ -266,6 +266,53 @@ fn mesh_file_gives_the_same_lines_as_decimating() {
 }
 
 #[test]
+fn tiled_decimation_contours_the_same_tin_mesh_writes() {
+    // Above --tile-size, contour decimates through the tiled engine: the lines are those of
+    // the welded TIN `tinsmith mesh --tile-size` writes, for 1 or 2 threads.
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    let d = Dir::new();
+    let tiles = ["--tile-size", "128", "--max-error", "5"];
+    let mut m = vec!["mesh", &input, "-o", "m.ply", "-q"];
+    m.extend_from_slice(&tiles);
+    run_ok(&d, &m);
+    run_ok(
+        &d,
+        &[
+            "contour",
+            &input,
+            "-o",
+            "a.geojson",
+            "--interval",
+            "50",
+            "--mesh",
+            "m.ply",
+            "-q",
+        ],
+    );
+    for threads in ["1", "2"] {
+        let mut b = vec![
+            "contour",
+            &input,
+            "-o",
+            "b.geojson",
+            "--interval",
+            "50",
+            "-q",
+        ];
+        b.extend_from_slice(&tiles);
+        b.extend_from_slice(&["--threads", threads]);
+        run_ok(&d, &b);
+        let (fa, fb) = (
+            features(&d.path("a.geojson")),
+            features(&d.path("b.geojson")),
+        );
+        assert!(fa.len() > 10, "{} lines", fa.len());
+        assert_eq!(canonical(fa), canonical(fb), "{threads} threads");
+        std::fs::remove_file(d.path("b.geojson")).unwrap();
+    }
+}
+
+#[test]
 fn decimated_contours_have_fewer_segments_than_the_full_grid() {
     let input = fixture("becmodel_dem_bc_albers_50m.tif");
     let d = Dir::new();

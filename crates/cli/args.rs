@@ -259,6 +259,15 @@ pub struct ContourArgs {
     /// reprojecting to WGS84 longitude/latitude as RFC 7946 wants.
     #[arg(long)]
     pub geojson_source_crs: bool,
+    /// Samples per tile side: with --max-error > 0, a raster wider or taller than this is
+    /// decimated tile by tile (in parallel, reading a window at a time), as `tinsmith mesh`
+    /// does; the lines are then drawn on the welded TIN.
+    #[arg(long, value_name = "N", default_value_t = tinsmith_tile::DEFAULT_TILE_SIZE,
+          value_parser = clap::value_parser!(u32).range(2..))]
+    pub tile_size: u32,
+    /// Worker threads for tiles [default: one per core].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub threads: Option<u32>,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,

@@ -7,7 +7,10 @@
 //! proved by the verifier in core's tests; it is not re-verified here); or, for
 //! `--max-error 0` (the default), the full grid, two triangles per valid cell, built
 //! directly ([`tinsmith_contour::ContourMesh::from_grid`]): the same surface decimation at
-//! 0 would give, without its cost. Lines are computed in grid coordinates and mapped to the
+//! 0 would give, without its cost. A raster wider or taller than `--tile-size` is decimated
+//! by the tiled engine instead (a window at a time, in parallel, every tile verified; the
+//! same TIN `tinsmith mesh --tile-size` writes), so memory is the TIN, not the raster.
+//! Lines are computed in grid coordinates and mapped to the
 //! world position of sample centres through the geotransform, as `tinsmith mesh` writes
 //! vertices, so a line through a vertex passes through the mesh file's vertex exactly.
 //! With `--simplify D` each line is then simplified by Douglas–Peucker within `D` in those
@@ -22,7 +25,8 @@ use anyhow::{bail, Context, Result};
 use tinsmith_contour::{contour, interval_levels, simplify_indices, sorted_levels, ContourMesh};
 use tinsmith_core::{decimate, DecimationOptions, Grid};
 use tinsmith_export::LineFormat;
-use tinsmith_raster::Raster;
+use tinsmith_raster::{Raster, RasterInfo};
+use tinsmith_tile::{mesh_tiles, MeshCollector, RasterSource, TileOptions};
 
 use crate::args::ContourArgs;
 use crate::export::file_crs;
@@ -44,43 +48,20 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         );
     }
     check_writable_target(&args.output)?;
-    let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
-    let grid = &raster.grid;
-    let georef = Georef::new(raster.info.transform(), args.pixel_coords);
-
-    let (mesh, source) = match &args.mesh {
-        Some(path) => (
-            mesh_from_file(path, &raster, georef)?,
-            "mesh file".to_owned(),
-        ),
-        None => {
-            if grid.valid_cell_count() == 0 {
-                bail!(
-                    "{}: band {} has no 2x2 block of valid samples, so there is nothing to contour",
-                    args.input.display(),
-                    args.band
-                );
-            }
-            let e = args.max_error.unwrap_or(0.0);
-            if e == 0.0 {
-                let mesh = ContourMesh::from_grid(grid.width(), grid.height(), grid.values())
-                    .with_context(|| format!("{}", args.input.display()))?;
-                (mesh, "full grid".to_owned())
-            } else {
-                let tin = decimate(grid, &DecimationOptions::new(e))
-                    .with_context(|| format!("{}", args.input.display()))?
-                    .tin;
-                let vertices = tin
-                    .vertices()
-                    .iter()
-                    .map(|v| [v.x as f64, v.y as f64, v.z])
-                    .collect();
-                let mesh = ContourMesh::new(vertices, tin.triangles().to_vec())
-                    .with_context(|| format!("{}: decimated TIN", args.input.display()))?;
-                (mesh, format!("TIN within {e}"))
-            }
-        }
+    let e = args.max_error.unwrap_or(0.0);
+    let tiled = args.mesh.is_none() && e > 0.0 && {
+        let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
+        reader.width() > args.tile_size || reader.height() > args.tile_size
     };
+    let (mesh, info, source) = if tiled {
+        let (mesh, info, tiles) = tiled_tin(args, e)?;
+        (mesh, info, format!("TIN within {e} ({tiles} tiles)"))
+    } else {
+        let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
+        let (mesh, source) = untiled_tin(args, e, &raster)?;
+        (mesh, raster.info, source)
+    };
+    let georef = Georef::new(info.transform(), args.pixel_coords);
 
     let levels = match args.interval {
         Some(interval) => match mesh.height_range() {
@@ -125,7 +106,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     }
     let wgs84 = format == LineFormat::GeoJson && !args.geojson_source_crs;
     let crs = file_crs(
-        &raster,
+        &info,
         args.pixel_coords,
         wgs84,
         &mut points,
@@ -161,6 +142,69 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         );
     }
     Ok(true)
+}
+
+/// The TIN to contour from the whole raster in memory: the `--mesh` file, the grid
+/// decimated within `e > 0`, or the full grid for `e = 0`; with a word on where it came
+/// from.
+fn untiled_tin(args: &ContourArgs, e: f64, raster: &Raster) -> Result<(ContourMesh, String)> {
+    let grid = &raster.grid;
+    if let Some(path) = &args.mesh {
+        let georef = Georef::new(raster.info.transform(), args.pixel_coords);
+        return Ok((
+            mesh_from_file(path, raster, georef)?,
+            "mesh file".to_owned(),
+        ));
+    }
+    if grid.valid_cell_count() == 0 {
+        bail!(
+            "{}: band {} has no 2x2 block of valid samples, so there is nothing to contour",
+            args.input.display(),
+            args.band
+        );
+    }
+    if e == 0.0 {
+        let mesh = ContourMesh::from_grid(grid.width(), grid.height(), grid.values())
+            .with_context(|| format!("{}", args.input.display()))?;
+        return Ok((mesh, "full grid".to_owned()));
+    }
+    let tin = decimate(grid, &DecimationOptions::new(e))
+        .with_context(|| format!("{}", args.input.display()))?
+        .tin;
+    let vertices = tin
+        .vertices()
+        .iter()
+        .map(|v| [v.x as f64, v.y as f64, v.z])
+        .collect();
+    let mesh = ContourMesh::new(vertices, tin.triangles().to_vec())
+        .with_context(|| format!("{}: decimated TIN", args.input.display()))?;
+    Ok((mesh, format!("TIN within {e}")))
+}
+
+/// The TIN to contour from a raster larger than `--tile-size`: decimated within `e` by the
+/// tiled engine (windowed reads, in parallel, each tile verified), welded in memory. Returns
+/// it with the raster's description and the number of tiles.
+fn tiled_tin(args: &ContourArgs, e: f64) -> Result<(ContourMesh, RasterInfo, usize)> {
+    let input = args.input.display();
+    tinsmith_raster::limit_block_cache(crate::tiled::TILED_BLOCK_CACHE_MB);
+    let info = tinsmith_raster::open_info(&args.input, args.band)?;
+    let source = RasterSource::new(&info)?;
+    let options = TileOptions::new(DecimationOptions::new(e))
+        .with_tile_size(args.tile_size)
+        .with_threads(args.threads.map_or(0, |n| n as usize));
+    let mut collector = MeshCollector::new();
+    let report = mesh_tiles(&source, &options, &mut collector, &mut |_| {})
+        .with_context(|| format!("{input}"))?;
+    if report.final_triangles == 0 {
+        bail!(
+            "{input}: band {} has no 2x2 block of valid samples, so there is nothing to contour",
+            args.band
+        );
+    }
+    let (vertices, triangles) = collector.into_parts();
+    let mesh =
+        ContourMesh::new(vertices, triangles).with_context(|| format!("{input}: decimated TIN"))?;
+    Ok((mesh, info, report.plan.len()))
 }
 
 /// Reads a mesh file written from `raster` (as `tinsmith verify` reads it: GeoJSON in

@@ -8,7 +8,7 @@ use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use tinsmith_core::Grid;
 use tinsmith_export::{CrsRef, LocalOrigin, MeshFormat, MeshRef, WriteOptions};
-use tinsmith_raster::Raster;
+use tinsmith_raster::{Raster, RasterInfo};
 
 use crate::args::MeshArgs;
 use crate::georef::Georef;
@@ -219,7 +219,7 @@ pub fn write(
     let path = out(args);
     let wgs84 = plan.format == MeshFormat::GeoJson && !args.export.geojson_source_crs;
     let crs = file_crs(
-        raster,
+        &raster.info,
         args.pixel_coords,
         wgs84,
         &mut vertices,
@@ -247,14 +247,13 @@ pub fn write(
 /// the file records EPSG 4326; without a CRS the points stay as they are, with a note on
 /// stderr unless `quiet`.
 pub fn file_crs<'r>(
-    raster: &'r Raster,
+    info: &'r RasterInfo,
     pixel_coords: bool,
     wgs84: bool,
     points: &mut [[f64; 3]],
     path: &Path,
     quiet: bool,
 ) -> Result<CrsRef<'r>> {
-    let info = &raster.info;
     let crs = match pixel_coords || info.transform().is_none() {
         true => CrsRef::default(),
         false => CrsRef::new(info.crs_wkt.as_deref(), info.epsg),

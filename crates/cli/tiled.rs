@@ -21,7 +21,7 @@ use crate::report::{MeshSummary, Outcome, Seconds};
 
 /// GDAL block cache in tiled mode, in MB: several rows of tiles of a 16k-wide Float32
 /// raster, whether it is stored in strips or blocks.
-const TILED_BLOCK_CACHE_MB: u64 = 256;
+pub const TILED_BLOCK_CACHE_MB: u64 = 256;
 
 /// The output file when the untiled engine should run: no `--per-tile`, and the raster
 /// fits in one tile. `None` when the tiled engine should run.

@@ -458,6 +458,14 @@ fn greedy(
     }
 }
 
+/// The largest hole (ring vertices) decimation retriangulates; vertices with more
+/// neighbours stay. Removing a line of vertices one after another can hand each one's hole
+/// on to the next, so rings grow with the line and ear clipping, cubic in the ring, took
+/// most of the time (ETOPO5 at 100 m in tiles of 2048: rings up to 706, 25.6 s; capped at
+/// 64: 8.8 s). Measured on ETOPO5, Big Tujunga, a CT slice and Vinschgau at 5 to 100: the
+/// cap changes triangle counts by at most 0.002 %.
+const MAX_HOLE_RING: usize = 64;
+
 /// Removes single vertices; holds the buffers reused across attempts.
 struct Remover<'g> {
     star: Star,
@@ -469,6 +477,8 @@ struct Remover<'g> {
     rules: Rules<'g>,
     /// In border mode, `(width, height)`: samples on the grid's outer border stay.
     locked_border: Option<(u32, u32)>,
+    /// Vertices with more neighbours than this are not tried (see [`MAX_HOLE_RING`]).
+    max_ring: usize,
 }
 
 impl<'g> Remover<'g> {
@@ -482,6 +492,7 @@ impl<'g> Remover<'g> {
             new_triangles: Vec::new(),
             rules,
             locked_border: None,
+            max_ring: MAX_HOLE_RING,
         }
     }
 
@@ -514,7 +525,9 @@ impl<'g> Remover<'g> {
             max_edge_squared: i64::MAX,
             ..saved
         };
+        self.max_ring = usize::MAX;
         let planned = self.plan(mesh, v);
+        self.max_ring = MAX_HOLE_RING;
         self.rules = saved;
         match planned {
             None => Err("it is a corner of the domain, or its hole has no triangulation"),
@@ -582,6 +595,9 @@ impl<'g> Remover<'g> {
         self.points.clear();
         self.points.extend(star.ring.iter().map(|&u| mesh.point(u)));
         let centre = mesh.point(v);
+        if star.ring.len() > self.max_ring {
+            return None;
+        }
         if self.rules.limit == 0.0 && self.points.iter().any(|p| p.z != centre.z) {
             // Below the rounding slack only exactly flat stars go: their bound arithmetic
             // is exact (all differences are zero).

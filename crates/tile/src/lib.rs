@@ -7,7 +7,8 @@
 //! decimated with those vertices locked (`tinsmith_core::decimate_with_border`), checked by
 //! the independent verifier, and streamed, in tile order, into a [`TileSink`]:
 //! [`WeldedWriter`] writes one welded mesh (each shared vertex once, global indices),
-//! [`PerTileWriter`] one file per tile. [`mesh_tiles`] documents the guarantees.
+//! [`PerTileWriter`] one file per tile, [`MeshCollector`] keeps the welded mesh in memory.
+//! [`mesh_tiles`] documents the guarantees.
 //!
 //! Samples come from a [`TileSource`]: [`RasterSource`] reads a GDAL raster a window at a
 //! time (one dataset per worker thread), [`GridSource`] cuts a grid in memory.
@@ -39,6 +40,7 @@
 #![deny(rustdoc::broken_intra_doc_links)]
 #![forbid(unsafe_code)]
 
+mod collect;
 mod edge;
 mod engine;
 mod error;
@@ -53,6 +55,7 @@ mod terrain;
 mod weld;
 mod welded;
 
+pub use collect::MeshCollector;
 pub use edge::{edge_limit, edge_span, EdgeProfile};
 pub use engine::{mesh_tiles, TileOptions, TileProgress, TilesReport, DEFAULT_TILE_SIZE};
 pub use error::{Error, Result};

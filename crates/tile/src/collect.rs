@@ -1,0 +1,50 @@
+//! The sink that keeps the welded mesh in memory, for callers that use the TIN itself
+//! (contouring) rather than a file.
+
+use crate::sink::{FinishedTile, SinkError, TileSink};
+
+/// Collects the tiles of a run into one welded mesh in memory: vertices in raster
+/// coordinates (column, row, value), numbered as [`FinishedTile`] describes, and triangles
+/// counter-clockwise in raster coordinates. Memory is the welded mesh, not the raster.
+#[derive(Debug, Default)]
+pub struct MeshCollector {
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl MeshCollector {
+    /// An empty collector.
+    pub fn new() -> MeshCollector {
+        MeshCollector::default()
+    }
+
+    /// The welded mesh: vertices (column, row, value) and triangles indexing them.
+    pub fn into_parts(self) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        (self.vertices, self.triangles)
+    }
+}
+
+impl TileSink for MeshCollector {
+    fn tile(&mut self, tile: &FinishedTile) -> Result<(), SinkError> {
+        if self.vertices.len() != tile.first_new_id() as usize {
+            return Err(format!(
+                "tiles out of order: {} vertices collected, the tile's first new one is {}",
+                self.vertices.len(),
+                tile.first_new_id()
+            )
+            .into());
+        }
+        for (i, v) in tile.vertices().iter().enumerate() {
+            if tile.is_new(i) {
+                self.vertices.push([f64::from(v.x), f64::from(v.y), v.z]);
+            }
+        }
+        let ids = tile.ids();
+        self.triangles.extend(
+            tile.triangles()
+                .iter()
+                .map(|t| t.map(|local| ids[local as usize])),
+        );
+        Ok(())
+    }
+}

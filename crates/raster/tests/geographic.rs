@@ -9,7 +9,8 @@
 //! the bounding box of the input it reads, and widens it (smoothing) when the box looks
 //! larger than the output. Full-width bands of 217 rows of the Albers fixture are off the
 //! whole warp by up to 6 m on 264,000 samples that way. The rasters here are small enough
-//! for GDAL to warp the whole lattice in one chunk; see docs/results.md for a large one.
+//! for GDAL to warp the whole lattice in one chunk. On large ones GDAL's window heuristic
+//! still varies from chunk to chunk and from block to block (docs/results.md, ETOPO5).
 
 use std::path::{Path, PathBuf};
 

@@ -27,9 +27,11 @@ pub(super) trait RowSource: Sync {
 /// bounding box of the input window it reads: when the box looks larger than the output,
 /// as it does for a long thin strip of lon/lat rows tilted against a projected grid, it
 /// widens the kernel as if downsampling, and smooths. Blocks as wide as they are tall keep
-/// the plain four-sample kernel wherever the whole lattice warped in one piece gets it
-/// (`crates/raster/tests/geographic.rs`); GDAL's own chunks of a large whole warp did not
-/// always (docs/results.md).
+/// the whole warp's four-sample kernel on the test rasters
+/// (`crates/raster/tests/geographic.rs`); GDAL's heuristic still varies on large or
+/// 0..360 inputs, as it did between the chunks of a large whole warp (docs/results.md).
+/// The samples only have to be the same in both passes, which they are: the bands and
+/// blocks are fixed by the level alone.
 pub(super) struct Warp<'a> {
     pub(super) path: &'a Path,
     pub(super) band: usize,
@@ -107,8 +109,9 @@ struct Level {
 
 /// Streams levels `max_zoom` down to `min_zoom` of `bounds` from `source` into `sink`.
 ///
-/// The finest level is read in bands of `band_tile_rows` tile rows (up to one band per
-/// thread at a time, in parallel). After each band, from the finest level down, each
+/// The finest level is read in bands of `band_tile_rows` tile rows, a group of one band per
+/// thread at a time, in parallel; the next group is warped while this group's rows go
+/// through the levels. After each band, from the finest level down, each
 /// level hands its complete tile rows to the sink, then makes every coarser row its rows
 /// allow, then drops the rows neither its tiles nor the coarser level need any more.
 ///
@@ -122,7 +125,8 @@ struct Level {
 ///   inside its footprint has already reached it: a coarser row needs finer rows beyond
 ///   the footprint's tile rows, and a level hands out its tile rows before making coarser
 ///   rows.
-/// - Held rows per level: at most a band plus one tile row and a few halo rows.
+/// - Held rows per level: at most a band plus one tile row and a few halo rows; besides,
+///   two groups of warped bands.
 ///
 /// # Errors
 /// The first error of the source or the sink; the stream stops there.
@@ -145,21 +149,42 @@ pub(super) fn stream_levels(
         })
         .collect();
     let bands = bands(&levels[0].rows, band_tile_rows);
-    for group in bands.chunks(pool.current_num_threads().max(1)) {
+    let groups: Vec<&[Range<usize>]> = bands.chunks(pool.current_num_threads().max(1)).collect();
+    // The finest level's geometry, for the warps running beside the tiles.
+    let finest = LevelRows::new(bounds, max_zoom);
+    let warp = |group: &[Range<usize>]| -> (Vec<TerrainResult<Vec<f32>>>, f64) {
         let t = Instant::now();
-        let finest = &levels[0].rows;
-        let warped: Vec<TerrainResult<Vec<f32>>> = pool.install(|| {
+        let warped = pool.install(|| {
             group
                 .par_iter()
-                .map(|rows| source.rows(finest, rows.clone()))
+                .map(|rows| source.rows(&finest, rows.clone()))
                 .collect()
         });
-        levels[0].seconds += t.elapsed().as_secs_f64();
-        for samples in warped {
-            levels[0].rows.push(&samples?);
-            cascade(&mut levels, pool, sink)?;
+        (warped, t.elapsed().as_secs_f64())
+    };
+    // The next group is warped on its own thread while this one's tiles are built; the
+    // samples do not depend on the timing.
+    std::thread::scope(|scope| -> TerrainResult<()> {
+        let mut next = groups
+            .first()
+            .map(|&group| scope.spawn(move || warp(group)));
+        for k in 0..groups.len() {
+            let (warped, seconds) = next
+                .take()
+                .expect("a warp per group")
+                .join()
+                .expect("the warp thread does not panic");
+            next = groups
+                .get(k + 1)
+                .map(|&group| scope.spawn(move || warp(group)));
+            levels[0].seconds += seconds;
+            for samples in warped {
+                levels[0].rows.push(&samples?);
+                cascade(&mut levels, pool, sink)?;
+            }
         }
-    }
+        Ok(())
+    })?;
     for level in &levels {
         assert!(
             level.done,

@@ -165,22 +165,25 @@ fn warp_pass(path: &Path, opened: &OpenBand, lattice: &GeoLattice, shift: f64) -
         rb.fill(f64::NAN, None).map_err(|e| warp_error(path, e))?;
     }
     reproject(opened.dataset(), &target).map_err(|e| warp_error(path, e))?;
-    let rb = target.rasterband(1).map_err(|e| warp_error(path, e))?;
-    let buffer = rb
-        .read_as::<f32>((0, 0), (width, height), (width, height), None)
+    let buffer = target
+        .rasterband(1)
+        .and_then(|rb| rb.read_as::<f32>((0, 0), (width, height), (width, height), None))
         .map_err(|e| warp_error(path, e))?;
-    let data = buffer.data();
+    drop(target);
+    let (_, mut values) = buffer.into_shape_and_vec();
+    // GDAL's row 0 is the northernmost; the lattice's is the southernmost.
+    for row in 0..height / 2 {
+        let (south, north) = values.split_at_mut((height - 1 - row) * width);
+        south[row * width..(row + 1) * width].swap_with_slice(&mut north[..width]);
+    }
     let (scale, offset) = (info.scale as f32, info.offset as f32);
     let nodata = info.nodata.map(|v| v as f32);
-    let mut values = Vec::with_capacity(width * height);
-    for row in (0..height).rev() {
-        values.extend(data[row * width..(row + 1) * width].iter().map(|&v| {
-            if !v.is_finite() || Some(v) == nodata {
-                f32::NAN
-            } else {
-                v * scale + offset
-            }
-        }));
+    for v in &mut values {
+        *v = if !v.is_finite() || Some(*v) == nodata {
+            f32::NAN
+        } else {
+            *v * scale + offset
+        };
     }
     Ok(values)
 }

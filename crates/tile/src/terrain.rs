@@ -2,18 +2,24 @@
 //! tiles, y = 0 in the south), each decimated within `quality x e(level)`, with shared
 //! edges simplified once so that same-level neighbours keep identical edge vertices.
 
+mod rows;
+mod stream;
+
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use rayon::prelude::*;
 use tinsmith_core::{decimate_with_border, DecimationOptions, Grid};
-use tinsmith_export::{gzip, surface_normal, GeoRectangle, QuantizedMeshTile, QUANTIZED_MAX};
-use tinsmith_raster::{geographic_bounds, warp_to_geographic, GeoBounds, GeoLattice};
+use tinsmith_export::{gzip, GeoRectangle, QuantizedMeshTile, QUANTIZED_MAX};
+use tinsmith_raster::{geographic_bounds, GeoBounds};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
 use crate::edge::{edge_limit, edge_span, EdgeProfile};
+use rows::LevelRows;
+use stream::{band_tile_rows, stream_levels, LevelSink, RowSource, Warp};
 
 /// Cesium's level-zero geometric error for the geographic scheme, in metres:
 /// `maximumRadius * 2 pi * 0.25 / (65 * 2)` (`TerrainProvider`
@@ -170,7 +176,10 @@ pub struct LevelReport {
     pub vertices: u64,
     /// Triangles over all tiles.
     pub triangles: u64,
-    /// Seconds spent on the level (including the warp or downsampling that made it).
+    /// Seconds spent on the level, summed over both passes: making its rows (the warp
+    /// for the finest level, the downsampling for the others), its statistics and its
+    /// tiles. Levels interleave in time, so the levels' seconds add up to about the wall
+    /// time.
     pub seconds: f64,
 }
 
@@ -185,21 +194,6 @@ pub struct TerrainReport {
     pub max_zoom: u8,
     /// Per level, coarsest first.
     pub levels: Vec<LevelReport>,
-}
-
-/// The samples of one level on its lattice, over whole tiles: global lattice column
-/// `x0 + i`, row `y0 + j` (row 0 the southernmost), NaN where there is no data.
-struct LevelRaster {
-    level: u8,
-    /// First tile column and TMS row covered.
-    tx0: u32,
-    ty0: u32,
-    /// Tiles covered.
-    tiles_x: u32,
-    tiles_y: u32,
-    width: usize,
-    height: usize,
-    values: Vec<f32>,
 }
 
 /// Lattice spacing of a level, in degrees.
@@ -254,177 +248,20 @@ fn tile_range(bounds: &GeoBounds, level: u8) -> ([u32; 2], [u32; 2]) {
     (x, y)
 }
 
-impl LevelRaster {
-    fn empty(bounds: &GeoBounds, level: u8) -> LevelRaster {
-        let ([x0, x1], [y0, y1]) = tile_range(bounds, level);
-        let (tiles_x, tiles_y) = (x1 - x0 + 1, y1 - y0 + 1);
-        let width = (tiles_x * TILE_CELLS + 1) as usize;
-        let height = (tiles_y * TILE_CELLS + 1) as usize;
-        LevelRaster {
-            level,
-            tx0: x0,
-            ty0: y0,
-            tiles_x,
-            tiles_y,
-            width,
-            height,
-            values: vec![f32::NAN; width * height],
-        }
-    }
-
-    /// The finest level, warped from the input by GDAL.
-    fn warped(path: &Path, band: usize, bounds: &GeoBounds, level: u8) -> TerrainResult<Self> {
-        let mut raster = LevelRaster::empty(bounds, level);
-        let d = step(level);
-        let lattice = GeoLattice {
-            west: -180.0 + f64::from(raster.tx0 * TILE_CELLS) * d,
-            south: -90.0 + f64::from(raster.ty0 * TILE_CELLS) * d,
-            step: d,
-            width: raster.width as u32,
-            height: raster.height as u32,
-        };
-        raster.values = warp_to_geographic(path, band, &lattice)?;
-        Ok(raster)
-    }
-
-    /// The next coarser level: lattice point (X, Y) is the finer level's (2X, 2Y),
-    /// low-pass filtered with the binomial [1 4 6 4 1] x [1 4 6 4 1] kernel over the valid
-    /// finer samples; nodata only where all 25 are. The domain so grows by at most one
-    /// coarse sample per level, which keeps small inputs visible at coarse levels.
-    fn coarser(&self, bounds: &GeoBounds) -> LevelRaster {
-        let mut out = LevelRaster::empty(bounds, self.level - 1);
-        let fx0 = i64::from(self.tx0 * TILE_CELLS);
-        let fy0 = i64::from(self.ty0 * TILE_CELLS);
-        let cx0 = i64::from(out.tx0 * TILE_CELLS);
-        let cy0 = i64::from(out.ty0 * TILE_CELLS);
-        let fine = |gx: i64, gy: i64| -> f32 {
-            let (i, j) = (gx - fx0, gy - fy0);
-            if i < 0 || j < 0 || i >= self.width as i64 || j >= self.height as i64 {
-                f32::NAN
-            } else {
-                self.values[j as usize * self.width + i as usize]
-            }
-        };
-        const TAPS: [(i64, f64); 5] = [(-2, 1.0), (-1, 4.0), (0, 6.0), (1, 4.0), (2, 1.0)];
-        let width = out.width;
-        out.values
-            .par_chunks_mut(width)
-            .enumerate()
-            .for_each(|(j, row)| {
-                let gy = 2 * (cy0 + j as i64);
-                for (i, slot) in row.iter_mut().enumerate() {
-                    let gx = 2 * (cx0 + i as i64);
-                    let (mut sum, mut weight) = (0.0f64, 0.0f64);
-                    for (dy, wy) in TAPS {
-                        for (dx, wx) in TAPS {
-                            let v = fine(gx + dx, gy + dy);
-                            if v.is_finite() {
-                                sum += wx * wy * f64::from(v);
-                                weight += wx * wy;
-                            }
-                        }
-                    }
-                    if weight == 0.0 {
-                        continue;
-                    }
-                    *slot = (sum / weight) as f32;
-                }
-            });
-        out
-    }
-
-    fn at(&self, i: usize, j: usize) -> f64 {
-        f64::from(self.values[j * self.width + i])
-    }
-
-    /// Whether the cell with lower-left sample (i, j) lies in the raster and has four
-    /// valid corners.
-    fn cell_valid(&self, i: i64, j: i64) -> bool {
-        if i < 0 || j < 0 || i + 1 >= self.width as i64 || j + 1 >= self.height as i64 {
-            return false;
-        }
-        let (i, j) = (i as usize, j as usize);
-        [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]
-            .iter()
-            .all(|&(a, b)| self.at(a, b).is_finite())
-    }
-
-    /// The edge from sample (i, j) along +x (`horizontal`) or +y, `TILE_CELLS` steps,
-    /// as both tiles beside it see it.
-    fn edge(&self, i: usize, j: usize, horizontal: bool) -> EdgeProfile {
-        let n = TILE_CELLS as usize;
-        let (i, j) = (i as i64, j as i64);
-        let point = |k: i64| if horizontal { (i + k, j) } else { (i, j + k) };
-        let values = (0..=n as i64)
-            .map(|k| {
-                let (a, b) = point(k);
-                self.at(a as usize, b as usize)
-            })
-            .collect();
-        let open = (0..n as i64)
-            .map(|k| {
-                let (a, b) = point(k);
-                // The cells on both sides of the step; a side outside the raster is the
-                // raster's outer border, where no tile has data.
-                let (side1, side2) = if horizontal {
-                    ((a, b - 1), (a, b))
-                } else {
-                    ((a - 1, b), (a, b))
-                };
-                let inside = |(x, y): (i64, i64)| {
-                    x >= 0 && y >= 0 && x + 1 < self.width as i64 && y + 1 < self.height as i64
-                };
-                [side1, side2]
-                    .iter()
-                    .all(|&c| !inside(c) || self.cell_valid(c.0, c.1))
-            })
-            .collect();
-        EdgeProfile::new(values, open)
-    }
-
-    /// Unit ECEF normal at sample (i, j) from central differences of the level's samples
-    /// (one-sided at nodata or the raster's edge): the same for every tile that has the
-    /// sample, so normals are continuous across tile edges.
-    fn normal(&self, i: usize, j: usize, lon: f64, lat: f64) -> [f64; 3] {
-        let d = step(self.level).to_radians();
-        let z = self.at(i, j);
-        let sample = |a: i64, b: i64| -> Option<f64> {
-            if a < 0 || b < 0 || a >= self.width as i64 || b >= self.height as i64 {
-                return None;
-            }
-            Some(self.at(a as usize, b as usize)).filter(|v| v.is_finite())
-        };
-        let slope = |lo: Option<f64>, hi: Option<f64>, spacing: f64| match (lo, hi) {
-            (Some(a), Some(b)) => (b - a) / (2.0 * spacing),
-            (None, Some(b)) => (b - z) / spacing,
-            (Some(a), None) => (z - a) / spacing,
-            (None, None) => 0.0,
-        };
-        let (ii, jj) = (i as i64, j as i64);
-        let dx = tinsmith_export::WGS84_A * d * lat.to_radians().cos().max(1e-6);
-        let dy = tinsmith_export::WGS84_A * d;
-        let ge = slope(sample(ii - 1, jj), sample(ii + 1, jj), dx);
-        let gn = slope(sample(ii, jj - 1), sample(ii, jj + 1), dy);
-        let (e, n, u) = (-ge, -gn, 1.0);
-        let len = (e * e + n * n + u * u).sqrt();
-        let (e, n, u) = (e / len, n / len, u / len);
-        let (lon, lat) = (lon.to_radians(), lat.to_radians());
-        let east = [-lon.sin(), lon.cos(), 0.0];
-        let north = [-lat.sin() * lon.cos(), -lat.sin() * lon.sin(), lat.cos()];
-        let up = surface_normal(lon.to_degrees(), lat.to_degrees());
-        [0, 1, 2].map(|k| e * east[k] + n * north[k] + u * up[k])
-    }
-}
-
 /// The level's bound and its height quantum.
 #[derive(Debug, Clone, Copy)]
 struct LevelBudget {
+    /// The bound asked for, `quality x e(level)`.
+    bound: f64,
+    /// The height quantum.
     step: f64,
     /// Longest edge, in lattice spacings (see [`max_edge_length`]).
     max_edge: Option<u32>,
     /// What decimation may use: the bound less the quantization error (half a step).
     decimation: f64,
+    /// What the verifier checks: the bound, or half a step (and a margin) when larger.
     verify: f64,
+    /// The finest level's largest |height| (every level's rounding slack).
     max_abs: f64,
 }
 
@@ -454,9 +291,16 @@ type Available = Vec<BTreeSet<(u32, u32)>>;
 ///   `height_step`), so they decode to the same heights.
 /// - **Determinism.** The same input and options give the same bytes for any `threads`.
 /// - Tiles without a valid cell are not written and not listed in `available`.
+/// - **Memory.** Bounded by a few bands of tile rows per level (a band is at most 2^22
+///   samples of the finest level, or one tile row when a row is wider), plus one band per
+///   thread during the warp: it does not grow with the raster's height.
 ///
-/// The finest level is warped once from the input with GDAL (bilinear); each coarser level
-/// is the finer one smoothed and halved, so the input is read once.
+/// The finest level is warped from the input with GDAL (bilinear), band by band; each
+/// coarser level is the finer one smoothed and halved, row by row as the finer rows
+/// arrive. Each level's height quantum depends on its widest tile, and the rounding slack
+/// of every level on the finest level's largest |height|, both known only once the level
+/// has been seen whole, so the levels are streamed twice: once for these statistics, once
+/// for the tiles (the input is read twice, never held whole).
 pub fn build_terrain(
     input: &Path,
     out_dir: &Path,
@@ -482,42 +326,18 @@ pub fn build_terrain(
             options.min_zoom
         )));
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(options.threads)
-        .build()
-        .map_err(|source| TerrainError::Threads {
-            threads: options.threads,
-            source,
-        })?;
     std::fs::create_dir_all(out_dir).map_err(|source| TerrainError::Output {
         path: out_dir.to_path_buf(),
         source,
     })?;
-
-    let mut available: Available = vec![BTreeSet::new(); usize::from(max_zoom) + 1];
-    let mut levels = Vec::new();
-    let mut t = Instant::now();
-    let mut raster = LevelRaster::warped(input, options.band, &bounds, max_zoom)?;
-    // One rounding slack for every level, from the finest raster's largest |height|.
-    let max_abs = raster
-        .values
-        .iter()
-        .filter(|v| v.is_finite())
-        .fold(0.0f64, |m, &v| m.max(f64::from(v).abs()));
-    loop {
-        let level = raster.level;
-        let mut report =
-            pool.install(|| build_level(&raster, out_dir, options, max_abs, &mut available))?;
-        report.seconds = t.elapsed().as_secs_f64();
-        progress(&report);
-        levels.push(report);
-        if level == options.min_zoom {
-            break;
-        }
-        t = Instant::now();
-        raster = pool.install(|| raster.coarser(&bounds));
-    }
-    levels.reverse();
+    let source = Warp {
+        path: input,
+        band: options.band,
+    };
+    let band_rows = band_tile_rows(&bounds, max_zoom);
+    let (levels, available) = build_pyramid(
+        &source, &bounds, max_zoom, band_rows, out_dir, options, progress,
+    )?;
     write_layer_json(input, out_dir, options, &bounds, max_zoom, &available)?;
     Ok(TerrainReport {
         bounds: [bounds.west, bounds.south, bounds.east, bounds.north],
@@ -527,108 +347,233 @@ pub fn build_terrain(
     })
 }
 
-/// The tiles of one level, in TMS row then column order.
-fn level_tiles(raster: &LevelRaster) -> Vec<(u32, u32)> {
-    (0..raster.tiles_y)
-        .flat_map(|j| (0..raster.tiles_x).map(move |i| (raster.tx0 + i, raster.ty0 + j)))
+/// The tiles of [`build_terrain`] from `source`, its finest level read in bands of
+/// `band_rows` tile rows: the level reports, coarsest first, and the tiles written.
+fn build_pyramid(
+    source: &dyn RowSource,
+    bounds: &GeoBounds,
+    max_zoom: u8,
+    band_rows: u32,
+    out_dir: &Path,
+    options: &TerrainOptions,
+    progress: &mut dyn FnMut(&LevelReport),
+) -> TerrainResult<(Vec<LevelReport>, Available)> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(options.threads)
+        .build()
+        .map_err(|source| TerrainError::Threads {
+            threads: options.threads,
+            source,
+        })?;
+    let zooms = (options.min_zoom, max_zoom);
+    let mut stats = LevelStats::new(max_zoom, &pool);
+    stream_levels(source, bounds, zooms, band_rows, &pool, &mut stats)?;
+    let mut writer = TileWriter::new(stats, out_dir, options, &pool, progress);
+    stream_levels(source, bounds, zooms, band_rows, &pool, &mut writer)?;
+    let mut levels = writer.finished;
+    levels.reverse();
+    Ok((levels, writer.available))
+}
+
+/// The first pass: what every tile of a level must agree on, from the whole level.
+struct LevelStats<'p> {
+    max_zoom: u8,
+    /// The largest |height| of the finest level.
+    max_abs: f64,
+    /// Per level: the widest range of valid heights of any of its tiles.
+    widest: Vec<f64>,
+    /// Per level: seconds spent.
+    seconds: Vec<f64>,
+    pool: &'p rayon::ThreadPool,
+}
+
+impl<'p> LevelStats<'p> {
+    fn new(max_zoom: u8, pool: &'p rayon::ThreadPool) -> Self {
+        let levels = usize::from(max_zoom) + 1;
+        LevelStats {
+            max_zoom,
+            max_abs: 0.0,
+            widest: vec![0.0; levels],
+            seconds: vec![0.0; levels],
+            pool,
+        }
+    }
+}
+
+impl LevelSink for LevelStats<'_> {
+    fn tile_rows(&mut self, level: &LevelRows, tile_rows: Range<u32>) -> TerrainResult<()> {
+        let t = Instant::now();
+        let tiles = tiles_of(level, tile_rows);
+        let ranges: Vec<(f64, f64)> = self.pool.install(|| {
+            tiles
+                .par_iter()
+                .filter_map(|&(x, y)| level.tile_height_range(x, y))
+                .collect()
+        });
+        let z = usize::from(level.level);
+        for (lo, hi) in ranges {
+            self.widest[z] = self.widest[z].max(hi - lo);
+            // Every sample of the finest level is in one of its tiles.
+            if level.level == self.max_zoom {
+                self.max_abs = self.max_abs.max(lo.abs()).max(hi.abs());
+            }
+        }
+        self.seconds[z] += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    fn level_done(&mut self, level: u8, seconds: f64) -> TerrainResult<()> {
+        self.seconds[usize::from(level)] += seconds;
+        Ok(())
+    }
+}
+
+/// The tiles of tile rows `tile_rows` (local) of a level, in TMS row then column order.
+fn tiles_of(level: &LevelRows, tile_rows: Range<u32>) -> Vec<(u32, u32)> {
+    tile_rows
+        .flat_map(|j| (0..level.tiles_x).map(move |i| (level.tx0 + i, level.ty0 + j)))
         .collect()
 }
 
-/// The range of valid heights of tile (x, y), if it has any.
-fn tile_height_range(raster: &LevelRaster, x: u32, y: u32) -> Option<(f64, f64)> {
-    let n = TILE_CELLS as usize;
-    let i0 = ((x - raster.tx0) * TILE_CELLS) as usize;
-    let j0 = ((y - raster.ty0) * TILE_CELLS) as usize;
-    let mut range: Option<(f64, f64)> = None;
-    for j in j0..=j0 + n {
-        for v in &raster.values[j * raster.width + i0..=j * raster.width + i0 + n] {
-            if v.is_finite() {
-                let v = f64::from(*v);
-                range = Some(match range {
-                    Some((lo, hi)) => (lo.min(v), hi.max(v)),
-                    None => (v, v),
-                });
-            }
-        }
-    }
-    range
-}
-
-fn build_level(
-    raster: &LevelRaster,
-    out_dir: &Path,
-    options: &TerrainOptions,
-    max_abs: f64,
-    available: &mut Available,
-) -> TerrainResult<LevelReport> {
-    let level = raster.level;
-    let tiles = level_tiles(raster);
+/// The level's bound and height quantum, from its widest tile and the finest level's
+/// largest |height|.
+fn level_budget(level: u8, widest: f64, quality: f64, max_abs: f64) -> LevelBudget {
     // The height quantum: the smallest power of two that fits every tile's range in
     // 32766 steps (so a minimum rounded down to the lattice still leaves room).
-    let widest = tiles
-        .par_iter()
-        .filter_map(|&(x, y)| tile_height_range(raster, x, y))
-        .map(|(lo, hi)| hi - lo)
-        .reduce(|| 0.0, f64::max);
     let mut height_step = MIN_HEIGHT_STEP;
     while height_step * f64::from(QUANTIZED_MAX - 1) < widest {
         height_step *= 2.0;
     }
-    let bound = options.quality * LEVEL_ZERO_ERROR / (1u64 << level) as f64;
+    let bound = quality * LEVEL_ZERO_ERROR / (1u64 << level) as f64;
     let half_step = height_step / 2.0;
     // The quantization error is at most half a step; keep a relative margin of 2^-30 for
     // the float arithmetic of interpolation.
     let margin = (bound + max_abs) / (1u64 << 30) as f64;
-    let budget = LevelBudget {
+    LevelBudget {
+        bound,
         step: height_step,
         max_edge: max_edge_length(level, bound),
         decimation: (bound - half_step - margin).max(0.0),
         verify: bound.max(half_step + margin),
         max_abs,
-    };
-
-    let metadata_available = if options.metadata && level.is_multiple_of(METADATA_AVAILABILITY) {
-        Some(&*available)
-    } else {
-        None
-    };
-    let results: Vec<TerrainResult<Option<TileOut>>> = tiles
-        .par_iter()
-        .map(|&(x, y)| build_tile(raster, x, y, &budget, options, metadata_available))
-        .collect();
-
-    let mut report = LevelReport {
-        level,
-        bound,
-        achieved_bound: budget.verify,
-        height_step,
-        measured_max_error: 0.0,
-        tiles: 0,
-        empty_tiles: 0,
-        bytes: 0,
-        vertices: 0,
-        triangles: 0,
-        seconds: 0.0,
-    };
-    for result in results {
-        let Some(tile) = result? else {
-            report.empty_tiles += 1;
-            continue;
-        };
-        let dir = out_dir.join(level.to_string()).join(tile.x.to_string());
-        std::fs::create_dir_all(&dir).map_err(|source| TerrainError::Output {
-            path: dir.clone(),
-            source,
-        })?;
-        write_atomic(&dir.join(format!("{}.terrain", tile.y)), &tile.bytes)?;
-        available[usize::from(level)].insert((tile.x, tile.y));
-        report.tiles += 1;
-        report.bytes += tile.bytes.len() as u64;
-        report.vertices += tile.vertices as u64;
-        report.triangles += tile.triangles as u64;
-        report.measured_max_error = report.measured_max_error.max(tile.max_error);
     }
-    Ok(report)
+}
+
+/// The second pass: builds, checks and writes the tiles, row by row of each level.
+struct TileWriter<'a> {
+    out_dir: &'a Path,
+    options: &'a TerrainOptions,
+    pool: &'a rayon::ThreadPool,
+    progress: &'a mut dyn FnMut(&LevelReport),
+    budgets: Vec<LevelBudget>,
+    /// Per level, while it is being written.
+    reports: Vec<LevelReport>,
+    /// Seconds of the first pass, per level.
+    stats_seconds: Vec<f64>,
+    available: Available,
+    /// Finished levels, finest first.
+    finished: Vec<LevelReport>,
+}
+
+impl<'a> TileWriter<'a> {
+    fn new(
+        stats: LevelStats<'_>,
+        out_dir: &'a Path,
+        options: &'a TerrainOptions,
+        pool: &'a rayon::ThreadPool,
+        progress: &'a mut dyn FnMut(&LevelReport),
+    ) -> Self {
+        let budgets: Vec<LevelBudget> = (0..=stats.max_zoom)
+            .map(|z| {
+                level_budget(
+                    z,
+                    stats.widest[usize::from(z)],
+                    options.quality,
+                    stats.max_abs,
+                )
+            })
+            .collect();
+        let reports = budgets
+            .iter()
+            .zip(0..)
+            .map(|(budget, level)| LevelReport {
+                level,
+                bound: budget.bound,
+                achieved_bound: budget.verify,
+                height_step: budget.step,
+                measured_max_error: 0.0,
+                tiles: 0,
+                empty_tiles: 0,
+                bytes: 0,
+                vertices: 0,
+                triangles: 0,
+                seconds: 0.0,
+            })
+            .collect();
+        TileWriter {
+            out_dir,
+            options,
+            pool,
+            progress,
+            budgets,
+            reports,
+            stats_seconds: stats.seconds,
+            available: vec![BTreeSet::new(); usize::from(stats.max_zoom) + 1],
+            finished: Vec::new(),
+        }
+    }
+}
+
+impl LevelSink for TileWriter<'_> {
+    fn tile_rows(&mut self, level: &LevelRows, tile_rows: Range<u32>) -> TerrainResult<()> {
+        let t = Instant::now();
+        let z = level.level;
+        let tiles = tiles_of(level, tile_rows);
+        let budget = &self.budgets[usize::from(z)];
+        let options = self.options;
+        // Finer levels inside these tiles' footprints are complete (see `stream_levels`).
+        let metadata_available = if options.metadata && z.is_multiple_of(METADATA_AVAILABILITY) {
+            Some(&self.available)
+        } else {
+            None
+        };
+        let results: Vec<TerrainResult<Option<TileOut>>> = self.pool.install(|| {
+            tiles
+                .par_iter()
+                .map(|&(x, y)| build_tile(level, x, y, budget, options, metadata_available))
+                .collect()
+        });
+        let report = &mut self.reports[usize::from(z)];
+        for result in results {
+            let Some(tile) = result? else {
+                report.empty_tiles += 1;
+                continue;
+            };
+            let dir = self.out_dir.join(z.to_string()).join(tile.x.to_string());
+            std::fs::create_dir_all(&dir).map_err(|source| TerrainError::Output {
+                path: dir.clone(),
+                source,
+            })?;
+            write_atomic(&dir.join(format!("{}.terrain", tile.y)), &tile.bytes)?;
+            self.available[usize::from(z)].insert((tile.x, tile.y));
+            report.tiles += 1;
+            report.bytes += tile.bytes.len() as u64;
+            report.vertices += tile.vertices as u64;
+            report.triangles += tile.triangles as u64;
+            report.measured_max_error = report.measured_max_error.max(tile.max_error);
+        }
+        report.seconds += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    fn level_done(&mut self, level: u8, seconds: f64) -> TerrainResult<()> {
+        let z = usize::from(level);
+        let report = &mut self.reports[z];
+        report.seconds += seconds + self.stats_seconds[z];
+        (self.progress)(report);
+        self.finished.push(report.clone());
+        Ok(())
+    }
 }
 
 fn write_atomic(path: &Path, bytes: &[u8]) -> TerrainResult<()> {
@@ -644,7 +589,7 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> TerrainResult<()> {
 }
 
 fn build_tile(
-    raster: &LevelRaster,
+    raster: &LevelRows,
     x: u32,
     y: u32,
     budget: &LevelBudget,
@@ -653,16 +598,8 @@ fn build_tile(
 ) -> TerrainResult<Option<TileOut>> {
     let z = raster.level;
     let n = TILE_CELLS as usize;
-    let i0 = ((x - raster.tx0) * TILE_CELLS) as usize;
-    let j0 = ((y - raster.ty0) * TILE_CELLS) as usize;
-    let mut values = Vec::with_capacity((n + 1) * (n + 1));
-    for j in j0..=j0 + n {
-        values.extend(
-            raster.values[j * raster.width + i0..=j * raster.width + i0 + n]
-                .iter()
-                .map(|&v| f64::from(v)),
-        );
-    }
+    let (i0, j0) = raster.tile_origin(x, y);
+    let values = raster.tile_values(x, y);
     let grid = Grid::new(TILE_CELLS + 1, TILE_CELLS + 1, values).expect("a 218 x 218 grid");
     if grid.valid_cell_count() == 0 {
         return Ok(None);
@@ -974,6 +911,80 @@ mod tests {
         assert_eq!(
             rectangles(&tiles, [2, 9], all),
             vec![[2, 0, 2, 1], [5, 1, 5, 1]]
+        );
+    }
+
+    /// Every file under `root`, by relative path.
+    fn files(root: &Path) -> std::collections::BTreeMap<PathBuf, Vec<u8>> {
+        let mut out = std::collections::BTreeMap::new();
+        let mut stack = vec![root.to_path_buf()];
+        while let Some(dir) = stack.pop() {
+            for entry in std::fs::read_dir(&dir).unwrap() {
+                let path = entry.unwrap().path();
+                if path.is_dir() {
+                    stack.push(path);
+                } else {
+                    let bytes = std::fs::read(&path).unwrap();
+                    out.insert(path.strip_prefix(root).unwrap().to_path_buf(), bytes);
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn pyramid_bytes_do_not_depend_on_the_band_height() {
+        // 4 x 3 tiles at level 12 with a hole; level 10 carries the metadata of 11 and 12,
+        // so it must see their availability complete although the levels interleave.
+        let bounds = GeoBounds {
+            west: 10.01,
+            south: 45.01,
+            east: 10.11,
+            north: 45.11,
+            resolution: 0.0002,
+        };
+        let source = stream::Hills {
+            hole: [10.06, 45.04, 0.015],
+        };
+        let options = TerrainOptions {
+            min_zoom: 9,
+            max_zoom: Some(12),
+            normals: true,
+            metadata: true,
+            threads: 2,
+            ..TerrainOptions::default()
+        };
+        let mut outputs = Vec::new();
+        for band_rows in [1, 100] {
+            let dir = tempfile::tempdir().unwrap();
+            let mut finished = Vec::new();
+            let (mut levels, available) = build_pyramid(
+                &source,
+                &bounds,
+                12,
+                band_rows,
+                dir.path(),
+                &options,
+                &mut |level| finished.push(level.level),
+            )
+            .unwrap();
+            assert_eq!(finished, [12, 11, 10, 9]);
+            for level in &mut levels {
+                level.seconds = 0.0;
+            }
+            outputs.push((files(dir.path()), levels, available));
+        }
+        let (files, levels, available) = &outputs[0];
+        assert_eq!(levels[3].tiles, 12);
+        assert_eq!(
+            files.len() as u64,
+            levels.iter().map(|l| l.tiles).sum::<u64>()
+        );
+        let level_10 = &available[10];
+        assert!(!level_10.is_empty() && !available[12].is_empty());
+        assert!(
+            outputs[0] == outputs[1],
+            "bands of 1 and 100 tile rows differ"
         );
     }
 

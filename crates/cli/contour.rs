@@ -157,11 +157,7 @@ fn untiled_tin(args: &ContourArgs, e: f64, raster: &Raster) -> Result<(ContourMe
         ));
     }
     if grid.valid_cell_count() == 0 {
-        bail!(
-            "{}: band {} has no 2x2 block of valid samples, so there is nothing to contour",
-            args.input.display(),
-            args.band
-        );
+        return Err(nothing_to_contour(args));
     }
     if e == 0.0 {
         let mesh = ContourMesh::from_grid(grid.width(), grid.height(), grid.values())
@@ -196,15 +192,21 @@ fn tiled_tin(args: &ContourArgs, e: f64) -> Result<(ContourMesh, RasterInfo, usi
     let report = mesh_tiles(&source, &options, &mut collector, &mut |_| {})
         .with_context(|| format!("{input}"))?;
     if report.final_triangles == 0 {
-        bail!(
-            "{input}: band {} has no 2x2 block of valid samples, so there is nothing to contour",
-            args.band
-        );
+        return Err(nothing_to_contour(args));
     }
     let (vertices, triangles) = collector.into_parts();
     let mesh =
         ContourMesh::new(vertices, triangles).with_context(|| format!("{input}: decimated TIN"))?;
     Ok((mesh, info, report.plan.len()))
+}
+
+/// The error for a band without a valid 2x2 block of samples.
+fn nothing_to_contour(args: &ContourArgs) -> anyhow::Error {
+    anyhow::anyhow!(
+        "{}: band {} has no 2x2 block of valid samples, so there is nothing to contour",
+        args.input.display(),
+        args.band
+    )
 }
 
 /// Reads a mesh file written from `raster` (as `tinsmith verify` reads it: GeoJSON in

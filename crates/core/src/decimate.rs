@@ -589,15 +589,12 @@ impl<'g> Remover<'g> {
         }
         let star = &mut self.ring_star;
         mesh.star(v, star);
-        if mesh.classify(v, star) == VertexClass::Corner {
+        if star.ring.len() > self.max_ring || mesh.classify(v, star) == VertexClass::Corner {
             return None;
         }
         self.points.clear();
         self.points.extend(star.ring.iter().map(|&u| mesh.point(u)));
         let centre = mesh.point(v);
-        if star.ring.len() > self.max_ring {
-            return None;
-        }
         if self.rules.limit == 0.0 && self.points.iter().any(|p| p.z != centre.z) {
             // Below the rounding slack only exactly flat stars go: their bound arithmetic
             // is exact (all differences are zero).

@@ -26,25 +26,12 @@ impl MeshCollector {
 
 impl TileSink for MeshCollector {
     fn tile(&mut self, tile: &FinishedTile) -> Result<(), SinkError> {
-        if self.vertices.len() != tile.first_new_id() as usize {
-            return Err(format!(
-                "tiles out of order: {} vertices collected, the tile's first new one is {}",
-                self.vertices.len(),
-                tile.first_new_id()
-            )
-            .into());
-        }
-        for (i, v) in tile.vertices().iter().enumerate() {
-            if tile.is_new(i) {
-                self.vertices.push([f64::from(v.x), f64::from(v.y), v.z]);
-            }
-        }
-        let ids = tile.ids();
-        self.triangles.extend(
-            tile.triangles()
-                .iter()
-                .map(|t| t.map(|local| ids[local as usize])),
+        tile.check_follows(self.vertices.len())?;
+        self.vertices.extend(
+            tile.new_vertices()
+                .map(|v| [f64::from(v.x), f64::from(v.y), v.z]),
         );
+        self.triangles.extend(tile.welded_triangles());
         Ok(())
     }
 }

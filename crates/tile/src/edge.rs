@@ -34,14 +34,10 @@ pub fn edge_limit(max_error: f64, max_abs_value: f64) -> f64 {
 pub fn edge_span(max_edge_length: Option<u32>) -> usize {
     match max_edge_length {
         None => usize::MAX,
-        Some(l) => {
-            let target = u64::from(l) * u64::from(l);
-            let mut s = 1u64;
-            while (s + 1) * (s + 1) < target {
-                s += 1;
-            }
-            s as usize
-        }
+        Some(l) => (u64::from(l) * u64::from(l))
+            .saturating_sub(1)
+            .isqrt()
+            .max(1) as usize,
     }
 }
 

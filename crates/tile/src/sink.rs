@@ -82,6 +82,35 @@ impl FinishedTile {
         self.ids[i] >= self.first_new_id
     }
 
+    /// The tile's new vertices, in welded-id order.
+    pub fn new_vertices(&self) -> impl Iterator<Item = &TinVertex> + '_ {
+        self.vertices
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| self.is_new(i))
+            .map(|(_, v)| v)
+    }
+
+    /// The tile's triangles with welded ids, counter-clockwise in raster coordinates.
+    pub fn welded_triangles(&self) -> impl Iterator<Item = [u32; 3]> + '_ {
+        self.triangles
+            .iter()
+            .map(|t| t.map(|local| self.ids[local as usize]))
+    }
+
+    /// An error unless this tile's first new vertex is number `written`: a sink that
+    /// appends vertices calls it with the count it holds, so tiles out of order are caught.
+    pub fn check_follows(&self, written: usize) -> Result<(), SinkError> {
+        if written == self.first_new_id as usize {
+            return Ok(());
+        }
+        Err(format!(
+            "tiles out of order: {written} vertices so far, the tile's first new one is {}",
+            self.first_new_id
+        )
+        .into())
+    }
+
     /// The decimation's counts and timings for this tile.
     pub fn report(&self) -> &DecimationReport {
         &self.report

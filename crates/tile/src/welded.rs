@@ -66,29 +66,16 @@ impl WeldedWriter {
 
 impl TileSink for WeldedWriter {
     fn tile(&mut self, tile: &FinishedTile) -> std::result::Result<(), SinkError> {
-        if self.stream.vertex_count() != tile.first_new_id() as usize {
-            return Err(format!(
-                "tiles out of order: the file has {} vertices, the tile's first new one is {}",
-                self.stream.vertex_count(),
-                tile.first_new_id()
-            )
-            .into());
-        }
+        tile.check_follows(self.stream.vertex_count())?;
         self.vertices.clear();
-        for (i, v) in tile.vertices().iter().enumerate() {
-            if tile.is_new(i) {
-                let [x, y] = self.placement.position(v.x, v.y);
-                self.vertices.push([x, y, v.z]);
-            }
-        }
+        self.vertices.extend(tile.new_vertices().map(|v| {
+            let [x, y] = self.placement.position(v.x, v.y);
+            [x, y, v.z]
+        }));
         self.stream.write_vertices(&self.vertices)?;
-        let ids = tile.ids();
         self.triangles.clear();
-        self.triangles.extend(
-            tile.triangles()
-                .iter()
-                .map(|t| self.placement.orient(t.map(|local| ids[local as usize]))),
-        );
+        self.triangles
+            .extend(tile.welded_triangles().map(|t| self.placement.orient(t)));
         self.stream.write_triangles(&self.triangles)?;
         Ok(())
     }

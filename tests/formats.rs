@@ -555,8 +555,9 @@ fn float32_formats_refuse_rasters_too_wide_for_float32_positions() {
          NODATA_value -9999\n{row}\n{row}\n"
     );
     let asc = d.write("wide.asc", &text).to_string_lossy().into_owned();
-    // One tile, so that the float32 check (not the tiled engine's format rule) answers.
-    for name in ["w.stl", "w.glb"] {
+    // One tile and many: the untiled and tiled engines make the same check, before
+    // decimating, and write nothing.
+    for (name, size) in [("w.stl", "40000"), ("w.glb", "40000"), ("w.stl", "1024")] {
         let o = d.run(&[
             "mesh",
             &asc,
@@ -565,13 +566,11 @@ fn float32_formats_refuse_rasters_too_wide_for_float32_positions() {
             "--max-error",
             "1",
             "--tile-size",
-            "40000",
+            size,
         ]);
         crate::util::assert_fails_naming(&o, &[name, "too large for float32"]);
+        assert!(!d.path(name).exists());
     }
-    // The tiled engine writes PLY/OBJ only, and says so.
-    let o = d.run(&["mesh", &asc, "-o", "w.stl", "--max-error", "1"]);
-    crate::util::assert_fails_naming(&o, &["w.stl", "tile-size"]);
     // Double-precision formats are fine.
     mesh(&d, &asc, "w.fgb", "1", &["--tile-size", "40000"]);
     verify(&d, &asc, "w.fgb", "1", &[]);

@@ -305,21 +305,90 @@ fn per_tile_refuses_a_non_empty_directory_and_leaves_nothing() {
 }
 
 #[test]
-fn count_targets_need_the_untiled_engine() {
+fn count_targets_run_untiled_whatever_the_tile_size() {
     let dem = fixture("becmodel_dem_bc_albers_50m.tif");
     let d = Dir::new();
+    let r = mesh(
+        &d,
+        &[
+            &dem,
+            "-o",
+            "t.ply",
+            "--max-triangles",
+            "1000",
+            "--tile-size",
+            "64",
+            "-q",
+        ],
+    );
+    assert!(
+        r.get("tiles").is_none(),
+        "a count target needs the whole raster"
+    );
+    assert!(r["triangles_after"].as_u64().unwrap() <= 1000);
+    let v = verify(&d, &dem, "t.ply", "1e9", false);
+    assert_eq!(r["measured_max_error"], v["max_error"]);
+
     let o = d.run(&[
         "mesh",
         &dem,
-        "-o",
-        "t.ply",
+        "--per-tile",
+        "tiles",
         "--max-triangles",
         "1000",
         "--tile-size",
         "64",
     ]);
-    assert_fails_naming(&o, &["becmodel_dem_bc_albers_50m.tif", "--tile-size"]);
-    assert!(d.files().is_empty());
+    assert_fails_naming(&o, &["becmodel_dem_bc_albers_50m.tif", "--per-tile"]);
+    assert_eq!(d.files(), vec!["r.json", "t.ply"]);
+}
+
+#[test]
+fn every_format_is_written_from_tiles() {
+    // PLY and OBJ stream tile by tile; the others are welded in memory and written at the
+    // end. Every file keeps the bound (float32 formats too) and holds the same mesh.
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let d = Dir::new();
+    let e = "2";
+    let base = mesh(
+        &d,
+        &[
+            &dem,
+            "-o",
+            "t.ply",
+            "--max-error",
+            e,
+            "--tile-size",
+            "64",
+            "-q",
+        ],
+    );
+    for name in ["t.fgb", "t.geojson", "t.stl", "t.glb", "t.xml", "t.obj"] {
+        let r = mesh(
+            &d,
+            &[
+                &dem,
+                "-o",
+                name,
+                "--max-error",
+                e,
+                "--tile-size",
+                "64",
+                "-q",
+            ],
+        );
+        assert!(r["tiles"]["count"].as_u64().unwrap() > 4, "{name}: tiled");
+        let v = verify(&d, &dem, name, e, false);
+        assert!(v["max_error"].as_f64().unwrap() <= 2.0, "{name}: {v:#}");
+        assert_eq!(v["triangles"], r["triangles_after"], "{name}");
+        // STL stores unshared corners; the others share vertices as the PLY does.
+        if name != "t.stl" {
+            assert_eq!(v["vertices"], base["vertices_after"], "{name}");
+        }
+        if !name.ends_with(".stl") && !name.ends_with(".glb") {
+            assert_eq!(r["triangles_after"], base["triangles_after"], "{name}");
+        }
+    }
 }
 
 #[test]

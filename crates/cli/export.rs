@@ -8,7 +8,7 @@ use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use tinsmith_core::Grid;
 use tinsmith_export::{CrsRef, LocalOrigin, MeshFormat, MeshRef, WriteOptions};
-use tinsmith_raster::{Raster, RasterInfo};
+use tinsmith_raster::RasterInfo;
 
 use crate::args::MeshArgs;
 use crate::georef::Georef;
@@ -74,11 +74,17 @@ pub struct PlanReport {
 }
 
 impl Plan {
-    /// For STL and glTF: the origin in the middle of the grid's file coordinates and
+    /// For STL and glTF: the origin in the middle of the raster's file coordinates and
     /// heights, the largest float32 rounding of a height, and the bound left for the
     /// decimator; fails when float32 cannot hold the positions to a sample or the heights
-    /// within `max_error`.
-    pub fn new(format: MeshFormat, raster: &Raster, args: &MeshArgs) -> Result<Plan> {
+    /// within `max_error`. With the `grid` in memory the rounding is measured at every
+    /// valid sample; without it (the tiled engine) it is bounded from the height range.
+    pub fn new(
+        format: MeshFormat,
+        info: &RasterInfo,
+        grid: Option<&Grid>,
+        args: &MeshArgs,
+    ) -> Result<Plan> {
         let max_error = args.max_error.unwrap_or(f64::INFINITY);
         if !format.is_float32() {
             return Ok(Plan {
@@ -88,8 +94,7 @@ impl Plan {
                 decimation_bound: max_error,
             });
         }
-        let grid = &raster.grid;
-        if let (Some(base), Some(min)) = (args.export.base, raster.info.min) {
+        if let (Some(base), Some(min)) = (args.export.base, info.min) {
             if base >= min {
                 bail!(
                     "{}: --base {base} must be below the lowest height ({min})",
@@ -97,16 +102,22 @@ impl Plan {
                 );
             }
         }
-        let georef = Georef::new(raster.info.transform(), args.pixel_coords);
-        let (min, max) = extent(grid, &georef);
+        let georef = Georef::new(info.transform(), args.pixel_coords);
+        let (min, max) = extent(info, &georef);
         let origin = LocalOrigin::around(min, max);
-        check_position_rounding(grid, &georef, origin, min, max, out(args))?;
+        check_position_rounding(info, &georef, origin, min, max, out(args))?;
 
-        let mut height_rounding = 0.0f64;
-        for &z in grid.values().iter().filter(|z| z.is_finite()) {
-            let stored = origin.quantize([0.0, 0.0, z])[2];
-            height_rounding = height_rounding.max((stored - z).abs());
-        }
+        let height_rounding = match grid {
+            Some(grid) => {
+                let mut rounding = 0.0f64;
+                for &z in grid.values().iter().filter(|z| z.is_finite()) {
+                    let stored = origin.quantize([0.0, 0.0, z])[2];
+                    rounding = rounding.max((stored - z).abs());
+                }
+                rounding
+            }
+            None => height_rounding_bound(origin, min[2], max[2]),
+        };
         let decimation_bound = max_error - height_rounding;
         if decimation_bound < 0.0 {
             bail!(
@@ -143,12 +154,19 @@ impl Plan {
     }
 }
 
-/// Min and max of the grid's file coordinates (sample centres) and valid heights.
-fn extent(grid: &Grid, georef: &Georef) -> ([f64; 3], [f64; 3]) {
-    let (w, h) = (
-        grid.width().saturating_sub(1),
-        grid.height().saturating_sub(1),
-    );
+/// An upper bound on |stored - z| for every height `z` in `[min, max]` stored as float32
+/// relative to `origin`: half a float32 step of the largest offset (2^-24 of it), plus the
+/// `f64` roundings of the subtraction and the addition back, with a factor 2 to spare.
+fn height_rounding_bound(origin: LocalOrigin, min: f64, max: f64) -> f64 {
+    let oz = origin.offset()[2];
+    let offset = (max - oz).abs().max((min - oz).abs());
+    let magnitude = max.abs().max(min.abs());
+    2.0 * (offset * 2f64.powi(-24) + (offset + magnitude) * 2f64.powi(-52))
+}
+
+/// Min and max of the raster's file coordinates (sample centres) and valid heights.
+fn extent(info: &RasterInfo, georef: &Georef) -> ([f64; 3], [f64; 3]) {
+    let (w, h) = (info.width.saturating_sub(1), info.height.saturating_sub(1));
     let mut min = [f64::INFINITY; 3];
     let mut max = [f64::NEG_INFINITY; 3];
     for (x, y) in [(0, 0), (w, 0), (0, h), (w, h)] {
@@ -158,10 +176,9 @@ fn extent(grid: &Grid, georef: &Georef) -> ([f64; 3], [f64; 3]) {
             max[axis] = max[axis].max(p[axis]);
         }
     }
-    for &z in grid.values().iter().filter(|z| z.is_finite()) {
-        min[2] = min[2].min(z);
-        max[2] = max[2].max(z);
-    }
+    // The statistics of the heights decimation sees (after scale and offset).
+    min[2] = info.min.unwrap_or(0.0);
+    max[2] = info.max.unwrap_or(0.0);
     (min, max)
 }
 
@@ -169,7 +186,7 @@ fn extent(grid: &Grid, georef: &Georef) -> ([f64; 3], [f64; 3]) {
 /// [`MAX_POSITION_ROUNDING_PX`] of its centre (a bound: half a float32 step at the largest
 /// offset, plus the `f64` roundings, in pixels through the inverse geotransform).
 fn check_position_rounding(
-    grid: &Grid,
+    info: &RasterInfo,
     georef: &Georef,
     origin: LocalOrigin,
     min: [f64; 3],
@@ -199,8 +216,8 @@ fn check_position_rounding(
              (rounding up to {pixels:.2e} pixel); use a double-precision format (.ply, \
              .obj, .fgb, .geojson, .xml)",
             output.display(),
-            grid.width(),
-            grid.height()
+            info.width,
+            info.height
         );
     }
     Ok(())
@@ -212,14 +229,14 @@ fn check_position_rounding(
 pub fn write(
     plan: &Plan,
     args: &MeshArgs,
-    raster: &Raster,
+    info: &RasterInfo,
     mut vertices: Vec<[f64; 3]>,
     triangles: &[[u32; 3]],
 ) -> Result<()> {
     let path = out(args);
     let wgs84 = plan.format == MeshFormat::GeoJson && !args.export.geojson_source_crs;
     let crs = file_crs(
-        &raster.info,
+        info,
         args.pixel_coords,
         wgs84,
         &mut vertices,
@@ -227,7 +244,7 @@ pub fn write(
         args.quiet,
     )?;
     if let Some(origin) = plan.origin {
-        check_positions_map_back(&vertices, origin, raster, args)?;
+        check_positions_map_back(&vertices, origin, info, args)?;
     }
     let options = WriteOptions::new()
         .with_origin(plan.origin)
@@ -284,10 +301,10 @@ pub fn file_crs<'r>(
 fn check_positions_map_back(
     vertices: &[[f64; 3]],
     origin: LocalOrigin,
-    raster: &Raster,
+    info: &RasterInfo,
     args: &MeshArgs,
 ) -> Result<()> {
-    let georef = Georef::new(raster.info.transform(), args.pixel_coords);
+    let georef = Georef::new(info.transform(), args.pixel_coords);
     for (i, &v) in vertices.iter().enumerate() {
         let q = origin.quantize(v);
         georef.sample_at([q[0], q[1]]).with_context(|| {
@@ -305,8 +322,8 @@ pub fn parse_format(name: &str) -> std::result::Result<MeshFormat, String> {
     MeshFormat::from_name(name).map_err(|e| e.to_string())
 }
 
-/// The output path of an untiled `mesh` run (where `--output` is always given; the tiled
-/// engine, which allows `--per-tile` alone, does not come here).
+/// The output path of a `mesh` run that writes one file (`--per-tile` runs do not come
+/// here).
 fn out(args: &MeshArgs) -> &std::path::Path {
     args.output.as_deref().unwrap_or(std::path::Path::new("-"))
 }

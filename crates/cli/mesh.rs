@@ -53,7 +53,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     }
 
     let max_error = args.max_error.unwrap_or(f64::INFINITY);
-    let plan = crate::export::Plan::new(format, &raster, args)?;
+    let plan = crate::export::Plan::new(format, &raster.info, Some(grid), args)?;
     // Float32 formats leave the decimator the bound less their height rounding.
     let options = args.decimation_options(plan.decimation_bound);
     let mut bar = crate::progress::Progress::new(args.quiet);
@@ -99,7 +99,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
 
     let t = Instant::now();
     let (vertices, triangles) = file_mesh(tin, &georef);
-    crate::export::write(&plan, args, &raster, vertices, &triangles)?;
+    crate::export::write(&plan, args, &raster.info, vertices, &triangles)?;
     let write_seconds = t.elapsed().as_secs_f64();
 
     let r = &result.report;

@@ -10,12 +10,14 @@ use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use tinsmith_export::MeshFormat;
+use tinsmith_raster::RasterInfo;
 use tinsmith_tile::{
-    mesh_tiles, PerTileWriter, Placement, RasterSource, TileOptions, TilePlan, TileProgress,
-    TilesReport, WeldedWriter,
+    mesh_tiles, MeshCollector, PerTileWriter, Placement, RasterSource, TileOptions, TilePlan,
+    TileProgress, TilesReport, WeldedWriter,
 };
 
 use crate::args::{MeshArgs, TileFormatArg};
+use crate::georef::Georef;
 use crate::output::{check_writable_target, write_atomically};
 use crate::report::{MeshSummary, Outcome, Seconds};
 
@@ -24,7 +26,8 @@ use crate::report::{MeshSummary, Outcome, Seconds};
 pub const TILED_BLOCK_CACHE_MB: u64 = 256;
 
 /// The output file when the untiled engine should run: no `--per-tile`, and the raster
-/// fits in one tile. `None` when the tiled engine should run.
+/// fits in one tile or a triangle or vertex count is the target (which needs the whole
+/// raster at once). `None` when the tiled engine should run.
 pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
     let Some(output) = args.output.as_deref() else {
         return Ok(None);
@@ -33,20 +36,12 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
         return Ok(None);
     }
     // Checks the untiled path makes first, so that errors come in the same order.
-    let format = crate::export::format(args)?;
+    crate::export::format(args)?;
     check_writable_target(output)?;
     let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
     let fits = reader.width() <= args.tile_size && reader.height() <= args.tile_size;
-    if !fits && !matches!(format, MeshFormat::Ply | MeshFormat::Obj) {
-        anyhow::bail!(
-            "{}: the raster ({} x {}) is larger than --tile-size {}, and tiled output is              written as .ply or .obj only; choose one of those or a larger --tile-size",
-            output.display(),
-            reader.width(),
-            reader.height(),
-            args.tile_size
-        );
-    }
-    Ok(fits.then_some(output))
+    let count_target = args.max_triangles.is_some() || args.max_vertices.is_some();
+    Ok((fits || count_target).then_some(output))
 }
 
 /// The `--report` JSON in tiled mode: the untiled report's fields (counts over the welded
@@ -56,6 +51,9 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
 struct TiledMeshReport<'a> {
     #[serde(flatten)]
     summary: MeshSummary<'a>,
+    /// The format and float32 fields, for `-o`.
+    #[serde(flatten)]
+    output_format: Option<crate::export::PlanReport>,
     seconds: Seconds,
     tiles: Tiles,
 }
@@ -84,9 +82,8 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let input = args.input.display();
     if args.max_triangles.is_some() || args.max_vertices.is_some() {
         bail!(
-            "{input}: --max-triangles and --max-vertices need the whole raster at once, and it \
-             is larger than --tile-size {}; raise --tile-size or give --max-error",
-            args.tile_size
+            "{input}: --max-triangles and --max-vertices need the whole raster at once, and \
+             --per-tile meshes it tile by tile; give --max-error"
         );
     }
     let Some(max_error) = args.max_error else {
@@ -94,7 +91,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     };
     let welded_format = match &args.output {
         Some(output) => {
-            let format = MeshFormat::from_path(output)?;
+            let format = crate::export::format(args)?;
             check_writable_target(output)?;
             Some(format)
         }
@@ -119,7 +116,13 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     bar.set_message("tiles");
     bar.reset_eta();
 
-    let decimation = args.decimation_options(max_error);
+    // Float32 formats leave the decimator the bound less their height rounding.
+    let export_plan = match welded_format {
+        Some(format) => Some(crate::export::Plan::new(format, &info, None, args)?),
+        None => None,
+    };
+    let bound = export_plan.map_or(max_error, |p| p.decimation_bound);
+    let decimation = args.decimation_options(bound);
     let options = TileOptions::new(decimation)
         .with_tile_size(args.tile_size)
         .with_threads(args.threads.map_or(0, |n| n as usize));
@@ -139,6 +142,21 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     };
 
     let (report, output, write_seconds) = match (&args.output, welded_format, &args.per_tile) {
+        (Some(output), Some(format), _) if !streams(format) => {
+            let mut collector = MeshCollector::new();
+            let report = mesh_tiles(&source, &options, &mut collector, &mut progress)
+                .with_context(|| format!("{input}"))?;
+            if report.final_triangles == 0 {
+                return Err(nothing_to_triangulate());
+            }
+            bar.set_message("writing");
+            let t = Instant::now();
+            let (vertices, triangles) = file_mesh(collector, &info, args.pixel_coords);
+            let plan = export_plan.expect("planned for -o");
+            crate::export::write(&plan, args, &info, vertices, &triangles)?;
+            let write = report.seconds_sink + t.elapsed().as_secs_f64();
+            (report, output.as_path(), write)
+        }
         (Some(output), Some(format), _) => {
             let mut writer = WeldedWriter::create(output, format, crs, placement)?;
             let report = mesh_tiles(&source, &options, &mut writer, &mut progress)
@@ -183,6 +201,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     };
     let json = TiledMeshReport {
         summary: MeshSummary::new(args, output, outcome),
+        output_format: export_plan.map(|p| p.report()),
         seconds: Seconds {
             read: scan_seconds + r.seconds_read,
             initial_mesh: 0.0,
@@ -212,6 +231,35 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         write_atomically(path, &serde_json::to_vec_pretty(&json)?)?;
     }
     Ok(true)
+}
+
+/// Whether the tiled engine streams `format` to the file tile by tile; the other formats
+/// are welded in memory (the mesh, not the raster) and written at the end.
+fn streams(format: MeshFormat) -> bool {
+    matches!(format, MeshFormat::Ply | MeshFormat::Obj)
+}
+
+/// The welded mesh in file coordinates, triangles counter-clockwise in them (normals up).
+fn file_mesh(
+    collector: MeshCollector,
+    info: &RasterInfo,
+    pixel_coords: bool,
+) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let georef = Georef::new(info.transform(), pixel_coords);
+    let (vertices, mut triangles) = collector.into_parts();
+    let vertices = vertices
+        .into_iter()
+        .map(|[x, y, z]| {
+            let [fx, fy] = georef.file_position(x as u32, y as u32);
+            [fx, fy, z]
+        })
+        .collect();
+    if georef.flips_orientation() {
+        for t in &mut triangles {
+            t.swap(1, 2);
+        }
+    }
+    (vertices, triangles)
 }
 
 /// Tiles done / total with the ETA on stderr; hidden when quiet or when stderr is not a

@@ -19,6 +19,10 @@ pub(crate) fn triangle_error(
     limit: f64,
 ) -> Option<ErrorBound> {
     debug_assert!(orient(a, b, c) > 0);
+    if orient(a, b, c) == 1 {
+        // Doubled area 1: by Pick's theorem the corners are the only samples.
+        return error_at(a, b, c, [a, b, c], limit);
+    }
     let g = plane_gradient(a, b, c);
     let width = grid.width() as usize;
     let values = grid.values();
@@ -60,6 +64,28 @@ pub(crate) fn triangle_error(
         }
     }
     Some(ErrorBound { above, below })
+}
+
+/// The above/below error of the plane through counter-clockwise triangle `abc` over the
+/// given samples only (the caller knows they are all the grid samples in the closed
+/// triangle), or `None` when either side exceeds `limit`. The arithmetic is
+/// [`triangle_error`]'s, so both give identical results on the same samples.
+pub(crate) fn error_at<'p>(
+    a: &Point,
+    b: &Point,
+    c: &Point,
+    samples: impl IntoIterator<Item = &'p Point>,
+    limit: f64,
+) -> Option<ErrorBound> {
+    let g = plane_gradient(a, b, c);
+    let (mut above, mut below) = (0.0f64, 0.0f64);
+    for p in samples {
+        let plane = (a.z + g[1] * (p.y - a.y) as f64) + g[0] * (p.x - a.x) as f64;
+        let d = p.z - plane;
+        above = above.max(d);
+        below = below.max(-d);
+    }
+    (above <= limit && below <= limit).then_some(ErrorBound { above, below })
 }
 
 fn div_floor(n: i64, d: i64) -> i64 {

@@ -22,7 +22,7 @@
 //! bound a true bound; the paper's boundary rule (§3.3.2) is the special case of (a) and
 //! (b) on the new boundary edge, which passes through `c`.
 
-use crate::exact::triangle_error;
+use crate::exact::{error_at, triangle_error};
 use crate::predicates::{in_closed_triangle, orient, plane_gradient, Point};
 use crate::{EdgeSelection, ErrorBound, ErrorModel, Grid, Retriangulation};
 
@@ -56,6 +56,10 @@ pub(crate) struct Retriangulator {
     star_gradients: Vec<[f64; 2]>,
     centre: Option<Point>,
     boundary: bool,
+    /// Every star triangle is a half cell (doubled area 1), so the hole holds no sample
+    /// but its ring vertices and the centre (Pick's theorem): a new triangle's exact error
+    /// is measured at its corners and, when it contains it, the centre.
+    unit_hole: bool,
     max_star_above: f64,
     max_star_below: f64,
     // Current polygon during ear clipping.
@@ -74,6 +78,8 @@ pub(crate) struct Retriangulator {
     cost: Vec<f64>,
     cost_sum: Vec<f64>,
     split: Vec<u32>,
+    /// Intervals still to rebuild after the DP.
+    stack: Vec<(usize, usize)>,
 }
 
 /// What the retriangulation needs besides the hole: the rules and the grid.
@@ -111,6 +117,8 @@ impl Retriangulator {
             let g = plane_gradient(&centre, &ring[i], &ring[(i + 1) % m]);
             self.star_gradients.push(g);
         }
+        self.unit_hole =
+            (0..star_bounds.len()).all(|i| orient(&centre, &ring[i], &ring[(i + 1) % m]) == 1);
         self.max_star_above = star_bounds
             .iter()
             .fold(f64::NEG_INFINITY, |m, b| m.max(b.above));
@@ -280,19 +288,20 @@ impl Retriangulator {
         edges: [SegmentError; 3],
         rules: &Rules<'_>,
     ) -> Option<ErrorBound> {
-        self.triangle_cost_capped(a, b, c, edges, rules, rules.limit)
+        self.triangle_cost_capped([a, b, c], edges, rules, rules.limit, false)
     }
 
     /// [`Retriangulator::triangle_cost`] within `cap <= rules.limit`: `None` as soon as the
     /// error is known to exceed `cap` (the DP passes the best cost found so far).
+    /// `in_hole` says the triangle is known to lie in the hole with no other ring vertex
+    /// in it (its sides are ring edges or diagonals), as the DP's triangles do.
     fn triangle_cost_capped(
         &mut self,
-        a: usize,
-        b: usize,
-        c: usize,
+        [a, b, c]: [usize; 3],
         edges: [SegmentError; 3],
         rules: &Rules<'_>,
         cap: f64,
+        in_hole: bool,
     ) -> Option<ErrorBound> {
         let (pa, pb, pc) = (&self.ring[a], &self.ring[b], &self.ring[c]);
         if [(pa, pb), (pb, pc), (pc, pa)]
@@ -303,6 +312,25 @@ impl Retriangulator {
         }
         let bound = match rules.model {
             ErrorModel::Bounds => self.triangle_bound(a, b, c, edges),
+            ErrorModel::Exact if self.unit_hole && in_hole => {
+                let centre = self.centre.expect("hole loaded");
+                let inside = in_closed_triangle(pa, pb, pc, &centre);
+                let samples = [pa, pb, pc, &centre];
+                let e = error_at(
+                    pa,
+                    pb,
+                    pc,
+                    samples[..3 + usize::from(inside)].iter().copied(),
+                    cap,
+                );
+                debug_assert_eq!(
+                    e.map(|b| (b.above.to_bits(), b.below.to_bits())),
+                    triangle_error(rules.grid, pa, pb, pc, cap)
+                        .map(|b| (b.above.to_bits(), b.below.to_bits())),
+                    "a unit hole holds no other sample"
+                );
+                e?
+            }
             ErrorModel::Exact => {
                 let mut key = [a as u64, b as u64, c as u64];
                 key.sort_unstable();
@@ -371,7 +399,8 @@ impl Retriangulator {
                         ErrorModel::Exact => [SegmentError::default(); 3],
                     };
                     let cap = rules.limit.min(best.0);
-                    let Some(t) = self.triangle_cost_capped(i, k, j, edges, rules, cap) else {
+                    let Some(t) = self.triangle_cost_capped([i, k, j], edges, rules, cap, true)
+                    else {
                         continue;
                     };
                     let c = sub.max(t.max());
@@ -389,7 +418,9 @@ impl Retriangulator {
             return false;
         }
         // Rebuild the triangles, recomputing each one's bound.
-        let mut stack = vec![(0usize, m - 1)];
+        let mut stack = std::mem::take(&mut self.stack);
+        stack.clear();
+        stack.push((0usize, m - 1));
         while let Some((i, j)) = stack.pop() {
             if j < i + 2 {
                 continue;
@@ -400,7 +431,7 @@ impl Retriangulator {
                 ErrorModel::Exact => [SegmentError::default(); 3],
             };
             let bound = self
-                .triangle_cost(i, k, j, edges, rules)
+                .triangle_cost_capped([i, k, j], edges, rules, rules.limit, true)
                 .expect("chosen triangle is within the limit");
             self.triangles.push(HoleTriangle {
                 corners: [i as u32, k as u32, j as u32],
@@ -409,6 +440,7 @@ impl Retriangulator {
             stack.push((k, j));
             stack.push((i, k));
         }
+        self.stack = stack;
         true
     }
 

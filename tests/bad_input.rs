@@ -134,3 +134,18 @@ fn verify_with_a_missing_mesh() {
     let o = d.run(&["verify", &dem(), "gone.ply"]);
     assert_fails_naming(&o, &["gone.ply"]);
 }
+
+#[test]
+fn a_pyramid_needs_a_crs_and_the_message_names_the_file_once() {
+    let d = Dir::new();
+    // ESRI ASCII without a .prj: a geotransform but no CRS.
+    d.write(
+        "nocrs.asc",
+        "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n4 5 6\n7 8 9\n",
+    );
+    let o = d.run(&["tiles", "nocrs.asc", "-o", "pyramid", "-q"]);
+    assert_fails_naming(&o, &["nocrs.asc", "no CRS"]);
+    let message = crate::util::stderr(&o);
+    assert_eq!(message.matches("nocrs.asc").count(), 1, "{message}");
+    assert_eq!(d.files(), vec!["nocrs.asc"]);
+}

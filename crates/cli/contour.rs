@@ -32,6 +32,7 @@ use crate::args::ContourArgs;
 use crate::export::file_crs;
 use crate::georef::Georef;
 use crate::output::check_writable_target;
+use crate::output::NamingFile;
 use crate::verify::read_mesh_file;
 
 /// Builds the TIN, contours it and writes the lines; `Ok(true)` on success.
@@ -66,7 +67,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     let levels = match args.interval {
         Some(interval) => match mesh.height_range() {
             Some((lo, hi)) => interval_levels(interval, args.offset.unwrap_or(0.0), lo, hi)
-                .with_context(|| format!("{}", args.input.display()))?,
+                .naming_file(&args.input)?,
             None => Vec::new(),
         },
         None => sorted_levels(&args.levels)?,
@@ -161,11 +162,11 @@ fn untiled_tin(args: &ContourArgs, e: f64, raster: &Raster) -> Result<(ContourMe
     }
     if e == 0.0 {
         let mesh = ContourMesh::from_grid(grid.width(), grid.height(), grid.values())
-            .with_context(|| format!("{}", args.input.display()))?;
+            .naming_file(&args.input)?;
         return Ok((mesh, "full grid".to_owned()));
     }
     let tin = decimate(grid, &DecimationOptions::new(e))
-        .with_context(|| format!("{}", args.input.display()))?
+        .naming_file(&args.input)?
         .tin;
     let vertices = tin
         .vertices()
@@ -189,8 +190,8 @@ fn tiled_tin(args: &ContourArgs, e: f64) -> Result<(ContourMesh, RasterInfo, usi
         .with_tile_size(args.tile_size)
         .with_threads(args.threads.map_or(0, |n| n as usize));
     let mut collector = MeshCollector::new();
-    let report = mesh_tiles(&source, &options, &mut collector, &mut |_| {})
-        .with_context(|| format!("{input}"))?;
+    let report =
+        mesh_tiles(&source, &options, &mut collector, &mut |_| {}).naming_file(&args.input)?;
     if report.final_triangles == 0 {
         return Err(nothing_to_contour(args));
     }

@@ -2,13 +2,14 @@
 
 use std::time::Instant;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use serde::Serialize;
 use tinsmith_core::{decimate_with_progress, Tin};
 use tinsmith_verify::{GridRef, VerifyOptions};
 
 use crate::args::MeshArgs;
 use crate::georef::Georef;
+use crate::output::NamingFile;
 use crate::output::{check_writable_target, write_atomically};
 use crate::report::{MeshSummary, Outcome, Seconds};
 
@@ -65,7 +66,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             p.removed
         ))
     })
-    .with_context(|| format!("{}", args.input.display()))?;
+    .naming_file(&args.input)?;
     bar.clear();
     let tin = &result.tin;
 

@@ -46,3 +46,24 @@ fn parent_dir(path: &Path) -> &Path {
         _ => Path::new("."),
     }
 }
+
+/// Prefixes errors with the input file's path, unless their message names it already
+/// (the raster reader's errors do), so that a message names the file exactly once.
+pub trait NamingFile<T> {
+    /// The result, its error naming `path`.
+    fn naming_file(self, path: &Path) -> Result<T>;
+}
+
+impl<T, E: Into<anyhow::Error>> NamingFile<T> for std::result::Result<T, E> {
+    fn naming_file(self, path: &Path) -> Result<T> {
+        self.map_err(|e| {
+            let e: anyhow::Error = e.into();
+            let shown = path.display().to_string();
+            if format!("{e:#}").contains(&shown) {
+                e
+            } else {
+                e.context(shown)
+            }
+        })
+    }
+}

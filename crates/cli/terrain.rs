@@ -1,9 +1,10 @@
 //! `tinsmith tiles`: a quantized-mesh terrain pyramid.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use tinsmith_tile::{build_terrain, TerrainOptions};
 
 use crate::args::TilesArgs;
+use crate::output::NamingFile;
 
 pub fn run(args: &TilesArgs) -> Result<bool> {
     let options = TerrainOptions {
@@ -33,7 +34,7 @@ pub fn run(args: &TilesArgs) -> Result<bool> {
             level.seconds
         );
     })
-    .with_context(|| format!("{}", args.input.display()))?;
+    .naming_file(&args.input)?;
     if let Some(path) = &args.report {
         crate::output::write_atomically(path, &serde_json::to_vec_pretty(&report)?)?;
     }

@@ -6,7 +6,7 @@ use std::io::IsTerminal;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use tinsmith_export::MeshFormat;
@@ -18,6 +18,7 @@ use tinsmith_tile::{
 
 use crate::args::{MeshArgs, TileFormatArg};
 use crate::georef::Georef;
+use crate::output::NamingFile;
 use crate::output::{check_writable_target, write_atomically};
 use crate::report::{MeshSummary, Outcome, Seconds};
 
@@ -110,8 +111,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let info = tinsmith_raster::open_info(&args.input, args.band)?;
     let source = RasterSource::new(&info)?;
     let scan_seconds = t.elapsed().as_secs_f64();
-    let plan = TilePlan::new(info.width, info.height, args.tile_size)
-        .with_context(|| format!("{input}"))?;
+    let plan = TilePlan::new(info.width, info.height, args.tile_size).naming_file(&args.input)?;
     bar.set_length(plan.len() as u64);
     bar.set_message("tiles");
     bar.reset_eta();
@@ -145,7 +145,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         (Some(output), Some(format), _) if !streams(format) => {
             let mut collector = MeshCollector::new();
             let report = mesh_tiles(&source, &options, &mut collector, &mut progress)
-                .with_context(|| format!("{input}"))?;
+                .naming_file(&args.input)?;
             if report.final_triangles == 0 {
                 return Err(nothing_to_triangulate());
             }
@@ -160,7 +160,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         (Some(output), Some(format), _) => {
             let mut writer = WeldedWriter::create(output, format, crs, placement)?;
             let report = mesh_tiles(&source, &options, &mut writer, &mut progress)
-                .with_context(|| format!("{input}"))?;
+                .naming_file(&args.input)?;
             if report.final_triangles == 0 {
                 return Err(nothing_to_triangulate());
             }
@@ -177,7 +177,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             };
             let mut writer = PerTileWriter::create(dir, format, crs, placement)?;
             let report = mesh_tiles(&source, &options, &mut writer, &mut progress)
-                .with_context(|| format!("{input}"))?;
+                .naming_file(&args.input)?;
             if report.final_triangles == 0 {
                 return Err(nothing_to_triangulate());
             }

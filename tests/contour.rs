@@ -239,7 +239,17 @@ fn mesh_file_gives_the_same_lines_as_decimating() {
         ("m.ply", &["--pixel-coords"][..]),
     ] {
         let d = Dir::new();
-        let mut m = vec!["mesh", &input, "-o", mesh, "--max-error", "0.5"];
+        // The TIN `contour` decimates is shaped for its levels; `mesh` shapes it alike.
+        let mut m = vec![
+            "mesh",
+            &input,
+            "-o",
+            mesh,
+            "--max-error",
+            "0.5",
+            "--contour-interval",
+            "1",
+        ];
         m.extend_from_slice(extra);
         run_ok(&d, &m);
         let mut a = vec!["contour", &input, "-o", "a.geojson", "--interval", "1"];
@@ -272,7 +282,15 @@ fn tiled_decimation_contours_the_same_tin_mesh_writes() {
     let input = fixture("becmodel_dem_bc_albers_50m.tif");
     let d = Dir::new();
     let tiles = ["--tile-size", "128", "--max-error", "5"];
-    let mut m = vec!["mesh", &input, "-o", "m.ply", "-q"];
+    let mut m = vec![
+        "mesh",
+        &input,
+        "-o",
+        "m.ply",
+        "-q",
+        "--contour-interval",
+        "50",
+    ];
     m.extend_from_slice(&tiles);
     run_ok(&d, &m);
     run_ok(
@@ -310,6 +328,36 @@ fn tiled_decimation_contours_the_same_tin_mesh_writes() {
         assert_eq!(canonical(fa), canonical(fb), "{threads} threads");
         std::fs::remove_file(d.path("b.geojson")).unwrap();
     }
+    // The same TIN not shaped for the levels: same bound, more segments.
+    let mut m = vec!["mesh", &input, "-o", "plain.ply", "-q"];
+    m.extend_from_slice(&tiles);
+    run_ok(&d, &m);
+    let contour_of = |mesh: &str, out: &str| {
+        let a = [
+            "contour",
+            &input,
+            "-o",
+            out,
+            "--interval",
+            "50",
+            "--mesh",
+            mesh,
+            "-q",
+        ];
+        run_ok(&d, &a);
+        features(&d.path(out))
+            .iter()
+            .map(|(_, points)| points.len() - 1)
+            .sum::<usize>()
+    };
+    let (shaped, plain) = (
+        contour_of("m.ply", "s.geojson"),
+        contour_of("plain.ply", "p.geojson"),
+    );
+    assert!(
+        shaped * 100 <= plain * 97,
+        "{shaped} segments shaped, {plain} plain"
+    );
 }
 
 #[test]

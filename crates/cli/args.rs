@@ -144,6 +144,18 @@ pub struct MeshArgs {
     /// at the cost of more triangles. The error bound holds either way.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
     pub max_edge_length: Option<u32>,
+    /// Shape the TIN for contour lines every I (plus --contour-offset) over the raster's
+    /// heights, as `tinsmith contour --max-error` does: `contour --mesh` then draws lines
+    /// with fewer segments. The error bound holds either way.
+    #[arg(long, value_name = "I", value_parser = parse_interval, conflicts_with = "contour_levels")]
+    pub contour_interval: Option<f64>,
+    /// Shift of the --contour-interval levels: offset + k * interval.
+    #[arg(long, value_name = "O", requires = "contour_interval", value_parser = parse_finite, allow_negative_numbers = true)]
+    pub contour_offset: Option<f64>,
+    /// Shape the TIN for contour lines at these levels, comma-separated (see
+    /// --contour-interval).
+    #[arg(long, value_delimiter = ',', value_parser = parse_finite, allow_hyphen_values = true)]
+    pub contour_levels: Vec<f64>,
     /// Write (column, row, value) instead of georeferenced coordinates.
     #[arg(long)]
     pub pixel_coords: bool,
@@ -283,8 +295,13 @@ pub enum ErrorModelArg {
 
 impl MeshArgs {
     /// The decimation options the flags ask for, with `max_error` as the bound (the
-    /// untiled path passes the bound less the output format's height rounding).
-    pub fn decimation_options(&self, max_error: f64) -> DecimationOptions {
+    /// untiled path passes the bound less the output format's height rounding); contour
+    /// levels from --contour-interval run over `heights`, the raster's valid range.
+    pub fn decimation_options(
+        &self,
+        max_error: f64,
+        heights: Option<(f64, f64)>,
+    ) -> anyhow::Result<DecimationOptions> {
         let mut options = DecimationOptions::new(max_error)
             .with_selection(self.selection.into())
             .with_error_model(self.error_model.into())
@@ -299,7 +316,21 @@ impl MeshArgs {
         if let Some(n) = self.max_vertices {
             options = options.with_max_vertices(n);
         }
-        options
+        let levels = match (self.contour_interval, heights) {
+            (Some(interval), Some((lo, hi))) => {
+                let offset = self.contour_offset.unwrap_or(0.0);
+                Some(tinsmith_contour::interval_levels(interval, offset, lo, hi)?)
+            }
+            (Some(_), None) => Some(Vec::new()),
+            (None, _) if !self.contour_levels.is_empty() => {
+                Some(tinsmith_contour::sorted_levels(&self.contour_levels)?)
+            }
+            (None, _) => None,
+        };
+        if let Some(levels) = levels {
+            options = options.with_contour_levels(&levels);
+        }
+        Ok(options)
     }
 }
 

@@ -54,24 +54,22 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
         reader.width() > args.tile_size || reader.height() > args.tile_size
     };
-    let (mesh, info, source) = if tiled {
-        let (mesh, info, tiles) = tiled_tin(args, e)?;
-        (mesh, info, format!("TIN within {e} ({tiles} tiles)"))
+    // A TIN decimated here is shaped for the levels (fewer segments, same bound), so they
+    // come from the raster's height range first; a --mesh file's come from its own heights.
+    let (mesh, info, source, levels) = if tiled {
+        tinsmith_raster::limit_block_cache(crate::tiled::TILED_BLOCK_CACHE_MB);
+        let info = tinsmith_raster::open_info(&args.input, args.band)?;
+        let levels = levels_for(args, info.min.zip(info.max))?;
+        let (mesh, tiles) = tiled_tin(args, e, &info, &levels)?;
+        let source = format!("TIN within {e} ({tiles} tiles)");
+        (mesh, info, source, levels)
     } else {
         let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
-        let (mesh, source) = untiled_tin(args, e, &raster)?;
-        (mesh, raster.info, source)
+        let (mesh, source, levels) = untiled_tin(args, e, &raster)?;
+        (mesh, raster.info, source, levels)
     };
     let georef = Georef::new(info.transform(), args.pixel_coords);
 
-    let levels = match args.interval {
-        Some(interval) => match mesh.height_range() {
-            Some((lo, hi)) => interval_levels(interval, args.offset.unwrap_or(0.0), lo, hi)
-                .naming_file(&args.input)?,
-            None => Vec::new(),
-        },
-        None => sorted_levels(&args.levels)?,
-    };
     let polylines = contour(&mesh, &levels)
         .with_context(|| format!("{}: contouring failed", args.input.display()))?;
 
@@ -145,29 +143,46 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     Ok(true)
 }
 
-/// The TIN to contour from the whole raster in memory: the `--mesh` file, the grid
-/// decimated within `e > 0`, or the full grid for `e = 0`; with a word on where it came
-/// from.
-fn untiled_tin(args: &ContourArgs, e: f64, raster: &Raster) -> Result<(ContourMesh, String)> {
+/// The levels to contour: `--levels`, or `--interval` levels over the height range `lo,
+/// hi` (none without a range).
+fn levels_for(args: &ContourArgs, range: Option<(f64, f64)>) -> Result<Vec<f64>> {
+    match args.interval {
+        Some(interval) => match range {
+            Some((lo, hi)) => interval_levels(interval, args.offset.unwrap_or(0.0), lo, hi)
+                .naming_file(&args.input),
+            None => Ok(Vec::new()),
+        },
+        None => Ok(sorted_levels(&args.levels)?),
+    }
+}
+
+/// The TIN to contour from the whole raster in memory, with a word on where it came from
+/// and the levels: the `--mesh` file (levels over its heights), the full grid for `e = 0`,
+/// or the grid decimated within `e > 0` and shaped for the levels (over the raster's
+/// heights).
+fn untiled_tin(
+    args: &ContourArgs,
+    e: f64,
+    raster: &Raster,
+) -> Result<(ContourMesh, String, Vec<f64>)> {
     let grid = &raster.grid;
     if let Some(path) = &args.mesh {
         let georef = Georef::new(raster.info.transform(), args.pixel_coords);
-        return Ok((
-            mesh_from_file(path, raster, georef)?,
-            "mesh file".to_owned(),
-        ));
+        let mesh = mesh_from_file(path, raster, georef)?;
+        let levels = levels_for(args, mesh.height_range())?;
+        return Ok((mesh, "mesh file".to_owned(), levels));
     }
+    let levels = levels_for(args, raster.info.min.zip(raster.info.max))?;
     if grid.valid_cell_count() == 0 {
         return Err(nothing_to_contour(args));
     }
     if e == 0.0 {
         let mesh = ContourMesh::from_grid(grid.width(), grid.height(), grid.values())
             .naming_file(&args.input)?;
-        return Ok((mesh, "full grid".to_owned()));
+        return Ok((mesh, "full grid".to_owned(), levels));
     }
-    let tin = decimate(grid, &DecimationOptions::new(e))
-        .naming_file(&args.input)?
-        .tin;
+    let options = DecimationOptions::new(e).with_contour_levels(&levels);
+    let tin = decimate(grid, &options).naming_file(&args.input)?.tin;
     let vertices = tin
         .vertices()
         .iter()
@@ -175,18 +190,21 @@ fn untiled_tin(args: &ContourArgs, e: f64, raster: &Raster) -> Result<(ContourMe
         .collect();
     let mesh = ContourMesh::new(vertices, tin.triangles().to_vec())
         .with_context(|| format!("{}: decimated TIN", args.input.display()))?;
-    Ok((mesh, format!("TIN within {e}")))
+    Ok((mesh, format!("TIN within {e}"), levels))
 }
 
-/// The TIN to contour from a raster larger than `--tile-size`: decimated within `e` by the
-/// tiled engine (windowed reads, in parallel, each tile verified), welded in memory. Returns
-/// it with the raster's description and the number of tiles.
-fn tiled_tin(args: &ContourArgs, e: f64) -> Result<(ContourMesh, RasterInfo, usize)> {
+/// The TIN to contour from a raster larger than `--tile-size`: decimated within `e` and
+/// shaped for `levels` by the tiled engine (windowed reads, in parallel, each tile
+/// verified), welded in memory. Returns it with the number of tiles.
+fn tiled_tin(
+    args: &ContourArgs,
+    e: f64,
+    info: &RasterInfo,
+    levels: &[f64],
+) -> Result<(ContourMesh, usize)> {
     let input = args.input.display();
-    tinsmith_raster::limit_block_cache(crate::tiled::TILED_BLOCK_CACHE_MB);
-    let info = tinsmith_raster::open_info(&args.input, args.band)?;
-    let source = RasterSource::new(&info)?;
-    let options = TileOptions::new(DecimationOptions::new(e))
+    let source = RasterSource::new(info)?;
+    let options = TileOptions::new(DecimationOptions::new(e).with_contour_levels(levels))
         .with_tile_size(args.tile_size)
         .with_threads(args.threads.map_or(0, |n| n as usize));
     let mut collector = MeshCollector::new();
@@ -198,7 +216,7 @@ fn tiled_tin(args: &ContourArgs, e: f64) -> Result<(ContourMesh, RasterInfo, usi
     let (vertices, triangles) = collector.into_parts();
     let mesh =
         ContourMesh::new(vertices, triangles).with_context(|| format!("{input}: decimated TIN"))?;
-    Ok((mesh, info, report.plan.len()))
+    Ok((mesh, report.plan.len()))
 }
 
 /// The error for a band without a valid 2x2 block of samples.

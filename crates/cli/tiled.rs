@@ -122,7 +122,9 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         None => None,
     };
     let bound = export_plan.map_or(max_error, |p| p.decimation_bound);
-    let decimation = args.decimation_options(bound);
+    let decimation = args
+        .decimation_options(bound, info.min.zip(info.max))
+        .naming_file(&args.input)?;
     let options = TileOptions::new(decimation)
         .with_tile_size(args.tile_size)
         .with_threads(args.threads.map_or(0, |n| n as usize));

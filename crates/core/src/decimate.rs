@@ -188,6 +188,7 @@ fn run(
         dp_max_ring: options.dp_max_ring,
         limit,
         max_edge_squared: max_edge_squared(options),
+        levels: options.contour_levels.as_deref(),
     };
     let mut remover = Remover::new(rules);
     let mut stats = Stats::default();
@@ -211,6 +212,9 @@ fn run(
                 progress,
             )
         }
+    }
+    if let Some(levels) = rules.levels {
+        crate::levels::flip_for_levels(&mut mesh, &rules, levels);
     }
     #[cfg(debug_assertions)]
     mesh.check_invariants();

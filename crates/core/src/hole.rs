@@ -23,6 +23,7 @@
 //! (b) on the new boundary edge, which passes through `c`.
 
 use crate::exact::{error_at, triangle_error};
+use crate::levels::{dirichlet_energy, triangle_levels};
 use crate::predicates::{in_closed_triangle, orient, plane_gradient, Point};
 use crate::{EdgeSelection, ErrorBound, ErrorModel, Grid, Retriangulation};
 
@@ -94,6 +95,8 @@ pub(crate) struct Rules<'g> {
     pub limit: f64,
     /// Largest squared edge length (in sample spacings) a new triangle may have.
     pub max_edge_squared: i64,
+    /// Contour levels (sorted) the DP minimizes the spanned count of, if any.
+    pub levels: Option<&'g [f64]>,
 }
 
 impl Retriangulator {
@@ -381,10 +384,18 @@ impl Retriangulator {
                     continue;
                 }
                 // Lexicographic: the largest error, then the sum of the triangles' errors
-                // (less error spent now leaves more room for later removals).
+                // (less error spent now leaves more room for later removals). With contour
+                // levels: among triangulations within the limit, the fewest levels spanned
+                // by the triangles, then the least Dirichlet energy.
                 let mut best = (f64::INFINITY, f64::INFINITY, u32::MAX);
                 for k in i + 1..j {
-                    let sub = self.cost[i * m + k].max(self.cost[k * m + j]);
+                    let (left, right) = (self.cost[i * m + k], self.cost[k * m + j]);
+                    // Either way a sub-result above the best cannot win (both costs only
+                    // grow as triangles are added).
+                    let sub = match rules.levels {
+                        Some(_) => left + right,
+                        None => left.max(right),
+                    };
                     if sub > best.0 || !self.diagonal_ok[i * m + k] || !self.diagonal_ok[k * m + j]
                     {
                         continue;
@@ -398,13 +409,23 @@ impl Retriangulator {
                         }
                         ErrorModel::Exact => [SegmentError::default(); 3],
                     };
-                    let cap = rules.limit.min(best.0);
+                    let cap = match rules.levels {
+                        Some(_) => rules.limit,
+                        None => rules.limit.min(best.0),
+                    };
                     let Some(t) = self.triangle_cost_capped([i, k, j], edges, rules, cap, true)
                     else {
                         continue;
                     };
-                    let c = sub.max(t.max());
-                    let sum = self.cost_sum[i * m + k] + self.cost_sum[k * m + j] + t.max();
+                    let sums = self.cost_sum[i * m + k] + self.cost_sum[k * m + j];
+                    let (c, sum) = match rules.levels {
+                        Some(levels) => {
+                            let (pi, pk, pj) = (&self.ring[i], &self.ring[k], &self.ring[j]);
+                            let spanned = triangle_levels(levels, pi, pk, pj) as f64;
+                            (sub + spanned, sums + dirichlet_energy(pi, pk, pj))
+                        }
+                        None => (sub.max(t.max()), sums + t.max()),
+                    };
                     if c < best.0 || (c == best.0 && sum < best.1) {
                         best = (c, sum, k as u32);
                     }
@@ -753,6 +774,7 @@ mod tests {
             dp_max_ring: 16,
             limit,
             max_edge_squared: i64::MAX,
+            levels: None,
         }
     }
 

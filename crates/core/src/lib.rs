@@ -33,6 +33,7 @@ mod exact;
 mod geo_transform;
 mod grid;
 mod hole;
+mod levels;
 mod mesh;
 mod options;
 mod predicates;

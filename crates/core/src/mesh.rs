@@ -269,6 +269,55 @@ impl<'g> Mesh<'g> {
         true
     }
 
+    /// The triangle across edge `j` of `t` (from corner `j` to corner `j + 1`), or
+    /// [`NONE`] on the domain boundary.
+    pub(crate) fn across(&self, t: u32, j: usize) -> u32 {
+        self.neighbours[t as usize][j]
+    }
+
+    /// Corners of live triangle `t`, counter-clockwise.
+    pub(crate) fn corners(&self, t: u32) -> [u32; 3] {
+        self.corners[t as usize]
+    }
+
+    /// Number of triangle slots (live or dead).
+    pub(crate) fn triangle_slots(&self) -> usize {
+        self.corners.len()
+    }
+
+    /// Flips edge `j` of live triangle `t` (from `a`, corner `j`, to `b`; `c` opposite),
+    /// shared with `u = (b, a, d)`, into the edge `c d`: `t` becomes `(c, a, d)` and `u`
+    /// becomes `(c, d, b)`, with the given bounds. The caller has checked that the
+    /// quadrilateral `c a d b` is strictly convex, so both stay counter-clockwise.
+    pub(crate) fn flip(&mut self, t: u32, j: usize, bounds: [ErrorBound; 2]) {
+        let [a, b, c] = [0, 1, 2].map(|k| self.corners[t as usize][(j + k) % 3]);
+        let u = self.neighbours[t as usize][j];
+        let k = self.edge_index(u, b, a);
+        let d = self.corners[u as usize][(k + 2) % 3];
+        let t_bc = self.neighbours[t as usize][(j + 1) % 3];
+        let t_ca = self.neighbours[t as usize][(j + 2) % 3];
+        let u_ad = self.neighbours[u as usize][(k + 1) % 3];
+        let u_db = self.neighbours[u as usize][(k + 2) % 3];
+        self.corners[t as usize] = [c, a, d];
+        self.neighbours[t as usize] = [t_ca, u_ad, u];
+        self.corners[u as usize] = [c, d, b];
+        self.neighbours[u as usize] = [t, u_db, t_bc];
+        if u_ad != NONE {
+            let e = self.edge_index(u_ad, d, a);
+            self.neighbours[u_ad as usize][e] = t;
+        }
+        if t_bc != NONE {
+            let e = self.edge_index(t_bc, c, b);
+            self.neighbours[t_bc as usize][e] = u;
+        }
+        self.bounds[t as usize] = bounds[0].into();
+        self.bounds[u as usize] = bounds[1].into();
+        self.vertex_triangle[a as usize] = t;
+        self.vertex_triangle[b as usize] = u;
+        self.vertex_triangle[c as usize] = t;
+        self.vertex_triangle[d as usize] = u;
+    }
+
     /// Marks the vertices where the domain pinches: a vertex on one fan of triangles has
     /// zero or two domain-boundary edges, a vertex where several fans meet has more.
     fn mark_pinched(&mut self) {

@@ -92,6 +92,9 @@ pub struct DecimationOptions {
     /// would need a longer edge is refused. For renderers that interpolate in another space
     /// than the grid's (e.g. terrain on a globe, where long edges cut below the surface).
     pub max_edge_length: Option<u32>,
+    /// Contour levels to shape the TIN for (see [`DecimationOptions::with_contour_levels`]);
+    /// sorted, finite, without duplicates.
+    pub contour_levels: Option<std::sync::Arc<[f64]>>,
 }
 
 impl DecimationOptions {
@@ -111,6 +114,7 @@ impl DecimationOptions {
             max_triangles: None,
             max_vertices: None,
             max_edge_length: None,
+            contour_levels: None,
         }
     }
 
@@ -146,6 +150,20 @@ impl DecimationOptions {
     /// [`DecimationOptions::max_edge_length`]).
     pub fn with_max_edge_length(mut self, samples: u32) -> DecimationOptions {
         self.max_edge_length = Some(samples);
+        self
+    }
+
+    /// Shapes the TIN for contour lines at `levels` (non-finite values are dropped): among
+    /// the hole triangulations within the bound, the dynamic program picks one whose
+    /// triangles span the fewest levels, and once no vertex can go, edges are flipped
+    /// where the new edge spans fewer levels and both new triangles stay within the bound.
+    /// Each triangle a level passes through gives a contour line one segment, so the
+    /// lines get fewer segments; the bound is kept exactly as without levels.
+    pub fn with_contour_levels(mut self, levels: &[f64]) -> DecimationOptions {
+        let mut levels: Vec<f64> = levels.iter().copied().filter(|l| l.is_finite()).collect();
+        levels.sort_by(f64::total_cmp);
+        levels.dedup();
+        self.contour_levels = Some(levels.into());
         self
     }
 

@@ -30,7 +30,11 @@ fn all_options(bound: f64) -> Vec<DecimationOptions> {
                 for selection in SELECTIONS {
                     all.push(base.clone().with_selection(selection));
                 }
-                all.push(base.with_retriangulation(Retriangulation::Dp));
+                let dp = base.with_retriangulation(Retriangulation::Dp);
+                // Levels spread over the small grids' values (see `small_grid`).
+                let levels: Vec<f64> = (-8..=8).map(|k| f64::from(k) * 1.5).collect();
+                all.push(dp.clone().with_contour_levels(&levels));
+                all.push(dp);
             }
         }
     }
@@ -242,6 +246,52 @@ fn rough_terrain_with_holes_stays_within_bound() {
         for options in all_options(bound) {
             check_with(&spec, &options).unwrap();
         }
+    }
+}
+
+/// Sum over the TIN's triangles of the levels each spans: the contour segments it gives.
+fn levels_spanned(tin: &Tin, levels: &[f64]) -> usize {
+    let v = tin.vertices();
+    tin.triangles()
+        .iter()
+        .map(|t| {
+            let z = t.map(|i| v[i as usize].z);
+            let (lo, hi) = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
+            levels.iter().filter(|&&l| lo < l && l <= hi).count()
+        })
+        .sum()
+}
+
+#[test]
+fn contour_levels_shape_the_tin_for_fewer_segments_within_the_bound() {
+    let spec = tinsmith_testkit::with_nodata_disc(
+        tinsmith_testkit::terrain(120, 90, 4.0, 11),
+        70.0,
+        40.0,
+        9.0,
+    );
+    let (lo, hi) = spec
+        .values
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    let levels: Vec<f64> = (0..20)
+        .map(|k| lo + (hi - lo) * f64::from(k) / 20.0)
+        .collect();
+    for bound in [0.25, 1.0, 4.0] {
+        let plain = check_with(&spec, &DecimationOptions::new(bound)).unwrap();
+        let shaped = DecimationOptions::new(bound).with_contour_levels(&levels);
+        let shaped = check_with(&spec, &shaped).unwrap();
+        let (before, after) = (
+            levels_spanned(&plain, &levels),
+            levels_spanned(&shaped, &levels),
+        );
+        assert!(
+            after * 100 <= before * 97,
+            "at {bound}: {after} segments with levels, {before} without"
+        );
     }
 }
 

@@ -245,10 +245,10 @@ def main():
                     notes.append(f"{label}, ε = {e:g}: levels on one side only: {missing}")
                 if e == interval / 10:
                     mesh = tmp / "m.ply"
-                    tm = timed([args.bin, "mesh", str(src), "-o", str(mesh), "--max-error", f"{e:g}", "-q"], 1)
+                    tm = timed([args.bin, "mesh", str(src), "-o", str(mesh), "--max-error", f"{e:g}", "--contour-levels", lv, "-q"], 1)
                     tmf = timed([args.bin, "contour", str(src), "--levels", lv, "--mesh", str(mesh), "-q", "-o", str(t_out_fgb)], args.repeat)
                     tmj = timed([args.bin, "contour", str(src), "--levels", lv, "--mesh", str(mesh), "-q", "-o", str(t_out_json), *SRC_CRS], args.repeat)
-                    emit(f"| {label} | {interval} | tinsmith --mesh (TIN made once by `tinsmith mesh` in {tm:.2f} s) | {e:g} | {tris} | {tmf:.2f} | {tmj:.2f} | {tl} | {ts} | {100 * (ts / gs - 1):+.0f} % | {tlen:.4g} | same lines |")
+                    emit(f"| {label} | {interval} | tinsmith --mesh (TIN made once by `tinsmith mesh --contour-levels` in {tm:.2f} s) | {e:g} | {tris} | {tmf:.2f} | {tmj:.2f} | {tl} | {ts} | {100 * (ts / gs - 1):+.0f} % | {tlen:.4g} | same lines |")
                     for frac in SIMPLIFY:
                         d = frac * pixel
                         simp = ["--simplify", f"{d:g}"]

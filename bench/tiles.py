@@ -16,13 +16,16 @@ under /usr/bin/time, and prints a Markdown report (also written to --out):
             crops of the 16384^2 DEM, all centred on the same point, so resolution is the
             same at every size, though the content is not (the 16384^2 run is main's when
             main runs in the same invocation; --scaling-sizes picks the sizes).
+  mosaic    time per sample from 1024^2 to 16384^2 on inputs of the same content: the
+            centred 1024^2 crop repeated side by side (a GDAL VRT, translated to a tiled
+            GeoTIFF), so every size has the same terrain per sample; 1 thread, as scaling.
   sizes     tile size sweep on a 4096^2 crop (how the default was chosen), 1 thread,
             defaults otherwise.
 
 Usage (from the repository root; GDAL command-line tools from Debian's gdal-bin):
     cargo build --release
     python3 bench/tiles.py [--shared ../shared] [--work /tmp/tinsmith-bench]
-        [--sections main,ratio,scaling,sizes] [--repeat 1] [--out FILE.md]
+        [--sections main,ratio,scaling,mosaic,sizes] [--repeat 1] [--out FILE.md]
 
 The machine is shared: each run records its CPU seconds (user + sys) beside the wall
 time, and the load average before it, so that contention shows. With --repeat N the
@@ -64,6 +67,32 @@ def crop(work, big, big_size, size):
         off = (big_size - size) // 2
         sh(["gdal_translate", "-q", "-srcwin", str(off), str(off), str(size), str(size),
             "-co", "TILED=YES", str(big), str(path)])
+    return path
+
+
+def mosaic(work, tile, tile_size, size):
+    """A size x size Float32 GeoTIFF holding the tile_size^2 raster `tile` repeated."""
+    if size == tile_size:
+        return tile
+    path = work / f"mosaic_{size}_of_{tile_size}.tif"
+    if not path.exists():
+        n = size // tile_size
+        sources = "".join(
+            f'<SimpleSource><SourceFilename relativeToVRT="0">{tile}</SourceFilename>'
+            f'<SourceBand>1</SourceBand>'
+            f'<SrcRect xOff="0" yOff="0" xSize="{tile_size}" ySize="{tile_size}"/>'
+            f'<DstRect xOff="{i * tile_size}" yOff="{j * tile_size}" xSize="{tile_size}" '
+            f'ySize="{tile_size}"/></SimpleSource>'
+            for j in range(n) for i in range(n))
+        vrt = work / f"mosaic_{size}.vrt"
+        vrt.write_text(
+            f'<VRTDataset rasterXSize="{n * tile_size}" rasterYSize="{n * tile_size}">'
+            f'<GeoTransform>0, 1, 0, {n * tile_size}, 0, -1</GeoTransform>'
+            f'<VRTRasterBand dataType="Float32" band="1">{sources}</VRTRasterBand>'
+            f'</VRTDataset>')
+        sh(["gdal_translate", "-q", "-co", "TILED=YES", "-co", "BIGTIFF=IF_SAFER", str(vrt),
+            str(path)])
+        vrt.unlink()
     return path
 
 
@@ -122,7 +151,7 @@ def main():
     ap.add_argument("--shared", default="../shared")
     ap.add_argument("--work", default="/tmp/tinsmith-bench")
     ap.add_argument("--bin", default="target/release/tinsmith")
-    ap.add_argument("--sections", default="main,ratio,scaling,sizes")
+    ap.add_argument("--sections", default="main,ratio,scaling,mosaic,sizes")
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--scaling-sizes", default="1024,2048,4096,8192,16384")
     ap.add_argument("--out")
@@ -139,7 +168,8 @@ def main():
         lines.append(text)
 
     big_size = 16384
-    big = build_dem(shared, work, big_size) if {"main", "scaling", "sizes"} & set(sections) else None
+    uses_big = {"main", "scaling", "mosaic", "sizes"} & set(sections)
+    big = build_dem(shared, work, big_size) if uses_big else None
 
     one = two = None
     if "main" in sections:
@@ -195,6 +225,24 @@ def main():
         for r in runs:
             per = r["wall"] / samples(r)
             emit(row(f"{r['report']['width']}^2", r, f" {per * 1e6:.3f} | {per / ref:.2f} |"))
+        emit()
+
+    if "mosaic" in sections:
+        emit("### Time per sample on the same content: the centred 1024^2 crop repeated, "
+             "1 thread")
+        emit()
+        emit(HEADER + " us / sample | vs 1024^2 |")
+        emit(RULE + "---|---|")
+        tile = crop(work, big, big_size, 1024)
+        ref = None
+        for size in [int(s) for s in args.scaling_sizes.split(",")]:
+            dem = mosaic(work, tile, 1024, size)
+            r = mesh(binary, dem, work, ["--threads", "1"], args.repeat)
+            per = r["wall"] / samples(r)
+            ref = ref or per
+            emit(row(f"{r['report']['width']}^2", r, f" {per * 1e6:.3f} | {per / ref:.2f} |"))
+            if dem != tile:
+                dem.unlink()
         emit()
 
     if "sizes" in sections:

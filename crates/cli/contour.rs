@@ -208,8 +208,16 @@ fn tiled_tin(
         .with_tile_size(args.tile_size)
         .with_threads(args.threads.map_or(0, |n| n as usize));
     let mut collector = MeshCollector::new();
+    let bar = crate::tiled::progress_bar(args.quiet);
+    bar.set_message("tiles");
+    let mut progress = |p: tinsmith_tile::TileProgress| {
+        bar.set_length(p.total as u64);
+        bar.set_position(p.done as u64);
+    };
     let report =
-        mesh_tiles(&source, &options, &mut collector, &mut |_| {}).naming_file(&args.input)?;
+        mesh_tiles(&source, &options, &mut collector, &mut progress).naming_file(&args.input);
+    bar.finish_and_clear();
+    let report = report?;
     if report.final_triangles == 0 {
         return Err(nothing_to_contour(args));
     }

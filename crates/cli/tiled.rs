@@ -266,7 +266,7 @@ fn file_mesh(
 
 /// Tiles done / total with the ETA on stderr; hidden when quiet or when stderr is not a
 /// terminal.
-fn progress_bar(quiet: bool) -> ProgressBar {
+pub fn progress_bar(quiet: bool) -> ProgressBar {
     if quiet || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }

@@ -111,15 +111,8 @@ impl Retriangulator {
         self.ring.extend_from_slice(ring);
         self.star_bounds.clear();
         self.star_bounds.extend_from_slice(star_bounds);
-        self.star_gradients.clear();
         let m = ring.len();
-        self.segments.clear();
-        self.segments.resize(m * m, None);
         self.exact_errors.clear();
-        for i in 0..star_bounds.len() {
-            let g = plane_gradient(&centre, &ring[i], &ring[(i + 1) % m]);
-            self.star_gradients.push(g);
-        }
         self.unit_hole =
             (0..star_bounds.len()).all(|i| orient(&centre, &ring[i], &ring[(i + 1) % m]) == 1);
         self.max_star_above = star_bounds
@@ -137,7 +130,12 @@ impl Retriangulator {
         if !self.centre_can_fit(rules.limit) {
             return None;
         }
-        let found = if rules.method == Retriangulation::Dp && self.ring.len() <= rules.dp_max_ring {
+        let dp = rules.method == Retriangulation::Dp && self.ring.len() <= rules.dp_max_ring;
+        // The exact model's DP needs no segment errors; the rest does.
+        if rules.model == ErrorModel::Bounds || !dp {
+            self.prepare_segments();
+        }
+        let found = if dp {
             self.dynamic_programming(rules)
         } else {
             match rules.selection {
@@ -156,6 +154,20 @@ impl Retriangulator {
             .iter()
             .fold(0.0f64, |w, t| w.max(t.bound.max()));
         Some((&self.triangles, worst))
+    }
+
+    /// The star triangles' gradients and an empty table of segment errors, for the error
+    /// propagation of §3.3 and the ears' introduced error.
+    fn prepare_segments(&mut self) {
+        let centre = self.centre.expect("hole loaded");
+        let m = self.ring.len();
+        self.segments.clear();
+        self.segments.resize(m * m, None);
+        self.star_gradients.clear();
+        for i in 0..self.star_bounds.len() {
+            let g = plane_gradient(&centre, &self.ring[i], &self.ring[(i + 1) % m]);
+            self.star_gradients.push(g);
+        }
     }
 
     /// A necessary condition, cheap to test: whatever the triangulation, the removed vertex

@@ -158,12 +158,13 @@ impl DecimationOptions {
     /// triangles span the fewest levels, and once no vertex can go, edges are flipped
     /// where the new edge spans fewer levels and both new triangles stay within the bound.
     /// Each triangle a level passes through gives a contour line one segment, so the
-    /// lines get fewer segments; the bound is kept exactly as without levels.
+    /// lines get fewer segments; the bound is kept exactly as without levels. No finite
+    /// level leaves the options as they were.
     pub fn with_contour_levels(mut self, levels: &[f64]) -> DecimationOptions {
         let mut levels: Vec<f64> = levels.iter().copied().filter(|l| l.is_finite()).collect();
         levels.sort_by(f64::total_cmp);
         levels.dedup();
-        self.contour_levels = Some(levels.into());
+        self.contour_levels = (!levels.is_empty()).then(|| levels.into());
         self
     }
 

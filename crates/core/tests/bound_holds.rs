@@ -296,6 +296,17 @@ fn contour_levels_shape_the_tin_for_fewer_segments_within_the_bound() {
 }
 
 #[test]
+fn no_finite_contour_level_changes_nothing() {
+    let spec = tinsmith_testkit::terrain(40, 30, 4.0, 3);
+    let plain = check_with(&spec, &DecimationOptions::new(1.0)).unwrap();
+    for levels in [&[][..], &[f64::NAN, f64::INFINITY][..]] {
+        let options = DecimationOptions::new(1.0).with_contour_levels(levels);
+        assert_eq!(options.contour_levels, None);
+        assert_eq!(check_with(&spec, &options).unwrap(), plain);
+    }
+}
+
+#[test]
 fn empty_domain_gives_an_empty_tin() {
     let spec = GridSpec {
         width: 1,

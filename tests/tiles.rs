@@ -127,6 +127,34 @@ fn welded_mesh_keeps_the_bound_and_has_no_cracks() {
 }
 
 #[test]
+fn a_tin_shaped_for_contours_keeps_the_bound_and_has_no_cracks() {
+    // Level-aware DP and edge flips inside tiles must leave the shared borders alone.
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let d = Dir::new();
+    for (size, e) in [("64", "5"), ("17", "2")] {
+        let r = mesh(
+            &d,
+            &[
+                &dem,
+                "-o",
+                "t.ply",
+                "--max-error",
+                e,
+                "--tile-size",
+                size,
+                "--contour-interval",
+                "20",
+                "--pixel-coords",
+                "-q",
+            ],
+        );
+        let v = verify(&d, &dem, "t.ply", e, true);
+        assert_eq!(r["triangles_after"], v["triangles"]);
+        assert_crack_free(&dem, &d.path("t.ply"));
+    }
+}
+
+#[test]
 fn raster_not_a_multiple_of_the_tile_size() {
     // 430 x 516: with 108 the last tile column is 2 samples wide; with 100 neither
     // dimension is a multiple.

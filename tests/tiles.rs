@@ -127,11 +127,16 @@ fn welded_mesh_keeps_the_bound_and_has_no_cracks() {
 }
 
 #[test]
-fn a_tin_shaped_for_contours_keeps_the_bound_and_has_no_cracks() {
-    // Level-aware DP and edge flips inside tiles must leave the shared borders alone.
+fn flips_in_tiles_keep_the_bound_and_leave_no_cracks() {
+    // Level-aware DP and both kinds of edge flips inside tiles must leave the shared
+    // borders alone.
     let dem = fixture("becmodel_dem_bc_albers_50m.tif");
     let d = Dir::new();
-    for (size, e) in [("64", "5"), ("17", "2")] {
+    for (size, e, extra) in [
+        ("64", "5", "--contour-interval=20"),
+        ("17", "2", "--contour-interval=20"),
+        ("64", "1", "--flip-rounds=3"),
+    ] {
         let r = mesh(
             &d,
             &[
@@ -142,8 +147,7 @@ fn a_tin_shaped_for_contours_keeps_the_bound_and_has_no_cracks() {
                 e,
                 "--tile-size",
                 size,
-                "--contour-interval",
-                "20",
+                extra,
                 "--pixel-coords",
                 "-q",
             ],

@@ -144,6 +144,11 @@ pub struct MeshArgs {
     /// at the cost of more triangles. The error bound holds either way.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
     pub max_edge_length: Option<u32>,
+    /// After decimating, up to N rounds of edge flips that lower triangle errors, each
+    /// followed by another sweep: fewer triangles at small bounds, at more time; the
+    /// error bound holds either way. Not with --max-triangles/--max-vertices.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub flip_rounds: usize,
     /// Shape the TIN for contour lines every I (plus --contour-offset) over the raster's
     /// heights, as `tinsmith contour --max-error` does: `contour --mesh` then draws lines
     /// with fewer segments. The error bound holds either way.
@@ -310,6 +315,7 @@ impl MeshArgs {
             .with_initial_mesh(self.initial_mesh.into());
         options.dp_max_ring = self.dp_max_ring as usize;
         options.max_edge_length = self.max_edge_length;
+        options.flip_rounds = self.flip_rounds;
         if let Some(n) = self.max_triangles {
             options = options.with_max_triangles(n);
         }

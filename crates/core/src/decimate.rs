@@ -213,6 +213,14 @@ fn run(
             )
         }
     }
+    if !count_target {
+        for _ in 0..options.flip_rounds {
+            if crate::flips::flip_for_error(&mut mesh, &rules) == 0 {
+                break;
+            }
+            sweep(&mut mesh, &mut remover, &mut stats, progress);
+        }
+    }
     if let Some(levels) = rules.levels {
         crate::levels::flip_for_levels(&mut mesh, &rules, levels);
     }

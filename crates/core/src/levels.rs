@@ -59,18 +59,10 @@ pub(crate) fn flip_for_levels(mesh: &mut Mesh<'_>, rules: &Rules<'_>, levels: &[
             continue;
         }
         for j in 0..3 {
-            let u = mesh.across(t, j);
-            if u == NONE {
-                continue;
-            }
-            let corners = mesh.corners(t);
-            let [a, b, c] = [0, 1, 2].map(|k| corners[(j + k) % 3]);
-            let other = mesh.corners(u);
-            let Some(k) = (0..3).find(|&k| other[k] == b) else {
+            let Some((u, quad)) = mesh.quad(t, j) else {
                 continue;
             };
-            let d = other[(k + 2) % 3];
-            let [pa, pb, pc, pd] = [a, b, c, d].map(|v| mesh.point(v));
+            let [pa, pb, pc, pd] = quad.map(|v| mesh.point(v));
             if spanned(&pc, &pd) >= spanned(&pa, &pb)
                 || orient(&pc, &pa, &pd) <= 0
                 || orient(&pc, &pd, &pb) <= 0

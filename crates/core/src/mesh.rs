@@ -285,6 +285,21 @@ impl<'g> Mesh<'g> {
         self.corners.len()
     }
 
+    /// The quadrilateral around edge `j` of live triangle `t`: the triangle `u` across it
+    /// and the corners `[a, b, c, d]`, where `t = (a, b, c)` and `u = (b, a, d)`; `None`
+    /// on the domain boundary.
+    pub(crate) fn quad(&self, t: u32, j: usize) -> Option<(u32, [u32; 4])> {
+        let u = self.neighbours[t as usize][j];
+        if u == NONE {
+            return None;
+        }
+        let corners = self.corners[t as usize];
+        let [a, b, c] = [0, 1, 2].map(|k| corners[(j + k) % 3]);
+        let k = self.edge_index(u, b, a);
+        let d = self.corners[u as usize][(k + 2) % 3];
+        Some((u, [a, b, c, d]))
+    }
+
     /// Flips edge `j` of live triangle `t` (from `a`, corner `j`, to `b`; `c` opposite),
     /// shared with `u = (b, a, d)`, into the edge `c d`: `t` becomes `(c, a, d)` and `u`
     /// becomes `(c, d, b)`, with the given bounds. The caller has checked that the

@@ -34,6 +34,7 @@ fn all_options(bound: f64) -> Vec<DecimationOptions> {
                 // Levels spread over the small grids' values (see `small_grid`).
                 let levels: Vec<f64> = (-8..=8).map(|k| f64::from(k) * 1.5).collect();
                 all.push(dp.clone().with_contour_levels(&levels));
+                all.push(dp.clone().with_flip_rounds(2));
                 all.push(dp);
             }
         }
@@ -291,6 +292,27 @@ fn contour_levels_shape_the_tin_for_fewer_segments_within_the_bound() {
         assert!(
             after * 100 <= before * 97,
             "at {bound}: {after} segments with levels, {before} without"
+        );
+    }
+}
+
+#[test]
+fn flip_rounds_keep_the_bound_with_fewer_triangles() {
+    let spec = tinsmith_testkit::with_nodata_disc(
+        tinsmith_testkit::terrain(120, 90, 4.0, 5),
+        30.0,
+        60.0,
+        8.0,
+    );
+    for bound in [0.25, 1.0] {
+        let plain = check_with(&spec, &DecimationOptions::new(bound)).unwrap();
+        let flipped = DecimationOptions::new(bound).with_flip_rounds(4);
+        let flipped = check_with(&spec, &flipped).unwrap();
+        assert!(
+            flipped.triangles().len() < plain.triangles().len(),
+            "at {bound}: {} triangles with flips, {} without",
+            flipped.triangles().len(),
+            plain.triangles().len()
         );
     }
 }

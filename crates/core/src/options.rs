@@ -176,7 +176,7 @@ impl DecimationOptions {
     /// quadrilateral is strictly convex into the other diagonal when both new triangles'
     /// exact errors are within the bound and below 0.9 times the larger error of the two
     /// old ones, then sweep again for the vertices that can now go. Fewer triangles at
-    /// small bounds (3–5 % in two to eight rounds on rough DEMs at 0.5 m), at more time;
+    /// small bounds (2–5 % in two to eight rounds at ε ≤ 1 on real DEMs), at 2–5 × the time;
     /// the bound is kept. A round that flips nothing ends them. Ignored with count targets.
     pub fn with_flip_rounds(mut self, rounds: usize) -> DecimationOptions {
         self.flip_rounds = rounds;

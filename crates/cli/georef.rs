@@ -22,6 +22,29 @@ impl Georef {
         }
     }
 
+    /// Vertices `(column, row, height)` in file coordinates, and triangles reordered to
+    /// stay counter-clockwise in them (normals up) where the geotransform flips
+    /// orientation.
+    pub fn file_mesh(
+        self,
+        vertices: impl IntoIterator<Item = (u32, u32, f64)>,
+        triangles: impl IntoIterator<Item = [u32; 3]>,
+    ) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let vertices = vertices
+            .into_iter()
+            .map(|(x, y, z)| {
+                let [fx, fy] = self.file_position(x, y);
+                [fx, fy, z]
+            })
+            .collect();
+        let flip = self.flips_orientation();
+        let triangles = triangles
+            .into_iter()
+            .map(|[a, b, c]| if flip { [a, c, b] } else { [a, b, c] })
+            .collect();
+        (vertices, triangles)
+    }
+
     /// File coordinates of sample `(x, y)`.
     pub fn file_position(self, x: u32, y: u32) -> [f64; 2] {
         match self {

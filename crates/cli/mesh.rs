@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Result};
 use serde::Serialize;
-use tinsmith_core::{decimate_with_progress, Tin};
+use tinsmith_core::decimate_with_progress;
 use tinsmith_verify::{GridRef, VerifyOptions};
 
 use crate::args::MeshArgs;
@@ -101,7 +101,10 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     }
 
     let t = Instant::now();
-    let (vertices, triangles) = file_mesh(tin, &georef);
+    let (vertices, triangles) = georef.file_mesh(
+        tin.vertices().iter().map(|v| (v.x, v.y, v.z)),
+        tin.triangles().iter().copied(),
+    );
     crate::export::write(&plan, args, &raster.info, vertices, &triangles)?;
     let write_seconds = t.elapsed().as_secs_f64();
 
@@ -146,23 +149,4 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         write_atomically(path, &json)?;
     }
     Ok(true)
-}
-
-/// Vertices in file coordinates and triangles counter-clockwise in them (normals up).
-fn file_mesh(tin: &Tin, georef: &Georef) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let vertices = tin
-        .vertices()
-        .iter()
-        .map(|v| {
-            let [x, y] = georef.file_position(v.x, v.y);
-            [x, y, v.z]
-        })
-        .collect();
-    let flip = georef.flips_orientation();
-    let triangles = tin
-        .triangles()
-        .iter()
-        .map(|&[a, b, c]| if flip { [a, c, b] } else { [a, b, c] })
-        .collect();
-    (vertices, triangles)
 }

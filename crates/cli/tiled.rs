@@ -10,7 +10,6 @@ use anyhow::{bail, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use tinsmith_export::MeshFormat;
-use tinsmith_raster::RasterInfo;
 use tinsmith_tile::{
     mesh_tiles, MeshCollector, PerTileWriter, Placement, RasterSource, TileOptions, TilePlan,
     TileProgress, TilesReport, WeldedWriter,
@@ -153,7 +152,12 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             }
             bar.set_message("writing");
             let t = Instant::now();
-            let (vertices, triangles) = file_mesh(collector, &info, args.pixel_coords);
+            let (vertices, triangles) = collector.into_parts();
+            let georef = Georef::new(info.transform(), args.pixel_coords);
+            let (vertices, triangles) = georef.file_mesh(
+                vertices.iter().map(|&[x, y, z]| (x as u32, y as u32, z)),
+                triangles,
+            );
             let plan = export_plan.expect("planned for -o");
             crate::export::write(&plan, args, &info, vertices, &triangles)?;
             let write = report.seconds_sink + t.elapsed().as_secs_f64();
@@ -239,29 +243,6 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
 /// are welded in memory (the mesh, not the raster) and written at the end.
 fn streams(format: MeshFormat) -> bool {
     matches!(format, MeshFormat::Ply | MeshFormat::Obj)
-}
-
-/// The welded mesh in file coordinates, triangles counter-clockwise in them (normals up).
-fn file_mesh(
-    collector: MeshCollector,
-    info: &RasterInfo,
-    pixel_coords: bool,
-) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let georef = Georef::new(info.transform(), pixel_coords);
-    let (vertices, mut triangles) = collector.into_parts();
-    let vertices = vertices
-        .into_iter()
-        .map(|[x, y, z]| {
-            let [fx, fy] = georef.file_position(x as u32, y as u32);
-            [fx, fy, z]
-        })
-        .collect();
-    if georef.flips_orientation() {
-        for t in &mut triangles {
-            t.swap(1, 2);
-        }
-    }
-    (vertices, triangles)
 }
 
 /// Tiles done / total with the ETA on stderr; hidden when quiet or when stderr is not a

@@ -6,7 +6,7 @@
 use crate::exact::triangle_error;
 use crate::hole::{squared_length, Rules};
 use crate::mesh::{Mesh, NONE};
-use crate::predicates::orient;
+use crate::predicates::{orient, Point};
 
 /// A flip must bring the larger error of the two triangles below this fraction of what it
 /// was: small gains are not worth a rasterization and would make passes long.
@@ -30,25 +30,50 @@ pub(crate) fn flip_for_error(mesh: &mut Mesh<'_>, rules: &Rules<'_>) -> usize {
             if u < t {
                 continue; // each edge once, from its lower slot
             }
-            let [pa, pb, pc, pd] = quad.map(|v| mesh.point(v));
-            if orient(&pc, &pa, &pd) <= 0
-                || orient(&pc, &pd, &pb) <= 0
-                || squared_length(&pc, &pd) > rules.max_edge_squared
-            {
+            let points = quad.map(|v| mesh.point(v));
+            let old = mesh.bound(t).max().max(mesh.bound(u).max());
+            if !flip_within(
+                mesh,
+                rules,
+                t,
+                j,
+                &points,
+                (FLIP_GAIN * old).min(rules.limit),
+            ) {
                 continue;
             }
-            let old = mesh.bound(t).max().max(mesh.bound(u).max());
-            let cap = (FLIP_GAIN * old).min(rules.limit);
-            let Some(first) = triangle_error(rules.grid, &pc, &pa, &pd, cap) else {
-                continue;
-            };
-            let Some(second) = triangle_error(rules.grid, &pc, &pd, &pb, cap) else {
-                continue;
-            };
-            mesh.flip(t, j, [first, second]);
             flips += 1;
             break; // t has changed: its other edges wait for the next pass
         }
     }
     flips
+}
+
+/// Flips edge `j` of live triangle `t`, whose quadrilateral has the corner `points` of
+/// [`Mesh::quad`], into the other diagonal when the quadrilateral is strictly convex, the
+/// new edge is within the longest edge allowed and both new triangles' exact errors are
+/// within `cap`. Returns whether it flipped.
+pub(crate) fn flip_within(
+    mesh: &mut Mesh<'_>,
+    rules: &Rules<'_>,
+    t: u32,
+    j: usize,
+    points: &[Point; 4],
+    cap: f64,
+) -> bool {
+    let [pa, pb, pc, pd] = points;
+    if orient(pc, pa, pd) <= 0
+        || orient(pc, pd, pb) <= 0
+        || squared_length(pc, pd) > rules.max_edge_squared
+    {
+        return false;
+    }
+    let Some(first) = triangle_error(rules.grid, pc, pa, pd, cap) else {
+        return false;
+    };
+    let Some(second) = triangle_error(rules.grid, pc, pd, pb, cap) else {
+        return false;
+    };
+    mesh.flip(t, j, [first, second]);
+    true
 }

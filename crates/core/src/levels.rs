@@ -7,8 +7,8 @@
 //! Neither changes the guarantee: every new triangle's exact error is measured against
 //! the same limit.
 
-use crate::exact::triangle_error;
-use crate::hole::{squared_length, Rules};
+use crate::flips::flip_within;
+use crate::hole::Rules;
 use crate::mesh::{Mesh, NONE};
 use crate::predicates::{orient, plane_gradient, Point};
 
@@ -62,21 +62,12 @@ pub(crate) fn flip_for_levels(mesh: &mut Mesh<'_>, rules: &Rules<'_>, levels: &[
             let Some((u, quad)) = mesh.quad(t, j) else {
                 continue;
             };
-            let [pa, pb, pc, pd] = quad.map(|v| mesh.point(v));
-            if spanned(&pc, &pd) >= spanned(&pa, &pb)
-                || orient(&pc, &pa, &pd) <= 0
-                || orient(&pc, &pd, &pb) <= 0
-                || squared_length(&pc, &pd) > rules.max_edge_squared
+            let points = quad.map(|v| mesh.point(v));
+            let [pa, pb, pc, pd] = &points;
+            if spanned(pc, pd) >= spanned(pa, pb) || !flip_within(mesh, rules, t, j, &points, limit)
             {
                 continue;
             }
-            let Some(first) = triangle_error(rules.grid, &pc, &pa, &pd, limit) else {
-                continue;
-            };
-            let Some(second) = triangle_error(rules.grid, &pc, &pd, &pb, limit) else {
-                continue;
-            };
-            mesh.flip(t, j, [first, second]);
             flips += 1;
             for w in [
                 t,

@@ -220,52 +220,25 @@ impl<'g> Mesh<'g> {
             return false;
         }
         let i = self.local(t, v);
-        let e = (i + 1) % 3;
-        // t = (c, a, b) with c = v; the edge a -> b is opposite v.
-        let [c, a, b] = [
-            v,
-            self.corners[t as usize][e],
-            self.corners[t as usize][(e + 1) % 3],
-        ];
         if self.neighbours[t as usize][i] != NONE
             || self.neighbours[t as usize][(i + 2) % 3] != NONE
         {
             return false; // v has more than one triangle
         }
-        let u = self.neighbours[t as usize][e];
-        if u == NONE {
+        // t = (a, b, v): the edge a -> b is opposite v; u = (b, a, d) across it.
+        let e = (i + 1) % 3;
+        let Some((_, quad)) = self.quad(t, e) else {
+            return false;
+        };
+        let [pa, pb, pc, pd] = quad.map(|w| self.point(w));
+        if orient(&pc, &pa, &pd) <= 0 || orient(&pc, &pd, &pb) <= 0 {
             return false;
         }
-        // u = (b, a, d): the quadrilateral is c, a, d, b counter-clockwise.
-        let k = self.edge_index(u, b, a);
-        let d = self.corners[u as usize][(k + 2) % 3];
-        let (pa, pb, pc, pd) = (self.point(a), self.point(b), self.point(c), self.point(d));
-        if orient(&pc, &pa, &pd) <= 0 || orient(&pd, &pb, &pc) <= 0 {
-            return false;
-        }
-        // Outer neighbours: t's edges b -> c and c -> a are boundary (checked above);
-        // u's edges a -> d and d -> b.
-        let u_ad = self.neighbours[u as usize][(k + 1) % 3];
-        let u_db = self.neighbours[u as usize][(k + 2) % 3];
-        // New t = (c, a, d): edges c -> a (boundary), a -> d (u_ad), d -> c (u).
-        // New u = (c, d, b): edges c -> d (t), d -> b (u_db), b -> c (boundary).
-        self.corners[t as usize] = [c, a, d];
-        self.neighbours[t as usize] = [NONE, u_ad, u];
-        self.corners[u as usize] = [c, d, b];
-        self.neighbours[u as usize] = [t, u_db, NONE];
-        if u_ad != NONE {
-            let j = self.edge_index(u_ad, d, a);
-            self.neighbours[u_ad as usize][j] = t;
-        }
-        for (slot, [p, q, r]) in [(t, [pc, pa, pd]), (u, [pc, pd, pb])] {
-            let bound = crate::exact::triangle_error(self.grid, &p, &q, &r, f64::INFINITY)
-                .expect("no limit");
-            self.bounds[slot as usize] = bound.into();
-        }
-        self.vertex_triangle[a as usize] = t;
-        self.vertex_triangle[b as usize] = u;
-        self.vertex_triangle[c as usize] = t;
-        self.vertex_triangle[d as usize] = u;
+        let exact = |p: &Point, q: &Point, r: &Point| {
+            crate::exact::triangle_error(self.grid, p, q, r, f64::INFINITY).expect("no limit")
+        };
+        let bounds = [exact(&pc, &pa, &pd), exact(&pc, &pd, &pb)];
+        self.flip(t, e, bounds);
         true
     }
 

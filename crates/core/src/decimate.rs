@@ -1,6 +1,5 @@
 //! The decimation driver: the paper's sweep over candidate vertices (§3.1).
 
-use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use std::time::Instant;
 
@@ -311,7 +310,7 @@ fn sweep(
 ) {
     let n = mesh.vertex_slots();
     let mut queued = vec![false; n];
-    let mut this_sweep: BinaryHeap<Reverse<u32>> = BinaryHeap::new();
+    let mut this_sweep = AscendingQueue::new(n);
     let mut next_sweep: Vec<u32> = Vec::new();
     for v in 0..n as u32 {
         if mesh.contains_vertex(v) {
@@ -321,7 +320,9 @@ fn sweep(
     }
     while !next_sweep.is_empty() {
         stats.sweeps += 1;
-        this_sweep.extend(next_sweep.drain(..).map(Reverse));
+        for v in next_sweep.drain(..) {
+            this_sweep.insert(v);
+        }
         let mut sweep_size = this_sweep.len();
         let mut tried = 0usize;
         progress(Progress {
@@ -329,7 +330,7 @@ fn sweep(
             sweep_fraction: 0.0,
             removed: stats.removed,
         });
-        while let Some(Reverse(v)) = this_sweep.pop() {
+        while let Some(v) = this_sweep.pop_min() {
             queued[v as usize] = false;
             stats.attempts += 1;
             tried += 1;
@@ -348,7 +349,7 @@ fn sweep(
                     if !queued[u as usize] {
                         queued[u as usize] = true;
                         if u > v {
-                            this_sweep.push(Reverse(u));
+                            this_sweep.insert(u);
                             sweep_size += 1;
                         } else {
                             next_sweep.push(u);
@@ -357,6 +358,54 @@ fn sweep(
                 }
             }
         }
+    }
+}
+
+/// A set of vertex slots taken out smallest first: a bit per slot and a cursor below which
+/// no bit is set. In a sweep every insertion is above the slot last taken, so the cursor
+/// only moves forward and both operations cost O(1) amortized (a heap costs O(log n)).
+struct AscendingQueue {
+    words: Vec<u64>,
+    /// No bit is set in the words before this one.
+    cursor: usize,
+    len: usize,
+}
+
+impl AscendingQueue {
+    fn new(slots: usize) -> AscendingQueue {
+        AscendingQueue {
+            words: vec![0; slots.div_ceil(64)],
+            cursor: 0,
+            len: 0,
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.len
+    }
+
+    fn insert(&mut self, v: u32) {
+        let (word, bit) = (v as usize / 64, v % 64);
+        let mask = 1u64 << bit;
+        if self.words[word] & mask == 0 {
+            self.words[word] |= mask;
+            self.len += 1;
+        }
+        self.cursor = self.cursor.min(word);
+    }
+
+    /// Takes the smallest slot.
+    fn pop_min(&mut self) -> Option<u32> {
+        if self.len == 0 {
+            return None;
+        }
+        while self.words[self.cursor] == 0 {
+            self.cursor += 1;
+        }
+        let word = self.words[self.cursor];
+        self.words[self.cursor] = word & (word - 1);
+        self.len -= 1;
+        Some((self.cursor * 64) as u32 + word.trailing_zeros())
     }
 }
 

@@ -6,7 +6,7 @@ use std::time::Instant;
 use crate::hole::{Retriangulator, Rules};
 use crate::mesh::{Mesh, Star, VertexClass};
 use crate::predicates::Point;
-use crate::rtin::rtin_triangles;
+use crate::rtin::{rtin_for_count, rtin_triangles};
 use crate::{
     DecimationOptions, Error, ErrorBound, Grid, InitialMesh, Order, Result, Tin, TinVertex,
 };
@@ -162,6 +162,16 @@ fn run(
     // measured errors are not exact enough for that, so it starts from the full grid. In
     // border mode the RTIN keeps half cells along the border (see `remove_border`).
     let mut mesh = match options.initial_mesh {
+        InitialMesh::Rtin if count_target && limit > 0.0 => {
+            let (corners, bounds) = rtin_for_count(
+                grid,
+                COUNT_START_FACTOR.saturating_mul(target_triangles(options)),
+                limit,
+                max_edge_squared(options),
+                keep_border.is_some(),
+            );
+            Mesh::from_triangles(grid, corners, bounds)
+        }
         InitialMesh::Rtin if limit > 0.0 => {
             let (corners, bounds) = rtin_triangles(
                 grid,
@@ -244,6 +254,21 @@ fn run(
         seconds_decimation,
     };
     Ok(Decimation { tin, report })
+}
+
+/// A count target's RTIN start has at least this many times the triangles asked for, so
+/// that the greedy removal, not the RTIN, picks the last ones to go. Measured (session 4,
+/// ETOPO5 to 1 M triangles, Big Tujunga to 100 k): at 4 the error matches or beats the
+/// full-grid start (124.5 vs 128; 7 vs 7) in a quarter to half of its time; 2 is twice as
+/// fast again but 9–14 % worse; 1 doubles the error.
+const COUNT_START_FACTOR: usize = 4;
+
+/// The triangles a count target asks for (a mesh of `v` vertices has about `2 v`).
+fn target_triangles(options: &DecimationOptions) -> usize {
+    let by_vertices = options
+        .max_vertices
+        .map_or(usize::MAX, |v| v.saturating_mul(2));
+    options.max_triangles.unwrap_or(usize::MAX).min(by_vertices)
 }
 
 /// The squared maximum edge length, `i64::MAX` when there is none.

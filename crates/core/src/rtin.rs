@@ -57,24 +57,47 @@ pub(crate) fn rtin_triangles(
     full_border: bool,
 ) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
     let rtin = Rtin::new(grid, limit, max_edge_squared, full_border);
-    let need = if rtin.finest_split_fraction() > TOP_DOWN_BELOW {
-        rtin.saturate()
-    } else {
-        rtin.refine()
-    };
-    let s = rtin.size;
-    let halves = [((0, 0), (s, s), (s, 0)), ((s, s), (0, 0), (0, s))];
-    // Count first so that the arrays are allocated once, at their size: at small bounds
-    // they hold nearly two triangles per sample, and doubling growth would waste up to half.
-    let mut count = 0;
-    for (a, b, c) in halves {
-        rtin.emit(a, b, c, &need, &mut |_| count += 1);
+    let need = rtin.refinement();
+    rtin.triangles(&need)
+}
+
+/// The start for a count target: of the RTINs at bounds `range / 2^k`, k = 1, 2, ...
+/// (`range` the spread of the grid's values) that are within `limit`, the first with at
+/// least `triangles` triangles, or the last tried if none has (a nearly planar grid).
+/// Greedy removal then decimates to the count from there: from the RTIN at no bound at
+/// all it would start below the count, and from the full grid it would spend its time on
+/// removals the RTIN makes for free. The bounds tried do not depend on `limit` beyond
+/// skipping those above it, so a rerun within the bound a count target reported starts
+/// from the same mesh.
+pub(crate) fn rtin_for_count(
+    grid: &Grid,
+    triangles: usize,
+    limit: f64,
+    max_edge_squared: i64,
+    full_border: bool,
+) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
+    let (lo, hi) = grid
+        .values()
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    let range = if hi > lo { hi - lo } else { 1.0 };
+    let mut bound = range / 2.0;
+    // 2^-40 of the range is far below any meaningful error, and the RTIN there is close
+    // to the full grid.
+    for _ in 0..40 {
+        if bound <= limit {
+            let rtin = Rtin::new(grid, bound, max_edge_squared, full_border);
+            let need = rtin.refinement();
+            if rtin.count(&need) >= triangles {
+                return rtin.triangles(&need);
+            }
+        }
+        bound /= 2.0;
     }
-    let mut out = (Vec::with_capacity(count), Vec::with_capacity(count));
-    for (a, b, c) in halves {
-        rtin.emit(a, b, c, &need, &mut |t| rtin.push(t, &mut out));
-    }
-    out
+    rtin_triangles(grid, bound.min(limit), max_edge_squared, full_border)
 }
 
 /// The probed fraction of finest squares that split, below which [`rtin_triangles`] refines
@@ -285,6 +308,40 @@ impl<'g> Rtin<'g> {
             s *= 2;
         }
         need
+    }
+
+    /// The split diamonds, by whichever refinement the probe picks (see the module docs).
+    fn refinement(&self) -> Vec<bool> {
+        if self.finest_split_fraction() > TOP_DOWN_BELOW {
+            self.saturate()
+        } else {
+            self.refine()
+        }
+    }
+
+    /// How many triangles [`Rtin::triangles`] would give.
+    fn count(&self, need: &[bool]) -> usize {
+        let s = self.size;
+        let mut count = 0;
+        for (a, b, c) in [((0, 0), (s, s), (s, 0)), ((s, s), (0, 0), (0, s))] {
+            self.emit(a, b, c, need, &mut |_| count += 1);
+        }
+        count
+    }
+
+    /// The triangles (counter-clockwise sample indices) of the refinement `need`, with
+    /// their exact errors.
+    fn triangles(&self, need: &[bool]) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
+        let s = self.size;
+        // Counted first so that the arrays are allocated once, at their size: at small
+        // bounds they hold nearly two triangles per sample, and doubling growth would
+        // waste up to half.
+        let count = self.count(need);
+        let mut out = (Vec::with_capacity(count), Vec::with_capacity(count));
+        for (a, b, c) in [((0, 0), (s, s), (s, 0)), ((s, s), (0, 0), (0, s))] {
+            self.emit(a, b, c, need, &mut |t| self.push(t, &mut out));
+        }
+        out
     }
 
     /// The fraction of a sparse, fixed sample of 2x2 squares (one in [`PROBE_STRIDE`]²)

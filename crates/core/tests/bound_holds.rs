@@ -382,3 +382,33 @@ fn exact_keeps_no_more_than_bounds_on_terrain() {
         );
     }
 }
+
+#[test]
+fn count_targets_reach_the_count_on_a_power_of_two_grid() {
+    // 257 x 257 is one RTIN square: without a start refined for the target, the RTIN at
+    // an unlimited error would be two triangles, far below any count asked for.
+    let spec = tinsmith_testkit::terrain(257, 257, 1.0, 5);
+    let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
+    let r = decimate(
+        &grid,
+        &DecimationOptions::new(f64::INFINITY).with_max_triangles(3000),
+    )
+    .unwrap();
+    let triangles = r.tin.triangles().len();
+    assert!((2999..=3000).contains(&triangles), "{triangles}");
+    let r = decimate(
+        &grid,
+        &DecimationOptions::new(f64::INFINITY).with_max_vertices(700),
+    )
+    .unwrap();
+    assert_eq!(r.tin.vertices().len(), 700);
+    // Starting from the full grid reaches the same count with an error of the same order.
+    let full = decimate(
+        &grid,
+        &DecimationOptions::new(f64::INFINITY)
+            .with_max_vertices(700)
+            .with_initial_mesh(InitialMesh::Full),
+    )
+    .unwrap();
+    assert!(r.report.max_bound <= 1.5 * full.report.max_bound);
+}

@@ -149,3 +149,39 @@ fn a_pyramid_needs_a_crs_and_the_message_names_the_file_once() {
     assert_eq!(message.matches("nocrs.asc").count(), 1, "{message}");
     assert_eq!(d.files(), vec!["nocrs.asc"]);
 }
+
+#[test]
+fn count_target_on_a_raster_too_large_for_memory() {
+    // A VRT that declares a 1,000,000 x 1,000,000 raster over the fixture: nothing is read,
+    // and a count target (which needs the whole raster at once) is refused up front
+    // instead of being killed partway.
+    let d = Dir::new();
+    d.write(
+        "huge.vrt",
+        &format!(
+            r#"<VRTDataset rasterXSize="1000000" rasterYSize="1000000">
+  <VRTRasterBand dataType="Float32" band="1">
+    <SimpleSource>
+      <SourceFilename relativeToVRT="0">{}</SourceFilename>
+      <SourceBand>1</SourceBand>
+    </SimpleSource>
+  </VRTRasterBand>
+</VRTDataset>
+"#,
+            dem()
+        ),
+    );
+    for target in ["--max-triangles", "--max-vertices"] {
+        let o = d.run(&["mesh", "huge.vrt", "-o", "out.ply", target, "1000"]);
+        assert_fails_naming(
+            &o,
+            &[
+                "huge.vrt",
+                "1000000x1000000",
+                "GB is available",
+                "--max-error",
+            ],
+        );
+        assert_eq!(d.files(), vec!["huge.vrt"]);
+    }
+}

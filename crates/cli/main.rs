@@ -8,6 +8,7 @@ mod contour;
 mod export;
 mod georef;
 mod info;
+mod memory;
 mod mesh;
 mod output;
 mod progress;

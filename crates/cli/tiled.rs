@@ -41,6 +41,18 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
     let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
     let fits = reader.width() <= args.tile_size && reader.height() <= args.tile_size;
     let count_target = args.max_triangles.is_some() || args.max_vertices.is_some();
+    if count_target && !fits {
+        let by_vertices = args
+            .max_vertices
+            .map_or(u64::MAX, |v| (v as u64).saturating_mul(2));
+        let target = (args.max_triangles.map_or(u64::MAX, |t| t as u64)).min(by_vertices);
+        crate::memory::check_whole_raster_fits(
+            &args.input,
+            reader.width() as usize,
+            reader.height() as usize,
+            target,
+        )?;
+    }
     Ok((fits || count_target).then_some(output))
 }
 

@@ -151,10 +151,10 @@ fn a_pyramid_needs_a_crs_and_the_message_names_the_file_once() {
 }
 
 #[test]
-fn count_target_on_a_raster_too_large_for_memory() {
+fn whole_raster_runs_on_a_raster_too_large_for_memory() {
     // A VRT that declares a 1,000,000 x 1,000,000 raster over the fixture: nothing is read,
-    // and a count target (which needs the whole raster at once) is refused up front
-    // instead of being killed partway.
+    // and every run that needs the whole raster at once is refused up front instead of
+    // being killed partway.
     let d = Dir::new();
     d.write(
         "huge.vrt",
@@ -184,4 +184,24 @@ fn count_target_on_a_raster_too_large_for_memory() {
         );
         assert_eq!(d.files(), vec!["huge.vrt"]);
     }
+    // The other whole-raster runs: the full grid's contours, one huge tile, verify.
+    let o = d.run(&["contour", "huge.vrt", "-o", "out.fgb", "--interval", "10"]);
+    assert_fails_naming(
+        &o,
+        &["huge.vrt", "contouring the full grid", "--max-error > 0"],
+    );
+    let o = d.run(&[
+        "mesh",
+        "huge.vrt",
+        "-o",
+        "out.ply",
+        "--max-error",
+        "1",
+        "--tile-size",
+        "2000000",
+    ]);
+    assert_fails_naming(&o, &["huge.vrt", "one tile", "smaller --tile-size"]);
+    let o = d.run(&["verify", "huge.vrt", "out.ply"]);
+    assert_fails_naming(&o, &["huge.vrt", "verify needs the whole"]);
+    assert_eq!(d.files(), vec!["huge.vrt"]);
 }

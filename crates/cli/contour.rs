@@ -64,6 +64,39 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         let source = format!("TIN within {e} ({tiles} tiles)");
         (mesh, info, source, levels)
     } else {
+        let size = crate::memory::raster_size(&args.input, args.band)?;
+        match &args.mesh {
+            Some(mesh) => crate::memory::check_whole_raster_fits(
+                &args.input,
+                size,
+                crate::memory::Need {
+                    bytes_per_sample: 24,
+                    extra_bytes: 2 * crate::memory::file_bytes(mesh),
+                },
+                "contouring a --mesh",
+                "contour it with --max-error instead (decimated tile by tile, in bounded memory)",
+            )?,
+            None if e == 0.0 => crate::memory::check_whole_raster_fits(
+                &args.input,
+                size,
+                crate::memory::Need {
+                    bytes_per_sample: 120,
+                    extra_bytes: 0,
+                },
+                "contouring the full grid",
+                "give --max-error > 0 (decimated tile by tile, in bounded memory)",
+            )?,
+            None => crate::memory::check_whole_raster_fits(
+                &args.input,
+                size,
+                crate::memory::Need {
+                    bytes_per_sample: 120,
+                    extra_bytes: 0,
+                },
+                "contouring in one tile (the raster fits --tile-size)",
+                "give a smaller --tile-size",
+            )?,
+        }
         let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
         let (mesh, source, levels) = untiled_tin(args, e, &raster)?;
         (mesh, raster.info, source, levels)

@@ -1,45 +1,51 @@
-//! Whether a whole-raster run fits in memory: count targets (`--max-triangles`,
-//! `--max-vertices`) need the whole raster at once, so on a raster too large for the
-//! machine they would be killed by the kernel partway; they are refused up front instead.
+//! Whether a whole-raster run fits in memory. Count targets (`--max-triangles`,
+//! `--max-vertices`), contouring the full grid, `contour --mesh` and `verify` hold the
+//! whole raster (and a mesh) at once; on a raster too large for the machine they would be
+//! killed partway, so they are refused up front with the estimate instead.
 
 use std::path::Path;
 
 use anyhow::{bail, Result};
 
-/// Bytes per raster sample of a count-target run besides its start mesh: the raster as
-/// `f64`, the RTIN's and the mesh's per-sample arrays and the verifier's. Measured 47 on
-/// ETOPO5 (9.3 M samples, 1 M triangles: 437 MB in all); rounded up.
-const BYTES_PER_SAMPLE: u64 = 48;
+/// What a whole-raster run holds, per raster sample and in all (measured on ETOPO5,
+/// 9.3 M samples, session 4; rounded up).
+#[derive(Debug, Clone, Copy)]
+pub struct Need {
+    /// Bytes per sample: 48 for a count target (raster as `f64`, the RTIN's and the
+    /// mesh's per-sample arrays, the verifier's; 47 measured), 120 to contour the full
+    /// grid (its TIN has two triangles per cell; 115 measured), 24 for `verify` and
+    /// `contour --mesh` (18 and 21 measured).
+    pub bytes_per_sample: u64,
+    /// Bytes besides, such as a start mesh or a mesh file read in.
+    pub extra_bytes: u64,
+}
 
-/// Bytes per triangle of the start mesh (slots, links, bounds, output), rounded up.
-const BYTES_PER_TRIANGLE: u64 = 40;
+/// Bytes per triangle of a count target's start mesh (slots, links, bounds, output).
+pub const BYTES_PER_START_TRIANGLE: u64 = 40;
 
-/// Fails, naming `input`, when a count-target run on a `width` x `height` raster for
-/// `target_triangles` (the start mesh has up to four times as many, at most two per sample)
-/// would need more memory than the system reports available. Passes when the system does
-/// not say (no `/proc/meminfo`).
+/// Fails, naming `input`, when holding a `width` x `height` raster as `need` says would
+/// take more memory than the system reports available; `what` names the run and
+/// `instead` what to do about it. Passes when the system does not say (no
+/// `/proc/meminfo`).
 pub fn check_whole_raster_fits(
     input: &Path,
-    width: usize,
-    height: usize,
-    target_triangles: u64,
+    (width, height): (u32, u32),
+    need: Need,
+    what: &str,
+    instead: &str,
 ) -> Result<()> {
     let Some(available) = available_bytes() else {
         return Ok(());
     };
-    let samples = (width as u64).saturating_mul(height as u64);
-    let start_triangles = target_triangles
-        .saturating_mul(4)
-        .min(samples.saturating_mul(2));
+    let samples = u64::from(width) * u64::from(height);
     let needed = samples
-        .saturating_mul(BYTES_PER_SAMPLE)
-        .saturating_add(start_triangles.saturating_mul(BYTES_PER_TRIANGLE));
+        .saturating_mul(need.bytes_per_sample)
+        .saturating_add(need.extra_bytes);
     if needed > available {
         let gb = |bytes: u64| bytes as f64 / 1e9;
         bail!(
-            "{}: --max-triangles and --max-vertices need the whole {width}x{height} raster in \
-             memory at once, about {:.1} GB, and {:.1} GB is available; give --max-error \
-             instead (decimated tile by tile, in bounded memory)",
+            "{}: {what} needs the whole {width}x{height} raster in memory at once, about \
+             {:.1} GB, and {:.1} GB is available; {instead}",
             input.display(),
             gb(needed),
             gb(available)
@@ -54,4 +60,15 @@ fn available_bytes() -> Option<u64> {
     let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
     let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kib.saturating_mul(1024))
+}
+
+/// The size of `path` in bytes, 0 when it cannot be read (the reader reports that).
+pub fn file_bytes(path: &Path) -> u64 {
+    std::fs::metadata(path).map_or(0, |m| m.len())
+}
+
+/// The raster's `(width, height)`, without reading its samples.
+pub fn raster_size(input: &Path, band: usize) -> Result<(u32, u32)> {
+    let reader = tinsmith_raster::WindowReader::open(input, band)?;
+    Ok((reader.width(), reader.height()))
 }

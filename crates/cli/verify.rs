@@ -12,6 +12,16 @@ use crate::georef::Georef;
 
 /// Runs the verifier; `Ok(false)` when the mesh is invalid or exceeds `--max-error`.
 pub fn run(args: &VerifyArgs) -> Result<bool> {
+    crate::memory::check_whole_raster_fits(
+        &args.input,
+        crate::memory::raster_size(&args.input, args.band)?,
+        crate::memory::Need {
+            bytes_per_sample: 24,
+            extra_bytes: 2 * crate::memory::file_bytes(&args.mesh),
+        },
+        "verify",
+        "verification has no tiled mode; use a machine with more memory",
+    )?;
     let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
     let georef = Georef::new(raster.info.transform(), args.pixel_coords);
     let mesh = read_mesh_file(&args.mesh, &raster, georef)?;

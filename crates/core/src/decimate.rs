@@ -499,6 +499,14 @@ fn greedy(
             }
         }
     }
+    // For the progress fraction: a count target's removals are known up front (each one
+    // takes two triangles away); a bound's are not, so they count against all vertices.
+    let expected_removals = match (target.vertices, target.triangles) {
+        (Some(v), _) => initial_vertices.saturating_sub(v),
+        (None, Some(t)) => mesh.triangle_count().saturating_sub(t) / 2,
+        (None, None) => initial_vertices,
+    }
+    .max(1);
     let reached = |mesh: &Mesh<'_>, removed: usize| {
         target.triangles.is_some_and(|t| mesh.triangle_count() <= t)
             || target
@@ -521,7 +529,7 @@ fn greedy(
         remover.apply(mesh, v);
         stats.removed += 1;
         if stats.removed.is_multiple_of(65_536) {
-            let sweep_fraction = stats.removed as f64 / initial_vertices.max(1) as f64;
+            let sweep_fraction = (stats.removed as f64 / expected_removals as f64).min(1.0);
             progress(Progress {
                 sweep: 1,
                 sweep_fraction,

@@ -412,3 +412,30 @@ fn count_targets_reach_the_count_on_a_power_of_two_grid() {
     .unwrap();
     assert!(r.report.max_bound <= 1.5 * full.report.max_bound);
 }
+
+#[test]
+fn count_targets_with_nodata_come_close_to_the_full_grid_start() {
+    // Nodata and a grid that fills only part of its power-of-two square force RTIN splits
+    // whatever the bound; they must not pass for room to decimate in, or the start's
+    // coarse triangles set the error (before session 4's fix: 1.28 x the full grid's
+    // error at 100 vertices here, 7 x on becmodel at 300).
+    let spec = tinsmith_testkit::with_nodata_disc(
+        tinsmith_testkit::terrain(215, 258, 4.0, 9),
+        200.0,
+        60.0,
+        25.0,
+    );
+    let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
+    for vertices in [100, 200] {
+        let options = DecimationOptions::new(f64::INFINITY).with_max_vertices(vertices);
+        let rtin = decimate(&grid, &options).unwrap();
+        let full = decimate(&grid, &options.clone().with_initial_mesh(InitialMesh::Full)).unwrap();
+        assert_eq!(rtin.tin.vertices().len(), full.tin.vertices().len());
+        assert!(
+            rtin.report.max_bound <= 1.25 * full.report.max_bound,
+            "{vertices} vertices: {} from the RTIN, {} from the full grid",
+            rtin.report.max_bound,
+            full.report.max_bound
+        );
+    }
+}

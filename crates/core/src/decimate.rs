@@ -267,11 +267,10 @@ const COUNT_START_FACTOR: usize = 4;
 
 /// The fewest triangles a count target's RTIN start has besides those the domain's shape
 /// forces (or as many as the grid gives), however small the count. For small counts four
-/// times is not enough where most of the grid is flat:
-/// a CT slice to 300 vertices kept 310.5 from a start of 4 x, 196.5 from 100 k triangles
-/// and 194.4 from the full grid; Big Tujunga and becmodel to 300 vertices and 1,000
-/// triangles stay within 3 % of the full grid's error either way, at about 2 s instead of
-/// 4–17 s.
+/// times is not enough where most of the grid is flat: a CT slice to 300 vertices kept
+/// 310.5 from a start of 4 x, 196.5 from 100 k triangles and 194.4 from the full grid; Big
+/// Tujunga and becmodel to 300 vertices and 1,000 triangles stay within 3 % of the full
+/// grid's error either way, at about 2 s instead of 4–17 s.
 const COUNT_START_MIN_TRIANGLES: usize = 100_000;
 
 /// The triangles a count target asks for (a mesh of `v` vertices has about `2 v`).

@@ -161,9 +161,10 @@ fn run(
     // Below the slack only exactly flat stars may go (see `Remover::plan`); the RTIN's
     // measured errors are not exact enough for that, so it starts from the full grid. In
     // border mode the RTIN keeps half cells along the border (see `remove_border`).
+    let mut count_start_bound = None;
     let mut mesh = match options.initial_mesh {
         InitialMesh::Rtin if count_target && limit > 0.0 => {
-            let (corners, bounds) = rtin_for_count(
+            let (corners, bounds, start_bound) = rtin_for_count(
                 grid,
                 COUNT_START_FACTOR
                     .saturating_mul(target_triangles(options))
@@ -172,6 +173,7 @@ fn run(
                 max_edge_squared(options),
                 keep_border.is_some(),
             );
+            count_start_bound = Some(start_bound);
             Mesh::from_triangles(grid, corners, bounds)
         }
         InitialMesh::Rtin if limit > 0.0 => {
@@ -208,12 +210,22 @@ fn run(
         remover.locked_border = Some((grid.width(), grid.height()));
     }
     match options.order {
-        Order::Sweep => sweep(&mut mesh, &mut remover, &mut stats, progress),
+        Order::Sweep => sweep(&mut mesh, &mut remover, &mut stats, progress, None),
         Order::Greedy => {
             let target = Target {
                 triangles: options.max_triangles,
                 vertices: options.max_vertices,
             };
+            if let Some(bound) = count_start_bound {
+                // A count target first sweeps within its start's bound: those removals
+                // cost the greedy order a heap and six re-planned neighbours each, and
+                // it would make them first anyway (they are the cheapest). Measured: the
+                // same or lower error in half the time.
+                remover.rules.limit = bound.min(limit);
+                let stop = Some((target, start_vertices));
+                sweep(&mut mesh, &mut remover, &mut stats, progress, stop);
+                remover.rules.limit = limit;
+            }
             greedy(
                 &mut mesh,
                 &mut remover,
@@ -229,7 +241,7 @@ fn run(
             if crate::flips::flip_for_error(&mut mesh, &rules) == 0 {
                 break;
             }
-            sweep(&mut mesh, &mut remover, &mut stats, progress);
+            sweep(&mut mesh, &mut remover, &mut stats, progress, None);
         }
     }
     if let Some(levels) = rules.levels {
@@ -270,7 +282,7 @@ const COUNT_START_FACTOR: usize = 4;
 /// times is not enough where most of the grid is flat: a CT slice to 300 vertices kept
 /// 310.5 from a start of 4 x, 196.5 from 100 k triangles and 194.4 from the full grid; Big
 /// Tujunga and becmodel to 300 vertices and 1,000 triangles stay within 3 % of the full
-/// grid's error either way, at about 2 s instead of 4–17 s.
+/// grid's error either way (measured before the pre-sweep, which lowers them further).
 const COUNT_START_MIN_TRIANGLES: usize = 100_000;
 
 /// The triangles a count target asks for (a mesh of `v` vertices has about `2 v`).
@@ -336,12 +348,14 @@ struct Stats {
 
 /// The paper's sweep, made cheap: a vertex whose star did not change since it last failed
 /// would fail again, so each sweep visits only vertices whose star changed, in the same
-/// row-major order a full sweep would.
+/// row-major order a full sweep would. With `stop` (a count target and the vertices at the
+/// start), it ends as soon as the count is reached.
 fn sweep(
     mesh: &mut Mesh<'_>,
     remover: &mut Remover<'_>,
     stats: &mut Stats,
     progress: &mut dyn FnMut(Progress),
+    stop: Option<(Target, usize)>,
 ) {
     let n = mesh.vertex_slots();
     let mut queued = vec![false; n];
@@ -380,6 +394,11 @@ fn sweep(
             if remover.plan(mesh, v).is_some() {
                 remover.apply(mesh, v);
                 stats.removed += 1;
+                if stop
+                    .is_some_and(|(target, initial)| target.reached(mesh, initial, stats.removed))
+                {
+                    return;
+                }
                 for &u in &remover.star.ring {
                     if !queued[u as usize] {
                         queued[u as usize] = true;
@@ -451,6 +470,16 @@ struct Target {
     vertices: Option<usize>,
 }
 
+impl Target {
+    /// Whether `mesh` is down to the count, `removed` of its `initial_vertices` gone.
+    fn reached(&self, mesh: &Mesh<'_>, initial_vertices: usize, removed: usize) -> bool {
+        self.triangles.is_some_and(|t| mesh.triangle_count() <= t)
+            || self
+                .vertices
+                .is_some_and(|t| initial_vertices - removed <= t)
+    }
+}
+
 /// A removal candidate: its cost, then the vertex, so ties go to the lower index.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Candidate {
@@ -517,12 +546,7 @@ fn greedy(
         (None, None) => initial_vertices,
     }
     .max(1);
-    let reached = |mesh: &Mesh<'_>, removed: usize| {
-        target.triangles.is_some_and(|t| mesh.triangle_count() <= t)
-            || target
-                .vertices
-                .is_some_and(|t| initial_vertices - removed <= t)
-    };
+    let reached = |mesh: &Mesh<'_>, removed: usize| target.reached(mesh, initial_vertices, removed);
     while let Some(c) = heap.pop() {
         if reached(mesh, stats.removed) {
             break;

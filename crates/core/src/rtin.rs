@@ -76,7 +76,7 @@ pub(crate) fn rtin_for_count(
     limit: f64,
     max_edge_squared: i64,
     full_border: bool,
-) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
+) -> (Vec<[u32; 3]>, Vec<CompactBound>, f64) {
     let (lo, hi) = grid
         .values()
         .iter()
@@ -101,12 +101,14 @@ pub(crate) fn rtin_for_count(
             let rtin = Rtin::new(grid, bound, max_edge_squared, full_border);
             let need = rtin.refinement();
             if rtin.count(&need) >= triangles {
-                return rtin.triangles(&need);
+                let (c, b) = rtin.triangles(&need);
+                return (c, b, bound);
             }
         }
         bound /= 2.0;
     }
-    rtin_triangles(grid, bound.min(limit), max_edge_squared, full_border)
+    let (c, b) = rtin_triangles(grid, bound.min(limit), max_edge_squared, full_border);
+    (c, b, bound.min(limit))
 }
 
 /// The probed fraction of finest squares that split, below which [`rtin_triangles`] refines

@@ -174,7 +174,13 @@ fn run(
                 keep_border.is_some(),
             );
             count_start_bound = Some(start_bound);
-            Mesh::from_triangles(grid, corners, bounds)
+            if corners.len() < target_triangles(options) {
+                // Even the finest RTIN tried has fewer triangles than asked for (a nearly
+                // planar grid): the full grid lets the count be met exactly.
+                Mesh::from_grid(grid)
+            } else {
+                Mesh::from_triangles(grid, corners, bounds)
+            }
         }
         InitialMesh::Rtin if limit > 0.0 => {
             let (corners, bounds) = rtin_triangles(

@@ -439,3 +439,34 @@ fn count_targets_with_nodata_come_close_to_the_full_grid_start() {
         );
     }
 }
+
+#[test]
+fn a_count_target_stops_at_the_count_on_a_plane() {
+    // A plane with one spike: the sweep that precedes the greedy order (within the start's
+    // bound) could take nearly every vertex, so it must stop at the count too.
+    let (w, h) = (101u32, 101u32);
+    let values = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            if (x, y) == (50, 50) {
+                40.0
+            } else {
+                0.5 * x as f64 - 0.25 * y as f64
+            }
+        })
+        .collect();
+    let grid = Grid::new(w, h, values).unwrap();
+    let r = decimate(
+        &grid,
+        &DecimationOptions::new(f64::INFINITY).with_max_triangles(500),
+    )
+    .unwrap();
+    let triangles = r.tin.triangles().len();
+    assert!((499..=500).contains(&triangles), "{triangles}");
+    let r = decimate(
+        &grid,
+        &DecimationOptions::new(f64::INFINITY).with_max_vertices(300),
+    )
+    .unwrap();
+    assert_eq!(r.tin.vertices().len(), 300);
+}

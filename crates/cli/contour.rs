@@ -50,10 +50,9 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     }
     check_writable_target(&args.output)?;
     let e = args.max_error.unwrap_or(0.0);
-    let tiled = args.mesh.is_none() && e > 0.0 && {
-        let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
-        reader.width() > args.tile_size || reader.height() > args.tile_size
-    };
+    let size = crate::memory::raster_size(&args.input, args.band)?;
+    let tiled =
+        args.mesh.is_none() && e > 0.0 && (size.0 > args.tile_size || size.1 > args.tile_size);
     // A TIN decimated here is shaped for the levels (fewer segments, same bound), so they
     // come from the raster's height range first; a --mesh file's come from its own heights.
     let (mesh, info, source, levels) = if tiled {
@@ -64,39 +63,35 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         let source = format!("TIN within {e} ({tiles} tiles)");
         (mesh, info, source, levels)
     } else {
-        let size = crate::memory::raster_size(&args.input, args.band)?;
-        match &args.mesh {
-            Some(mesh) => crate::memory::check_whole_raster_fits(
-                &args.input,
-                size,
+        let (need, what, instead) = match &args.mesh {
+            Some(mesh) => (
                 crate::memory::Need {
                     bytes_per_sample: 24,
                     extra_bytes: 2 * crate::memory::file_bytes(mesh),
                 },
                 "contouring a --mesh",
                 "contour it with --max-error instead (decimated tile by tile, in bounded memory)",
-            )?,
-            None if e == 0.0 => crate::memory::check_whole_raster_fits(
-                &args.input,
-                size,
-                crate::memory::Need {
+            ),
+            None => {
+                let (what, instead) = if e == 0.0 {
+                    (
+                        "contouring the full grid",
+                        "give --max-error > 0 (decimated tile by tile, in bounded memory)",
+                    )
+                } else {
+                    (
+                        "contouring in one tile (the raster fits --tile-size)",
+                        "give a smaller --tile-size",
+                    )
+                };
+                let need = crate::memory::Need {
                     bytes_per_sample: 120,
                     extra_bytes: 0,
-                },
-                "contouring the full grid",
-                "give --max-error > 0 (decimated tile by tile, in bounded memory)",
-            )?,
-            None => crate::memory::check_whole_raster_fits(
-                &args.input,
-                size,
-                crate::memory::Need {
-                    bytes_per_sample: 120,
-                    extra_bytes: 0,
-                },
-                "contouring in one tile (the raster fits --tile-size)",
-                "give a smaller --tile-size",
-            )?,
-        }
+                };
+                (need, what, instead)
+            }
+        };
+        crate::memory::check_whole_raster_fits(&args.input, size, need, what, instead)?;
         let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
         let (mesh, source, levels) = untiled_tin(args, e, &raster)?;
         (mesh, raster.info, source, levels)

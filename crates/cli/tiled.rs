@@ -167,23 +167,27 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         info.crs_wkt.as_deref()
     };
     let mut progress = |p: TileProgress| bar.set_position(p.done as u64);
-    let nothing_to_triangulate = || {
-        anyhow::anyhow!(
-            "{input}: band {} has no 2x2 block of valid samples, so there is nothing to \
-             triangulate",
-            args.band
-        )
+    // What every arm does with the engine's report: no triangle at all is an error, and
+    // what is left is writing.
+    let meshed = |report: TilesReport| -> Result<TilesReport> {
+        if report.final_triangles == 0 {
+            bail!(
+                "{input}: band {} has no 2x2 block of valid samples, so there is nothing to \
+                 triangulate",
+                args.band
+            );
+        }
+        bar.set_message("writing");
+        Ok(report)
     };
 
     let (report, output, write_seconds) = match (&args.output, welded_format, &args.per_tile) {
         (Some(output), Some(format), _) if !streams(format) => {
             let mut collector = MeshCollector::new();
-            let report = mesh_tiles(&source, &options, &mut collector, &mut progress)
-                .naming_file(&args.input)?;
-            if report.final_triangles == 0 {
-                return Err(nothing_to_triangulate());
-            }
-            bar.set_message("writing");
+            let report = meshed(
+                mesh_tiles(&source, &options, &mut collector, &mut progress)
+                    .naming_file(&args.input)?,
+            )?;
             let t = Instant::now();
             let (vertices, triangles) = collector.into_parts();
             let georef = Georef::new(info.transform(), args.pixel_coords);
@@ -198,12 +202,10 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         }
         (Some(output), Some(format), _) => {
             let mut writer = WeldedWriter::create(output, format, crs, placement)?;
-            let report = mesh_tiles(&source, &options, &mut writer, &mut progress)
-                .naming_file(&args.input)?;
-            if report.final_triangles == 0 {
-                return Err(nothing_to_triangulate());
-            }
-            bar.set_message("writing");
+            let report = meshed(
+                mesh_tiles(&source, &options, &mut writer, &mut progress)
+                    .naming_file(&args.input)?,
+            )?;
             let t = Instant::now();
             writer.finish()?;
             let write = report.seconds_sink + t.elapsed().as_secs_f64();
@@ -215,11 +217,10 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
                 TileFormatArg::Obj => MeshFormat::Obj,
             };
             let mut writer = PerTileWriter::create(dir, format, crs, placement)?;
-            let report = mesh_tiles(&source, &options, &mut writer, &mut progress)
-                .naming_file(&args.input)?;
-            if report.final_triangles == 0 {
-                return Err(nothing_to_triangulate());
-            }
+            let report = meshed(
+                mesh_tiles(&source, &options, &mut writer, &mut progress)
+                    .naming_file(&args.input)?,
+            )?;
             let t = Instant::now();
             writer.finish()?;
             let write = report.seconds_sink + t.elapsed().as_secs_f64();

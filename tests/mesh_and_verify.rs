@@ -141,7 +141,12 @@ fn verify_rejects_a_mesh_with_a_hole() {
 #[test]
 fn info_reports_nodata_and_crs() {
     let d = Dir::new();
-    let o = d.run(&["info", &fixture("tintn_valid_raster_3857.tif"), "--json"]);
+    let o = d.run(&[
+        "info",
+        &fixture("tintn_valid_raster_3857.tif"),
+        "--json",
+        "-q",
+    ]);
     assert!(o.status.success());
     let j: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert_eq!(j["width"], 100);

@@ -57,7 +57,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     // come from the raster's height range first; a --mesh file's come from its own heights.
     let (mesh, info, source, levels) = if tiled {
         tinsmith_raster::limit_block_cache(crate::tiled::TILED_BLOCK_CACHE_MB);
-        let info = tinsmith_raster::open_info(&args.input, args.band)?;
+        let info = crate::progress::scan_raster(&args.input, args.band, args.quiet)?;
         let levels = levels_for(args, info.min.zip(info.max))?;
         let (mesh, tiles) = tiled_tin(args, e, &info, &levels)?;
         let source = format!("TIN within {e} ({tiles} tiles)");

@@ -6,7 +6,7 @@ use crate::args::InfoArgs;
 
 /// Prints the band's metadata and value statistics; always `Ok(true)` on success.
 pub fn run(args: &InfoArgs) -> Result<bool> {
-    let info = tinsmith_raster::open_info(&args.input, args.band)?;
+    let info = crate::progress::scan_raster(&args.input, args.band, args.quiet)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&info)?);
         return Ok(true);

@@ -40,3 +40,22 @@ impl Progress {
         }
     }
 }
+
+/// Scans band `band` of `input` for its statistics ([`tinsmith_raster::open_info`]: a full
+/// read, long on a large raster), showing the share of rows done unless `quiet`.
+pub fn scan_raster(
+    input: &std::path::Path,
+    band: usize,
+    quiet: bool,
+) -> tinsmith_raster::Result<tinsmith_raster::RasterInfo> {
+    let mut progress = Progress::new(quiet);
+    let name = input.display();
+    let info = tinsmith_raster::open_info_with_progress(input, band, &mut |done, rows| {
+        progress.show(&format!(
+            "{name}: scanning, {} % of the rows",
+            done * 100 / rows.max(1)
+        ));
+    });
+    progress.clear();
+    info
+}

@@ -137,12 +137,11 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     // Tiles need only the blocks of the current row of tiles; GDAL's default (5 % of the
     // machine's memory) would keep most of a large raster resident.
     tinsmith_raster::limit_block_cache(TILED_BLOCK_CACHE_MB);
-    let bar = progress_bar(args.quiet);
-    bar.set_message("scanning the raster");
     let t = Instant::now();
-    let info = tinsmith_raster::open_info(&args.input, args.band)?;
+    let info = crate::progress::scan_raster(&args.input, args.band, args.quiet)?;
     let source = RasterSource::new(&info)?;
     let scan_seconds = t.elapsed().as_secs_f64();
+    let bar = progress_bar(args.quiet);
     let plan = TilePlan::new(info.width, info.height, args.tile_size).naming_file(&args.input)?;
     bar.set_length(plan.len() as u64);
     bar.set_message("tiles");

@@ -67,6 +67,6 @@ pub use error::{Error, Result};
 pub use geographic::{geographic_bounds, warp_to_geographic, GeoBounds, GeoLattice};
 pub use info::{Raster, RasterInfo};
 pub use quiet::silence_gdal_errors;
-pub use read::{open_info, read_grid};
+pub use read::{open_info, open_info_with_progress, read_grid};
 pub use reproject::{from_wgs84, to_wgs84};
 pub use window::{read_window, WindowReader};

@@ -26,14 +26,29 @@ const STRIP_SAMPLES: usize = 1 << 20;
 /// [`Error::NotFound`], [`Error::NotARaster`], [`Error::BandOutOfRange`],
 /// [`Error::UnsupportedType`] and [`Error::Read`], each naming `path`.
 pub fn open_info(path: &Path, band: usize) -> Result<RasterInfo> {
+    open_info_with_progress(path, band, &mut |_, _| {})
+}
+
+/// [`open_info`], calling `progress(rows_scanned, rows)` after each strip of rows, so that
+/// a long scan of a large raster can show how far it is.
+///
+/// # Errors
+/// As [`open_info`].
+pub fn open_info_with_progress(
+    path: &Path,
+    band: usize,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<RasterInfo> {
     let opened = OpenBand::open(path, band)?;
     let rb = opened.band()?;
     let mut stats = Stats::default();
     let mut buf = Vec::new();
+    let height = u64::from(opened.info.height);
     for (y0, rows) in opened.strips(&rb) {
         buf.resize(rows * opened.width(), 0.0);
         opened.read_strip(&rb, y0, rows, &mut buf)?;
         stats.add(&buf);
+        progress((y0 + rows) as u64, height);
     }
     Ok(opened.finish(stats))
 }

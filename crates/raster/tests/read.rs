@@ -168,6 +168,20 @@ fn hugo_site_esri_ascii_int_with_minus_9999() {
 }
 
 #[test]
+fn scan_progress_counts_rows_up_to_the_height() {
+    let path = fixture("landlab_hugo_site.asc");
+    let mut calls = Vec::new();
+    let info = tinsmith_raster::open_info_with_progress(&path, 1, &mut |done, rows| {
+        calls.push((done, rows))
+    })
+    .expect("info");
+    assert_eq!(info, open_info(&path, 1).expect("info"));
+    assert!(!calls.is_empty());
+    assert!(calls.windows(2).all(|w| w[0].0 < w[1].0), "{calls:?}");
+    assert_eq!(calls.last(), Some(&(55, 55)));
+}
+
+#[test]
 fn info_serialises_to_json_with_stable_field_names() {
     let info = open_info(&fixture("landlab_hugo_site.asc"), 1).expect("info");
     let json = serde_json::to_value(&info).expect("json");

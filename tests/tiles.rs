@@ -100,8 +100,8 @@ fn assert_crack_free(input: &str, mesh: &Path) {
 #[test]
 fn welded_mesh_keeps_the_bound_and_has_no_cracks() {
     let dem = fixture("becmodel_dem_bc_albers_50m.tif");
-    // The level-aware DP and both kinds of edge flips inside tiles must leave the shared
-    // borders alone too.
+    // The level-aware DP, both kinds of edge flips and the extended holes' flips inside
+    // tiles must leave the shared borders alone too.
     for (size, e, extra) in [
         ("64", "5", &[][..]),
         ("17", "2", &[]),
@@ -109,6 +109,12 @@ fn welded_mesh_keeps_the_bound_and_has_no_cracks() {
         ("64", "5", &["--contour-interval", "20"]),
         ("17", "2", &["--contour-interval", "20"]),
         ("64", "1", &["--flip-rounds", "3"]),
+        ("64", "1", &["--extend-rounds", "2"]),
+        (
+            "17",
+            "2",
+            &["--extend-rounds", "1", "--error-model", "bounds"],
+        ),
     ] {
         let d = Dir::new();
         let mut args = vec![

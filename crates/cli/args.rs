@@ -152,6 +152,12 @@ pub struct MeshArgs {
     /// error bound holds either way. Not with --max-triangles/--max-vertices.
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub flip_rounds: usize,
+    /// After decimating, up to N rounds that try each vertex left again with its hole
+    /// extended across its ring edges, each followed by another sweep: 3-6 % fewer
+    /// triangles at small bounds, for 2-5 x the time; the error bound holds either way.
+    /// Not with --max-triangles/--max-vertices.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub extend_rounds: usize,
     /// Shape the TIN for contour lines every I (plus --contour-offset) over the raster's
     /// heights, as `tinsmith contour --max-error` does: `contour --mesh` then draws lines
     /// with fewer segments. The error bound holds either way.
@@ -319,6 +325,7 @@ impl MeshArgs {
         options.dp_max_ring = self.dp_max_ring as usize;
         options.max_edge_length = self.max_edge_length;
         options.flip_rounds = self.flip_rounds;
+        options.extend_rounds = self.extend_rounds;
         if let Some(n) = self.max_triangles {
             options = options.with_max_triangles(n);
         }

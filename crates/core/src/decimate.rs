@@ -243,6 +243,20 @@ fn run(
         }
     }
     if !count_target {
+        for _ in 0..options.extend_rounds {
+            let removed = crate::extend::remove_through_extended_holes(
+                &mut mesh,
+                &mut remover,
+                progress,
+                stats.sweeps,
+                stats.removed,
+            );
+            if removed == 0 {
+                break;
+            }
+            stats.removed += removed;
+            sweep(&mut mesh, &mut remover, &mut stats, progress, None);
+        }
         for _ in 0..options.flip_rounds {
             if crate::flips::flip_for_error(&mut mesh, &rules) == 0 {
                 break;
@@ -601,14 +615,14 @@ fn greedy(
 const MAX_HOLE_RING: usize = 64;
 
 /// Removes single vertices; holds the buffers reused across attempts.
-struct Remover<'g> {
+pub(crate) struct Remover<'g> {
     star: Star,
     ring_star: Star,
     hole: Retriangulator,
     points: Vec<Point>,
     bounds: Vec<ErrorBound>,
     new_triangles: Vec<(u32, [u32; 3], ErrorBound)>,
-    rules: Rules<'g>,
+    pub(crate) rules: Rules<'g>,
     /// In border mode, `(width, height)`: samples on the grid's outer border stay.
     locked_border: Option<(u32, u32)>,
     /// Vertices with more neighbours than this are not tried (see [`MAX_HOLE_RING`]).
@@ -711,7 +725,7 @@ impl<'g> Remover<'g> {
     /// Plans the removal of `v`: if it is interior or boundary and its hole can be
     /// retriangulated within the limit, returns the largest new bound and keeps the plan
     /// for [`Remover::apply`]. Does not change the mesh.
-    fn plan(&mut self, mesh: &Mesh<'_>, v: u32) -> Option<f64> {
+    pub(crate) fn plan(&mut self, mesh: &Mesh<'_>, v: u32) -> Option<f64> {
         if !mesh.contains_vertex(v) {
             return None;
         }
@@ -760,7 +774,7 @@ impl<'g> Remover<'g> {
 
     /// Carries out the last successful [`Remover::plan`], which must have been for `v`
     /// with the mesh unchanged since; afterwards `self.star` holds `v`'s former star.
-    fn apply(&mut self, mesh: &mut Mesh<'_>, v: u32) {
+    pub(crate) fn apply(&mut self, mesh: &mut Mesh<'_>, v: u32) {
         std::mem::swap(&mut self.star, &mut self.ring_star);
         mesh.replace_star(v, &self.star, &self.new_triangles);
         #[cfg(test)]

@@ -30,6 +30,7 @@ mod decimate;
 mod error;
 mod error_bound;
 mod exact;
+mod extend;
 mod flips;
 mod geo_transform;
 mod grid;

@@ -98,6 +98,9 @@ pub struct DecimationOptions {
     /// Rounds of error-lowering edge flips, each followed by another sweep (see
     /// [`DecimationOptions::with_flip_rounds`]); 0 (the default) for none.
     pub flip_rounds: usize,
+    /// Rounds of removal through extended holes, each followed by another sweep (see
+    /// [`DecimationOptions::with_extend_rounds`]); 0 (the default) for none.
+    pub extend_rounds: usize,
 }
 
 impl DecimationOptions {
@@ -119,6 +122,7 @@ impl DecimationOptions {
             max_edge_length: None,
             contour_levels: None,
             flip_rounds: 0,
+            extend_rounds: 0,
         }
     }
 
@@ -180,6 +184,17 @@ impl DecimationOptions {
     /// the bound is kept. A round that flips nothing ends them. Ignored with count targets.
     pub fn with_flip_rounds(mut self, rounds: usize) -> DecimationOptions {
         self.flip_rounds = rounds;
+        self
+    }
+
+    /// Once no vertex can go, tries each remaining vertex again with its hole extended
+    /// across its ring edges (the triangle beyond a ring edge joins the hole, one edge at a
+    /// time, then all at once), which gives the retriangulation more freedom; then sweeps
+    /// again. Repeats `rounds` times, or until a round removes nothing. Fewer triangles at
+    /// every bound (3–6 % on real DEMs at ε ≤ 1), for 2–5 × the time; the bound is kept
+    /// (every new triangle is measured as in a sweep). Ignored with count targets.
+    pub fn with_extend_rounds(mut self, rounds: usize) -> DecimationOptions {
+        self.extend_rounds = rounds;
         self
     }
 

@@ -30,11 +30,18 @@ fn all_options(bound: f64) -> Vec<DecimationOptions> {
                 for selection in SELECTIONS {
                     all.push(base.clone().with_selection(selection));
                 }
+                all.push(base.clone().with_extend_rounds(1));
                 let dp = base.with_retriangulation(Retriangulation::Dp);
                 // Levels spread over the small grids' values (see `small_grid`).
                 let levels: Vec<f64> = (-8..=8).map(|k| f64::from(k) * 1.5).collect();
                 all.push(dp.clone().with_contour_levels(&levels));
                 all.push(dp.clone().with_flip_rounds(2));
+                all.push(dp.clone().with_extend_rounds(2));
+                all.push(
+                    dp.clone()
+                        .with_extend_rounds(1)
+                        .with_contour_levels(&levels),
+                );
                 all.push(dp);
             }
         }
@@ -314,6 +321,29 @@ fn flip_rounds_keep_the_bound_with_fewer_triangles() {
             flipped.triangles().len(),
             plain.triangles().len()
         );
+    }
+}
+
+#[test]
+fn extended_holes_keep_the_bound_with_fewer_triangles() {
+    let spec = tinsmith_testkit::with_nodata_disc(
+        tinsmith_testkit::terrain(120, 90, 4.0, 5),
+        30.0,
+        60.0,
+        8.0,
+    );
+    for model in [ErrorModel::Exact, ErrorModel::Bounds] {
+        for bound in [0.25, 1.0] {
+            let base = DecimationOptions::new(bound).with_error_model(model);
+            let plain = check_with(&spec, &base).unwrap();
+            let extended = check_with(&spec, &base.clone().with_extend_rounds(2)).unwrap();
+            assert!(
+                extended.triangles().len() < plain.triangles().len(),
+                "{model:?} at {bound}: {} triangles with extended holes, {} without",
+                extended.triangles().len(),
+                plain.triangles().len()
+            );
+        }
     }
 }
 

@@ -10,7 +10,7 @@ use crate::decimate::{Progress, Remover};
 use crate::exact::triangle_error;
 use crate::mesh::{Mesh, Star};
 use crate::predicates::orient;
-use crate::{ErrorBound, ErrorModel};
+use crate::{ErrorBound, ErrorModel, Retriangulation};
 
 /// A flipped ring edge: the star triangle it was in (now `(v, a, d)`) and the bounds of
 /// the two triangles before the flip, to undo it.
@@ -48,6 +48,13 @@ pub(crate) fn remove_through_extended_holes(
         }
         mesh.star(v, &mut star);
         let ring_edges = star.triangles.len();
+        // The hole extended at every edge at once only where the DP solves it: ear
+        // clipping on the larger rings costs about 40 % more time for 0.1 % fewer
+        // triangles.
+        let largest_ring = match remover.rules.method {
+            Retriangulation::Dp => remover.rules.dp_max_ring,
+            Retriangulation::Ears => usize::MAX,
+        };
         let mut gone = false;
         for i in 0..ring_edges {
             flipped.clear();
@@ -69,6 +76,10 @@ pub(crate) fn remove_through_extended_holes(
                 0 => false,
                 1 => {
                     // Tried above.
+                    undo(mesh, &flipped);
+                    false
+                }
+                n if star.ring.len() + n > largest_ring => {
                     undo(mesh, &flipped);
                     false
                 }

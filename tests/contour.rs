@@ -513,6 +513,19 @@ fn contour_bad_input_fails_cleanly() {
             vec!["levels"],
         ),
         (
+            // Levels beyond f64's integers: this used to loop forever.
+            vec![
+                &dem,
+                "-o",
+                "c.geojson",
+                "--interval",
+                "10",
+                "--offset",
+                "1e17",
+            ],
+            vec!["f64 can tell apart"],
+        ),
+        (
             vec![
                 &dem,
                 "-o",

@@ -71,6 +71,23 @@ pub enum Error {
         /// The offset given.
         offset: f64,
     },
+    /// The levels `offset + k * interval` over the heights cannot be told apart in `f64`:
+    /// the interval is below the resolution of numbers that large.
+    #[error(
+        "interval {interval} with offset {offset} over heights {min}..{max}: the levels are \
+         closer than f64 can tell apart at that magnitude; give a larger interval, an offset \
+         nearer the heights, or explicit --levels"
+    )]
+    IntervalBelowResolution {
+        /// The interval given.
+        interval: f64,
+        /// The offset given.
+        offset: f64,
+        /// Lowest height.
+        min: f64,
+        /// Highest height.
+        max: f64,
+    },
     /// The interval is so small for the height range that there would be too many levels.
     #[error(
         "interval {interval} over heights {min}..{max} gives {count} levels (at most {max_levels})"

@@ -42,17 +42,29 @@ pub fn interval_levels(interval: f64, offset: f64, min: f64, max: f64) -> Result
             max_levels: MAX_LEVELS,
         });
     }
-    let mut levels = Vec::new();
+    // Every k must be an exact integer in f64, and neighbouring levels distinct.
+    let below_resolution = Error::IntervalBelowResolution {
+        interval,
+        offset,
+        min,
+        max,
+    };
+    const EXACT_INTEGERS: f64 = (1u64 << 53) as f64;
+    if first.abs() + 1.0 >= EXACT_INTEGERS || last.abs() + 1.0 >= EXACT_INTEGERS {
+        return Err(below_resolution);
+    }
+    let mut levels: Vec<f64> = Vec::new();
     // One step past each end, filtered by value, absorbs rounding in `first` and `last`.
-    let mut k = first - 1.0;
-    while k <= last + 1.0 {
-        let level = offset + k * interval;
+    let steps = (last - first) as i64 + 3;
+    for i in 0..steps.max(0) {
+        let level = offset + (first - 1.0 + i as f64) * interval;
         if (min..=max).contains(&level) {
+            if levels.last().is_some_and(|&l| l >= level) {
+                return Err(below_resolution);
+            }
             levels.push(level);
         }
-        k += 1.0;
     }
-    levels.dedup();
     Ok(levels)
 }
 
@@ -120,6 +132,28 @@ mod tests {
             interval_levels(1e-6, 0.0, 0.0, 1000.0),
             Err(Error::TooManyLevels { .. })
         ));
+    }
+
+    #[test]
+    fn levels_closer_than_f64_resolution_are_refused() {
+        // Heights near 1e18 (f64 spacing 128) with an interval of 50, and an offset so far
+        // from the heights that k passes 2^53: both used to loop forever.
+        for (interval, offset, min, max) in [
+            (50.0, 0.0, 1e18, 1e18 + 4e6),
+            (10.0, 1e17, 388.0, 3863.0),
+            (1.0, 0.0, 2f64.powi(53), 2f64.powi(53) + 100.0),
+        ] {
+            assert!(
+                matches!(
+                    interval_levels(interval, offset, min, max),
+                    Err(Error::IntervalBelowResolution { .. })
+                ),
+                "{interval} {offset} {min} {max}"
+            );
+        }
+        // Large but resolvable: fine.
+        let levels = interval_levels(1024.0, 0.0, 1e15, 1e15 + 10_240.0).unwrap();
+        assert_eq!(levels.len(), 11);
     }
 
     #[test]

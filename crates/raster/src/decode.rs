@@ -55,13 +55,17 @@ impl SampleType {
 /// Maps one raw sample (as GDAL converts it to `f64`) to a height, or to NaN for nodata.
 ///
 /// A sample is nodata when it is NaN or infinite, or when it equals the band's nodata value
-/// *in the band's own type*: for Float32 bands the nodata value is first rounded to `f32`
-/// (vinschgau declares `-3.4e38`, which is not `-FLT_MAX` and is stored as the nearest
-/// `f32`), for integer bands it is rounded to the nearest integer and ignored when outside
-/// the type's range (no sample can hold it). Valid samples are then mapped through the
+/// *in the band's own type*, by GDAL's rule: for Float32 bands the nodata value is first
+/// rounded to `f32` (vinschgau declares `-3.4e38`, which is not `-FLT_MAX` and is stored as
+/// the nearest `f32`), and float samples match within GDAL's tolerance (see
+/// `gdal_real_equal`); for integer bands it is rounded to the nearest integer and ignored
+/// when outside the type's range (no sample can hold it). Valid samples are then mapped through the
 /// band's scale and offset (`value * scale + offset`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct SampleDecoder {
+    sample_type: SampleType,
+    /// Float32 or Float64: nodata is matched with GDAL's tolerance.
+    float: bool,
     signed_byte: bool,
     /// The nodata value as the raw `f64` a nodata sample reads as; never NaN.
     nodata_key: Option<f64>,
@@ -87,6 +91,8 @@ impl SampleDecoder {
                 SampleType::Float64 => Some(nd),
             });
         SampleDecoder {
+            sample_type,
+            float: matches!(sample_type, SampleType::Float32 | SampleType::Float64),
             signed_byte: sample_type == SampleType::SignedByte,
             nodata_key,
             scale: if scale.is_finite() { scale } else { 1.0 },
@@ -102,11 +108,31 @@ impl SampleDecoder {
         } else {
             raw
         };
-        if !v.is_finite() || Some(v) == self.nodata_key {
+        let nodata = match self.nodata_key {
+            Some(key) if self.float => gdal_real_equal(self.sample_type, v, key),
+            key => Some(v) == key,
+        };
+        if !v.is_finite() || nodata {
             return f64::NAN;
         }
         v * self.scale + self.offset
     }
+}
+
+/// GDAL's test for a floating-point sample equal to the nodata value (`ARE_REAL_EQUAL` in
+/// its nodata mask band): equal, or closer than two `f32` epsilons of their sum. So a
+/// Float32 file that declares `-3.4028230607370965e+38` (as ArcGIS writes) while its
+/// samples hold `-f32::MAX`, two `f32` steps away, has those samples as nodata, as GDAL's
+/// own tools see it.
+fn gdal_real_equal(sample_type: SampleType, value: f64, nodata: f64) -> bool {
+    let (a, b) = if sample_type == SampleType::Float32 {
+        (value as f32 as f64, nodata as f32 as f64)
+    } else {
+        (value, nodata)
+    };
+    // In f64, so that the sum of two values near ±f32::MAX does not overflow (in GDAL's
+    // f32 arithmetic it does, and then everything near the nodata value matches).
+    a == b || (a - b).abs() < f64::from(f32::EPSILON) * (a + b).abs() * 2.0
 }
 
 /// The integer an integer band stores for nodata value `nd`, if the type can hold it.
@@ -164,14 +190,23 @@ mod tests {
         assert_eq!(d.decode(-3.3e38_f32 as f64), -3.3e38_f32 as f64);
         let d = SampleDecoder::new(ty("Float32"), Some(f32::MIN as f64), 1.0, 0.0);
         assert!(d.decode(f32::MIN as f64).is_nan());
+        // ArcGIS-style: declared two f32 steps short of -FLT_MAX, samples hold -FLT_MAX
+        // (GDAL's own rule treats them as nodata).
+        let d = SampleDecoder::new(ty("Float32"), Some(-3.4028230607370965e38), 1.0, 0.0);
+        assert!(d.decode(f32::MIN as f64).is_nan());
+        assert_eq!(d.decode(-3.3e38_f32 as f64), -3.3e38_f32 as f64);
+        let d = SampleDecoder::new(ty("Float32"), Some(3.4028230607370965e38), 1.0, 0.0);
+        assert!(d.decode(f32::MAX as f64).is_nan());
         assert_eq!(d.decode(12.5), 12.5);
     }
 
     #[test]
-    fn float64_nodata_is_exact() {
+    fn float64_nodata_matches_within_gdal_tolerance() {
+        // GDAL's ARE_REAL_EQUAL: |a - b| < 2 f32 epsilons of |a + b| (0.0048 at -9999).
         let d = SampleDecoder::new(ty("Float64"), Some(-9999.0), 1.0, 0.0);
         assert!(d.decode(-9999.0).is_nan());
-        assert_eq!(d.decode(-9999.000001), -9999.000001);
+        assert!(d.decode(-9999.000001).is_nan());
+        assert_eq!(d.decode(-9998.99), -9998.99);
         assert_eq!(d.decode(-3.4e38_f32 as f64), -3.4e38_f32 as f64);
     }
 

@@ -22,6 +22,9 @@ pub fn run(args: &InfoArgs) -> Result<bool> {
         Some(n) => println!("nodata:        {n}"),
         None => println!("nodata:        none"),
     }
+    if let Some(mask) = &info.mask {
+        println!("mask:          {mask} (its zeros are nodata)");
+    }
     println!(
         "valid samples: {} ({} nodata)",
         info.valid_samples, info.nodata_samples

@@ -40,6 +40,10 @@ pub struct RasterInfo {
     /// The dataset's geotransform (GDAL's six coefficients), or `None` when the dataset has
     /// none (GDAL then reports a failure and an identity default, which is not returned).
     pub geo_transform: Option<[f64; 6]>,
+    /// The kind of GDAL mask the band has besides its nodata value (`"alpha band"`,
+    /// `"per-dataset mask"` or `"mask band"`), whose zero samples count as nodata; `None`
+    /// when it has none.
+    pub mask: Option<String>,
     /// Samples that are not nodata.
     pub valid_samples: u64,
     /// Samples that are nodata: equal to [`RasterInfo::nodata`] in the band's type, NaN or

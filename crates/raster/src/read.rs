@@ -3,7 +3,7 @@
 use std::io;
 use std::path::Path;
 
-use gdal::raster::RasterBand;
+use gdal::raster::{ColorInterpretation, RasterBand};
 use gdal::spatial_ref::SpatialRef;
 use gdal::{Dataset, DatasetOptions, GdalOpenFlags, Metadata};
 use tinsmith_core::Grid;
@@ -109,6 +109,16 @@ pub(crate) struct OpenBand {
     /// Metadata; the statistics are still zero.
     pub(crate) info: RasterInfo,
     decoder: SampleDecoder,
+    mask_source: Option<MaskSource>,
+}
+
+/// Where the band's validity mask comes from, besides its nodata value.
+#[derive(Debug, Clone, Copy)]
+enum MaskSource {
+    /// GDAL's mask band (per-dataset, per-band or a Byte alpha band), of this kind.
+    Gdal(&'static str),
+    /// An alpha band (by number) of a type GDAL does not take as a mask.
+    Alpha(usize),
 }
 
 impl OpenBand {
@@ -146,6 +156,32 @@ impl OpenBand {
                 data_type: gdal_type,
             });
         };
+        // A mask GDAL keeps besides nodata (an alpha band, a per-dataset or per-band mask,
+        // as gdalwarp -dstalpha or gdal_translate -mask write): its zeros are nodata too.
+        // GDAL counts an alpha band as a mask only when it is Byte (or UInt16); gdalwarp
+        // uses one of any type, and so do we.
+        let alpha_band = (1..=count).find(|&b| {
+            b != band
+                && dataset
+                    .rasterband(b)
+                    .is_ok_and(|a| a.color_interpretation() == ColorInterpretation::AlphaBand)
+        });
+        let mask_source = match rb.mask_flags() {
+            Ok(flags) if !flags.is_all_valid() && !flags.is_nodata() => {
+                Some(MaskSource::Gdal(if flags.is_alpha() {
+                    "alpha band"
+                } else if flags.is_per_dataset() {
+                    "per-dataset mask"
+                } else {
+                    "mask band"
+                }))
+            }
+            _ => alpha_band.map(MaskSource::Alpha),
+        };
+        let mask = mask_source.map(|m| match m {
+            MaskSource::Gdal(kind) => kind.to_owned(),
+            MaskSource::Alpha(b) => format!("alpha band {b}"),
+        });
         let nodata = rb.no_data_value();
         let scale = rb.scale().filter(|s| s.is_finite()).unwrap_or(1.0);
         let offset = rb.offset().filter(|o| o.is_finite()).unwrap_or(0.0);
@@ -175,6 +211,7 @@ impl OpenBand {
             crs_wkt,
             epsg,
             geo_transform,
+            mask,
             valid_samples: 0,
             nodata_samples: 0,
             min: None,
@@ -184,6 +221,7 @@ impl OpenBand {
             dataset,
             info,
             decoder,
+            mask_source,
         })
     }
 
@@ -220,6 +258,27 @@ impl OpenBand {
         .map_err(|e| self.read_error(e))?;
         for v in dst.iter_mut() {
             *v = self.decoder.decode(*v);
+        }
+        if let Some(source) = self.mask_source {
+            let mask = match source {
+                MaskSource::Gdal(_) => rb.open_mask_band(),
+                MaskSource::Alpha(b) => self.dataset.rasterband(b),
+            }
+            .map_err(|e| self.read_error(e))?;
+            let mut valid = vec![0u8; dst.len()];
+            mask.read_into_slice::<u8>(
+                (origin.0 as isize, origin.1 as isize),
+                size,
+                size,
+                &mut valid,
+                None,
+            )
+            .map_err(|e| self.read_error(e))?;
+            for (v, &m) in dst.iter_mut().zip(&valid) {
+                if m == 0 {
+                    *v = f64::NAN;
+                }
+            }
         }
         Ok(())
     }

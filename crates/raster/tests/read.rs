@@ -469,13 +469,66 @@ fn float64_with_minus_9999_like_codem() {
         ..Spec::new(3, 2, values)
     };
     let path = spec.tif(&dir.path().join("f64nd.tif"));
-    check_stats(
-        &open_info(&path, 1).expect("info"),
-        3,
-        3,
-        -9998.99,
-        290.5,
-    );
+    check_stats(&open_info(&path, 1).expect("info"), 3, 3, -9998.99, 290.5);
+}
+
+#[test]
+fn alpha_band_zeros_are_nodata_whatever_its_type() {
+    // gdalwarp -dstalpha writes an alpha band of the data's type; GDAL takes only a Byte
+    // (or UInt16) alpha as the band's mask, gdalwarp any. Both must leave out the zeros.
+    let dir = tempdir();
+    let heights = [10, 11, 12, 13, 14, 15];
+    let alpha = [255, 0, 255, 255, 0, 255];
+    let int16 = Spec {
+        bands: vec![heights.to_vec(), alpha.to_vec()],
+        options: &[("ALPHA", "YES")],
+        ..Spec::new(3, 2, Vec::<i16>::new())
+    };
+    let byte = Spec {
+        bands: vec![
+            heights.iter().map(|&h| h as u8).collect(),
+            alpha.iter().map(|&a| a as u8).collect(),
+        ],
+        options: &[("ALPHA", "YES")],
+        ..Spec::new(3, 2, Vec::<u8>::new())
+    };
+    for (path, kind) in [
+        (int16.tif(&dir.path().join("i16.tif")), "alpha band 2"),
+        (byte.tif(&dir.path().join("u8.tif")), "alpha band"),
+    ] {
+        let raster = read_grid(&path, 1).expect("read");
+        assert_eq!(raster.info.mask.as_deref(), Some(kind), "{path:?}");
+        check_stats(&raster.info, 4, 2, 10.0, 15.0);
+        assert!(raster.grid.get(1, 0).is_none() && raster.grid.get(1, 1).is_none());
+        assert_eq!(raster.grid.get(0, 1), Some(13.0));
+        assert_eq!(&open_info(&path, 1).expect("info"), &raster.info);
+    }
+}
+
+#[test]
+fn per_dataset_mask_zeros_are_nodata() {
+    let dir = tempdir();
+    let path =
+        Spec::new(3, 2, vec![1.0f32, 2.0, 3.0, 4.0, 5.0, 6.0]).tif(&dir.path().join("m.tif"));
+    {
+        let ds = Dataset::open_ex(
+            &path,
+            gdal::DatasetOptions {
+                open_flags: gdal::GdalOpenFlags::GDAL_OF_UPDATE,
+                ..Default::default()
+            },
+        )
+        .expect("open for update");
+        let mut band = ds.rasterband(1).expect("band");
+        band.create_mask_band(true).expect("mask");
+        let mut mask = band.open_mask_band().expect("mask band");
+        let mut buf = Buffer::new((3, 2), vec![255u8, 255, 0, 255, 255, 255]);
+        mask.write((0, 0), (3, 2), &mut buf).expect("write mask");
+    }
+    let raster = read_grid(&path, 1).expect("read");
+    assert_eq!(raster.info.mask.as_deref(), Some("per-dataset mask"));
+    check_stats(&raster.info, 5, 1, 1.0, 6.0);
+    assert!(raster.grid.get(2, 0).is_none());
 }
 
 #[test]

@@ -37,6 +37,7 @@ fn mesh_then_verify(input: &str, e: f64, extra: &[&str], ext: &str) -> serde_jso
         serde_json::from_slice(&std::fs::read(d.path("r.json")).unwrap()).unwrap();
     assert_eq!(report["triangles_after"], json["triangles"]);
     assert_eq!(report["measured_max_error"], json["max_error"]);
+    assert_eq!(report["isolated_samples"], json["isolated_samples"]);
     report
 }
 
@@ -93,6 +94,18 @@ fn signed_ct_slice_at_the_papers_bounds() {
 fn ascii_grid_half_nodata_watershed() {
     let r = mesh_then_verify(&fixture("landlab_hugo_site.asc"), 0.5, &[], "ply");
     assert_eq!(r["valid_samples"], 2152);
+    // Two valid samples touch no valid cell: the mesh says so, and so does verify.
+    assert_eq!(r["isolated_samples"], 2);
+    let d = Dir::new();
+    let dem = fixture("landlab_hugo_site.asc");
+    let o = d.run(&["mesh", &dem, "-o", "m.ply", "--max-error", "0.5"]);
+    assert!(crate::util::stderr(&o).contains("2 valid samples are in no 2x2 block"));
+    let v = d.run(&["verify", &dem, "m.ply"]);
+    assert!(
+        stdout(&v).contains("isolated:        2 valid samples"),
+        "{}",
+        stdout(&v)
+    );
 }
 
 #[test]

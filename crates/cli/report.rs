@@ -15,6 +15,9 @@ pub struct MeshSummary<'a> {
     width: u32,
     height: u32,
     valid_samples: u64,
+    /// Valid samples that are not a corner of any valid cell: not in the domain, so not
+    /// meshed (and not checked).
+    isolated_samples: u64,
     max_error: Option<f64>,
     max_triangles: Option<usize>,
     max_vertices: Option<usize>,
@@ -58,6 +61,7 @@ impl<'a> MeshSummary<'a> {
         MeshSummary {
             input: &args.input,
             band: args.band,
+            isolated_samples: outcome.valid_samples.saturating_sub(vertices_before),
             width: outcome.size.0,
             height: outcome.size.1,
             valid_samples: outcome.valid_samples,
@@ -97,6 +101,14 @@ impl<'a> MeshSummary<'a> {
                 None => "(no bound asked)".into(),
             }
         );
+        if self.isolated_samples > 0 {
+            eprintln!(
+                "{}: note: {} valid samples are in no 2x2 block of valid samples, so no \
+                 triangle can hold them; they are not in the mesh",
+                self.input.display(),
+                self.isolated_samples
+            );
+        }
     }
 }
 

@@ -105,6 +105,13 @@ fn print_report(report: &Report, args: &VerifyArgs) {
     if let Some(e) = report.max_error_allowed {
         println!("allowed:         {e}");
     }
+    if report.isolated_samples > 0 {
+        println!(
+            "isolated:        {} valid samples in no 2x2 block of valid samples (no triangle \
+             can hold them; not checked)",
+            report.isolated_samples
+        );
+    }
     println!(
         "mesh valid:      {}",
         if report.mesh_is_valid() { "yes" } else { "NO" }

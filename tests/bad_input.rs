@@ -205,3 +205,77 @@ fn whole_raster_runs_on_a_raster_too_large_for_memory() {
     assert_fails_naming(&o, &["huge.vrt", "verify needs the whole"]);
     assert_eq!(d.files(), vec!["huge.vrt"]);
 }
+
+#[cfg(unix)]
+#[test]
+fn output_that_is_the_input_is_refused_and_the_input_kept() {
+    let d = Dir::new();
+    let copy = d.path("dem.tif");
+    std::fs::copy(dem(), &copy).unwrap();
+    let before = std::fs::read(&copy).unwrap();
+    std::os::unix::fs::symlink("dem.tif", d.path("alias.ply")).unwrap();
+    std::os::unix::fs::symlink("dem.tif", d.path("alias.geojson")).unwrap();
+    let cases: [(&[&str], &str); 4] = [
+        (
+            &[
+                "mesh",
+                "dem.tif",
+                "-o",
+                "dem.tif",
+                "--format",
+                "ply",
+                "--max-error",
+                "1",
+            ],
+            "dem.tif",
+        ),
+        (
+            &["mesh", "dem.tif", "-o", "alias.ply", "--max-error", "1"],
+            "alias.ply",
+        ),
+        (
+            &[
+                "mesh",
+                "dem.tif",
+                "-o",
+                "m.ply",
+                "--max-error",
+                "1",
+                "--report",
+                "dem.tif",
+            ],
+            "dem.tif",
+        ),
+        (
+            &[
+                "contour",
+                "dem.tif",
+                "-o",
+                "alias.geojson",
+                "--interval",
+                "10",
+            ],
+            "alias.geojson",
+        ),
+    ];
+    for (args, named) in cases {
+        let o = d.run(args);
+        assert_fails_naming(&o, &[named, "input raster"]);
+    }
+    assert_eq!(std::fs::read(&copy).unwrap(), before);
+    assert!(!d.path("m.ply").exists());
+}
+
+#[cfg(unix)]
+#[test]
+fn a_symlinked_output_stays_a_link() {
+    let d = Dir::new();
+    std::os::unix::fs::symlink("real.ply", d.path("link.ply")).unwrap();
+    let o = d.run(&["mesh", &dem(), "-o", "link.ply", "--max-error", "1", "-q"]);
+    assert!(o.status.success(), "{}", crate::util::stderr(&o));
+    let link = std::fs::symlink_metadata(d.path("link.ply")).unwrap();
+    assert!(link.file_type().is_symlink());
+    assert!(std::fs::read(d.path("real.ply"))
+        .unwrap()
+        .starts_with(b"ply"));
+}

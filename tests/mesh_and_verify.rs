@@ -185,6 +185,18 @@ fn quiet_mesh_prints_nothing_and_report_has_every_phase() {
     ]);
     assert!(o.status.success());
     assert_eq!(crate::util::stderr(&o), "");
+    #[cfg(unix)]
+    {
+        // Readable by others as the umask allows, like the mesh (not tempfile's 0600).
+        use std::os::unix::fs::PermissionsExt;
+        let mode = |name: &str| {
+            std::fs::metadata(d.path(name))
+                .unwrap()
+                .permissions()
+                .mode()
+        };
+        assert_eq!(mode("r.json") & 0o777, mode("m.obj") & 0o777);
+    }
     let r: serde_json::Value =
         serde_json::from_slice(&std::fs::read(d.path("r.json")).unwrap()).unwrap();
     for phase in [

@@ -352,6 +352,22 @@ fn check_pyramid(input: &str, quality: f64) {
     );
     let (one, two) = (all_files(&dir.path("one")), all_files(&dir.path("two")));
     assert!(one == two, "1 and 2 threads wrote different bytes");
+    #[cfg(unix)]
+    {
+        // A web server running as another user must read them: the umask decides, as
+        // for `File::create`, not tempfile's private 0600.
+        use std::os::unix::fs::PermissionsExt;
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        let reference = dir.path("reference");
+        std::fs::File::create(&reference).unwrap();
+        for file in one.keys() {
+            assert_eq!(
+                mode(&dir.path("one").join(file)),
+                mode(&reference),
+                "{file:?}"
+            );
+        }
+    }
 
     let layer: Value = serde_json::from_slice(&one[Path::new("layer.json")]).unwrap();
     assert_eq!(layer["format"], "quantized-mesh-1.0");

@@ -48,7 +48,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             args.output.display()
         );
     }
-    check_writable_target(&args.output)?;
+    check_writable_target(&args.output, &args.input)?;
     let e = args.max_error.unwrap_or(0.0);
     let size = crate::memory::raster_size(&args.input, args.band)?;
     let tiled =

@@ -36,9 +36,9 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     };
     let total = Instant::now();
     let format = crate::export::format(args)?;
-    check_writable_target(output)?;
+    check_writable_target(output, &args.input)?;
     if let Some(report) = &args.report {
-        check_writable_target(report)?;
+        check_writable_target(report, &args.input)?;
     }
 
     let t = Instant::now();

@@ -5,9 +5,10 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 
-/// Fails early, before long work, when `path`'s directory is missing or `path` is a
-/// directory.
-pub fn check_writable_target(path: &Path) -> Result<()> {
+/// Fails early, before long work, when `path`'s directory is missing, `path` is a
+/// directory, or `path` is the `input` file.
+pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
+    check_not_input(path, input)?;
     let dir = parent_dir(path);
     if !dir.is_dir() {
         bail!(
@@ -22,11 +23,41 @@ pub fn check_writable_target(path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Fails when `output` is the file `input` (the same file by any path, links included):
+/// writing would destroy the input.
+pub fn check_not_input(output: &Path, input: &Path) -> Result<()> {
+    let target = tinsmith_export::resolve_output(output);
+    if let (Ok(a), Ok(b)) = (std::fs::canonicalize(target), std::fs::canonicalize(input)) {
+        if a == b {
+            bail!(
+                "{}: is the input raster {}; writing there would destroy it",
+                output.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Writes `bytes` to `path` through a temporary file in the same directory and an atomic
-/// rename: `path` is either untouched or complete.
+/// rename: `path` is either untouched or complete. A symlink is followed (it stays a
+/// link); a device or pipe is written in place.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = parent_dir(path);
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).with_context(|| {
+    let target = tinsmith_export::resolve_output(path);
+    if tinsmith_export::is_special_file(&target) {
+        return std::fs::write(&target, bytes)
+            .with_context(|| format!("{}: write failed", path.display()));
+    }
+    let dir = parent_dir(&target);
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".tinsmith-").suffix(".tmp");
+    #[cfg(unix)]
+    {
+        // Like `File::create`: the umask decides, instead of tempfile's private 0o600.
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut tmp = builder.tempfile_in(dir).with_context(|| {
         format!(
             "{}: cannot create a file in {}",
             path.display(),
@@ -35,7 +66,7 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     })?;
     tmp.write_all(bytes)
         .with_context(|| format!("{}: write failed", path.display()))?;
-    tmp.persist(path)
+    tmp.persist(&target)
         .with_context(|| format!("{}: cannot write", path.display()))?;
     Ok(())
 }

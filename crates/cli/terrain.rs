@@ -18,7 +18,7 @@ pub fn run(args: &TilesArgs) -> Result<bool> {
         threads: args.threads,
     };
     if let Some(report) = &args.report {
-        crate::output::check_writable_target(report)?;
+        crate::output::check_writable_target(report, &args.input)?;
     }
     let report = build_terrain(&args.input, &args.output, &options, &mut |level| {
         if args.quiet {

@@ -37,7 +37,7 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
     }
     // Checks the untiled path makes first, so that errors come in the same order.
     crate::export::format(args)?;
-    check_writable_target(output)?;
+    check_writable_target(output, &args.input)?;
     let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
     let fits = reader.width() <= args.tile_size && reader.height() <= args.tile_size;
     let count_target = args.max_triangles.is_some() || args.max_vertices.is_some();
@@ -125,13 +125,13 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let welded_format = match &args.output {
         Some(output) => {
             let format = crate::export::format(args)?;
-            check_writable_target(output)?;
+            check_writable_target(output, &args.input)?;
             Some(format)
         }
         None => None,
     };
     if let Some(report) = &args.report {
-        check_writable_target(report)?;
+        check_writable_target(report, &args.input)?;
     }
 
     // Tiles need only the blocks of the current row of tiles; GDAL's default (5 % of the

@@ -2,7 +2,7 @@
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 
@@ -46,18 +46,25 @@ where
     })
 }
 
-/// A complete, synced temporary file waiting to be renamed over its target.
-pub(crate) struct Staged<'p> {
-    temp: tempfile::NamedTempFile,
-    path: &'p Path,
+/// A complete, synced temporary file waiting to be renamed over its target, or output
+/// already written in place to a device or pipe.
+pub(crate) struct Staged {
+    /// `None` when the output went straight to a device or pipe.
+    temp: Option<tempfile::NamedTempFile>,
+    /// The file the rename lands on: the path asked for, or what its symlink points to.
+    target: PathBuf,
+    /// The path asked for, for messages.
+    path: PathBuf,
 }
 
-impl Staged<'_> {
+impl Staged {
     /// Renames the temporary file over the target.
     pub(crate) fn commit(self) -> Result<()> {
-        let path = self.path;
-        self.temp.persist(path).map_err(|error| Error::Io {
-            path: path.to_path_buf(),
+        let Some(temp) = self.temp else {
+            return Ok(());
+        };
+        temp.persist(&self.target).map_err(|error| Error::Io {
+            path: self.path,
             action: "move the finished temporary file into place",
             source: error.error,
         })?;
@@ -65,16 +72,43 @@ impl Staged<'_> {
     }
 }
 
-/// Writes the content of `path` to a synced temporary file beside it; dropping the result
-/// without [`Staged::commit`] removes the temporary file.
-pub(crate) fn stage<F>(path: &Path, write: F) -> Result<Staged<'_>>
+/// Where writing `path` lands: when `path` is a symbolic link, the file it points to (so
+/// the link stays a link, as when a program opens it for writing), else `path`.
+pub fn resolve_output(path: &Path) -> PathBuf {
+    match std::fs::symlink_metadata(path) {
+        Ok(meta) if meta.file_type().is_symlink() => std::fs::canonicalize(path)
+            .or_else(|_| {
+                // A dangling link: its target, relative to the link's directory.
+                std::fs::read_link(path).map(|target| parent_dir(path).join(target))
+            })
+            .unwrap_or_else(|_| path.to_path_buf()),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// Whether `path` exists and is neither a regular file nor a directory: a device, FIFO or
+/// socket, written in place (a rename would replace it, and all-or-nothing means nothing
+/// for a pipe).
+pub fn is_special_file(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    }
+}
+
+/// Writes the content of `path` to a synced temporary file beside its target (see
+/// [`resolve_output`]); dropping the result without [`Staged::commit`] removes the
+/// temporary file. A device or pipe (see [`is_special_file`]) is written in place.
+pub(crate) fn stage<F>(path: &Path, write: F) -> Result<Staged>
 where
     F: FnOnce(&mut BufWriter<&mut File>) -> io::Result<()>,
 {
-    let dir = match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    };
+    let target = resolve_output(path);
+    let dir = parent_dir(&target);
     let io_error = |action: &'static str| {
         move |source: io::Error| Error::Io {
             path: path.to_path_buf(),
@@ -91,6 +125,21 @@ where
         }
         // Anything else (not a directory, no permission) surfaces below with its cause.
         _ => {}
+    }
+
+    if is_special_file(&target) {
+        let mut file = File::options()
+            .write(true)
+            .open(&target)
+            .map_err(io_error("open"))?;
+        let mut writer = BufWriter::with_capacity(BUFFER_SIZE, &mut file);
+        write(&mut writer).map_err(io_error("write"))?;
+        writer.flush().map_err(io_error("write"))?;
+        return Ok(Staged {
+            temp: None,
+            target,
+            path: path.to_path_buf(),
+        });
     }
 
     let mut builder = tempfile::Builder::new();
@@ -111,7 +160,11 @@ where
         writer.flush().map_err(io_error("write"))?;
     }
     temp.as_file().sync_all().map_err(io_error("write"))?;
-    Ok(Staged { temp, path })
+    Ok(Staged {
+        temp: Some(temp),
+        target,
+        path: path.to_path_buf(),
+    })
 }
 
 #[cfg(test)]
@@ -252,6 +305,56 @@ mod tests {
             .permissions()
             .mode();
         assert_eq!(mode & 0o777, expected & 0o777);
+        Ok(())
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symlink_stays_a_link_to_the_new_content() -> Result<()> {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let real = dir.path().join("real.bin");
+        std::fs::write(&real, b"old").expect("seed");
+        let link = dir.path().join("link.bin");
+        std::os::unix::fs::symlink("real.bin", &link).expect("symlink");
+        write_atomically(&link, |w| w.write_all(b"new"))?;
+        assert!(std::fs::symlink_metadata(&link)
+            .expect("stat")
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read(&real).expect("read back"), b"new");
+        // A dangling link gets its target created.
+        let dangling = dir.path().join("dangling.bin");
+        std::os::unix::fs::symlink("made.bin", &dangling).expect("symlink");
+        write_atomically(&dangling, |w| w.write_all(b"made"))?;
+        assert_eq!(
+            std::fs::read(dir.path().join("made.bin")).expect("read"),
+            b"made"
+        );
+        assert_eq!(
+            entries(dir.path()),
+            vec![dangling, link, dir.path().join("made.bin"), real.clone()]
+        );
+        Ok(())
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_pipe_is_written_in_place_not_replaced() -> Result<()> {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let fifo = dir.path().join("pipe.ply");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .expect("mkfifo");
+        assert!(made.success());
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(fifo).expect("read the pipe"))
+        };
+        write_atomically(&fifo, |w| w.write_all(b"through the pipe"))?;
+        assert_eq!(reader.join().expect("reader"), b"through the pipe");
+        assert!(is_special_file(&fifo), "the pipe was replaced");
+        assert_eq!(entries(dir.path()), vec![fifo]);
         Ok(())
     }
 

@@ -582,7 +582,15 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> TerrainResult<()> {
         source,
     };
     let dir = path.parent().unwrap_or(Path::new("."));
-    let mut file = tempfile::NamedTempFile::new_in(dir).map_err(output)?;
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        // Like `File::create`: the umask decides, instead of tempfile's private 0o600
+        // (a web server running as another user must be able to read the tiles).
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut file = builder.tempfile_in(dir).map_err(output)?;
     std::io::Write::write_all(&mut file, bytes).map_err(output)?;
     file.persist(path).map_err(|e| output(e.error))?;
     Ok(())

@@ -279,3 +279,79 @@ fn a_symlinked_output_stays_a_link() {
         .unwrap()
         .starts_with(b"ply"));
 }
+
+#[test]
+fn options_that_would_be_ignored_are_refused() {
+    let d = Dir::new();
+    let dem = dem();
+    for (args, named) in [
+        (
+            &[
+                "mesh",
+                &dem,
+                "-o",
+                "m.ply",
+                "--max-error",
+                "1",
+                "--tile-format",
+                "obj",
+            ][..],
+            "--tile-format",
+        ),
+        (
+            &[
+                "mesh",
+                &dem,
+                "-o",
+                "m.ply",
+                "--max-triangles",
+                "100",
+                "--flip-rounds",
+                "2",
+            ],
+            "--flip-rounds",
+        ),
+        (
+            &[
+                "mesh",
+                &dem,
+                "-o",
+                "m.ply",
+                "--max-vertices",
+                "100",
+                "--extend-rounds",
+                "1",
+            ],
+            "--extend-rounds",
+        ),
+    ] {
+        let o = d.run(args);
+        assert_fails_naming(&o, &[named]);
+        assert!(d.files().is_empty(), "{:?}", d.files());
+    }
+}
+
+#[test]
+fn an_unreachable_count_is_noted() {
+    let d = Dir::new();
+    let o = d.run(&["mesh", &dem(), "-o", "m.ply", "--max-triangles", "1"]);
+    assert!(o.status.success());
+    let err = crate::util::stderr(&o);
+    assert!(err.contains("is above --max-triangles 1"), "{err}");
+    let o = d.run(&[
+        "mesh",
+        &dem(),
+        "-o",
+        "m.ply",
+        "--max-triangles",
+        "10",
+        "--max-error",
+        "0.01",
+    ]);
+    assert!(o.status.success());
+    let err = crate::util::stderr(&o);
+    assert!(
+        err.contains("--max-error 0.01 stopped the decimation first"),
+        "{err}"
+    );
+}

@@ -191,9 +191,10 @@ pub struct MeshArgs {
     /// of one welded mesh; always uses tiles.
     #[arg(long, value_name = "DIR", conflicts_with = "output")]
     pub per_tile: Option<PathBuf>,
-    /// Format of the --per-tile files.
-    #[arg(long, value_enum, default_value_t = TileFormatArg::Ply, requires = "per_tile")]
-    pub tile_format: TileFormatArg,
+    /// Format of the --per-tile files [default: ply]. Only with --per-tile.
+    // Checked in `mesh::run`: clap's `requires` lets it through beside -o.
+    #[arg(long, value_enum)]
+    pub tile_format: Option<TileFormatArg>,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -326,6 +327,14 @@ impl MeshArgs {
         options.max_edge_length = self.max_edge_length;
         options.flip_rounds = self.flip_rounds;
         options.extend_rounds = self.extend_rounds;
+        let count_target = self.max_triangles.is_some() || self.max_vertices.is_some();
+        if count_target && (self.flip_rounds > 0 || self.extend_rounds > 0) {
+            anyhow::bail!(
+                "{}: --flip-rounds and --extend-rounds work to an error bound, not with \
+                 --max-triangles or --max-vertices",
+                self.input.display()
+            );
+        }
         if let Some(n) = self.max_triangles {
             options = options.with_max_triangles(n);
         }
@@ -397,7 +406,8 @@ impl From<InitialMeshArg> for InitialMesh {
 pub enum RetriangulateArg {
     /// The paper's greedy ear selection, with --selection.
     Ears,
-    /// Min-max-error triangulation by dynamic programming (holes up to 16 vertices).
+    /// Min-max-error triangulation by dynamic programming (holes up to --dp-max-ring
+    /// vertices; larger ones by ears).
     Dp,
 }
 

@@ -31,6 +31,12 @@ struct MeshReport<'a> {
 /// Reads, decimates, verifies in memory and writes; the mesh is written only if the
 /// independent verifier confirms the bound.
 pub fn run(args: &MeshArgs) -> Result<bool> {
+    if args.tile_format.is_some() && args.per_tile.is_none() {
+        anyhow::bail!(
+            "--tile-format sets the format of the --per-tile files; without --per-tile the \
+             format follows -o's extension (or --format)"
+        );
+    }
     let Some(output) = crate::tiled::untiled_output(args)? else {
         return crate::tiled::run(args);
     };

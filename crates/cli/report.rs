@@ -101,6 +101,24 @@ impl<'a> MeshSummary<'a> {
                 None => "(no bound asked)".into(),
             }
         );
+        let short = [
+            ("--max-triangles", self.max_triangles, self.triangles_after),
+            ("--max-vertices", self.max_vertices, self.vertices_after),
+        ];
+        for (flag, target, reached) in short {
+            if let Some(target) = target.filter(|&t| reached > t as u64) {
+                let why = match self.max_error {
+                    Some(e) => format!("--max-error {e} stopped the decimation first"),
+                    None => {
+                        "the domain's outline needs them (its corners are never removed)".into()
+                    }
+                };
+                eprintln!(
+                    "{}: note: {reached} is above {flag} {target}: {why}",
+                    self.output.display()
+                );
+            }
+        }
         if self.isolated_samples > 0 {
             eprintln!(
                 "{}: note: {} valid samples are in no 2x2 block of valid samples, so no \

@@ -211,7 +211,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             (report, output.as_path(), write)
         }
         (_, _, Some(dir)) => {
-            let format = match args.tile_format {
+            let format = match args.tile_format.unwrap_or(TileFormatArg::Ply) {
                 TileFormatArg::Ply => MeshFormat::Ply,
                 TileFormatArg::Obj => MeshFormat::Obj,
             };

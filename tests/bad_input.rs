@@ -355,3 +355,44 @@ fn an_unreachable_count_is_noted() {
         "{err}"
     );
 }
+
+#[test]
+fn a_pyramid_is_written_whole_or_not_at_all() {
+    let d = Dir::new();
+    // Every sample nodata: nothing to write, so no directory and no layer.json.
+    d.write(
+        "empty.asc",
+        "ncols 3\nnrows 3\nxllcorner 7\nyllcorner 46\ncellsize 0.01\nNODATA_value -9999\n\
+         -9999 -9999 -9999\n-9999 -9999 -9999\n-9999 -9999 -9999\n",
+    );
+    d.write(
+        "empty.prj",
+        "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],\
+         PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]",
+    );
+    let o = d.run(&["tiles", "empty.asc", "-o", "pyramid", "-q"]);
+    assert_fails_naming(&o, &["empty.asc"]);
+    assert_eq!(d.files(), vec!["empty.asc", "empty.prj"]);
+
+    // A directory that holds other files is never written into.
+    std::fs::create_dir(d.path("taken")).unwrap();
+    std::fs::write(d.path("taken/keep.txt"), "mine").unwrap();
+    let o = d.run(&["tiles", &dem(), "-o", "taken", "-q"]);
+    assert_fails_naming(&o, &["taken", "not an empty directory"]);
+    let left: Vec<_> = std::fs::read_dir(d.path("taken")).unwrap().collect();
+    assert_eq!(left.len(), 1);
+
+    // An empty directory (or a missing one, parents included) gets the whole pyramid.
+    std::fs::create_dir(d.path("ready")).unwrap();
+    for out in ["ready", "new/parent/pyramid"] {
+        let o = d.run(&["tiles", &dem(), "-o", out, "-q"]);
+        assert!(o.status.success(), "{}", crate::util::stderr(&o));
+        assert!(d.path(out).join("layer.json").is_file());
+    }
+    let hidden: Vec<_> = std::fs::read_dir(d.path(""))
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with(".tinsmith-"))
+        .collect();
+    assert!(hidden.is_empty(), "temporary directories left: {hidden:?}");
+}

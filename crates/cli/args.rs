@@ -36,7 +36,8 @@ pub enum Command {
 pub struct TilesArgs {
     /// Any georeferenced raster GDAL can read, in any CRS (reprojected to EPSG:4326).
     pub input: PathBuf,
-    /// Output directory: {z}/{x}/{y}.terrain and layer.json.
+    /// Output directory, new or empty: {z}/{x}/{y}.terrain and layer.json, moved into place
+    /// whole when done.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Band to read (1-based).

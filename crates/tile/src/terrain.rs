@@ -326,25 +326,100 @@ pub fn build_terrain(
             options.min_zoom
         )));
     }
-    std::fs::create_dir_all(out_dir).map_err(|source| TerrainError::Output {
-        path: out_dir.to_path_buf(),
-        source,
-    })?;
+    // All or nothing: the pyramid is built in a temporary directory beside `out_dir` and
+    // renamed into place at the end; a failure (or nothing to write) leaves no trace.
+    let staging = staging_dir(out_dir)?;
     let source = Warp {
         path: input,
         band: options.band,
     };
     let band_rows = band_tile_rows(&bounds, max_zoom);
     let (levels, available) = build_pyramid(
-        &source, &bounds, max_zoom, band_rows, out_dir, options, progress,
+        &source,
+        &bounds,
+        max_zoom,
+        band_rows,
+        staging.path(),
+        options,
+        progress,
     )?;
-    write_layer_json(input, out_dir, options, &bounds, max_zoom, &available)?;
+    if levels.iter().all(|l| l.tiles == 0) {
+        let hint = if options.max_zoom.is_some() {
+            " (at this --max-zoom the tile samples may be too far apart for the raster's \
+             extent: try a larger one)"
+        } else {
+            ""
+        };
+        return Err(TerrainError::Options(format!(
+            "{}: band {} has no tile with a 2x2 block of valid samples at levels {}..={max_zoom}, \
+             so there is no terrain to write{hint}",
+            input.display(),
+            options.band,
+            options.min_zoom
+        )));
+    }
+    write_layer_json(
+        input,
+        staging.path(),
+        options,
+        &bounds,
+        max_zoom,
+        &available,
+    )?;
+    let staged = staging.keep();
+    std::fs::rename(&staged, out_dir).map_err(|source| {
+        let _ = std::fs::remove_dir_all(&staged);
+        TerrainError::Output {
+            path: out_dir.to_path_buf(),
+            source,
+        }
+    })?;
     Ok(TerrainReport {
         bounds: [bounds.west, bounds.south, bounds.east, bounds.north],
         min_zoom: options.min_zoom,
         max_zoom,
         levels,
     })
+}
+
+/// A temporary directory beside `out_dir` (which must not exist, or be an empty
+/// directory; its missing parents are created) to build the pyramid in.
+fn staging_dir(out_dir: &Path) -> TerrainResult<tempfile::TempDir> {
+    let refuse = |reason: String| TerrainError::Options(format!("{}: {reason}", out_dir.display()));
+    if let Ok(meta) = std::fs::symlink_metadata(out_dir) {
+        let empty = meta.is_dir()
+            && std::fs::read_dir(out_dir).is_ok_and(|mut entries| entries.next().is_none());
+        if !empty {
+            return Err(refuse(
+                "exists and is not an empty directory; give a new directory (the pyramid is \
+                 written whole, never mixed with other files)"
+                    .into(),
+            ));
+        }
+    }
+    let parent = match out_dir.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    // Missing parents are created, as `mkdir -p` would.
+    std::fs::create_dir_all(parent).map_err(|source| TerrainError::Output {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".tinsmith-").suffix(".tmp");
+    #[cfg(unix)]
+    {
+        // Like `create_dir`: the umask decides, instead of tempfile's private 0o700.
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o777));
+    }
+    builder
+        .tempdir_in(parent)
+        .map_err(|source| TerrainError::Output {
+            path: out_dir.to_path_buf(),
+            source,
+        })
 }
 
 /// The tiles of [`build_terrain`] from `source`, its finest level read in bands of

@@ -28,9 +28,18 @@ use crate::args::{Cli, Command};
 const EXIT_VERIFY_FAILED: u8 = 1;
 /// Exit code for bad input and other errors.
 const EXIT_ERROR: u8 = 2;
+/// Exit code after Ctrl-C or SIGTERM (128 + SIGINT, as shells report an interrupt).
+const EXIT_INTERRUPTED: i32 = 130;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Ctrl-C or SIGTERM: no half-written temporary file or directory may stay behind
+    // (their owners' drops, which remove them on errors, do not run on a signal's exit).
+    let _ = ctrlc::set_handler(|| {
+        tinsmith_export::remove_pending();
+        eprintln!("\ntinsmith: interrupted; unfinished output removed");
+        std::process::exit(EXIT_INTERRUPTED);
+    });
     // Errors come back as values with GDAL's message; GDAL need not print them too.
     tinsmith_raster::silence_gdal_errors();
     let result = match cli.command {

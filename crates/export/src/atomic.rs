@@ -51,6 +51,8 @@ where
 pub(crate) struct Staged {
     /// `None` when the output went straight to a device or pipe.
     temp: Option<tempfile::NamedTempFile>,
+    /// Keeps the temporary file registered for removal on a signal until it is renamed.
+    _pending: Option<crate::PendingGuard>,
     /// The file the rename lands on: the path asked for, or what its symlink points to.
     target: PathBuf,
     /// The path asked for, for messages.
@@ -137,6 +139,7 @@ where
         writer.flush().map_err(io_error("write"))?;
         return Ok(Staged {
             temp: None,
+            _pending: None,
             target,
             path: path.to_path_buf(),
         });
@@ -153,6 +156,7 @@ where
     let mut temp = builder
         .tempfile_in(dir)
         .map_err(io_error("create a temporary file in the output directory"))?;
+    let pending = crate::track_pending(temp.path());
 
     {
         let mut writer = BufWriter::with_capacity(BUFFER_SIZE, temp.as_file_mut());
@@ -162,6 +166,7 @@ where
     temp.as_file().sync_all().map_err(io_error("write"))?;
     Ok(Staged {
         temp: Some(temp),
+        _pending: Some(pending),
         target,
         path: path.to_path_buf(),
     })

@@ -50,6 +50,7 @@
 #![forbid(unsafe_code)]
 
 mod atomic;
+mod pending;
 mod error;
 mod fgb;
 mod file;
@@ -70,6 +71,7 @@ mod weld;
 
 pub use atomic::{is_special_file, resolve_output};
 pub use error::{Error, Result};
+pub use pending::{remove_pending, track_pending, PendingGuard};
 pub use file::{prj_path, read_mesh, read_mesh_as, write_mesh, write_mesh_with};
 pub use format::MeshFormat;
 pub use lines::{write_lines, CrsRef, LineFormat, LinePoint};

@@ -271,6 +271,8 @@ impl MeshStreamWriter {
 struct Spool {
     file: tempfile::NamedTempFile,
     writer: BufWriter<File>,
+    /// Keeps the spool registered for removal on a signal.
+    _pending: crate::PendingGuard,
 }
 
 impl Spool {
@@ -280,7 +282,12 @@ impl Spool {
             .suffix(".spool.tmp")
             .tempfile_in(dir)?;
         let writer = BufWriter::with_capacity(BUFFER_SIZE, file.as_file().try_clone()?);
-        Ok(Spool { file, writer })
+        let _pending = crate::track_pending(file.path());
+        Ok(Spool {
+            file,
+            writer,
+            _pending,
+        })
     }
 
     /// Flushes the writer and returns a handle reading the spool from its start.

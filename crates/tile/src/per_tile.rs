@@ -22,6 +22,8 @@ use crate::sink::{FinishedTile, SinkError, TileSink};
 pub struct PerTileWriter {
     dir: PathBuf,
     temp: tempfile::TempDir,
+    /// Keeps the temporary directory registered for removal on a signal.
+    _pending: tinsmith_export::PendingGuard,
     format: MeshFormat,
     crs_wkt: Option<String>,
     placement: Placement,
@@ -78,6 +80,7 @@ impl PerTileWriter {
             .map_err(|e| output("cannot create a temporary directory beside it", Some(e)))?;
         Ok(PerTileWriter {
             dir: dir.to_path_buf(),
+            _pending: tinsmith_export::track_pending(temp.path()),
             temp,
             format,
             crs_wkt: crs_wkt.map(str::to_owned),

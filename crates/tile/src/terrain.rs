@@ -329,6 +329,7 @@ pub fn build_terrain(
     // All or nothing: the pyramid is built in a temporary directory beside `out_dir` and
     // renamed into place at the end; a failure (or nothing to write) leaves no trace.
     let staging = staging_dir(out_dir)?;
+    let _pending = tinsmith_export::track_pending(staging.path());
     let source = Warp {
         path: input,
         band: options.band,

@@ -1,0 +1,69 @@
+//! Temporary files and directories on their way to becoming outputs, so that an
+//! interrupted run (Ctrl-C, SIGTERM) can remove them: a temporary file is otherwise removed
+//! only when its owner is dropped, which a signal's exit skips.
+
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Registers `path` (a temporary file or directory) until the returned guard is dropped.
+pub fn track_pending(path: &Path) -> PendingGuard {
+    if let Ok(mut pending) = PENDING.lock() {
+        pending.push(path.to_path_buf());
+    }
+    PendingGuard(path.to_path_buf())
+}
+
+/// Unregisters its path when dropped (the owner has renamed or removed it by then).
+#[derive(Debug)]
+pub struct PendingGuard(PathBuf);
+
+impl Drop for PendingGuard {
+    fn drop(&mut self) {
+        if let Ok(mut pending) = PENDING.lock() {
+            if let Some(i) = pending.iter().rposition(|p| p == &self.0) {
+                pending.swap_remove(i);
+            }
+        }
+    }
+}
+
+/// Removes every registered temporary file and directory (for a signal handler, just
+/// before the process exits). Paths that are gone already are skipped.
+pub fn remove_pending() {
+    let paths = match PENDING.lock() {
+        Ok(pending) => pending.clone(),
+        Err(poisoned) => poisoned.into_inner().clone(),
+    };
+    for path in paths {
+        if path.is_dir() {
+            let _ = std::fs::remove_dir_all(&path);
+        } else {
+            let _ = std::fs::remove_file(&path);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn registered_paths_are_removed_until_their_guard_drops() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let (a, b) = (dir.path().join("a.tmp"), dir.path().join("b.tmp"));
+        std::fs::write(&a, b"a").unwrap();
+        std::fs::create_dir(&b).unwrap();
+        std::fs::write(b.join("inner"), b"x").unwrap();
+        let guard_a = track_pending(&a);
+        {
+            let _guard_b = track_pending(&b);
+        }
+        // b's guard is gone: b is kept; a is removed.
+        remove_pending();
+        assert!(!a.exists());
+        assert!(b.join("inner").exists());
+        drop(guard_a);
+    }
+}

@@ -374,6 +374,17 @@ fn a_pyramid_is_written_whole_or_not_at_all() {
     assert_fails_naming(&o, &["empty.asc"]);
     assert_eq!(d.files(), vec!["empty.asc", "empty.prj"]);
 
+    // Heights beyond what quantized-mesh's f32 height range can hold.
+    d.write(
+        "huge.asc",
+        "ncols 3\nnrows 3\nxllcorner 7\nyllcorner 46\ncellsize 0.01\n\
+         3.0e38 -3.0e38 3.0e38\n-3.0e38 3.0e38 -3.0e38\n3.0e38 -3.0e38 3.0e38\n",
+    );
+    std::fs::copy(d.path("empty.prj"), d.path("huge.prj")).unwrap();
+    let o = d.run(&["tiles", "huge.asc", "-o", "pyramid", "-q"]);
+    assert_fails_naming(&o, &["huge.asc", "quantized-mesh"]);
+    assert!(!d.path("pyramid").exists());
+
     // A directory that holds other files is never written into.
     std::fs::create_dir(d.path("taken")).unwrap();
     std::fs::write(d.path("taken/keep.txt"), "mine").unwrap();

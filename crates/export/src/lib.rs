@@ -50,7 +50,6 @@
 #![forbid(unsafe_code)]
 
 mod atomic;
-mod pending;
 mod error;
 mod fgb;
 mod file;
@@ -63,6 +62,7 @@ mod mesh;
 mod obj;
 mod options;
 mod origin;
+mod pending;
 mod ply;
 mod quantized_mesh;
 mod stl;
@@ -71,13 +71,13 @@ mod weld;
 
 pub use atomic::{is_special_file, resolve_output};
 pub use error::{Error, Result};
-pub use pending::{remove_pending, track_pending, PendingGuard};
 pub use file::{prj_path, read_mesh, read_mesh_as, write_mesh, write_mesh_with};
 pub use format::MeshFormat;
 pub use lines::{write_lines, CrsRef, LineFormat, LinePoint};
 pub use mesh::{Mesh, MeshRef};
 pub use options::WriteOptions;
 pub use origin::LocalOrigin;
+pub use pending::{remove_pending, track_pending, PendingGuard};
 pub use quantized_mesh::{
     geodetic_to_ecef, gzip, oct_encode, surface_normal, EncodeError, GeoRectangle,
     QuantizedMeshTile, EXTENSION_METADATA, EXTENSION_NORMALS, HEADER_BYTES, MAX_16BIT_VERTICES,

@@ -444,6 +444,15 @@ fn build_pyramid(
     let zooms = (options.min_zoom, max_zoom);
     let mut stats = LevelStats::new(max_zoom, &pool);
     stream_levels(source, bounds, zooms, band_rows, &pool, &mut stats)?;
+    // Quantized-mesh stores a tile's height range in f32, and its heights as steps of it.
+    let widest = stats.widest.iter().fold(0.0f64, |w, &x| w.max(x));
+    if !(stats.max_abs < f64::from(f32::MAX) / 2.0 && widest < f64::from(f32::MAX) / 2.0) {
+        return Err(TerrainError::Options(format!(
+            "heights up to {:e} (tiles spanning up to {:e}) are beyond what quantized-mesh \
+             tiles can hold (their height range is stored in f32)",
+            stats.max_abs, widest
+        )));
+    }
     let mut writer = TileWriter::new(stats, out_dir, options, &pool, progress);
     stream_levels(source, bounds, zooms, band_rows, &pool, &mut writer)?;
     let mut levels = writer.finished;

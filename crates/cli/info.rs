@@ -3,6 +3,7 @@
 use anyhow::Result;
 
 use crate::args::InfoArgs;
+use crate::number::readable;
 
 /// Prints the band's metadata and value statistics; always `Ok(true)` on success.
 pub fn run(args: &InfoArgs) -> Result<bool> {
@@ -19,7 +20,7 @@ pub fn run(args: &InfoArgs) -> Result<bool> {
     );
     println!("type:          {}", info.data_type);
     match info.nodata {
-        Some(n) => println!("nodata:        {n}"),
+        Some(n) => println!("nodata:        {}", readable(n)),
         None => println!("nodata:        none"),
     }
     if let Some(mask) = &info.mask {
@@ -30,7 +31,7 @@ pub fn run(args: &InfoArgs) -> Result<bool> {
         info.valid_samples, info.nodata_samples
     );
     match (info.min, info.max) {
-        (Some(lo), Some(hi)) => println!("value range:   {lo} .. {hi}"),
+        (Some(lo), Some(hi)) => println!("value range:   {} .. {}", readable(lo), readable(hi)),
         _ => println!("value range:   no valid sample"),
     }
     match info.epsg {

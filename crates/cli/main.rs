@@ -10,6 +10,7 @@ mod georef;
 mod info;
 mod memory;
 mod mesh;
+mod number;
 mod output;
 mod progress;
 mod report;

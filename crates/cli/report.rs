@@ -5,6 +5,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::args::MeshArgs;
+use crate::number::readable;
 
 /// What every mesh report says: the input, the options, the counts before and after, the
 /// bound and the independently measured error, and where the mesh went.
@@ -95,9 +96,9 @@ impl<'a> MeshSummary<'a> {
             self.triangles_before,
             self.triangles_after,
             self.decimation_percent,
-            self.measured_max_error,
+            readable(self.measured_max_error),
             match self.max_error {
-                Some(e) => e.to_string(),
+                Some(e) => readable(e),
                 None => "(no bound asked)".into(),
             }
         );
@@ -108,7 +109,7 @@ impl<'a> MeshSummary<'a> {
         for (flag, target, reached) in short {
             if let Some(target) = target.filter(|&t| reached > t as u64) {
                 let why = match self.max_error {
-                    Some(e) => format!("--max-error {e} stopped the decimation first"),
+                    Some(e) => format!("--max-error {} stopped the decimation first", readable(e)),
                     None => {
                         "the domain's outline needs them (its corners are never removed)".into()
                     }

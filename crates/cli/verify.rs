@@ -9,6 +9,7 @@ use tinsmith_verify::{GridRef, MeshRef, Orientation, Report, VerifyOptions};
 
 use crate::args::VerifyArgs;
 use crate::georef::Georef;
+use crate::number::readable;
 
 /// Runs the verifier; `Ok(false)` when the mesh is invalid or exceeds `--max-error`.
 pub fn run(args: &VerifyArgs) -> Result<bool> {
@@ -98,12 +99,16 @@ fn print_report(report: &Report, args: &VerifyArgs) {
     match &report.max_error_at {
         Some(at) => println!(
             "max error:       {} at column {}, row {} (sample {}, TIN {})",
-            report.max_error, at.x, at.y, at.sample, at.interpolated
+            readable(report.max_error),
+            at.x,
+            at.y,
+            readable(at.sample),
+            readable(at.interpolated)
         ),
-        None => println!("max error:       {}", report.max_error),
+        None => println!("max error:       {}", readable(report.max_error)),
     }
     if let Some(e) = report.max_error_allowed {
-        println!("allowed:         {e}");
+        println!("allowed:         {}", readable(e));
     }
     if report.isolated_samples > 0 {
         println!(

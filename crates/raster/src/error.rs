@@ -43,7 +43,9 @@ pub enum Error {
     },
     /// The band holds complex or otherwise non-real samples.
     #[error(
-        "{}: band {band} has data type {data_type}, which is not a real-valued sample type",
+        "{}: band {band} has data type {data_type}, which is not a real-valued sample type \
+         (complex types such as CInt16 or CFloat32 show as Unknown); convert it first, for \
+         example with gdal_translate -ot Float32",
         path.display()
     )]
     UnsupportedType {

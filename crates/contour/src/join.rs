@@ -13,8 +13,9 @@ use crate::{levels::sorted_levels, ContourMesh, Error, Polyline, Result};
 /// every line is a path, not a soup: it is closed when it comes back to its first edge, and
 /// otherwise it runs from a boundary edge to a boundary edge (the domain's outline or a
 /// nodata hole). Crossings that coincide at a vertex lying exactly on the level are merged
-/// into one point, and a line that collapses to a single point (it only touches the level
-/// at a vertex) is dropped.
+/// into one point; a line running out along an edge at the level and back (`A, B, A`)
+/// loses the excursion; and a line that collapses to a point or a ring that encloses
+/// nothing (ground that only touches the level at a vertex or along edges) is dropped.
 ///
 /// # Output order (deterministic)
 /// Sorted by level (ascending; `levels` may be in any order, duplicates are contoured
@@ -217,8 +218,11 @@ impl Joiner<'_> {
             points.push(point);
             edges.push([p, q]);
         }
+        remove_spikes(&mut points, &mut edges);
         let degenerate = if closed {
-            points.len() < 3
+            // A ring needs three distinct points (its first is repeated at the end): `A,
+            // B, A` encloses nothing.
+            points.len() < 4
         } else {
             points.len() < 2
         };
@@ -231,4 +235,28 @@ impl Joiner<'_> {
             });
         }
     }
+}
+
+/// Removes the back-and-forth excursions `A, B, A` inside a line (keeping the first `A`),
+/// repeatedly, so `A, B, C, B, A` goes too. They come from ground that only touches the
+/// level along an edge (a ridge at the level between lower ground): the rule that a height
+/// at the level counts as above makes the line run out along the edge and back. The first
+/// and last points stay, so open lines still end on their boundary edges and rings close.
+fn remove_spikes(points: &mut Vec<[f64; 2]>, edges: &mut Vec<[u32; 2]>) {
+    let n = points.len();
+    if n < 4 {
+        return;
+    }
+    let mut kept = 1;
+    for i in 1..n {
+        points[kept] = points[i];
+        edges[kept] = edges[i];
+        kept += 1;
+        // A spike tip at `kept - 2`, not touching the first or the last point.
+        while kept >= 3 && i < n - 1 && points[kept - 3] == points[kept - 1] {
+            kept -= 2;
+        }
+    }
+    points.truncate(kept);
+    edges.truncate(kept);
 }

@@ -21,7 +21,8 @@
 //!   to the level counts as above it. Contours then separate the vertices below the level
 //!   from those at or above it; a line touching a vertex at the level passes through that
 //!   vertex exactly; a triangle flat at the level is uncut (the line runs along the edge of
-//!   a flat area at the level); a vertex only touching the level makes no line; saddles
+//!   a flat area at the level); a vertex or a ridge of edges only touching the level makes
+//!   no line, and a line does not run out along such a ridge and back; saddles
 //!   need nothing more, as every crossed edge has exactly one crossing.
 //! - **Deterministic.** The output depends only on the mesh and the levels (see
 //!   [`contour`] for the order); nothing is hashed or threaded.

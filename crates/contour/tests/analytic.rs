@@ -186,6 +186,37 @@ fn plateau_at_the_level_is_outlined_along_its_edge() {
 }
 
 #[test]
+fn a_ridge_that_only_touches_the_level_makes_no_line_and_no_spike() {
+    let n = 9;
+    // A ridge of three samples at 1 in a field of 0: the ground at or above the level is
+    // the ridge itself, which encloses nothing, so there is no line (not a ring
+    // A, B, C, B, A running out along the ridge and back).
+    let ridge = |x: f64, y: f64| y == 4.0 && (3.0..=5.0).contains(&x);
+    let v = grid(n, n, |x, y| if ridge(x, y) { 1.0 } else { 0.0 });
+    assert!(contour(&full(n, n, &v), &[1.0]).unwrap().is_empty());
+    // The same ridge on a hill that reaches the level elsewhere: the hill's line has no
+    // excursion along the ridge (no point followed by another and then itself again).
+    let v = grid(n, n, |x, y| {
+        if ridge(x, y) {
+            1.0
+        } else if x >= 6.0 {
+            2.0
+        } else {
+            0.0
+        }
+    });
+    let lines = contour(&full(n, n, &v), &[1.0]).unwrap();
+    assert!(!lines.is_empty());
+    for line in &lines {
+        let p = line.points();
+        assert!(
+            (2..p.len()).all(|i| p[i] != p[i - 2]),
+            "back and forth in {p:?}"
+        );
+    }
+}
+
+#[test]
 fn a_vertex_that_only_touches_the_level_makes_no_line() {
     let n = 7;
     // A single peak at 1 in the middle, another on the border.

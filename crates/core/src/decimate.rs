@@ -4,6 +4,7 @@ use std::collections::BinaryHeap;
 use std::time::Instant;
 
 use crate::hole::{Retriangulator, Rules};
+use crate::levels::triangle_levels;
 use crate::mesh::{Mesh, Star, VertexClass};
 use crate::predicates::Point;
 use crate::rtin::{rtin_for_count, rtin_triangles};
@@ -210,6 +211,9 @@ fn run(
         levels: options.contour_levels.as_deref(),
     };
     let mut remover = Remover::new(rules);
+    // Shaped for contours to a bound (not a count): a removal whose new triangles span
+    // more levels than the old ones would add contour segments, so it is not made.
+    remover.segments_may_not_grow = rules.levels.is_some() && !count_target;
     let mut stats = Stats::default();
     if let Some(keep) = keep_border {
         remove_border(&mut mesh, &mut remover, keep)?;
@@ -627,6 +631,9 @@ pub(crate) struct Remover<'g> {
     locked_border: Option<(u32, u32)>,
     /// Vertices with more neighbours than this are not tried (see [`MAX_HOLE_RING`]).
     max_ring: usize,
+    /// With contour levels: refuse a removal whose new triangles span more levels in all
+    /// than the star's did (it would give the contour lines more segments).
+    segments_may_not_grow: bool,
 }
 
 impl<'g> Remover<'g> {
@@ -641,6 +648,7 @@ impl<'g> Remover<'g> {
             rules,
             locked_border: None,
             max_ring: MAX_HOLE_RING,
+            segments_may_not_grow: false,
         }
     }
 
@@ -764,6 +772,24 @@ impl<'g> Remover<'g> {
             .extend(star.triangles.iter().map(|&t| mesh.bound(t)));
         self.hole.load(centre, &self.points, &self.bounds);
         let (triangles, worst) = self.hole.retriangulate(&self.rules)?;
+        if let Some(levels) = self.rules.levels.filter(|_| self.segments_may_not_grow) {
+            let m = self.points.len();
+            let before: usize = (0..star.triangles.len())
+                .map(|i| {
+                    triangle_levels(levels, &centre, &self.points[i], &self.points[(i + 1) % m])
+                })
+                .sum();
+            let after: usize = triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.corners.map(|k| &self.points[k as usize]);
+                    triangle_levels(levels, a, b, c)
+                })
+                .sum();
+            if after > before {
+                return None;
+            }
+        }
         self.new_triangles.clear();
         for (tri, &slot) in triangles.iter().zip(&star.triangles) {
             let corners = tri.corners.map(|i| star.ring[i as usize]);

@@ -163,11 +163,13 @@ impl DecimationOptions {
 
     /// Shapes the TIN for contour lines at `levels` (non-finite values are dropped): among
     /// the hole triangulations within the bound, the dynamic program picks one whose
-    /// triangles span the fewest levels, and once no vertex can go, edges are flipped
-    /// where the new edge spans fewer levels and both new triangles stay within the bound.
-    /// Each triangle a level passes through gives a contour line one segment, so the
-    /// lines get fewer segments; the bound is kept exactly as without levels. No finite
-    /// level leaves the options as they were.
+    /// triangles span the fewest levels; a removal that would still span more levels than
+    /// the star it replaces is not made (to a bound; count targets remove regardless);
+    /// and once no vertex can go, edges are flipped where the new edge spans fewer levels
+    /// and both new triangles stay within the bound. Each triangle a level passes through
+    /// gives a contour line one segment, so the lines get fewer segments (for a few more
+    /// triangles); the bound is kept exactly as without levels. No finite level leaves
+    /// the options as they were.
     pub fn with_contour_levels(mut self, levels: &[f64]) -> DecimationOptions {
         let mut levels: Vec<f64> = levels.iter().copied().filter(|l| l.is_finite()).collect();
         levels.sort_by(f64::total_cmp);

@@ -296,8 +296,10 @@ fn contour_levels_shape_the_tin_for_fewer_segments_within_the_bound() {
             levels_spanned(&plain, &levels),
             levels_spanned(&shaped, &levels),
         );
+        // 0.73 / 0.74 / 0.80 at the three bounds; without refusing the removals that add
+        // segments it was 0.77 / 0.82 / 0.88.
         assert!(
-            after * 100 <= before * 97,
+            after * 100 <= before * 82,
             "at {bound}: {after} segments with levels, {before} without"
         );
     }

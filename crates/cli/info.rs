@@ -19,6 +19,13 @@ pub fn run(args: &InfoArgs) -> Result<bool> {
         info.width, info.height, info.band_count, info.band
     );
     println!("type:          {}", info.data_type);
+    if info.scale != 1.0 || info.offset != 0.0 {
+        println!(
+            "scale, offset: {}, {} (heights = sample x scale + offset)",
+            readable(info.scale),
+            readable(info.offset)
+        );
+    }
     match info.nodata {
         Some(n) => println!("nodata:        {}", readable(n)),
         None => println!("nodata:        none"),

@@ -118,6 +118,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let outcome = Outcome {
         size: (grid.width(), grid.height()),
         valid_samples: raster.info.valid_samples,
+        band_count: raster.info.band_count,
         before: (r.initial_triangles as u64, r.initial_vertices as u64),
         after: (r.final_triangles as u64, r.final_vertices as u64),
         max_error_bound: r.max_bound,

@@ -16,6 +16,8 @@ pub struct MeshSummary<'a> {
     width: u32,
     height: u32,
     valid_samples: u64,
+    /// Bands in the file (the one meshed is `band`).
+    band_count: usize,
     /// Valid samples that are not a corner of any valid cell: not in the domain, so not
     /// meshed (and not checked).
     isolated_samples: u64,
@@ -44,6 +46,8 @@ pub struct Outcome {
     pub size: (u32, u32),
     /// Valid samples of the band.
     pub valid_samples: u64,
+    /// Bands in the file.
+    pub band_count: usize,
     /// Full-grid triangles and domain samples.
     pub before: (u64, u64),
     /// Triangles and vertices written.
@@ -63,6 +67,7 @@ impl<'a> MeshSummary<'a> {
             input: &args.input,
             band: args.band,
             isolated_samples: outcome.valid_samples.saturating_sub(vertices_before),
+            band_count: outcome.band_count,
             width: outcome.size.0,
             height: outcome.size.1,
             valid_samples: outcome.valid_samples,
@@ -119,6 +124,14 @@ impl<'a> MeshSummary<'a> {
                     self.output.display()
                 );
             }
+        }
+        if self.band_count > 1 {
+            eprintln!(
+                "{}: note: meshed band {} of {} (--band picks another)",
+                self.input.display(),
+                self.band,
+                self.band_count
+            );
         }
         if self.isolated_samples > 0 {
             eprintln!(

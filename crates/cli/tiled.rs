@@ -233,6 +233,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let outcome = Outcome {
         size: (info.width, info.height),
         valid_samples: info.valid_samples,
+        band_count: info.band_count,
         before: (r.initial_triangles, r.initial_vertices),
         after: (r.final_triangles, r.final_vertices),
         max_error_bound: r.max_bound,

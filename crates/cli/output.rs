@@ -49,15 +49,7 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
             .with_context(|| format!("{}: write failed", path.display()));
     }
     let dir = parent_dir(&target);
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".tinsmith-").suffix(".tmp");
-    #[cfg(unix)]
-    {
-        // Like `File::create`: the umask decides, instead of tempfile's private 0o600.
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let mut tmp = builder.tempfile_in(dir).with_context(|| {
+    let mut tmp = tinsmith_export::output_temp_file(dir).with_context(|| {
         format!(
             "{}: cannot create a file in {}",
             path.display(),

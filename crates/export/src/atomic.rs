@@ -95,6 +95,34 @@ pub fn is_special_file(path: &Path) -> bool {
     std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
+/// A temporary file `.tinsmith-*.tmp` in `dir`, to be renamed over an output: its mode is
+/// what `File::create` would give (the umask decides), not tempfile's private 0600, so the
+/// output is readable as any other file the user writes (a web server serving tiles runs
+/// as another user).
+pub fn output_temp_file(dir: &Path) -> io::Result<tempfile::NamedTempFile> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".tinsmith-").suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder.tempfile_in(dir)
+}
+
+/// A temporary directory `.tinsmith-*.tmp` in `parent`, to be renamed into place as an
+/// output directory: its mode is what `create_dir` would give, not tempfile's 0700.
+pub fn output_temp_dir(parent: &Path) -> io::Result<tempfile::TempDir> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".tinsmith-").suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o777));
+    }
+    builder.tempdir_in(parent)
+}
+
 fn parent_dir(path: &Path) -> &Path {
     match path.parent() {
         Some(dir) if !dir.as_os_str().is_empty() => dir,
@@ -145,16 +173,7 @@ where
         });
     }
 
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".tinsmith-").suffix(".tmp");
-    #[cfg(unix)]
-    {
-        // Like `File::create`: the umask decides, instead of tempfile's private 0o600.
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let mut temp = builder
-        .tempfile_in(dir)
+    let mut temp = output_temp_file(dir)
         .map_err(io_error("create a temporary file in the output directory"))?;
     let pending = crate::track_pending(temp.path());
 

@@ -67,16 +67,7 @@ impl PerTileWriter {
                 None,
             ));
         }
-        let mut builder = tempfile::Builder::new();
-        builder.prefix(".tinsmith-").suffix(".tmp");
-        #[cfg(unix)]
-        {
-            // Like `create_dir`: the umask decides, instead of tempfile's private 0o700.
-            use std::os::unix::fs::PermissionsExt;
-            builder.permissions(std::fs::Permissions::from_mode(0o777));
-        }
-        let temp = builder
-            .tempdir_in(parent)
+        let temp = tinsmith_export::output_temp_dir(parent)
             .map_err(|e| output("cannot create a temporary directory beside it", Some(e)))?;
         Ok(PerTileWriter {
             dir: dir.to_path_buf(),

@@ -407,20 +407,10 @@ fn staging_dir(out_dir: &Path) -> TerrainResult<tempfile::TempDir> {
         path: out_dir.to_path_buf(),
         source,
     })?;
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".tinsmith-").suffix(".tmp");
-    #[cfg(unix)]
-    {
-        // Like `create_dir`: the umask decides, instead of tempfile's private 0o700.
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o777));
-    }
-    builder
-        .tempdir_in(parent)
-        .map_err(|source| TerrainError::Output {
-            path: out_dir.to_path_buf(),
-            source,
-        })
+    tinsmith_export::output_temp_dir(parent).map_err(|source| TerrainError::Output {
+        path: out_dir.to_path_buf(),
+        source,
+    })
 }
 
 /// The tiles of [`build_terrain`] from `source`, its finest level read in bands of
@@ -667,15 +657,7 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> TerrainResult<()> {
         source,
     };
     let dir = path.parent().unwrap_or(Path::new("."));
-    let mut builder = tempfile::Builder::new();
-    #[cfg(unix)]
-    {
-        // Like `File::create`: the umask decides, instead of tempfile's private 0o600
-        // (a web server running as another user must be able to read the tiles).
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let mut file = builder.tempfile_in(dir).map_err(output)?;
+    let mut file = tinsmith_export::output_temp_file(dir).map_err(output)?;
     std::io::Write::write_all(&mut file, bytes).map_err(output)?;
     file.persist(path).map_err(|e| output(e.error))?;
     Ok(())

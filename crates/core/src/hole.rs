@@ -415,6 +415,20 @@ impl Retriangulator {
                     if orient(&self.ring[i], &self.ring[k], &self.ring[j]) <= 0 {
                         continue;
                     }
+                    let sums = self.cost_sum[i * m + k] + self.cost_sum[k * m + j];
+                    // With levels the objective needs no error: a candidate that cannot
+                    // beat the best is dropped before its error is measured (the error
+                    // only decides whether it is allowed at all).
+                    let by_levels = rules.levels.map(|levels| {
+                        let (pi, pk, pj) = (&self.ring[i], &self.ring[k], &self.ring[j]);
+                        let spanned = triangle_levels(levels, pi, pk, pj) as f64;
+                        (sub + spanned, sums + dirichlet_energy(pi, pk, pj))
+                    });
+                    if by_levels
+                        .is_some_and(|(c, sum)| !(c < best.0 || (c == best.0 && sum < best.1)))
+                    {
+                        continue;
+                    }
                     let edges = match rules.model {
                         ErrorModel::Bounds => {
                             [self.segment(i, k), self.segment(k, j), self.segment(i, j)]
@@ -429,15 +443,7 @@ impl Retriangulator {
                     else {
                         continue;
                     };
-                    let sums = self.cost_sum[i * m + k] + self.cost_sum[k * m + j];
-                    let (c, sum) = match rules.levels {
-                        Some(levels) => {
-                            let (pi, pk, pj) = (&self.ring[i], &self.ring[k], &self.ring[j]);
-                            let spanned = triangle_levels(levels, pi, pk, pj) as f64;
-                            (sub + spanned, sums + dirichlet_energy(pi, pk, pj))
-                        }
-                        None => (sub.max(t.max()), sums + t.max()),
-                    };
+                    let (c, sum) = by_levels.unwrap_or((sub.max(t.max()), sums + t.max()));
                     if c < best.0 || (c == best.0 && sum < best.1) {
                         best = (c, sum, k as u32);
                     }

@@ -100,27 +100,27 @@ pub fn is_special_file(path: &Path) -> bool {
 /// output is readable as any other file the user writes (a web server serving tiles runs
 /// as another user).
 pub fn output_temp_file(dir: &Path) -> io::Result<tempfile::NamedTempFile> {
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".tinsmith-").suffix(".tmp");
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    builder.tempfile_in(dir)
+    temp_builder(0o666).tempfile_in(dir)
 }
 
 /// A temporary directory `.tinsmith-*.tmp` in `parent`, to be renamed into place as an
 /// output directory: its mode is what `create_dir` would give, not tempfile's 0700.
 pub fn output_temp_dir(parent: &Path) -> io::Result<tempfile::TempDir> {
+    temp_builder(0o777).tempdir_in(parent)
+}
+
+/// `.tinsmith-*.tmp`, created with `mode` before the umask (Unix).
+fn temp_builder(mode: u32) -> tempfile::Builder<'static, 'static> {
     let mut builder = tempfile::Builder::new();
     builder.prefix(".tinsmith-").suffix(".tmp");
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o777));
+        builder.permissions(std::fs::Permissions::from_mode(mode));
     }
-    builder.tempdir_in(parent)
+    #[cfg(not(unix))]
+    let _ = mode;
+    builder
 }
 
 fn parent_dir(path: &Path) -> &Path {

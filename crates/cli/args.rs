@@ -154,8 +154,8 @@ pub struct MeshArgs {
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub flip_rounds: usize,
     /// After decimating, up to N rounds that try each vertex left again with its hole
-    /// extended across its ring edges, each followed by another sweep: 3-6 % fewer
-    /// triangles at small bounds, for 2-5 x the time; the error bound holds either way.
+    /// extended across its ring edges, each followed by another sweep: 3-7 % fewer
+    /// triangles, for 3-6 x the time; the error bound holds either way.
     /// Not with --max-triangles/--max-vertices.
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub extend_rounds: usize,

@@ -193,8 +193,8 @@ impl DecimationOptions {
     /// across its ring edges (the triangle beyond a ring edge joins the hole, one edge at a
     /// time, then all at once), which gives the retriangulation more freedom; then sweeps
     /// again. Repeats `rounds` times, or until a round removes nothing. Fewer triangles at
-    /// every bound (3–6 % on real DEMs at ε ≤ 1), for 2–5 × the time; the bound is kept
-    /// (every new triangle is measured as in a sweep). Ignored with count targets.
+    /// every bound (3–7 % on real DEMs at ε from 0.5 to 5), for 3–6 × the time; the bound
+    /// is kept (every new triangle is measured as in a sweep). Ignored with count targets.
     pub fn with_extend_rounds(mut self, rounds: usize) -> DecimationOptions {
         self.extend_rounds = rounds;
         self

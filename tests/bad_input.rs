@@ -407,3 +407,59 @@ fn a_pyramid_is_written_whole_or_not_at_all() {
         .collect();
     assert!(hidden.is_empty(), "temporary directories left: {hidden:?}");
 }
+
+#[cfg(unix)]
+#[test]
+fn an_interrupted_run_leaves_no_temporary_file() {
+    let d = Dir::new();
+    // The fixture stretched 30 times (bilinear, so little is flat) and meshed at a zero
+    // bound: 12.8 M triangles, seconds of work with temporary files open most of the time.
+    d.write(
+        "big.vrt",
+        &format!(
+            r#"<VRTDataset rasterXSize="3000" rasterYSize="2400">
+  <VRTRasterBand dataType="Float32" band="1">
+    <NoDataValue>-3.4028234663852886e+38</NoDataValue>
+    <SimpleSource resampling="bilinear">
+      <SourceFilename relativeToVRT="0">{}</SourceFilename>
+      <SourceBand>1</SourceBand>
+      <SrcRect xOff="0" yOff="0" xSize="100" ySize="80"/>
+      <DstRect xOff="0" yOff="0" xSize="3000" ySize="2400"/>
+    </SimpleSource>
+  </VRTRasterBand>
+</VRTDataset>"#,
+            dem()
+        ),
+    );
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+        .args(["mesh", "big.vrt", "-o", "out.ply", "--max-error", "0", "-q"])
+        .current_dir(d.path(""))
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start tinsmith");
+    let temporary = || d.files().iter().any(|f| f.starts_with(".tinsmith-"));
+    let started = std::time::Instant::now();
+    while !temporary() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "finished before any temporary file was seen"
+        );
+        assert!(started.elapsed().as_secs() < 120, "no temporary file");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let killed = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(killed.success());
+    let out = child.wait_with_output().expect("wait");
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "{:?}: {}",
+        out.status,
+        crate::util::stderr(&out)
+    );
+    assert!(crate::util::stderr(&out).contains("interrupted"));
+    assert_eq!(d.files(), vec!["big.vrt"]);
+}

@@ -39,7 +39,10 @@ fn main() -> ExitCode {
     let _ = ctrlc::set_handler(|| {
         tinsmith_export::remove_pending();
         eprintln!("\ntinsmith: interrupted; unfinished output removed");
-        std::process::exit(EXIT_INTERRUPTED);
+        // SAFETY: `_exit` takes no pointers and never returns. Unlike `process::exit` it
+        // runs no atexit handlers, which would tear GDAL's global state down under the
+        // worker threads still reading (a segfault, seen in tests).
+        unsafe { libc::_exit(EXIT_INTERRUPTED) }
     });
     // Errors come back as values with GDAL's message; GDAL need not print them too.
     tinsmith_raster::silence_gdal_errors();
@@ -51,6 +54,13 @@ fn main() -> ExitCode {
         Command::Tiles(a) => terrain::run(&a),
         Command::Serve(a) => serve::run(&a),
     };
+    if tinsmith_export::interrupted() {
+        // The signal handler is removing the unfinished output (the error, if any, comes
+        // from that) and exits the process itself.
+        loop {
+            std::thread::park();
+        }
+    }
     match result {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(EXIT_VERIFY_FAILED),

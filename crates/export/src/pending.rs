@@ -3,9 +3,11 @@
 //! only when its owner is dropped, which a signal's exit skips.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
 /// Registers `path` (a temporary file or directory) until the returned guard is dropped.
 pub fn track_pending(path: &Path) -> PendingGuard {
@@ -30,8 +32,10 @@ impl Drop for PendingGuard {
 }
 
 /// Removes every registered temporary file and directory (for a signal handler, just
-/// before the process exits). Paths that are gone already are skipped.
+/// before the process exits), and from then on [`interrupted`] is true. Paths that are
+/// gone already are skipped.
 pub fn remove_pending() {
+    INTERRUPTED.store(true, Ordering::SeqCst);
     let paths = match PENDING.lock() {
         Ok(pending) => pending.clone(),
         Err(poisoned) => poisoned.into_inner().clone(),
@@ -43,6 +47,12 @@ pub fn remove_pending() {
             let _ = std::fs::remove_file(&path);
         }
     }
+}
+
+/// Whether [`remove_pending`] has run: the work still going on may fail on the files it
+/// removed, and should leave the process to the signal handler's exit.
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(Ordering::SeqCst)
 }
 
 #[cfg(test)]

@@ -6,6 +6,26 @@ fn dem() -> String {
     fixture("tintn_valid_raster_3857.tif")
 }
 
+/// A VRT that stretches the 100 x 80 fixture to `width` x `height` samples (bilinear, so
+/// little of it is flat); declaring it reads nothing.
+fn stretched_dem(width: u32, height: u32) -> String {
+    format!(
+        r#"<VRTDataset rasterXSize="{width}" rasterYSize="{height}">
+  <VRTRasterBand dataType="Float32" band="1">
+    <NoDataValue>-3.4028234663852886e+38</NoDataValue>
+    <SimpleSource resampling="bilinear">
+      <SourceFilename relativeToVRT="0">{}</SourceFilename>
+      <SourceBand>1</SourceBand>
+      <SrcRect xOff="0" yOff="0" xSize="100" ySize="80"/>
+      <DstRect xOff="0" yOff="0" xSize="{width}" ySize="{height}"/>
+    </SimpleSource>
+  </VRTRasterBand>
+</VRTDataset>
+"#,
+        dem()
+    )
+}
+
 #[test]
 fn missing_input_file() {
     let d = Dir::new();
@@ -156,21 +176,7 @@ fn whole_raster_runs_on_a_raster_too_large_for_memory() {
     // and every run that needs the whole raster at once is refused up front instead of
     // being killed partway.
     let d = Dir::new();
-    d.write(
-        "huge.vrt",
-        &format!(
-            r#"<VRTDataset rasterXSize="1000000" rasterYSize="1000000">
-  <VRTRasterBand dataType="Float32" band="1">
-    <SimpleSource>
-      <SourceFilename relativeToVRT="0">{}</SourceFilename>
-      <SourceBand>1</SourceBand>
-    </SimpleSource>
-  </VRTRasterBand>
-</VRTDataset>
-"#,
-            dem()
-        ),
-    );
+    d.write("huge.vrt", &stretched_dem(1_000_000, 1_000_000));
     for target in ["--max-triangles", "--max-vertices"] {
         let o = d.run(&["mesh", "huge.vrt", "-o", "out.ply", target, "1000"]);
         assert_fails_naming(
@@ -412,25 +418,9 @@ fn a_pyramid_is_written_whole_or_not_at_all() {
 #[test]
 fn an_interrupted_run_leaves_no_temporary_file() {
     let d = Dir::new();
-    // The fixture stretched 30 times (bilinear, so little is flat) and meshed at a zero
-    // bound: 12.8 M triangles, seconds of work with temporary files open most of the time.
-    d.write(
-        "big.vrt",
-        &format!(
-            r#"<VRTDataset rasterXSize="3000" rasterYSize="2400">
-  <VRTRasterBand dataType="Float32" band="1">
-    <NoDataValue>-3.4028234663852886e+38</NoDataValue>
-    <SimpleSource resampling="bilinear">
-      <SourceFilename relativeToVRT="0">{}</SourceFilename>
-      <SourceBand>1</SourceBand>
-      <SrcRect xOff="0" yOff="0" xSize="100" ySize="80"/>
-      <DstRect xOff="0" yOff="0" xSize="3000" ySize="2400"/>
-    </SimpleSource>
-  </VRTRasterBand>
-</VRTDataset>"#,
-            dem()
-        ),
-    );
+    // The fixture stretched 30 times and meshed at a zero bound: 12.8 M triangles, seconds
+    // of work with temporary files open most of the time.
+    d.write("big.vrt", &stretched_dem(3000, 2400));
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
         .args(["mesh", "big.vrt", "-o", "out.ply", "--max-error", "0", "-q"])
         .current_dir(d.path(""))

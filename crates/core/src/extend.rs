@@ -34,6 +34,12 @@ pub(crate) fn remove_through_extended_holes(
     let mut removed = 0;
     let mut star = Star::default();
     let mut flipped = Vec::new();
+    // The hole extended at every edge at once only where the DP solves it: ear clipping
+    // on the larger rings costs about 40 % more time for 0.1 % fewer triangles.
+    let largest_ring = match remover.rules.method {
+        Retriangulation::Dp => remover.rules.dp_max_ring,
+        Retriangulation::Ears => usize::MAX,
+    };
     let slots = mesh.vertex_slots() as u32;
     for v in 0..slots {
         if v % 65_536 == 0 {
@@ -48,13 +54,6 @@ pub(crate) fn remove_through_extended_holes(
         }
         mesh.star(v, &mut star);
         let ring_edges = star.triangles.len();
-        // The hole extended at every edge at once only where the DP solves it: ear
-        // clipping on the larger rings costs about 40 % more time for 0.1 % fewer
-        // triangles.
-        let largest_ring = match remover.rules.method {
-            Retriangulation::Dp => remover.rules.dp_max_ring,
-            Retriangulation::Ears => usize::MAX,
-        };
         let mut gone = false;
         for i in 0..ring_edges {
             flipped.clear();

@@ -64,8 +64,6 @@ impl SampleType {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct SampleDecoder {
     sample_type: SampleType,
-    /// Float32 or Float64: nodata is matched with GDAL's tolerance.
-    float: bool,
     signed_byte: bool,
     /// The nodata value as the raw `f64` a nodata sample reads as; never NaN.
     nodata_key: Option<f64>,
@@ -92,7 +90,6 @@ impl SampleDecoder {
             });
         SampleDecoder {
             sample_type,
-            float: matches!(sample_type, SampleType::Float32 | SampleType::Float64),
             signed_byte: sample_type == SampleType::SignedByte,
             nodata_key,
             scale: if scale.is_finite() { scale } else { 1.0 },
@@ -109,7 +106,9 @@ impl SampleDecoder {
             raw
         };
         let nodata = match self.nodata_key {
-            Some(key) if self.float => gdal_real_equal(self.sample_type, v, key),
+            Some(key) if matches!(self.sample_type, SampleType::Float32 | SampleType::Float64) => {
+                gdal_real_equal(self.sample_type, v, key)
+            }
             key => Some(v) == key,
         };
         if !v.is_finite() || nodata {

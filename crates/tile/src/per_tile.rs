@@ -49,13 +49,8 @@ impl PerTileWriter {
             reason: reason.to_owned(),
             source,
         };
-        if dir.exists() {
-            let empty = std::fs::read_dir(dir)
-                .map(|mut entries| entries.next().is_none())
-                .unwrap_or(false);
-            if !dir.is_dir() || !empty {
-                return Err(output("exists and is not an empty directory", None));
-            }
+        if is_occupied(dir) {
+            return Err(output("exists and is not an empty directory", None));
         }
         let parent = match dir.parent() {
             Some(p) if !p.as_os_str().is_empty() => p,
@@ -123,4 +118,12 @@ impl TileSink for PerTileWriter {
         write_mesh(&path, self.format, mesh)?;
         Ok(())
     }
+}
+
+/// Whether `dir` exists as anything but an empty directory (a file, a link, a directory
+/// with entries): an output directory renamed into place must not replace it.
+pub(crate) fn is_occupied(dir: &Path) -> bool {
+    std::fs::symlink_metadata(dir).is_ok_and(|meta| {
+        !meta.is_dir() || std::fs::read_dir(dir).map_or(true, |mut e| e.next().is_some())
+    })
 }

@@ -387,16 +387,12 @@ pub fn build_terrain(
 /// directory; its missing parents are created) to build the pyramid in.
 fn staging_dir(out_dir: &Path) -> TerrainResult<tempfile::TempDir> {
     let refuse = |reason: String| TerrainError::Options(format!("{}: {reason}", out_dir.display()));
-    if let Ok(meta) = std::fs::symlink_metadata(out_dir) {
-        let empty = meta.is_dir()
-            && std::fs::read_dir(out_dir).is_ok_and(|mut entries| entries.next().is_none());
-        if !empty {
-            return Err(refuse(
-                "exists and is not an empty directory; give a new directory (the pyramid is \
-                 written whole, never mixed with other files)"
-                    .into(),
-            ));
-        }
+    if crate::per_tile::is_occupied(out_dir) {
+        return Err(refuse(
+            "exists and is not an empty directory; give a new directory (the pyramid is \
+             written whole, never mixed with other files)"
+                .into(),
+        ));
     }
     let parent = match out_dir.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,

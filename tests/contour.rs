@@ -587,3 +587,90 @@ fn contour_bad_input_fails_cleanly() {
     assert_fails_naming(&o, &["m.ply", "vertex"]);
     assert_eq!(d.files(), vec!["m.ply"]);
 }
+
+#[test]
+fn wgs84_geojson_is_cut_at_the_antimeridian() {
+    // A cone centred on 180° E in a raster on 170..190° longitudes (WGS84): its rings cross
+    // the antimeridian twice each. RFC 7946 wants longitudes in [-180, 180] and no segment
+    // running the long way round; FlatGeobuf keeps the raster's coordinates uncut.
+    let d = Dir::new();
+    let mut asc = String::from("ncols 21\nnrows 11\nxllcorner 169.5\nyllcorner -5.5\ncellsize 1\n");
+    for row in 0..11 {
+        let lat = 5.0 - row as f64;
+        let values: Vec<String> = (0..21)
+            .map(|col| {
+                let lon = 170.0 + col as f64;
+                format!(
+                    "{}",
+                    100.0 - 10.0 * ((lon - 180.0).powi(2) + lat * lat).sqrt()
+                )
+            })
+            .collect();
+        asc.push_str(&values.join(" "));
+        asc.push('\n');
+    }
+    d.write("cone.asc", &asc);
+    d.write(
+        "cone.prj",
+        "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137,\
+         298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"Degree\",0.017453292519943295]]",
+    );
+    for out in ["c.geojson", "c.fgb"] {
+        run_ok(
+            &d,
+            &["contour", "cone.asc", "--interval", "15", "-o", out, "-q"],
+        );
+    }
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path("c.geojson")).unwrap()).unwrap();
+    let features = v["features"].as_array().unwrap();
+    let mut cut = 0;
+    for f in features {
+        let geometry = &f["geometry"];
+        let parts: Vec<Vec<[f64; 2]>> = match geometry["type"].as_str().unwrap() {
+            "LineString" => vec![serde_json::from_value(geometry["coordinates"].clone()).unwrap()],
+            "MultiLineString" => {
+                cut += 1;
+                serde_json::from_value(geometry["coordinates"].clone()).unwrap()
+            }
+            other => panic!("unexpected geometry {other}"),
+        };
+        for part in &parts {
+            assert!(part.len() >= 2);
+            assert!(
+                part.iter().all(|p| (-180.0..=180.0).contains(&p[0])),
+                "{part:?}"
+            );
+            for pair in part.windows(2) {
+                assert!((pair[1][0] - pair[0][0]).abs() < 5.0, "{pair:?}");
+            }
+        }
+        if parts.len() > 1 {
+            // Every cut ends a part on one side of 180° and starts the next on the other
+            // at the same latitude.
+            let ends: Vec<[f64; 2]> = parts
+                .iter()
+                .flat_map(|p| [p[0], p[p.len() - 1]])
+                .filter(|p| p[0].abs() == 180.0)
+                .collect();
+            assert_eq!(ends.len() % 2, 0, "{parts:?}");
+            for e in &ends {
+                assert!(
+                    ends.iter().any(|o| o[0] == -e[0] && o[1] == e[1]),
+                    "{e:?} has no partner across 180°: {parts:?}"
+                );
+            }
+        }
+    }
+    // The rings at 90, 75 and 60 close around 180° and are cut; lower levels reach the
+    // raster's top and bottom rows in arcs on either side.
+    assert!(cut >= 3, "{cut} of {} features cut", features.len());
+    // GDAL reads both files with the same features; the FlatGeobuf is uncut.
+    let geojson = ogrinfo(&d.path("c.geojson"));
+    let fgb = ogrinfo(&d.path("c.fgb"));
+    let count = format!("Feature Count: {}\n", features.len());
+    assert!(geojson.contains(&count), "{geojson}");
+    assert!(fgb.contains(&count), "{fgb}");
+    assert!(fgb.contains("Geometry: Line String"), "{fgb}");
+    assert!(fgb.contains("Extent: (170.0"), "{fgb}");
+}

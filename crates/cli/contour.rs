@@ -150,7 +150,27 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             line
         })
         .collect();
-    tinsmith_export::write_lines(&args.output, format, &lines, crs)?;
+    let segments = points.len() - lines.len();
+    if wgs84 {
+        // RFC 7946: longitudes in [-180, 180], lines cut where they cross the antimeridian.
+        let cut: Vec<(Vec<Vec<[f64; 2]>>, f64)> = lines
+            .iter()
+            .map(|&(line, level)| (tinsmith_export::cut_at_antimeridian(line), level))
+            .filter(|(parts, _)| !parts.is_empty())
+            .collect();
+        let parts: Vec<Vec<&[[f64; 2]]>> = cut
+            .iter()
+            .map(|(parts, _)| parts.iter().map(Vec::as_slice).collect())
+            .collect();
+        let lines: Vec<(&[&[[f64; 2]]], f64)> = parts
+            .iter()
+            .zip(&cut)
+            .map(|(parts, &(_, level))| (parts.as_slice(), level))
+            .collect();
+        tinsmith_export::write_multilines(&args.output, format, &lines, crs)?;
+    } else {
+        tinsmith_export::write_lines(&args.output, format, &lines, crs)?;
+    }
 
     if !args.quiet {
         eprintln!(
@@ -158,7 +178,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             args.output.display(),
             lines.len(),
             closed,
-            points.len() - lines.len(),
+            segments,
             args.simplify
                 .map(|d| format!(" (simplified within {d})"))
                 .unwrap_or_default(),

@@ -49,6 +49,7 @@
 #![deny(rustdoc::broken_intra_doc_links)]
 #![forbid(unsafe_code)]
 
+mod antimeridian;
 mod atomic;
 mod error;
 mod fgb;
@@ -69,11 +70,12 @@ mod stl;
 mod stream;
 mod weld;
 
+pub use antimeridian::{cut_at_antimeridian, wrap_longitude};
 pub use atomic::{is_special_file, output_temp_dir, output_temp_file, resolve_output};
 pub use error::{Error, Result};
 pub use file::{prj_path, read_mesh, read_mesh_as, write_mesh, write_mesh_with};
 pub use format::MeshFormat;
-pub use lines::{write_lines, CrsRef, LineFormat, LinePoint};
+pub use lines::{write_lines, write_multilines, CrsRef, LineFormat, LinePoint};
 pub use mesh::{Mesh, MeshRef};
 pub use options::WriteOptions;
 pub use origin::LocalOrigin;

@@ -146,26 +146,56 @@ pub fn write_lines<P: LinePoint>(
     lines: &[(&[P], f64)],
     crs: CrsRef<'_>,
 ) -> Result<()> {
-    for (line, (points, elev)) in lines.iter().enumerate() {
+    let single: Vec<(&[&[P]], f64)> = lines
+        .iter()
+        .map(|(points, elev)| (std::slice::from_ref(points), *elev))
+        .collect();
+    write_multilines(path, format, &single, crs)
+}
+
+/// [`write_lines`] for lines of one or more parts (a line cut where it crosses the
+/// antimeridian, say): a line of one part is a `LineString` feature, one of several a
+/// `MultiLineString` with the parts in the given order. In FlatGeobuf, whose header names
+/// one geometry type, every feature is then a `MultiLineString` if any line has several
+/// parts. Every part needs at least two points; errors name the line and the part.
+pub fn write_multilines<P: LinePoint>(
+    path: &Path,
+    format: LineFormat,
+    lines: &[(&[&[P]], f64)],
+    crs: CrsRef<'_>,
+) -> Result<()> {
+    for (line, (parts, elev)) in lines.iter().enumerate() {
         let invalid = |reason: String| Error::InvalidLine {
             path: path.to_path_buf(),
             line,
             reason,
         };
-        if points.len() < 2 {
-            return Err(invalid(format!(
-                "{} point(s); a line needs at least 2",
-                points.len()
-            )));
+        if parts.is_empty() {
+            return Err(invalid("no part; a line needs at least one".to_owned()));
         }
         if !elev.is_finite() {
             return Err(invalid(format!("non-finite elevation {elev}")));
         }
-        if let Some(k) = points
-            .iter()
-            .position(|p| !p.coordinates().iter().all(|c| c.is_finite()))
-        {
-            return Err(invalid(format!("point {k} has a non-finite coordinate")));
+        for (part, points) in parts.iter().enumerate() {
+            let which = if parts.len() > 1 {
+                format!("part {part}: ")
+            } else {
+                String::new()
+            };
+            if points.len() < 2 {
+                return Err(invalid(format!(
+                    "{which}{} point(s); a line needs at least 2",
+                    points.len()
+                )));
+            }
+            if let Some(k) = points
+                .iter()
+                .position(|p| !p.coordinates().iter().all(|c| c.is_finite()))
+            {
+                return Err(invalid(format!(
+                    "{which}point {k} has a non-finite coordinate"
+                )));
+            }
         }
     }
     write_atomically(path, |w| match format {
@@ -176,35 +206,54 @@ pub fn write_lines<P: LinePoint>(
 
 fn write_geojson<W: Write, P: LinePoint>(
     mut w: W,
-    lines: &[(&[P], f64)],
+    lines: &[(&[&[P]], f64)],
     crs: CrsRef<'_>,
 ) -> io::Result<()> {
     geojson::write_collection_start(&mut w, crs.wkt, crs.epsg)?;
-    for (i, (points, elev)) in lines.iter().enumerate() {
+    for (i, (parts, elev)) in lines.iter().enumerate() {
         if i > 0 {
             w.write_all(b",\n")?;
         }
+        let kind = if parts.len() > 1 {
+            "MultiLineString"
+        } else {
+            "LineString"
+        };
         write!(
             w,
             "{{\"type\":\"Feature\",\"properties\":{{\"id\":{i},\"elev\":{elev:?}}},\
-             \"geometry\":{{\"type\":\"LineString\",\"coordinates\":["
+             \"geometry\":{{\"type\":\"{kind}\",\"coordinates\":"
         )?;
-        for (k, p) in points.iter().enumerate() {
-            if k > 0 {
+        if parts.len() > 1 {
+            w.write_all(b"[")?;
+        }
+        for (part, points) in parts.iter().enumerate() {
+            if part > 0 {
                 w.write_all(b",")?;
             }
-            geojson::write_position(&mut w, p.coordinates())?;
+            w.write_all(b"[")?;
+            for (k, p) in points.iter().enumerate() {
+                if k > 0 {
+                    w.write_all(b",")?;
+                }
+                geojson::write_position(&mut w, p.coordinates())?;
+            }
+            w.write_all(b"]")?;
         }
-        w.write_all(b"]}}")?;
+        if parts.len() > 1 {
+            w.write_all(b"]")?;
+        }
+        w.write_all(b"}}")?;
     }
     w.write_all(b"\n]}\n")
 }
 
 fn write_fgb<W: Write, P: LinePoint>(
     w: W,
-    lines: &[(&[P], f64)],
+    lines: &[(&[&[P]], f64)],
     crs: CrsRef<'_>,
 ) -> io::Result<()> {
+    let multi = lines.iter().any(|(parts, _)| parts.len() > 1);
     let options = FgbWriterOptions {
         write_index: true,
         detect_type: false,
@@ -213,23 +262,36 @@ fn write_fgb<W: Write, P: LinePoint>(
         crs: fgb::crs(crs.wkt, crs.epsg),
         ..FgbWriterOptions::default()
     };
-    let mut out = FgbWriter::create_with_options("lines", GeometryType::LineString, options)
-        .map_err(fgb::io_error)?;
+    let kind = if multi {
+        GeometryType::MultiLineString
+    } else {
+        GeometryType::LineString
+    };
+    let mut out = FgbWriter::create_with_options("lines", kind, options).map_err(fgb::io_error)?;
     out.add_column(ID, ColumnType::Long, |_, _| {});
     out.add_column(ELEV, ColumnType::Double, |_, _| {});
-    for (i, (points, elev)) in lines.iter().enumerate() {
+    for (i, (parts, elev)) in lines.iter().enumerate() {
         out.property(0, ID, &ColumnValue::Long(i as i64))
             .map_err(fgb::io_error)?;
         out.property(1, ELEV, &ColumnValue::Double(*elev))
             .map_err(fgb::io_error)?;
-        out.linestring_begin(true, points.len(), 0)
-            .map_err(fgb::io_error)?;
-        for (k, p) in points.iter().enumerate() {
-            let c = p.coordinates();
-            out.coordinate(c[0], c[1], c.get(2).copied(), None, None, None, k)
+        if multi {
+            out.multilinestring_begin(parts.len(), 0)
                 .map_err(fgb::io_error)?;
         }
-        out.linestring_end(true, 0).map_err(fgb::io_error)?;
+        for (part, points) in parts.iter().enumerate() {
+            out.linestring_begin(!multi, points.len(), part)
+                .map_err(fgb::io_error)?;
+            for (k, p) in points.iter().enumerate() {
+                let c = p.coordinates();
+                out.coordinate(c[0], c[1], c.get(2).copied(), None, None, None, k)
+                    .map_err(fgb::io_error)?;
+            }
+            out.linestring_end(!multi, part).map_err(fgb::io_error)?;
+        }
+        if multi {
+            out.multilinestring_end(0).map_err(fgb::io_error)?;
+        }
         out.feature_end(i as u64).map_err(fgb::io_error)?;
     }
     out.write(w).map_err(fgb::io_error)
@@ -288,6 +350,70 @@ mod tests {
         }
         read.sort_by_key(|&(id, _)| id);
         assert_eq!(read, vec![(0, 5.0), (1, 10.5)]);
+        Ok(())
+    }
+
+    #[test]
+    fn lines_of_several_parts_are_multilinestrings() -> Result<()> {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let east: &[[f64; 2]] = &[[179.0, 0.0], [180.0, 0.5]];
+        let west: &[[f64; 2]] = &[[-180.0, 0.5], [-179.0, 1.0]];
+        let whole: &[[f64; 2]] = &[[10.0, 0.0], [11.0, 0.0]];
+        let lines: [(&[&[[f64; 2]]], f64); 2] = [(&[east, west], 5.0), (&[whole], 7.0)];
+        let path = dir.path().join("c.geojson");
+        write_multilines(
+            &path,
+            LineFormat::GeoJson,
+            &lines,
+            CrsRef::new(None, Some(4326)),
+        )?;
+        let text = std::fs::read_to_string(&path).expect("read back");
+        let value: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+        let first = &value["features"][0]["geometry"];
+        assert_eq!(first["type"], "MultiLineString");
+        assert_eq!(
+            first["coordinates"],
+            serde_json::json!([[[179.0, 0.0], [180.0, 0.5]], [[-180.0, 0.5], [-179.0, 1.0]]])
+        );
+        assert_eq!(value["features"][1]["geometry"]["type"], "LineString");
+
+        let path = dir.path().join("c.fgb");
+        write_multilines(
+            &path,
+            LineFormat::FlatGeobuf,
+            &lines,
+            CrsRef::new(None, Some(4326)),
+        )?;
+        let file = std::fs::File::open(&path).expect("open");
+        let reader = FgbReader::open(std::io::BufReader::new(file)).expect("fgb");
+        assert_eq!(
+            reader.header().geometry_type(),
+            GeometryType::MultiLineString
+        );
+        let mut features = reader.select_all_seq().expect("features");
+        let mut parts = Vec::new();
+        while let Some(feature) = features.next().expect("feature") {
+            let geometry = feature.geometry().expect("geometry");
+            let id = feature.property::<i64>("id").expect("id");
+            parts.push((id, geometry.ends().map(|e| e.len()).unwrap_or(0)));
+        }
+        parts.sort();
+        // Two parts: one end index between them; one part: no ends array.
+        assert_eq!(parts, vec![(0, 2), (1, 0)]);
+
+        let empty: [(&[&[[f64; 2]]], f64); 1] = [(&[], 1.0)];
+        let error = write_multilines(&path, LineFormat::GeoJson, &empty, CrsRef::default())
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(error.contains("line 0: no part"), "{error}");
+        let short: &[[f64; 2]] = &[[0.0, 0.0]];
+        let bad: [(&[&[[f64; 2]]], f64); 1] = [(&[whole, short], 1.0)];
+        let error = write_multilines(&path, LineFormat::GeoJson, &bad, CrsRef::default())
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(error.contains("line 0: part 1: 1 point(s)"), "{error}");
         Ok(())
     }
 

@@ -1,6 +1,6 @@
 //! Each bad input gives one clear line naming the file, exit code 2 and no output file.
 
-use crate::util::{assert_fails_naming, fixture, Dir};
+use crate::util::{assert_fails_naming, fixture, stderr, Dir};
 
 fn dem() -> String {
     fixture("tintn_valid_raster_3857.tif")
@@ -452,4 +452,29 @@ fn an_interrupted_run_leaves_no_temporary_file() {
     );
     assert!(crate::util::stderr(&out).contains("interrupted"));
     assert_eq!(d.files(), vec!["big.vrt"]);
+}
+
+#[test]
+fn info_and_verify_end_quietly_when_stdout_is_closed() {
+    // `tinsmith verify ... | head -1`: the reader is gone before the report is printed.
+    let d = Dir::new();
+    let o = d.run(&["mesh", &dem(), "--max-error", "2", "-o", "m.ply", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let m = d.path("m.ply");
+    for args in [
+        vec!["info", &dem()],
+        vec!["verify", &dem(), m.to_str().unwrap()],
+    ] {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+            .args(&args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("run tinsmith");
+        drop(child.stdout.take());
+        let out = child.wait_with_output().expect("wait");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(err.is_empty(), "{args:?}: {err}");
+    }
 }

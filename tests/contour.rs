@@ -594,27 +594,7 @@ fn wgs84_geojson_is_cut_at_the_antimeridian() {
     // the antimeridian twice each. RFC 7946 wants longitudes in [-180, 180] and no segment
     // running the long way round; FlatGeobuf keeps the raster's coordinates uncut.
     let d = Dir::new();
-    let mut asc = String::from("ncols 21\nnrows 11\nxllcorner 169.5\nyllcorner -5.5\ncellsize 1\n");
-    for row in 0..11 {
-        let lat = 5.0 - row as f64;
-        let values: Vec<String> = (0..21)
-            .map(|col| {
-                let lon = 170.0 + col as f64;
-                format!(
-                    "{}",
-                    100.0 - 10.0 * ((lon - 180.0).powi(2) + lat * lat).sqrt()
-                )
-            })
-            .collect();
-        asc.push_str(&values.join(" "));
-        asc.push('\n');
-    }
-    d.write("cone.asc", &asc);
-    d.write(
-        "cone.prj",
-        "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137,\
-         298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"Degree\",0.017453292519943295]]",
-    );
+    write_cone_across_180(&d);
     for out in ["c.geojson", "c.fgb"] {
         run_ok(
             &d,
@@ -672,5 +652,103 @@ fn wgs84_geojson_is_cut_at_the_antimeridian() {
     assert!(geojson.contains(&count), "{geojson}");
     assert!(fgb.contains(&count), "{fgb}");
     assert!(fgb.contains("Geometry: Line String"), "{fgb}");
-    assert!(fgb.contains("Extent: (170.0"), "{fgb}");
+    assert!(fgb.contains("Extent: (170.25"), "{fgb}");
+}
+
+/// `cone.asc` (+ `.prj`, WGS84) in `d`: a cone of height 100 centred on 180° E, 0° N, in a
+/// raster on 170.25..190.25° longitudes (none on 180), one sample per degree.
+fn write_cone_across_180(d: &Dir) {
+    let mut asc =
+        String::from("ncols 21\nnrows 11\nxllcorner 169.75\nyllcorner -5.5\ncellsize 1\n");
+    for row in 0..11 {
+        let lat = 5.0 - row as f64;
+        let values: Vec<String> = (0..21)
+            .map(|col| {
+                let lon = 170.25 + col as f64;
+                format!(
+                    "{}",
+                    100.0 - 10.0 * ((lon - 180.0).powi(2) + lat * lat).sqrt()
+                )
+            })
+            .collect();
+        asc.push_str(&values.join(" "));
+        asc.push('\n');
+    }
+    d.write("cone.asc", &asc);
+    d.write(
+        "cone.prj",
+        "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137,\
+         298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"Degree\",0.017453292519943295]]",
+    );
+}
+
+#[test]
+fn wgs84_geojson_meshes_across_the_antimeridian_verify_and_contour() {
+    // Triangles across 180° are written cut in two (MultiPolygon) with longitudes in
+    // [-180, 180]; verify and contour --mesh read them back onto the raster's 170..190.
+    let d = Dir::new();
+    write_cone_across_180(&d);
+    run_ok(
+        &d,
+        &[
+            "mesh",
+            "cone.asc",
+            "--max-error",
+            "0.5",
+            "-o",
+            "m.geojson",
+            "-q",
+        ],
+    );
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path("m.geojson")).unwrap()).unwrap();
+    let multi = v["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["geometry"]["type"] == "MultiPolygon")
+        .count();
+    assert!(multi > 0, "no triangle cut");
+    let text = v["features"].to_string();
+    assert!(
+        !text.contains("[181") && !text.contains("[190"),
+        "longitudes beyond 180"
+    );
+    let o = d.run(&["verify", "cone.asc", "m.geojson", "--max-error", "0.5"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The same lines as from the same mesh in PLY (the contour's GeoJSON kept in the
+    // raster's coordinates, uncut, to compare).
+    run_ok(
+        &d,
+        &[
+            "mesh",
+            "cone.asc",
+            "--max-error",
+            "0.5",
+            "-o",
+            "m.ply",
+            "-q",
+        ],
+    );
+    for (mesh, out) in [("m.geojson", "a.geojson"), ("m.ply", "b.geojson")] {
+        let args = [
+            "contour",
+            "cone.asc",
+            "--interval",
+            "15",
+            "--mesh",
+            mesh,
+            "-o",
+            out,
+        ];
+        let mut args = args.to_vec();
+        args.extend(["--geojson-source-crs", "-q"]);
+        run_ok(&d, &args);
+    }
+    let (a, b) = (
+        features(&d.path("a.geojson")),
+        features(&d.path("b.geojson")),
+    );
+    assert!(!a.is_empty());
+    assert_eq!(canonical(a), canonical(b));
 }

@@ -46,6 +46,9 @@ fn main() -> ExitCode {
     });
     // Errors come back as values with GDAL's message; GDAL need not print them too.
     tinsmith_raster::silence_gdal_errors();
+    if matches!(cli.command, Command::Info(_) | Command::Verify(_)) {
+        end_quietly_on_closed_stdout();
+    }
     let result = match cli.command {
         Command::Info(a) => info::run(&a),
         Command::Mesh(a) => mesh::run(&a),
@@ -71,6 +74,16 @@ fn main() -> ExitCode {
             eprintln!("tinsmith: {}", one_line(&err));
             ExitCode::from(EXIT_ERROR)
         }
+    }
+}
+
+/// `info` and `verify` print their results on stdout and write no file: like other Unix
+/// tools they end quietly when the reader of a pipe goes away (`| head`), where Rust's
+/// ignored SIGPIPE would make `println!` panic.
+fn end_quietly_on_closed_stdout() {
+    // SAFETY: restoring the default action of a signal; no handler code is involved.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 

@@ -55,9 +55,12 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
 
 /// Reads a mesh file written from `raster` in its file coordinates: RFC 7946 GeoJSON
 /// (WGS84 longitude, latitude) is transformed back to the raster's CRS.
+///
+/// Longitudes in WGS84 files are in [-180, 180] (RFC 7946); for a geographic raster they
+/// are moved by whole turns into the raster's own range (0..360 for many global grids).
 pub fn read_mesh_file(path: &Path, raster: &Raster, georef: Georef) -> Result<Mesh> {
     let mut mesh = tinsmith_export::read_mesh(path)?;
-    if let (Some(4326), Georef::World(_), Some(wkt)) =
+    if let (Some(4326), Georef::World(transform), Some(wkt)) =
         (mesh.epsg, georef, raster.info.crs_wkt.as_deref())
     {
         if raster.info.epsg != Some(4326) {
@@ -67,6 +70,23 @@ pub fn read_mesh_file(path: &Path, raster: &Raster, georef: Georef) -> Result<Me
                     path.display()
                 )
             })?;
+        }
+        if tinsmith_raster::is_geographic(wkt)? {
+            let (w, h) = (raster.info.width as f64, raster.info.height as f64);
+            let west = [
+                (-0.5, -0.5),
+                (w - 0.5, -0.5),
+                (-0.5, h - 0.5),
+                (w - 0.5, h - 0.5),
+            ]
+            .into_iter()
+            .map(|(x, y)| transform.sample_centre(x, y)[0])
+            .fold(f64::INFINITY, f64::min);
+            for v in &mut mesh.vertices {
+                if v[0] < west || v[0] >= west + 360.0 {
+                    v[0] = west + (v[0] - west).rem_euclid(360.0);
+                }
+            }
         }
     }
     Ok(mesh)

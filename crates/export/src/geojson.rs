@@ -2,7 +2,9 @@
 //! positions) per triangle, written as a stream of text and read back with serde.
 //!
 //! RFC 7946 coordinates are WGS84 longitude, latitude. A mesh whose EPSG code is 4326 is
-//! written that way, with no `crs` member. Any other CRS is not RFC 7946: the collection then
+//! written that way, with no `crs` member, longitudes wrapped into [-180, 180], and a
+//! triangle across the antimeridian as a `MultiPolygon` of its two parts (see
+//! [`crate::antimeridian`]); reading rejoins them. Any other CRS is not RFC 7946: the collection then
 //! gets the `crs` member of the 2008 GeoJSON specification (which GDAL and QGIS read), a
 //! `crs_wkt` member with the full WKT and a `tinsmith_note` saying so. A mesh without a CRS
 //! gets `"crs": null`, which the 2008 specification defines as "no CRS".
@@ -12,6 +14,7 @@ use std::io::{self, Read, Write};
 use serde::{Deserialize, Deserializer};
 use serde_json::Value;
 
+use crate::antimeridian::{triangle_from_parts, triangle_parts, TriangleParts};
 use crate::error::Problem;
 use crate::mesh::{Mesh, MeshRef};
 use crate::weld::Welder;
@@ -76,24 +79,51 @@ pub(crate) fn write_position<W: Write>(w: &mut W, p: &[f64]) -> io::Result<()> {
 pub(crate) fn write<W: Write>(mut w: W, mesh: MeshRef<'_>) -> io::Result<()> {
     let crs = mesh.crs_line();
     write_collection_start(&mut w, crs.as_deref(), mesh.epsg)?;
+    let rfc7946 = mesh.epsg == Some(4326);
     for (id, &[a, b, c]) in mesh.triangles.iter().enumerate() {
         if id > 0 {
             w.write_all(b",\n")?;
         }
+        let corners = [a, b, c].map(|i| mesh.vertices[i as usize]);
+        let parts = if rfc7946 {
+            triangle_parts(corners)
+        } else {
+            TriangleParts::Whole(corners)
+        };
+        let kind = match parts {
+            TriangleParts::Whole(_) => "Polygon",
+            TriangleParts::Cut(..) => "MultiPolygon",
+        };
         write!(
             w,
             "{{\"type\":\"Feature\",\"properties\":{{\"id\":{id}}},\
-             \"geometry\":{{\"type\":\"Polygon\",\"coordinates\":[["
+             \"geometry\":{{\"type\":\"{kind}\",\"coordinates\":"
         )?;
-        for (k, i) in [a, b, c, a].into_iter().enumerate() {
-            if k > 0 {
+        match parts {
+            TriangleParts::Whole(corners) => write_ring(&mut w, &corners)?,
+            TriangleParts::Cut(west, east) => {
+                w.write_all(b"[")?;
+                write_ring(&mut w, &west)?;
                 w.write_all(b",")?;
+                write_ring(&mut w, &east)?;
+                w.write_all(b"]")?;
             }
-            write_position(&mut w, &mesh.vertices[i as usize])?;
         }
-        w.write_all(b"]]}}")?;
+        w.write_all(b"}}")?;
     }
     w.write_all(b"\n]}\n")
+}
+
+/// Writes `[[p0, p1, ..., p0]]`: a polygon of one closed ring.
+fn write_ring<W: Write>(w: &mut W, ring: &[[f64; 3]]) -> io::Result<()> {
+    w.write_all(b"[[")?;
+    for (k, p) in ring.iter().chain(&ring[..1]).enumerate() {
+        if k > 0 {
+            w.write_all(b",")?;
+        }
+        write_position(w, p)?;
+    }
+    w.write_all(b"]]")
 }
 
 /// Deserializes a member that may be absent (`None`) or `null` (`Some(Value::Null)`).
@@ -123,7 +153,46 @@ struct Geometry {
     #[serde(rename = "type")]
     kind: String,
     #[serde(default)]
-    coordinates: Vec<Vec<Vec<f64>>>,
+    coordinates: Coordinates,
+}
+
+/// A `Polygon`'s rings or a `MultiPolygon`'s polygons.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum Coordinates {
+    Polygon(Vec<Vec<Vec<f64>>>),
+    MultiPolygon(Vec<Vec<Vec<Vec<f64>>>>),
+}
+
+impl Default for Coordinates {
+    fn default() -> Coordinates {
+        Coordinates::Polygon(Vec::new())
+    }
+}
+
+/// The positions of a closed ring of 4 (a triangle) or, with `cut`, 4 or 5 (a part of a
+/// triangle cut at the antimeridian), without the closing repeat.
+fn ring_positions(f: usize, ring: &[Vec<f64>], cut: bool) -> Result<Vec<[f64; 3]>, Problem> {
+    let sizes = if cut { 4..=5 } else { 4..=4 };
+    if !sizes.contains(&ring.len()) || ring[0] != ring[ring.len() - 1] {
+        return Err(Problem::unsupported(format_args!(
+            "feature {f} is not a triangle (a closed ring of 4 positions){}: only triangles \
+             are read",
+            if cut { " cut at the antimeridian" } else { "" }
+        )));
+    }
+    ring[..ring.len() - 1]
+        .iter()
+        .map(|position| match position.as_slice() {
+            &[x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => Ok([x, y, z]),
+            [_, _] => Err(Problem::unsupported(format_args!(
+                "feature {f} has no heights (2D positions)"
+            ))),
+            _ => Err(Problem::malformed(format_args!(
+                "feature {f} has a position that is not 3 finite numbers"
+            ))),
+        })
+        .collect()
 }
 
 /// The EPSG code in a CRS name such as `urn:ogc:def:crs:EPSG::3005` or `EPSG:3005`, or
@@ -182,42 +251,51 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
                 "feature {f} has no geometry"
             )));
         };
-        if geometry.kind != "Polygon" {
-            return Err(Problem::unsupported(format_args!(
-                "feature {f} is a {}; only Polygon triangles are read",
-                geometry.kind
-            )));
-        }
-        let ring = match geometry.coordinates.as_slice() {
-            [ring] => ring,
-            rings => {
+        let rfc7946 = mesh.epsg == Some(4326);
+        let corners: [[f64; 3]; 3] = match (geometry.kind.as_str(), &geometry.coordinates) {
+            ("Polygon", Coordinates::Polygon(rings)) => {
+                let ring = match rings.as_slice() {
+                    [ring] => ring,
+                    rings => {
+                        return Err(Problem::unsupported(format_args!(
+                            "feature {f} has {} rings; only triangles (one ring) are read",
+                            rings.len()
+                        )))
+                    }
+                };
+                let positions = ring_positions(f, ring, false)?;
+                [positions[0], positions[1], positions[2]]
+            }
+            ("MultiPolygon", Coordinates::MultiPolygon(polygons)) if rfc7946 => {
+                let parts = match polygons.as_slice() {
+                    [west, east] if west.len() == 1 && east.len() == 1 => [
+                        ring_positions(f, &west[0], true)?,
+                        ring_positions(f, &east[0], true)?,
+                    ],
+                    _ => {
+                        return Err(Problem::unsupported(format_args!(
+                            "feature {f} is a MultiPolygon other than a triangle cut in two \
+                             at the antimeridian"
+                        )))
+                    }
+                };
+                triangle_from_parts(&[&parts[0], &parts[1]]).ok_or_else(|| {
+                    Problem::malformed(format_args!("feature {f}: its two parts span no triangle"))
+                })?
+            }
+            (kind, _) => {
                 return Err(Problem::unsupported(format_args!(
-                    "feature {f} has {} rings; only triangles (one ring) are read",
-                    rings.len()
+                    "feature {f} is a {kind}; only Polygon triangles (and, in WGS84, \
+                     MultiPolygon triangles cut at the antimeridian) are read"
                 )))
             }
         };
-        if ring.len() != 4 || ring[0] != ring[3] {
-            return Err(Problem::unsupported(format_args!(
-                "feature {f} is not a triangle (a closed ring of 4 positions): only triangles \
-                 are read"
-            )));
-        }
         let mut triangle = [0u32; 3];
-        for (index, position) in triangle.iter_mut().zip(ring) {
-            let p = match position.as_slice() {
-                &[x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => [x, y, z],
-                [_, _] => {
-                    return Err(Problem::unsupported(format_args!(
-                        "feature {f} has no heights (2D positions)"
-                    )))
-                }
-                _ => {
-                    return Err(Problem::malformed(format_args!(
-                        "feature {f} has a position that is not 3 finite numbers"
-                    )))
-                }
-            };
+        for (index, mut p) in triangle.iter_mut().zip(corners) {
+            if rfc7946 && p[0] == -180.0 {
+                // One meridian: a vertex on it may be written either way.
+                p[0] = 180.0;
+            }
             *index = welder
                 .vertex(p)
                 .ok_or_else(|| Problem::unsupported("more than 2^32 vertices"))?;
@@ -231,6 +309,7 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::antimeridian::wrap_longitude;
 
     fn write_to_string(mesh: MeshRef<'_>) -> String {
         let mut bytes = Vec::new();
@@ -257,6 +336,60 @@ mod tests {
         assert_eq!(mesh.vertices, VERTICES);
         assert_eq!(mesh.triangles, TRIANGLES);
         assert_eq!((mesh.epsg, mesh.crs_wkt), (Some(4326), None));
+        Ok(())
+    }
+
+    #[test]
+    fn wgs84_triangles_across_180_are_cut_and_read_back_welded() -> Result<(), Problem> {
+        // A strip of four triangles on 0..360 longitudes around 180, a vertex on it.
+        let vertices = [
+            [179.0, 0.0, 1.0],
+            [180.0, 0.0, 2.0],
+            [181.0, 0.0, 3.0],
+            [179.0, 1.0, 4.0],
+            [180.0, 1.0, 5.0],
+            [181.0, 1.0, 6.0],
+        ];
+        let triangles = [[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]];
+        let mut cut = vertices;
+        cut[1][0] = 180.5; // so the first triangle crosses 180; the others touch it or not
+        let text = write_to_string(MeshRef::new(&cut, &triangles).with_epsg(4326));
+        let value: Value = serde_json::from_str(&text).expect("valid JSON");
+        let kinds: Vec<&str> = value["features"]
+            .as_array()
+            .expect("features")
+            .iter()
+            .map(|f| f["geometry"]["type"].as_str().expect("type"))
+            .collect();
+        assert_eq!(kinds, ["MultiPolygon", "Polygon", "Polygon", "Polygon"]);
+        for f in value["features"].as_array().expect("features") {
+            let text = f["geometry"]["coordinates"].to_string();
+            assert!(!text.contains("181") && !text.contains("180.5"), "{text}");
+        }
+        let mesh = read(text.as_bytes())?;
+        assert_eq!(mesh.triangles.len(), 4);
+        assert_eq!(mesh.vertices.len(), 6, "{:?}", mesh.vertices);
+        // Every triangle comes back with its corners (longitudes wrapped), in order.
+        for (t, read) in triangles.iter().zip(&mesh.triangles) {
+            let want = t.map(|i| [wrap_longitude(cut[i as usize][0]), cut[i as usize][1]]);
+            let got = read.map(|i| [mesh.vertices[i as usize][0], mesh.vertices[i as usize][1]]);
+            assert!(
+                (0..3).any(|r| (0..3).all(|k| got[(k + r) % 3] == want[k])),
+                "{got:?}"
+            );
+        }
+
+        // The vertices on 180 are written as 180 or -180 by the side of their triangle and
+        // read back as one.
+        let text = write_to_string(MeshRef::new(&vertices, &triangles).with_epsg(4326));
+        assert!(text.contains("[-180.0,0.0,2.0]") && text.contains("[180.0,0.0,2.0]"));
+        assert!(!text.contains("MultiPolygon"));
+        let mesh = read(text.as_bytes())?;
+        assert_eq!(mesh.vertices.len(), 6, "{:?}", mesh.vertices);
+
+        // Only in WGS84: elsewhere coordinates are written as they are.
+        let text = write_to_string(MeshRef::new(&cut, &triangles).with_epsg(32660));
+        assert!(!text.contains("MultiPolygon") && text.contains("181"));
         Ok(())
     }
 

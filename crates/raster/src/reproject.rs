@@ -98,6 +98,15 @@ pub fn from_wgs84(target_wkt: &str, points: &mut [[f64; 3]]) -> Result<()> {
     transform(&wgs84()?, &spatial_ref(target_wkt)?, points)
 }
 
+/// Whether the CRS given as WKT (or anything GDAL's `SetFromUserInput` takes) is
+/// geographic: its x is a longitude in degrees.
+///
+/// # Errors
+/// [`Error::Crs`] when GDAL cannot read the CRS.
+pub fn is_geographic(wkt: &str) -> Result<bool> {
+    Ok(spatial_ref(wkt)?.is_geographic())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -118,6 +127,14 @@ mod tests {
                 "{p:?}"
             );
         }
+        Ok(())
+    }
+
+    #[test]
+    fn geographic_or_not() -> Result<()> {
+        assert!(is_geographic("EPSG:4326")?);
+        assert!(is_geographic("EPSG:4269")?);
+        assert!(!is_geographic("EPSG:32633")?);
         Ok(())
     }
 

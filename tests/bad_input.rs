@@ -390,6 +390,21 @@ fn a_pyramid_is_written_whole_or_not_at_all() {
     let o = d.run(&["tiles", "huge.asc", "-o", "pyramid", "-q"]);
     assert_fails_naming(&o, &["huge.asc", "quantized-mesh"]);
     assert!(!d.path("pyramid").exists());
+    // Float64 heights beyond f32 altogether (clamped by the warp): the source's named.
+    d.write(
+        "beyond.asc",
+        "ncols 3\nnrows 3\nxllcorner 7\nyllcorner 46\ncellsize 0.01\n\
+         1e300 1e300 1e300\n1 2 3\n4 5 6\n",
+    );
+    std::fs::copy(d.path("empty.prj"), d.path("beyond.prj")).unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+        .args(["tiles", "beyond.asc", "-o", "pyramid", "-q"])
+        .current_dir(d.path(""))
+        .env("AAIGRID_DATATYPE", "Float64") // GDAL reads the grid as Float64
+        .output()
+        .expect("run tinsmith");
+    assert_fails_naming(&o, &["beyond.asc", "heights up to 1e300", "quantized-mesh"]);
+    assert!(!d.path("pyramid").exists());
 
     // A directory that holds other files is never written into.
     std::fs::create_dir(d.path("taken")).unwrap();

@@ -82,6 +82,17 @@ pub fn geographic_bounds(path: &Path, band: usize) -> Result<GeoBounds> {
     })
 }
 
+/// Whether the band's heights may lie beyond `f32`'s range, from its metadata alone: its
+/// samples are `Float64`, or a scale or offset could take them there. (The warp to
+/// geographic coordinates works in `f32`.)
+///
+/// # Errors
+/// As [`crate::open_info`].
+pub fn heights_may_exceed_f32(path: &Path, band: usize) -> Result<bool> {
+    let info = OpenBand::open(path, band)?.info;
+    Ok(info.data_type == "Float64" || info.scale.abs() > 1.0 || info.offset.abs() > 1e30)
+}
+
 /// The raster's extent in EPSG:4326 as PROJ gives it, longitudes not wrapped.
 fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
     let info = &opened.info;

@@ -64,7 +64,9 @@ mod window;
 
 pub use cache::limit_block_cache;
 pub use error::{Error, Result};
-pub use geographic::{geographic_bounds, warp_to_geographic, GeoBounds, GeoLattice};
+pub use geographic::{
+    geographic_bounds, heights_may_exceed_f32, warp_to_geographic, GeoBounds, GeoLattice,
+};
 pub use info::{Raster, RasterInfo};
 pub use quiet::silence_gdal_errors;
 pub use read::{open_info, open_info_with_progress, read_grid};

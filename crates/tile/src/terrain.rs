@@ -53,6 +53,18 @@ pub enum TerrainError {
     /// The options make no sense (the message says which).
     #[error("{0}")]
     Options(String),
+    /// Heights (largest magnitude, widest range of a tile) beyond what quantized-mesh
+    /// tiles, whose height ranges are stored in `f32`, can hold.
+    #[error(
+        "heights up to {max_abs:e} (tiles spanning up to {widest:e}) are beyond what \
+         quantized-mesh tiles can hold (their height range is stored in f32)"
+    )]
+    HeightsBeyondF32 {
+        /// The largest magnitude of a valid height.
+        max_abs: f64,
+        /// The widest range of valid heights of a tile.
+        widest: f64,
+    },
     /// The thread pool could not start.
     #[error("cannot start {threads} worker threads")]
     Threads {
@@ -326,6 +338,21 @@ pub fn build_terrain(
             options.min_zoom
         )));
     }
+    // The warp works in f32: heights beyond it would be clamped or lost as nodata, so a
+    // source that may hold them (Float64, or scaled) is scanned for them first.
+    if tinsmith_raster::heights_may_exceed_f32(input, options.band)? {
+        let info = tinsmith_raster::open_info(input, options.band)?;
+        if let (Some(lo), Some(hi)) = (info.min, info.max) {
+            let max_abs = lo.abs().max(hi.abs());
+            let limit = f64::from(f32::MAX) / 2.0;
+            if !(max_abs < limit && hi - lo < limit) {
+                return Err(TerrainError::HeightsBeyondF32 {
+                    max_abs,
+                    widest: hi - lo,
+                });
+            }
+        }
+    }
     // All or nothing: the pyramid is built in a temporary directory beside `out_dir` and
     // renamed into place at the end; a failure (or nothing to write) leaves no trace.
     let staging = staging_dir(out_dir)?;
@@ -433,11 +460,10 @@ fn build_pyramid(
     // Quantized-mesh stores a tile's height range in f32, and its heights as steps of it.
     let widest = stats.widest.iter().fold(0.0f64, |w, &x| w.max(x));
     if !(stats.max_abs < f64::from(f32::MAX) / 2.0 && widest < f64::from(f32::MAX) / 2.0) {
-        return Err(TerrainError::Options(format!(
-            "heights up to {:e} (tiles spanning up to {:e}) are beyond what quantized-mesh \
-             tiles can hold (their height range is stored in f32)",
-            stats.max_abs, widest
-        )));
+        return Err(TerrainError::HeightsBeyondF32 {
+            max_abs: stats.max_abs,
+            widest,
+        });
     }
     let mut writer = TileWriter::new(stats, out_dir, options, &pool, progress);
     stream_levels(source, bounds, zooms, band_rows, &pool, &mut writer)?;

@@ -151,8 +151,9 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         })
         .collect();
     let segments = points.len() - lines.len();
-    if wgs84 {
-        // RFC 7946: longitudes in [-180, 180], lines cut where they cross the antimeridian.
+    if format == LineFormat::GeoJson && crs.epsg == Some(4326) {
+        // RFC 7946 (the coordinates are longitude, latitude): longitudes in [-180, 180],
+        // lines cut where they cross the antimeridian.
         let cut: Vec<(Vec<Vec<[f64; 2]>>, f64)> = lines
             .iter()
             .map(|&(line, level)| (tinsmith_export::cut_at_antimeridian(line), level))

@@ -82,10 +82,22 @@ def raster_range(path, binary):
     return info["min"], info["max"], info["geo_transform"]
 
 
-def read_lines(path):
+def read_lines(path, west=None):
+    """Lines by level. With `west` (the raster's left edge), x below it is moved a turn
+    east and a MultiLineString's parts are joined: tinsmith's WGS84 GeoJSON wraps
+    longitudes into [-180, 180] and cuts lines at the antimeridian (RFC 7946), so a raster
+    on 0..360 (ETOPO5) is compared with gdal_contour in the raster's own frame."""
     by_level = {}
     for f in json.loads(pathlib.Path(path).read_text())["features"]:
-        pts = f["geometry"]["coordinates"]
+        g = f["geometry"]
+        parts = g["coordinates"] if g["type"] == "MultiLineString" else [g["coordinates"]]
+        pts = []
+        for part in parts:
+            for x, y, *rest in part:
+                if west is not None and x < west:
+                    x += 360.0
+                if not pts or pts[-1] != [x, y]:
+                    pts.append([x, y])
         by_level.setdefault(float(f["properties"]["elev"]), []).append(pts)
     return by_level
 
@@ -236,7 +248,7 @@ def main():
                 tj = timed(base + ["-o", str(t_out_json), *SRC_CRS], args.repeat)
                 _, p = run([args.bin, "contour", str(src), "--levels", lv, "--max-error", f"{e:g}", "-o", str(t_out_json), *SRC_CRS])
                 tris = p.stderr.split("(")[-1].split(" triangles")[0]
-                tin = read_lines(t_out_json)
+                tin = read_lines(t_out_json, gt[0])
                 tl, ts, tlen = stats(tin)
                 h, gap, missing, p99 = hausdorff(tin, gdal, cell)
                 src_name = "tinsmith, full grid" if e == 0 else "tinsmith, TIN"
@@ -254,8 +266,8 @@ def main():
                         simp = ["--simplify", f"{d:g}"]
                         tsf = timed(base + simp + ["-o", str(t_out_fgb)], args.repeat)
                         tsj = timed(base + simp + ["-o", str(t_out_json), *SRC_CRS], args.repeat)
-                        sl, ss, slen = stats(read_lines(t_out_json))
-                        h, gap, _, p99 = hausdorff(read_lines(t_out_json), gdal, cell)
+                        sl, ss, slen = stats(read_lines(t_out_json, gt[0]))
+                        h, gap, _, p99 = hausdorff(read_lines(t_out_json, gt[0]), gdal, cell)
                         emit(f"| {label} | {interval} | tinsmith --simplify {d:g} ({frac:g} pixel) | {e:g} | {tris} | {tsf:.2f} | {tsj:.2f} | {sl} | {ss} | {100 * (ss / gs - 1):+.0f} % | {slen:.4g} | {h:.4g} (gap ≤ {gap:.2g}); 99 %: {p99:.3g} |")
                         # The same simplification (GEOS, topology-preserving per line) on
                         # gdal_contour's lines: gdal_contour, then ogr2ogr.

@@ -150,7 +150,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             line
         })
         .collect();
-    let segments = points.len() - lines.len();
+    let mut segments = points.len() - lines.len();
     if format == LineFormat::GeoJson && crs.epsg == Some(4326) {
         // RFC 7946 (the coordinates are longitude, latitude): longitudes in [-180, 180],
         // lines cut where they cross the antimeridian.
@@ -163,6 +163,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             .iter()
             .map(|(parts, _)| parts.iter().map(Vec::as_slice).collect())
             .collect();
+        segments = parts.iter().flatten().map(|part| part.len() - 1).sum();
         let lines: Vec<(&[&[[f64; 2]]], f64)> = parts
             .iter()
             .zip(&cut)

@@ -732,3 +732,69 @@ fn wgs84_geojson_meshes_across_the_antimeridian_verify_and_contour() {
     assert!(!a.is_empty());
     assert_eq!(canonical(a), canonical(b));
 }
+
+#[test]
+fn a_projected_raster_across_the_antimeridian_round_trips_through_wgs84_geojson() {
+    // UTM zone 1N (central meridian 177° W) at 60° N: eastings 280..380 km span 180°.
+    // PROJ gives longitudes on both sides; the GeoJSON mesh is cut and still verifies
+    // after the transformation back, and contour lines across 180° are cut too.
+    let d = Dir::new();
+    let mut asc =
+        String::from("ncols 50\nnrows 50\nxllcorner 280000\nyllcorner 6650000\ncellsize 2000\n");
+    for row in 0..50 {
+        let values: Vec<String> = (0..50)
+            .map(|col| format!("{}", ((col * 7 + row * 3) % 23) as f64 + 0.1 * col as f64))
+            .collect();
+        asc.push_str(&values.join(" "));
+        asc.push('\n');
+    }
+    d.write("utm.asc", &asc);
+    d.write(
+        "utm.vrt",
+        "<VRTDataset rasterXSize=\"50\" rasterYSize=\"50\"><SRS>EPSG:32601</SRS>\
+         <GeoTransform>280000, 2000, 0, 6750000, 0, -2000</GeoTransform>\
+         <VRTRasterBand dataType=\"Float32\" band=\"1\"><SimpleSource>\
+         <SourceFilename relativeToVRT=\"1\">utm.asc</SourceFilename>\
+         <SourceBand>1</SourceBand></SimpleSource></VRTRasterBand></VRTDataset>",
+    );
+    run_ok(
+        &d,
+        &[
+            "mesh",
+            "utm.vrt",
+            "--max-error",
+            "2",
+            "-o",
+            "m.geojson",
+            "-q",
+        ],
+    );
+    let kinds = |name: &str| -> Vec<String> {
+        let v: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(d.path(name)).unwrap()).unwrap();
+        v["features"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f["geometry"]["type"].as_str().unwrap().to_owned())
+            .collect()
+    };
+    assert!(kinds("m.geojson").iter().any(|k| k == "MultiPolygon"));
+    let o = d.run(&["verify", "utm.vrt", "m.geojson", "--max-error", "2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    run_ok(
+        &d,
+        &[
+            "contour",
+            "utm.vrt",
+            "--interval",
+            "5",
+            "-o",
+            "c.geojson",
+            "-q",
+        ],
+    );
+    assert!(kinds("c.geojson").iter().any(|k| k == "MultiLineString"));
+    let info = ogrinfo(&d.path("c.geojson"));
+    assert!(info.contains("Extent: (-180.000000,"), "{info}");
+}

@@ -798,3 +798,46 @@ fn a_projected_raster_across_the_antimeridian_round_trips_through_wgs84_geojson(
     let info = ogrinfo(&d.path("c.geojson"));
     assert!(info.contains("Extent: (-180.000000,"), "{info}");
 }
+
+#[test]
+fn global_grids_with_both_edge_meridians_round_trip_through_wgs84_geojson() {
+    // 5° global grids whose first and last columns are the same meridian (-180 and 180, or
+    // 0 and 360), meshed coarsely enough for triangles wider than 180° of longitude: the
+    // GeoJSON mesh still verifies (edge vertices are not merged, wide triangles are not
+    // taken the short way round).
+    let d = Dir::new();
+    for (name, xll) in [("pm180", -182.5), ("zero360", -2.5)] {
+        let mut asc = format!("ncols 73\nnrows 37\nxllcorner {xll}\nyllcorner -92.5\ncellsize 5\n");
+        for row in 0..37 {
+            let lat = 90.0 - 5.0 * row as f64;
+            let values: Vec<String> = (0..73)
+                .map(|col| {
+                    let lon = xll + 2.5 + 5.0 * col as f64;
+                    let v = 1000.0 * (3.0 * lon.to_radians()).sin() * lat.to_radians().cos()
+                        + 300.0 * (4.0 * lat.to_radians()).cos();
+                    format!("{v:.3}")
+                })
+                .collect();
+            asc.push_str(&values.join(" "));
+            asc.push('\n');
+        }
+        d.write(&format!("{name}.asc"), &asc);
+        d.write(
+            &format!("{name}.prj"),
+            "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137,\
+             298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"Degree\",0.017453292519943295]]",
+        );
+        let input = format!("{name}.asc");
+        for target in [
+            ["--max-triangles", "12"],
+            ["--max-triangles", "200"],
+            ["--max-error", "100"],
+        ] {
+            let mut args = vec!["mesh", input.as_str(), "-o", "m.geojson", "-q"];
+            args.extend(target);
+            run_ok(&d, &args);
+            let o = d.run(&["verify", &input, "m.geojson"]);
+            assert!(o.status.success(), "{name} {target:?}: {}", stderr(&o));
+        }
+    }
+}

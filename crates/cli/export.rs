@@ -282,6 +282,10 @@ pub fn file_crs<'r>(
         Some(wkt) => {
             tinsmith_raster::to_wgs84(wkt, points)
                 .with_context(|| format!("{}: cannot reproject to WGS84", path.display()))?;
+            if !tinsmith_raster::is_geographic(wkt)? {
+                unwrap_around_centre(info, wkt, points)
+                    .with_context(|| format!("{}: cannot reproject to WGS84", path.display()))?;
+            }
             Ok(CrsRef::new(None, Some(4326)))
         }
         None => {
@@ -294,6 +298,31 @@ pub fn file_crs<'r>(
             Ok(crs)
         }
     }
+}
+
+/// PROJ gives a projected raster's longitudes in [-180, 180], so one that spans the
+/// antimeridian jumps there; the GeoJSON writers want one continuous frame (they cut at
+/// 180 themselves, RFC 7946), so longitudes are moved by a turn where they lie more than
+/// 180° from the raster centre's.
+fn unwrap_around_centre(info: &RasterInfo, wkt: &str, points: &mut [[f64; 3]]) -> Result<()> {
+    let Some(transform) = info.transform() else {
+        return Ok(());
+    };
+    let [x, y] = transform.sample_centre(
+        f64::from(info.width) / 2.0 - 0.5,
+        f64::from(info.height) / 2.0 - 0.5,
+    );
+    let mut centre = [[x, y, 0.0]];
+    tinsmith_raster::to_wgs84(wkt, &mut centre)?;
+    let c = centre[0][0];
+    for p in points {
+        if p[0] - c > 180.0 {
+            p[0] -= 360.0;
+        } else if p[0] - c < -180.0 {
+            p[0] += 360.0;
+        }
+    }
+    Ok(())
 }
 
 /// The last gate for float32 files: every stored position maps back to a sample centre

@@ -72,24 +72,70 @@ pub fn read_mesh_file(path: &Path, raster: &Raster, georef: Georef) -> Result<Me
             })?;
         }
         if tinsmith_raster::is_geographic(wkt)? {
-            let (w, h) = (raster.info.width as f64, raster.info.height as f64);
-            let west = [
-                (-0.5, -0.5),
-                (w - 0.5, -0.5),
-                (-0.5, h - 0.5),
-                (w - 0.5, h - 0.5),
-            ]
-            .into_iter()
-            .map(|(x, y)| transform.sample_centre(x, y)[0])
-            .fold(f64::INFINITY, f64::min);
-            for v in &mut mesh.vertices {
-                if v[0] < west || v[0] >= west + 360.0 {
-                    v[0] = west + (v[0] - west).rem_euclid(360.0);
-                }
-            }
+            into_raster_frame(&mut mesh, raster, transform);
         }
     }
     Ok(mesh)
+}
+
+/// Moves longitudes read from RFC 7946 GeoJSON (in [-180, 180]) by whole turns into a
+/// geographic raster's own frame (0..360 for many global grids), triangle by triangle:
+/// a corner outside the raster's extent into [west, west + 360), then, of the placements
+/// with corners a turn further east where that stays within the raster (the east edge of
+/// a grid whose first and last columns are the same meridian), the counter-clockwise one
+/// spanning the fewest degrees; corners are then welded again by position.
+fn into_raster_frame(mesh: &mut Mesh, raster: &Raster, transform: tinsmith_core::GeoTransform) {
+    let (w, h) = (f64::from(raster.info.width), f64::from(raster.info.height));
+    let xs: Vec<f64> = [
+        (-0.5, -0.5),
+        (w - 0.5, -0.5),
+        (-0.5, h - 0.5),
+        (w - 0.5, h - 0.5),
+    ]
+    .into_iter()
+    .map(|(x, y)| transform.sample_centre(x, y)[0])
+    .collect();
+    let west = xs.iter().copied().fold(f64::INFINITY, f64::min);
+    let east = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let base = |lon: f64| {
+        if lon < west || lon > east {
+            west + (lon - west).rem_euclid(360.0)
+        } else {
+            lon
+        }
+    };
+    let mut welded: std::collections::HashMap<[u64; 3], u32> = Default::default();
+    let mut vertices: Vec<[f64; 3]> = Vec::with_capacity(mesh.vertices.len());
+    for triangle in &mut mesh.triangles {
+        let corners = triangle.map(|i| mesh.vertices[i as usize]);
+        let lons = corners.map(|v| base(v[0]));
+        // Of the placements (each corner as is, or a turn east if that stays within the
+        // raster), the counter-clockwise one (as written) spanning the fewest degrees.
+        let mut best: Option<(f64, [f64; 3])> = None;
+        for turns in 0..8u32 {
+            let placed = [0, 1, 2].map(|k| lons[k] + 360.0 * f64::from((turns >> k) & 1));
+            if placed.iter().any(|&lon| lon > east) {
+                continue;
+            }
+            let [a, b, c] = [0, 1, 2].map(|k| [placed[k], corners[k][1]]);
+            let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            let span = placed.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                - placed.iter().copied().fold(f64::INFINITY, f64::min);
+            if area > 0.0 && best.is_none_or(|(s, _)| span < s) {
+                best = Some((span, placed));
+            }
+        }
+        let placed = best.map_or(lons, |(_, placed)| placed);
+        for (index, lon) in triangle.iter_mut().zip(placed) {
+            let v = mesh.vertices[*index as usize];
+            let p = [lon, v[1], v[2]];
+            *index = *welded.entry(p.map(f64::to_bits)).or_insert_with(|| {
+                vertices.push(p);
+                (vertices.len() - 1) as u32
+            });
+        }
+    }
+    mesh.vertices = vertices;
 }
 
 /// Mesh files hold triangles counter-clockwise in file coordinates (normals up), which is

@@ -521,7 +521,9 @@ impl Retriangulator {
             Some(_) => cap == f64::INFINITY,
             None => cap >= rules.limit,
         };
-        if best.2 != u32::MAX || uncapped || !joinable {
+        // With levels a sum of children within the cap can exceed it; a result above the
+        // cap came from a search pruned at the cap, so it is only a bound.
+        if (best.2 != u32::MAX && best.0 <= cap) || uncapped || !joinable {
             self.solved[at] = Solved::Exact;
             self.cost[at] = best.0;
             self.cost_sum[at] = best.1;

@@ -15,62 +15,94 @@ pub fn wrap_longitude(lon: f64) -> f64 {
     }
 }
 
-/// The parts of a line of `[longitude, latitude, ...]` points (degrees) with longitudes
-/// wrapped into [-180, 180] and cut wherever a segment crosses the antimeridian: a segment
-/// whose wrapped ends lie more than 180° apart is taken to cross it the short way, ends
-/// its part at ±180 and starts the next at ∓180 (the latitude of the crossing interpolated
-/// linearly, other values kept from the segment's start). Repeated points at a cut are
-/// dropped, and so are parts left with fewer than two points. A closed line (first point
-/// equal to last) that is cut has its last and first parts joined, since they meet at the
-/// first point. A line that never crosses comes back as one part with wrapped longitudes.
+/// The whole turns `k` such that `lon - 360 k` lies in [-180, 180], `lon` a longitude
+/// strictly inside its frame or the middle of a piece (a point on a meridian 180 + 360 j
+/// belongs to the frame east of it: it is only asked for pieces' middles).
+fn frame_of(lon: f64) -> f64 {
+    ((lon + 180.0) / 360.0).floor()
+}
+
+/// The meridians `180 + 360 j` strictly between `a` and `b` (in either order), west first.
+fn meridians_between(a: f64, b: f64) -> impl Iterator<Item = f64> {
+    let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
+    let first = ((lo - 180.0) / 360.0).floor() + 1.0;
+    (0..)
+        .map(move |j| 180.0 + 360.0 * (first + f64::from(j)))
+        .take_while(move |&m| m < hi)
+        .filter(move |&m| m > lo)
+}
+
+/// The point of segment `p q` at longitude `m`, other values interpolated linearly from
+/// the segment's west end (so both sides of a shared edge give the same bits).
+fn at_meridian<const N: usize>(p: &[f64; N], q: &[f64; N], m: f64) -> [f64; N] {
+    let (w, e) = if p[0] <= q[0] { (p, q) } else { (q, p) };
+    let t = (m - w[0]) / (e[0] - w[0]);
+    let mut out = *w;
+    for k in 1..N {
+        out[k] = w[k] + t * (e[k] - w[k]);
+    }
+    out[0] = m;
+    out
+}
+
+/// `p` with its longitude moved by `turns` whole turns west.
+fn shifted<const N: usize>(p: &[f64; N], turns: f64) -> [f64; N] {
+    let mut q = *p;
+    q[0] = p[0] - 360.0 * turns;
+    q
+}
+
+/// The parts of a line of `[longitude, latitude, ...]` points (degrees), the longitudes
+/// given in one continuous frame (as a geographic raster's, or a reprojected raster's
+/// unwrapped around its centre), for RFC 7946: each segment is cut where it crosses a
+/// meridian 180 + 360 j (the latitude and other values interpolated linearly), each piece
+/// is moved by whole turns into [-180, 180], and a new part starts where the turns change
+/// (so a part ends on 180 and the next starts on -180, or the other way). Repeated points
+/// are dropped, and so are parts left with fewer than two points. A closed line (first
+/// point equal to last) that is cut has its last and first parts joined when they meet
+/// there. A line that never crosses comes back as one part.
 pub fn cut_at_antimeridian<const N: usize>(points: &[[f64; N]]) -> Vec<Vec<[f64; N]>> {
-    let wrapped: Vec<[f64; N]> = points
-        .iter()
-        .map(|p| {
-            let mut q = *p;
-            q[0] = wrap_longitude(p[0]);
-            q
-        })
-        .collect();
     let closed = points.len() > 2 && points.first() == points.last();
-    let mut parts: Vec<Vec<[f64; N]>> = Vec::new();
-    let mut part: Vec<[f64; N]> = Vec::new();
-    for (k, &p) in wrapped.iter().enumerate() {
-        if let Some(&q) = k.checked_sub(1).map(|k| &wrapped[k]) {
-            if (p[0] - q[0]).abs() > 180.0 {
-                // East across 180 when the previous point is in the east, else west.
-                let east = q[0] > p[0];
-                let (edge, shifted) = if east {
-                    (180.0, p[0] + 360.0)
-                } else {
-                    (-180.0, p[0] - 360.0)
-                };
-                // Ends on both sides of the same meridian (180 and -180): cut at the start.
-                let t = if shifted == q[0] {
-                    0.0
-                } else {
-                    (edge - q[0]) / (shifted - q[0])
-                };
-                let mut cut = q;
-                cut[0] = edge;
-                cut[1] = q[1] + t * (p[1] - q[1]);
-                push_distinct(&mut part, cut);
-                parts.push(std::mem::take(&mut part));
-                cut[0] = -edge;
-                part.push(cut);
+    let mut parts: Vec<(f64, Vec<[f64; N]>)> = Vec::new();
+    let add_piece = |a: [f64; N], b: [f64; N], parts: &mut Vec<(f64, Vec<[f64; N]>)>| {
+        let turns = frame_of((a[0] + b[0]) / 2.0);
+        let (a, b) = (shifted(&a, turns), shifted(&b, turns));
+        match parts.last_mut() {
+            Some((t, part)) if *t == turns => {
+                push_distinct(part, a);
+                push_distinct(part, b);
             }
+            _ => parts.push((turns, vec![a, b])),
         }
-        push_distinct(&mut part, p);
+    };
+    if points.len() == 1 {
+        return Vec::new();
     }
-    parts.push(part);
-    if closed && parts.len() > 1 {
-        let last = parts.pop().expect("more than one part");
+    for pair in points.windows(2) {
+        let (p, q) = (&pair[0], &pair[1]);
+        let mut from = *p;
+        let mut cuts: Vec<f64> = meridians_between(p[0], q[0]).collect();
+        if q[0] < p[0] {
+            cuts.reverse();
+        }
+        for m in cuts {
+            let cut = at_meridian(p, q, m);
+            add_piece(from, cut, &mut parts);
+            from = cut;
+        }
+        add_piece(from, *q, &mut parts);
+    }
+    if closed && parts.len() > 1 && parts[0].0 == parts[parts.len() - 1].0 {
+        let (_, last) = parts.pop().expect("more than one part");
         let mut joined = last;
-        joined.extend_from_slice(&parts[0][1..]);
-        parts[0] = joined;
+        joined.extend_from_slice(&parts[0].1[1..]);
+        parts[0].1 = joined;
     }
-    parts.retain(|part| part.len() >= 2);
     parts
+        .into_iter()
+        .map(|(_, part)| part)
+        .filter(|part| part.len() >= 2)
+        .collect()
 }
 
 /// How a triangle of `[longitude, latitude, height]` corners is written in RFC 7946
@@ -85,68 +117,59 @@ pub(crate) enum TriangleParts {
     Cut(Vec<[f64; 3]>, Vec<[f64; 3]>),
 }
 
-/// The RFC 7946 form of a triangle: like [`cut_at_antimeridian`] for lines, corners whose
-/// wrapped longitudes lie more than 180° apart are taken to span the antimeridian the
-/// short way, and the triangle is cut there unless it only touches it. A cut point's
-/// latitude and height are interpolated linearly along the edge. Corners keep their
-/// wrapped longitude bit for bit (±180 on the side of their part), so a vertex shared with
-/// whole triangles reads back to the same position, 180 and -180 counting as one.
+/// The RFC 7946 form of a triangle whose longitudes are given in one continuous frame
+/// (see [`cut_at_antimeridian`]): moved by whole turns into [-180, 180] if no meridian
+/// 180 + 360 j passes strictly through it, else cut there into a west part (ending on 180)
+/// and an east part (starting on -180), the cut points interpolated linearly along the
+/// edges from their west ends (so a shared edge gives the same bits). A corner is moved by
+/// the turns of its part, so it keeps the same bits wherever it is written, except that a
+/// corner on the meridian is 180 in a part west of it and -180 east of it.
 pub(crate) fn triangle_parts(corners: [[f64; 3]; 3]) -> TriangleParts {
-    let wrapped = corners.map(|p| [wrap_longitude(p[0]), p[1], p[2]]);
-    let (lo, hi) = wrapped
+    let (lo, hi) = corners
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
             (lo.min(p[0]), hi.max(p[0]))
         });
-    if hi - lo <= 180.0 {
-        return TriangleParts::Whole(wrapped);
-    }
-    // Longitudes continued east across 180: [0, 360).
-    let east_of = |p: &[f64; 3]| if p[0] < 0.0 { p[0] + 360.0 } else { p[0] };
-    let unwrapped = wrapped.map(|p| [east_of(&p), p[1], p[2]]);
-    let west = unwrapped.iter().any(|p| p[0] < 180.0);
-    let east = unwrapped.iter().any(|p| p[0] > 180.0);
-    if !(west && east) {
-        // Only touching 180: put corners on it on the side of the others.
-        let side = if east { -180.0 } else { 180.0 };
-        return TriangleParts::Whole(wrapped.map(|p| {
-            if p[0].abs() == 180.0 {
-                [side, p[1], p[2]]
-            } else {
-                p
-            }
-        }));
-    }
-    let (mut west_part, mut east_part) = (Vec::with_capacity(4), Vec::with_capacity(4));
+    let Some(m) = meridians_between(lo, hi).next() else {
+        let turns = frame_of((lo + hi) / 2.0);
+        return TriangleParts::Whole(corners.map(|p| shifted(&p, turns)));
+    };
+    let west_turns = frame_of(m - 1.0);
+    let (mut west, mut east) = (Vec::with_capacity(4), Vec::with_capacity(4));
     for k in 0..3 {
-        let (p, q) = (unwrapped[k], unwrapped[(k + 1) % 3]);
-        let corner = wrapped[k];
-        if p[0] <= 180.0 {
-            west_part.push([if p[0] == 180.0 { 180.0 } else { corner[0] }, p[1], p[2]]);
+        let (p, q) = (&corners[k], &corners[(k + 1) % 3]);
+        if p[0] <= m {
+            west.push(shifted(p, west_turns));
         }
-        if p[0] >= 180.0 {
-            east_part.push([if p[0] == 180.0 { -180.0 } else { corner[0] }, p[1], p[2]]);
+        if p[0] >= m {
+            east.push(shifted(p, west_turns + 1.0));
         }
-        if (p[0] - 180.0) * (q[0] - 180.0) < 0.0 {
-            let t = (180.0 - p[0]) / (q[0] - p[0]);
-            let (lat, height) = (p[1] + t * (q[1] - p[1]), p[2] + t * (q[2] - p[2]));
-            west_part.push([180.0, lat, height]);
-            east_part.push([-180.0, lat, height]);
+        if (p[0] - m) * (q[0] - m) < 0.0 {
+            let cut = at_meridian(p, q, m);
+            west.push(shifted(&cut, west_turns));
+            east.push(shifted(&cut, west_turns + 1.0));
         }
     }
-    TriangleParts::Cut(west_part, east_part)
+    TriangleParts::Cut(west, east)
 }
 
 /// The triangle a [`TriangleParts::Cut`] came from, given its parts' positions (either
-/// part first): of the positions, the three spanning the largest area once negative
-/// longitudes (the east part's) are continued across 180 (the corners; cut points lie on
-/// its sides), counter-clockwise, with their written (wrapped) coordinates and -180 read
-/// as 180. `None` when there are fewer than three positions or they span no area.
+/// part first): of the positions, the three spanning the largest area once the east part
+/// (the one cut on -180) is continued a turn east (the corners; cut points lie on its
+/// sides), counter-clockwise, with their written (wrapped) coordinates. `None` when there
+/// are fewer than three positions or they span no area.
 pub(crate) fn triangle_from_parts(parts: &[&[[f64; 3]]]) -> Option<[[f64; 3]; 3]> {
+    // The east part is the one cut on -180; continued a turn east, it meets the west one.
     let points: Vec<([f64; 3], [f64; 2])> = parts
         .iter()
-        .flat_map(|part| part.iter())
-        .map(|p| (*p, [if p[0] < 0.0 { p[0] + 360.0 } else { p[0] }, p[1]]))
+        .flat_map(|part| {
+            let turn = if part.iter().any(|p| p[0] == -180.0) {
+                360.0
+            } else {
+                0.0
+            };
+            part.iter().map(move |p| (*p, [p[0] + turn, p[1]]))
+        })
         .collect();
     let area = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
         (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
@@ -164,12 +187,7 @@ pub(crate) fn triangle_from_parts(parts: &[&[[f64; 3]]]) -> Option<[[f64; 3]; 3]
         }
     }
     let (doubled, order) = best?;
-    (doubled > 0.0).then(|| {
-        order.map(|i| {
-            let p = points[i].0;
-            [if p[0] == -180.0 { 180.0 } else { p[0] }, p[1], p[2]]
-        })
-    })
+    (doubled > 0.0).then(|| order.map(|i| points[i].0))
 }
 
 fn push_distinct<const N: usize>(part: &mut Vec<[f64; N]>, p: [f64; N]) {
@@ -203,8 +221,8 @@ mod tests {
                 vec![[-180.0, 5.0], [-170.0, 10.0], [-160.0, 10.0]],
             ]
         );
-        // Westward, in already wrapped longitudes.
-        let parts = cut_at_antimeridian(&[[-175.0, 2.0], [175.0, 4.0]]);
+        // Westward across -180.
+        let parts = cut_at_antimeridian(&[[-175.0, 2.0], [-185.0, 4.0]]);
         assert_eq!(
             parts,
             vec![
@@ -243,8 +261,8 @@ mod tests {
     }
 
     #[test]
-    fn a_segment_from_180_to_minus_180_is_cut_at_its_start() {
-        let parts = cut_at_antimeridian(&[[179.0, 0.0], [180.0, 1.0], [-180.0, 2.0]]);
+    fn a_segment_along_180_belongs_to_the_east() {
+        let parts = cut_at_antimeridian(&[[179.0, 0.0], [180.0, 1.0], [180.0, 2.0]]);
         assert_eq!(
             parts,
             vec![
@@ -293,11 +311,27 @@ mod tests {
             triangle_parts(touching),
             TriangleParts::Whole([[-180.0, 0.0, 1.0], [-179.0, 0.0, 1.0], [-179.0, 1.0, 1.0]])
         );
-        let touching = [[-180.0, 0.0, 1.0], [179.0, 1.0, 1.0], [179.0, 0.0, 1.0]];
+        let touching = [[180.0, 0.0, 1.0], [179.0, 1.0, 1.0], [179.0, 0.0, 1.0]];
         assert_eq!(
             triangle_parts(touching),
             TriangleParts::Whole([[180.0, 0.0, 1.0], [179.0, 1.0, 1.0], [179.0, 0.0, 1.0]])
         );
+    }
+
+    #[test]
+    fn wide_triangles_are_cut_where_they_are_not_the_short_way() {
+        // 10 -> 300 degrees east in a 0..360 frame: through 180, not through 0.
+        let t = [[10.0, 0.0, 0.0], [300.0, 0.0, 0.0], [150.0, 40.0, 0.0]];
+        let TriangleParts::Cut(west, east) = triangle_parts(t) else {
+            panic!("not cut");
+        };
+        assert!(west.contains(&[10.0, 0.0, 0.0]) && west.contains(&[150.0, 40.0, 0.0]));
+        assert!(east.contains(&[-60.0, 0.0, 0.0]), "{east:?}");
+        // -170 -> 100 in a -180..180 frame never crosses 180: whole, unchanged.
+        let t = [[-170.0, 0.0, 0.0], [100.0, 0.0, 0.0], [0.0, 40.0, 0.0]];
+        assert_eq!(triangle_parts(t), TriangleParts::Whole(t));
+        let line = cut_at_antimeridian(&[[-170.0, 0.0], [100.0, 0.0]]);
+        assert_eq!(line, vec![vec![[-170.0, 0.0], [100.0, 0.0]]]);
     }
 
     #[test]
@@ -308,9 +342,14 @@ mod tests {
         };
         assert!(west.contains(&[180.0, 2.0, 0.0]) && east.contains(&[-180.0, 2.0, 0.0]));
         let back = triangle_from_parts(&[&east, &west]).expect("a triangle");
-        for corner in [[179.0, 0.0, 0.0], [-179.0, 0.0, 0.0], [180.0, 2.0, 0.0]] {
+        for corner in [[179.0, 0.0, 0.0], [-179.0, 0.0, 0.0]] {
             assert!(back.contains(&corner), "{back:?}");
         }
+        // The corner on the meridian, as written in either part.
+        assert!(
+            back.iter().any(|p| p[0].abs() == 180.0 && p[1] == 2.0),
+            "{back:?}"
+        );
     }
 
     #[test]

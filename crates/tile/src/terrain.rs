@@ -345,7 +345,7 @@ pub fn build_terrain(
         if let (Some(lo), Some(hi)) = (info.min, info.max) {
             // Each tile's range is checked after the warp; here only what the warp loses.
             let max_abs = lo.abs().max(hi.abs());
-            if !(max_abs < f64::from(f32::MAX) / 2.0) {
+            if max_abs >= f64::from(f32::MAX) / 2.0 {
                 return Err(TerrainError::Options(format!(
                     "heights up to {max_abs:e} are beyond what quantized-mesh tiles can hold \
                      (their height range is stored in f32)"

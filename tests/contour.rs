@@ -841,3 +841,47 @@ fn global_grids_with_both_edge_meridians_round_trip_through_wgs84_geojson() {
         }
     }
 }
+
+#[test]
+fn a_column_a_hair_off_180_is_put_on_it_in_wgs84_geojson() {
+    // A column whose centre the geotransform puts at 179.9999999999998 (as ETOPO5's on
+    // 0..360): written on 180, so triangles beside it are not cut into slivers; it still
+    // verifies.
+    let d = Dir::new();
+    let mut asc =
+        String::from("ncols 6\nnrows 5\nxllcorner 177.4999999999998\nyllcorner -2.5\ncellsize 1\n");
+    for row in 0..5 {
+        let values: Vec<String> = (0..6)
+            .map(|col| format!("{}", (col * col + 3 * row) as f64 * 1.5))
+            .collect();
+        asc.push_str(&values.join(" "));
+        asc.push('\n');
+    }
+    d.write("hair.asc", &asc);
+    d.write(
+        "hair.prj",
+        "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137,\
+         298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"Degree\",0.017453292519943295]]",
+    );
+    run_ok(
+        &d,
+        &[
+            "mesh",
+            "hair.asc",
+            "--max-error",
+            "0",
+            "-o",
+            "m.geojson",
+            "-q",
+        ],
+    );
+    let text = std::fs::read_to_string(d.path("m.geojson")).unwrap();
+    assert!(!text.contains("179.9999999999998"), "{text}");
+    assert!(
+        text.contains("[180.0,") && text.contains("[-180.0,"),
+        "{text}"
+    );
+    assert!(!text.contains("MultiPolygon"), "{text}");
+    let o = d.run(&["verify", "hair.asc", "m.geojson", "--max-error", "0"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

@@ -286,6 +286,7 @@ pub fn file_crs<'r>(
                 unwrap_around_centre(info, wkt, points)
                     .with_context(|| format!("{}: cannot reproject to WGS84", path.display()))?;
             }
+            snap_to_antimeridian(points);
             Ok(CrsRef::new(None, Some(4326)))
         }
         None => {
@@ -323,6 +324,19 @@ fn unwrap_around_centre(info: &RasterInfo, wkt: &str, points: &mut [[f64; 3]]) -
         }
     }
     Ok(())
+}
+
+/// Longitudes within 1e-9° of the antimeridian (180 + 360 j) put on it: a 0..360 grid's
+/// "180" column computed through its geotransform can lie at 179.9999999999998, and the
+/// GeoJSON writers would cut the triangles beside it into slivers 1e-13° wide. (1e-9° is
+/// 0.1 mm, far below any raster's spacing and the verifier's 1e-3 pixel.)
+fn snap_to_antimeridian(points: &mut [[f64; 3]]) {
+    for p in points {
+        let meridian = 180.0 + 360.0 * ((p[0] - 180.0) / 360.0).round();
+        if (p[0] - meridian).abs() < 1e-9 {
+            p[0] = meridian;
+        }
+    }
 }
 
 /// The last gate for float32 files: every stored position maps back to a sample centre

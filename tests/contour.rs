@@ -655,6 +655,10 @@ fn wgs84_geojson_is_cut_at_the_antimeridian() {
     assert!(fgb.contains("Extent: (170.25"), "{fgb}");
 }
 
+/// An ESRI `.prj` for WGS84 longitude, latitude (GDAL reads it beside an `.asc`).
+const WGS84_PRJ: &str = "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",\
+    6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"Degree\",0.017453292519943295]]";
+
 /// `cone.asc` (+ `.prj`, WGS84) in `d`: a cone of height 100 centred on 180° E, 0° N, in a
 /// raster on 170.25..190.25° longitudes (none on 180), one sample per degree.
 fn write_cone_across_180(d: &Dir) {
@@ -675,11 +679,7 @@ fn write_cone_across_180(d: &Dir) {
         asc.push('\n');
     }
     d.write("cone.asc", &asc);
-    d.write(
-        "cone.prj",
-        "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137,\
-         298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"Degree\",0.017453292519943295]]",
-    );
+    d.write("cone.prj", WGS84_PRJ);
 }
 
 #[test]
@@ -822,11 +822,7 @@ fn global_grids_with_both_edge_meridians_round_trip_through_wgs84_geojson() {
             asc.push('\n');
         }
         d.write(&format!("{name}.asc"), &asc);
-        d.write(
-            &format!("{name}.prj"),
-            "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137,\
-             298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"Degree\",0.017453292519943295]]",
-        );
+        d.write(&format!("{name}.prj"), WGS84_PRJ);
         let input = format!("{name}.asc");
         for target in [
             ["--max-triangles", "12"],
@@ -858,11 +854,7 @@ fn a_column_a_hair_off_180_is_put_on_it_in_wgs84_geojson() {
         asc.push('\n');
     }
     d.write("hair.asc", &asc);
-    d.write(
-        "hair.prj",
-        "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137,\
-         298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"Degree\",0.017453292519943295]]",
-    );
+    d.write("hair.prj", WGS84_PRJ);
     run_ok(
         &d,
         &[

@@ -401,18 +401,16 @@ mod tests {
         // Two parts: one end index between them; one part: no ends array.
         assert_eq!(parts, vec![(0, 2), (1, 0)]);
 
-        let empty: [(&[&[[f64; 2]]], f64); 1] = [(&[], 1.0)];
-        let error = write_multilines(&path, LineFormat::GeoJson, &empty, CrsRef::default())
-            .err()
-            .map(|e| e.to_string())
-            .unwrap_or_default();
+        let error_of = |lines: &[(&[&[[f64; 2]]], f64)]| {
+            write_multilines(&path, LineFormat::GeoJson, lines, CrsRef::default())
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default()
+        };
+        let error = error_of(&[(&[], 1.0)]);
         assert!(error.contains("line 0: no part"), "{error}");
         let short: &[[f64; 2]] = &[[0.0, 0.0]];
-        let bad: [(&[&[[f64; 2]]], f64); 1] = [(&[whole, short], 1.0)];
-        let error = write_multilines(&path, LineFormat::GeoJson, &bad, CrsRef::default())
-            .err()
-            .map(|e| e.to_string())
-            .unwrap_or_default();
+        let error = error_of(&[(&[whole, short], 1.0)]);
         assert!(error.contains("line 0: part 1: 1 point(s)"), "{error}");
         Ok(())
     }

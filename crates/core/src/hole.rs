@@ -194,17 +194,27 @@ impl Retriangulator {
             return true;
         }
         let centre = self.centre.expect("hole loaded");
+        // Triangle ijk contains the centre when each of its sides sees it on the left
+        // (doubled areas of the centre with each side >= 0), and the triangle's own doubled
+        // area is the sum of those three.
         for i in 0..m {
+            let a = &self.ring[i];
             for j in i + 1..m {
-                for k in j + 1..m {
-                    let (a, b, c) = (&self.ring[i], &self.ring[j], &self.ring[k]);
-                    if orient(a, b, c) > 0 && in_closed_triangle(a, b, c, &centre) {
-                        let g = plane_gradient(a, b, c);
-                        let at =
-                            a.z + g[0] * (centre.x - a.x) as f64 + g[1] * (centre.y - a.y) as f64;
-                        if (at - centre.z).abs() <= limit {
-                            return true;
-                        }
+                let b = &self.ring[j];
+                let ab = orient(&centre, a, b);
+                if ab < 0 {
+                    continue;
+                }
+                for c in &self.ring[j + 1..] {
+                    let (bc, ca) = (orient(&centre, b, c), orient(&centre, c, a));
+                    if bc < 0 || ca < 0 || ab + bc + ca <= 0 {
+                        continue;
+                    }
+                    debug_assert!(orient(a, b, c) > 0 && in_closed_triangle(a, b, c, &centre));
+                    let g = plane_gradient(a, b, c);
+                    let at = a.z + g[0] * (centre.x - a.x) as f64 + g[1] * (centre.y - a.y) as f64;
+                    if (at - centre.z).abs() <= limit {
+                        return true;
                     }
                 }
             }

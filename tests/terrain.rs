@@ -475,3 +475,65 @@ fn a_global_pyramid_bends_with_the_globe() {
     }
     assert!(check_shared_edges(&tiles) > 0);
 }
+
+#[test]
+fn a_pyramid_across_the_antimeridian_wraps_its_columns() {
+    // A UTM zone 60 raster whose east part lies past 180 degrees: its tiles are the last
+    // columns and the first ones, stitched across the antimeridian. (Its extent used to
+    // come out as west > east, and the lattice over it as petabytes.)
+    let dir = Dir::new();
+    let input = dir.path("utm60.tif");
+    let status = Command::new("gdal_translate")
+        .args(["-q", "-a_srs", "EPSG:32760", "-a_ullr"])
+        .args(["805000", "8000000", "817900", "7984520"])
+        .arg(fixture("becmodel_dem_bc_albers_50m.tif"))
+        .arg(&input)
+        .status()
+        .expect("gdal_translate runs");
+    assert!(status.success());
+    let input = input.to_string_lossy().into_owned();
+    check_pyramid(&input, 1.0);
+
+    let dir = Dir::new();
+    pyramid(&dir, &input, "p", &["-q"]);
+    let layer: Value =
+        serde_json::from_slice(&std::fs::read(dir.path("p/layer.json")).unwrap()).unwrap();
+    let bounds: Vec<f64> = layer["bounds"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert!(bounds[0] > 179.0 && bounds[2] < -179.0, "bounds {bounds:?}");
+    let tiles = decode_pyramid(&dir.path("p"));
+    let max_zoom = layer["maxzoom"].as_u64().unwrap() as u32;
+    let last = (2u32 << max_zoom) - 1;
+    let mut seams = 0;
+    for (&(z, x, y), t) in tiles.range((max_zoom, 0, 0)..) {
+        assert!(
+            x <= 4 || x >= last - 4,
+            "{z}/{x}/{y} is far from 180 degrees"
+        );
+        if x != last {
+            continue;
+        }
+        // The east edge of the last column is the west edge of column 0.
+        let Some(other) = tiles.get(&(z, 0, y)) else {
+            continue;
+        };
+        let (a, b) = (edge(t, 2), edge(other, 0));
+        let b_at: BTreeMap<i64, f64> = b.iter().copied().collect();
+        for (p, h) in &a {
+            let hb = b_at
+                .get(p)
+                .unwrap_or_else(|| panic!("{z}/{x}/{y}: no vertex at {p} across 180"));
+            assert!(
+                (h - hb).abs() < 1e-6,
+                "{z}/{x}/{y}: heights {h} vs {hb} across 180"
+            );
+            seams += 1;
+        }
+        assert_eq!(a.len(), b.len(), "{z}/{x}/{y}: edges differ across 180");
+    }
+    assert!(seams > 0, "no tile pair across 180 degrees");
+}

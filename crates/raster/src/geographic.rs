@@ -10,14 +10,15 @@ use gdal::DriverManager;
 use crate::error::{gdal_reason, Error, Result};
 use crate::read::OpenBand;
 
-/// Where a raster lies in EPSG:4326 (degrees), and how fine it is.
+/// Where a raster lies in EPSG:4326 (degrees), and how fine it is. `west` is in
+/// `[-180, 180]` and `east` after it: beyond 180 when the raster crosses the antimeridian.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GeoBounds {
     /// West longitude.
     pub west: f64,
     /// South latitude.
     pub south: f64,
-    /// East longitude.
+    /// East longitude, `west < east <= west + 360`; above 180 across the antimeridian.
     pub east: f64,
     /// North latitude.
     pub north: f64,
@@ -65,13 +66,21 @@ pub fn geographic_bounds(path: &Path, band: usize) -> Result<GeoBounds> {
     let opened = OpenBand::open(path, band)?;
     let b = raw_bounds(path, &opened)?;
     let (w, h) = (f64::from(opened.info.width), f64::from(opened.info.height));
-    let resolution = ((b[2] - b[0]) / w).min((b[3] - b[1]) / h);
-    // A geographic raster in 0..360 (or -360..0) longitudes wraps around: it covers the
-    // whole circle of longitudes it spans modulo 360.
-    let (west, east) = if b[2] > 180.0 || b[0] < -180.0 {
-        (-180.0, 180.0)
+    // PROJ gives west > east for an extent across the antimeridian (a projected raster
+    // over 180 degrees): count east on past 180 instead.
+    let (west, east) = if b[0] > b[2] {
+        (b[0], b[2] + 360.0)
     } else {
         (b[0], b[2])
+    };
+    let resolution = ((east - west) / w).min((b[3] - b[1]) / h);
+    let (west, east) = if east - west >= 360.0 {
+        // The whole circle of longitudes (a global grid, in any frame).
+        (-180.0, 180.0)
+    } else if west < -180.0 {
+        (west + 360.0, east + 360.0)
+    } else {
+        (west, east)
     };
     Ok(GeoBounds {
         west,

@@ -198,7 +198,8 @@ pub struct LevelReport {
 /// What [`build_terrain`] produced.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct TerrainReport {
-    /// The input's extent in EPSG:4326.
+    /// The input's extent in EPSG:4326, `[west, south, east, north]`: west > east across
+    /// the antimeridian.
     pub bounds: [f64; 4],
     /// Coarsest level.
     pub min_zoom: u8,
@@ -233,7 +234,25 @@ fn max_edge_length(level: u8, bound: f64) -> Option<u32> {
     }
 }
 
-/// The tile rectangle `z/x/y` (TMS y) in degrees.
+/// `[west, south, east, north]` in degrees; across the antimeridian `east` is wrapped back
+/// below 180, so west > east (as GeoJSON and TileJSON bounding boxes have it).
+fn bounds_array(bounds: &GeoBounds) -> [f64; 4] {
+    let east = if bounds.east > 180.0 {
+        bounds.east - 360.0
+    } else {
+        bounds.east
+    };
+    [bounds.west, bounds.south, east, bounds.north]
+}
+
+/// The tile column of lattice tile column `x` (which is past the last column across the
+/// antimeridian, see [`tile_range`]).
+fn tile_column(z: u8, x: u32) -> u32 {
+    x % (2u32 << z)
+}
+
+/// The tile rectangle `z/x/y` (TMS y) in degrees (east of 180 for `x` past the last
+/// column: the same tile a turn east).
 pub fn tile_rectangle(z: u8, x: u32, y: u32) -> GeoRectangle {
     let size = 180.0 / (1u64 << z) as f64;
     GeoRectangle {
@@ -244,14 +263,17 @@ pub fn tile_rectangle(z: u8, x: u32, y: u32) -> GeoRectangle {
     }
 }
 
-/// The tiles of `level` that the bounds touch: columns and rows, inclusive.
+/// The tiles of `level` that the bounds touch: columns and rows, inclusive. Across the
+/// antimeridian the last column is past the level's last (`2^(level+1)` columns): column
+/// `x` is then tile `x mod 2^(level+1)` (see [`tile_column`]), at most one full turn.
 fn tile_range(bounds: &GeoBounds, level: u8) -> ([u32; 2], [u32; 2]) {
     let n = 1u64 << level;
     let size = 180.0 / n as f64;
     let clamp = |v: f64, max: u64| (v.floor().max(0.0) as u64).min(max - 1) as u32;
+    let west = clamp((bounds.west + 180.0) / size, 2 * n);
     let x = [
-        clamp((bounds.west + 180.0) / size, 2 * n),
-        clamp((bounds.east + 180.0) / size, 2 * n),
+        west,
+        clamp((bounds.east + 180.0) / size, u64::from(west) + 2 * n),
     ];
     let y = [
         clamp((bounds.south + 90.0) / size, n),
@@ -403,7 +425,7 @@ pub fn build_terrain(
         }
     })?;
     Ok(TerrainReport {
-        bounds: [bounds.west, bounds.south, bounds.east, bounds.north],
+        bounds: bounds_array(&bounds),
         min_zoom: options.min_zoom,
         max_zoom,
         levels,
@@ -694,6 +716,8 @@ fn build_tile(
     metadata_available: Option<&Available>,
 ) -> TerrainResult<Option<TileOut>> {
     let z = raster.level;
+    // Where the tile is written (`x` may be a turn east, see `tile_range`).
+    let column = tile_column(z, x);
     let n = TILE_CELLS as usize;
     let (i0, j0) = raster.tile_origin(x, y);
     let values = raster.tile_values(x, y);
@@ -733,7 +757,12 @@ fn build_tile(
     decimation_options.max_abs_value = Some(budget.max_abs);
     decimation_options.max_edge_length = budget.max_edge;
     let tin = decimate_with_border(&grid, &decimation_options, &keep_border, &mut |_| {})
-        .map_err(|source| TerrainError::Decimate { z, x, y, source })?
+        .map_err(|source| TerrainError::Decimate {
+            z,
+            x: column,
+            y,
+            source,
+        })?
         .tin;
     if tin.triangles().is_empty() {
         return Ok(None);
@@ -779,14 +808,14 @@ fn build_tile(
     )
     .map_err(|e| TerrainError::Verify {
         z,
-        x,
+        x: column,
         y,
         problems: e.to_string(),
     })?;
     if !check.passed() {
         return Err(TerrainError::Verify {
             z,
-            x,
+            x: column,
             y,
             problems: check.problems.join("; "),
         });
@@ -808,7 +837,7 @@ fn build_tile(
             })
             .collect()
     });
-    let metadata = metadata_available.map(|available| metadata_json(available, z, x, y));
+    let metadata = metadata_available.map(|available| metadata_json(available, z, column, y));
     let mut tile = QuantizedMeshTile::new(
         rect,
         min_height as f32,
@@ -822,14 +851,17 @@ fn build_tile(
     if let Some(metadata) = &metadata {
         tile = tile.with_metadata(metadata);
     }
-    let mut bytes = tile
-        .encode()
-        .map_err(|source| TerrainError::Encode { z, x, y, source })?;
+    let mut bytes = tile.encode().map_err(|source| TerrainError::Encode {
+        z,
+        x: column,
+        y,
+        source,
+    })?;
     if options.gzip {
         bytes = gzip(&bytes);
     }
     Ok(Some(TileOut {
-        x,
+        x: column,
         y,
         bytes,
         vertices: quantized.len(),
@@ -956,7 +988,7 @@ fn write_layer_json(
         "tiles": ["{z}/{x}/{y}.terrain?v={version}"],
         "minzoom": options.min_zoom,
         "maxzoom": max_zoom,
-        "bounds": [bounds.west, bounds.south, bounds.east, bounds.north],
+        "bounds": bounds_array(bounds),
         "extensions": extensions,
         "available": available,
         "attribution": "",

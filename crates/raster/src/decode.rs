@@ -58,8 +58,8 @@ impl SampleType {
 /// *in the band's own type*, by GDAL's rule: for Float32 bands the nodata value is first
 /// rounded to `f32` (vinschgau declares `-3.4e38`, which is not `-FLT_MAX` and is stored as
 /// the nearest `f32`), and float samples match within GDAL's tolerance (see
-/// `gdal_real_equal`); for integer bands it is rounded to the nearest integer and ignored
-/// when outside the type's range (no sample can hold it). Valid samples are then mapped through the
+/// `gdal_real_equal`); for integer bands it matches only when it is an integer within the
+/// type's range (otherwise no sample can hold it). Valid samples are then mapped through the
 /// band's scale and offset (`value * scale + offset`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct SampleDecoder {
@@ -119,25 +119,26 @@ impl SampleDecoder {
 }
 
 /// GDAL's test for a floating-point sample equal to the nodata value (`ARE_REAL_EQUAL` in
-/// its nodata mask band): equal, or closer than two `f32` epsilons of their sum. So a
-/// Float32 file that declares `-3.4028230607370965e+38` (as ArcGIS writes) while its
-/// samples hold `-f32::MAX`, two `f32` steps away, has those samples as nodata, as GDAL's
-/// own tools see it.
+/// its nodata mask band and statistics): equal, or closer than two `f32` epsilons of their
+/// sum, computed in the band's own type. So a Float32 file that declares
+/// `-3.4028230607370965e+38` (as ArcGIS writes) or `-3.4e38` while its samples hold
+/// `-f32::MAX` has those samples as nodata, as `gdalinfo -stats` counts them: near
+/// `±f32::MAX` the `f32` sum overflows to infinity and everything that far out matches.
 fn gdal_real_equal(sample_type: SampleType, value: f64, nodata: f64) -> bool {
-    let (a, b) = if sample_type == SampleType::Float32 {
-        (value as f32 as f64, nodata as f32 as f64)
+    if sample_type == SampleType::Float32 {
+        let (a, b) = (value as f32, nodata as f32);
+        a == b || (a - b).abs() < f32::EPSILON * (a + b).abs() * 2.0
     } else {
-        (value, nodata)
-    };
-    // In f64, so that the sum of two values near ±f32::MAX does not overflow (in GDAL's
-    // f32 arithmetic it does, and then everything near the nodata value matches).
-    a == b || (a - b).abs() < f64::from(f32::EPSILON) * (a + b).abs() * 2.0
+        value == nodata
+            || (value - nodata).abs() < f64::from(f32::EPSILON) * (value + nodata).abs() * 2.0
+    }
 }
 
-/// The integer an integer band stores for nodata value `nd`, if the type can hold it.
+/// The integer an integer band stores for nodata value `nd`: none when the value is not an
+/// integer or the type cannot hold it (no sample can equal it; `gdalinfo -stats` counts
+/// no nodata then either).
 fn integer_key(nd: f64, min: f64, max: f64) -> Option<f64> {
-    let r = nd.round();
-    (r >= min && r <= max).then_some(r)
+    (nd.fract() == 0.0 && nd >= min && nd <= max).then_some(nd)
 }
 
 /// Running counts and range of decoded samples.
@@ -186,14 +187,19 @@ mod tests {
         assert_ne!(stored, -3.4e38);
         let d = SampleDecoder::new(ty("Float32"), Some(-3.4e38), 1.0, 0.0);
         assert!(d.decode(stored).is_nan());
-        assert_eq!(d.decode(-3.3e38_f32 as f64), -3.3e38_f32 as f64);
+        // -FLT_MAX too, as gdalinfo -stats counts it (the f32 sum overflows), and so
+        // everything that far out; ordinary heights are untouched.
+        assert!(d.decode(f32::MIN as f64).is_nan());
+        assert!(d.decode(-3.3e38_f32 as f64).is_nan());
+        assert_eq!(d.decode(-1e30_f32 as f64), -1e30_f32 as f64);
+        assert_eq!(d.decode(-9999.0), -9999.0);
         let d = SampleDecoder::new(ty("Float32"), Some(f32::MIN as f64), 1.0, 0.0);
         assert!(d.decode(f32::MIN as f64).is_nan());
         // ArcGIS-style: declared two f32 steps short of -FLT_MAX, samples hold -FLT_MAX
         // (GDAL's own rule treats them as nodata).
         let d = SampleDecoder::new(ty("Float32"), Some(-3.4028230607370965e38), 1.0, 0.0);
         assert!(d.decode(f32::MIN as f64).is_nan());
-        assert_eq!(d.decode(-3.3e38_f32 as f64), -3.3e38_f32 as f64);
+        assert_eq!(d.decode(-1e30_f32 as f64), -1e30_f32 as f64);
         let d = SampleDecoder::new(ty("Float32"), Some(3.4028230607370965e38), 1.0, 0.0);
         assert!(d.decode(f32::MAX as f64).is_nan());
         assert_eq!(d.decode(12.5), 12.5);
@@ -229,7 +235,7 @@ mod tests {
     }
 
     #[test]
-    fn integer_nodata_is_rounded_and_range_checked() {
+    fn integer_nodata_must_be_an_integer_in_range() {
         let d = SampleDecoder::new(ty("Int16"), Some(-32768.0), 1.0, 0.0);
         assert!(d.decode(-32768.0).is_nan());
         assert_eq!(d.decode(-32767.0), -32767.0);
@@ -237,7 +243,12 @@ mod tests {
         let d = SampleDecoder::new(ty("Byte"), Some(-9999.0), 1.0, 0.0);
         assert_eq!(d.decode(0.0), 0.0);
         assert_eq!(d.decode(255.0), 255.0);
-        let d = SampleDecoder::new(ty("UInt16"), Some(65535.4), 1.0, 0.0);
+        // Nor does one that is not an integer (GDAL 3.6's mask band would truncate 3.5 to 3;
+        // its statistics and later versions match nothing).
+        let d = SampleDecoder::new(ty("Int16"), Some(3.5), 1.0, 0.0);
+        assert_eq!(d.decode(3.0), 3.0);
+        assert_eq!(d.decode(4.0), 4.0);
+        let d = SampleDecoder::new(ty("UInt16"), Some(65535.0), 1.0, 0.0);
         assert!(d.decode(65535.0).is_nan());
     }
 

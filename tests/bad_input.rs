@@ -272,6 +272,77 @@ fn output_that_is_the_input_is_refused_and_the_input_kept() {
     assert!(!d.path("m.ply").exists());
 }
 
+#[test]
+fn two_files_of_one_run_that_are_the_same_file_are_refused() {
+    let d = Dir::new();
+    let o = d.run(&["mesh", &dem(), "-o", "m.geojson", "--max-error", "1", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mesh_before = std::fs::read(d.path("m.geojson")).unwrap();
+    std::os::unix::fs::symlink("m.geojson", d.path("alias.geojson")).unwrap();
+    let cases: [(&[&str], [&str; 2]); 4] = [
+        (
+            &[
+                "mesh",
+                &dem(),
+                "-o",
+                "t.ply",
+                "--max-error",
+                "1",
+                "--report",
+                "t.ply",
+            ],
+            ["t.ply", "the output"],
+        ),
+        (
+            &[
+                "mesh",
+                &dem(),
+                "-o",
+                "t.ply",
+                "--max-error",
+                "1",
+                "--report",
+                "./t.ply",
+                "--tile-size",
+                "16",
+            ],
+            ["t.ply", "the output"],
+        ),
+        (
+            &[
+                "contour",
+                &dem(),
+                "--mesh",
+                "m.geojson",
+                "-o",
+                "m.geojson",
+                "--interval",
+                "10",
+            ],
+            ["m.geojson", "--mesh input"],
+        ),
+        (
+            &[
+                "contour",
+                &dem(),
+                "--mesh",
+                "m.geojson",
+                "-o",
+                "alias.geojson",
+                "--interval",
+                "10",
+            ],
+            ["alias.geojson", "--mesh input"],
+        ),
+    ];
+    for (args, named) in cases {
+        let o = d.run(args);
+        assert_fails_naming(&o, &named);
+    }
+    assert!(!d.path("t.ply").exists());
+    assert_eq!(std::fs::read(d.path("m.geojson")).unwrap(), mesh_before);
+}
+
 #[cfg(unix)]
 #[test]
 fn a_symlinked_output_stays_a_link() {

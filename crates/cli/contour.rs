@@ -31,8 +31,8 @@ use tinsmith_tile::{mesh_tiles, MeshCollector, RasterSource, TileOptions};
 use crate::args::ContourArgs;
 use crate::export::file_crs;
 use crate::georef::Georef;
-use crate::output::check_writable_target;
 use crate::output::NamingFile;
+use crate::output::{check_distinct, check_writable_target};
 use crate::verify::read_mesh_file;
 
 /// Builds the TIN, contours it and writes the lines; `Ok(true)` on success.
@@ -49,6 +49,9 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         );
     }
     check_writable_target(&args.output, &args.input)?;
+    if let Some(mesh) = &args.mesh {
+        check_distinct(mesh, &args.output, "the --mesh input")?;
+    }
     let e = args.max_error.unwrap_or(0.0);
     let size = crate::memory::raster_size(&args.input, args.band)?;
     let tiled =

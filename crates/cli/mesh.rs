@@ -10,7 +10,7 @@ use tinsmith_verify::{GridRef, VerifyOptions};
 use crate::args::MeshArgs;
 use crate::georef::Georef;
 use crate::output::NamingFile;
-use crate::output::{check_writable_target, write_atomically};
+use crate::output::{check_distinct, check_writable_target, write_atomically};
 use crate::report::{MeshSummary, Outcome, Seconds};
 
 /// The `--report` JSON.
@@ -45,6 +45,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     check_writable_target(output, &args.input)?;
     if let Some(report) = &args.report {
         check_writable_target(report, &args.input)?;
+        check_distinct(output, report, "the output")?;
     }
 
     let t = Instant::now();

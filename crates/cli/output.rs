@@ -39,6 +39,33 @@ pub fn check_not_input(output: &Path, input: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Fails when two files of one run are the same file (by any path, links included, whether
+/// they exist yet or not): `second` (described as `what`) would overwrite or destroy
+/// `first`, e.g. `--report` naming the output mesh, or an output naming the `--mesh` input.
+pub fn check_distinct(first: &Path, second: &Path, what: &str) -> Result<()> {
+    if let (Some(a), Some(b)) = (file_identity(first), file_identity(second)) {
+        if a == b {
+            bail!(
+                "{}: is also {} {}; one would overwrite the other",
+                second.display(),
+                what,
+                first.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// A path that names the same file as every other path to it: the canonical path when the
+/// file exists, else the canonical directory joined with the file name.
+fn file_identity(path: &Path) -> Option<std::path::PathBuf> {
+    let target = tinsmith_export::resolve_output(path);
+    std::fs::canonicalize(&target).ok().or_else(|| {
+        let name = target.file_name()?;
+        Some(std::fs::canonicalize(parent_dir(&target)).ok()?.join(name))
+    })
+}
+
 /// Writes `bytes` to `path` through a temporary file in the same directory and an atomic
 /// rename: `path` is either untouched or complete. A symlink is followed (it stays a
 /// link); a device or pipe is written in place.

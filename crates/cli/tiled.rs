@@ -18,7 +18,7 @@ use tinsmith_tile::{
 use crate::args::{MeshArgs, TileFormatArg};
 use crate::georef::Georef;
 use crate::output::NamingFile;
-use crate::output::{check_writable_target, write_atomically};
+use crate::output::{check_distinct, check_writable_target, write_atomically};
 use crate::report::{MeshSummary, Outcome, Seconds};
 
 /// GDAL block cache in tiled mode, in MB: several rows of tiles of a 16k-wide Float32
@@ -132,6 +132,9 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     };
     if let Some(report) = &args.report {
         check_writable_target(report, &args.input)?;
+        if let Some(output) = &args.output {
+            check_distinct(output, report, "the output")?;
+        }
     }
 
     // Tiles need only the blocks of the current row of tiles; GDAL's default (5 % of the

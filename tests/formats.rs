@@ -533,6 +533,22 @@ fn flags_for_another_format_are_refused_and_format_overrides_the_extension() {
         "1e6",
     ]);
     crate::util::assert_fails_naming(&o, &["m.stl", "base"]);
+    // Nor one beyond float32 (the floor would be written at -inf).
+    for size in ["4096", "16"] {
+        let o = d.run(&[
+            "mesh",
+            &dem,
+            "-o",
+            "m.stl",
+            "--max-error",
+            E,
+            "--base",
+            "-1e40",
+            "--tile-size",
+            size,
+        ]);
+        crate::util::assert_fails_naming(&o, &["m.stl", "base", "float32"]);
+    }
     assert_eq!(d.files(), Vec::<String>::new(), "nothing written");
 
     mesh(&d, &dem, "tin.dat", E, &["--format", "fgb"]);

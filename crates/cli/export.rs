@@ -105,6 +105,15 @@ impl Plan {
         let georef = Georef::new(info.transform(), args.pixel_coords);
         let (min, max) = extent(info, &georef);
         let origin = LocalOrigin::around(min, max);
+        if let Some(base) = args.export.base {
+            // The solid's floor is written as float32 like every other coordinate.
+            if !((base - origin.offset()[2]) as f32).is_finite() {
+                bail!(
+                    "{}: --base {base} is beyond the range of the format's float32 coordinates",
+                    out(args).display()
+                );
+            }
+        }
         check_position_rounding(info, &georef, origin, min, max, out(args))?;
 
         let height_rounding = match grid {

@@ -71,7 +71,8 @@ pub struct DecimationReport {
 /// The result depends only on `grid` and `options`.
 ///
 /// # Errors
-/// [`Error::InvalidMaxError`] when `max_error` is negative, NaN or infinite.
+/// [`Error::InvalidMaxError`] when `max_error` is negative, NaN or infinite;
+/// [`Error::HeightsTooLarge`] when some |height| exceeds [`MAX_ABS_HEIGHT`].
 pub fn decimate(grid: &Grid, options: &DecimationOptions) -> Result<Decimation> {
     decimate_with_progress(grid, options, &mut |_| {})
 }
@@ -136,6 +137,10 @@ pub fn effective_limit(max_error: f64, max_abs_value: f64) -> f64 {
     }
 }
 
+/// The largest |height| decimation accepts: error bounds are stored as `f32`, and between
+/// heights up to this they stay well within its range (and planes far from `f64` overflow).
+pub const MAX_ABS_HEIGHT: f64 = 1e37;
+
 fn run(
     grid: &Grid,
     options: &DecimationOptions,
@@ -156,6 +161,9 @@ fn run(
         .max_abs_value
         .unwrap_or_else(|| grid.max_abs_value())
         .max(grid.max_abs_value());
+    if max_abs > MAX_ABS_HEIGHT {
+        return Err(Error::HeightsTooLarge(max_abs));
+    }
     let limit = effective_limit(max_error, max_abs);
 
     let started = Instant::now();

@@ -38,6 +38,12 @@ pub enum Error {
     /// longer than 1).
     #[error("maximum edge length must be at least 2 sample spacings, got {0}")]
     InvalidMaxEdgeLength(u32),
+    /// Some |height| exceeds [`crate::MAX_ABS_HEIGHT`]: errors between such heights could
+    /// not be stored or measured.
+    #[error(
+        "heights reach {0:e}; decimation takes heights within ±1e37 (errors are kept as float32)"
+    )]
+    HeightsTooLarge(f64),
     /// The maximum error is negative, NaN or infinite.
     #[error("maximum error must be a finite number >= 0, got {0}")]
     InvalidMaxError(f64),

@@ -44,7 +44,7 @@ mod tin;
 
 pub use decimate::{
     decimate, decimate_with_border, decimate_with_progress, effective_limit, Decimation,
-    DecimationReport, Progress,
+    DecimationReport, Progress, MAX_ABS_HEIGHT,
 };
 pub use error::{Error, Result};
 pub use error_bound::ErrorBound;

@@ -214,6 +214,33 @@ fn planar_grid_keeps_only_its_corners() {
 }
 
 #[test]
+fn heights_near_f64_overflow_are_refused_and_large_ones_keep_the_bound() {
+    // A checkerboard of ±h: its errors overflow f32 (where bounds are kept) from about
+    // 1e38, and planes through it overflow f64 near f64::MAX.
+    let board = |h: f64| GridSpec {
+        width: 6,
+        height: 5,
+        values: (0..30)
+            .map(|i| if (i % 6 + i / 6) % 2 == 0 { h } else { -h })
+            .collect(),
+    };
+    let spec = board(1.7e308);
+    let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
+    let err = decimate(&grid, &DecimationOptions::new(1e300)).unwrap_err();
+    assert!(
+        matches!(err, tinsmith_core::Error::HeightsTooLarge(_)),
+        "{err}"
+    );
+    // Just under the limit the bound holds, measured independently.
+    check(
+        &board(tinsmith_core::MAX_ABS_HEIGHT),
+        1e289,
+        EdgeSelection::Hybrid,
+    )
+    .unwrap();
+}
+
+#[test]
 fn constant_grid_decimates_even_at_zero_error() {
     let spec = GridSpec {
         width: 9,

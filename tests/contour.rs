@@ -799,6 +799,134 @@ fn a_projected_raster_across_the_antimeridian_round_trips_through_wgs84_geojson(
     assert!(info.contains("Extent: (-180.000000,"), "{info}");
 }
 
+/// A 40 x 40 raster of 10 km cells around (0, 0) of `srs`, with a wavy surface.
+fn write_projected(d: &Dir, name: &str, srs: &str, x0: f64, y0: f64) {
+    let mut asc = format!(
+        "ncols 40\nnrows 40\nxllcorner {x0}\nyllcorner {}\ncellsize 10000\n",
+        y0 - 400_000.0
+    );
+    for row in 0..40 {
+        let values: Vec<String> = (0..40)
+            .map(|col| {
+                let (x, y) = (f64::from(col), f64::from(row));
+                format!("{}", 50.0 * (x / 5.0).sin() * (y / 4.0).cos() + x)
+            })
+            .collect();
+        asc.push_str(&values.join(" "));
+        asc.push('\n');
+    }
+    d.write(&format!("{name}.asc"), &asc);
+    d.write(
+        &format!("{name}.vrt"),
+        &format!(
+            "<VRTDataset rasterXSize=\"40\" rasterYSize=\"40\"><SRS>{srs}</SRS>\
+             <GeoTransform>{x0}, 10000, 0, {y0}, 0, -10000</GeoTransform>\
+             <VRTRasterBand dataType=\"Float32\" band=\"1\"><SimpleSource>\
+             <SourceFilename relativeToVRT=\"1\">{name}.asc</SourceFilename>\
+             <SourceBand>1</SourceBand></SimpleSource></VRTRasterBand></VRTDataset>"
+        ),
+    );
+}
+
+#[test]
+fn a_polar_raster_contours_to_wgs84_and_its_mesh_needs_its_own_crs() {
+    // Polar stereographic around the north pole: longitudes go all the way round, so no
+    // frame is continuous. Contour lines are unwrapped along each line and cut at 180°
+    // (they used to jump to -180 at about 133° E); a GeoJSON mesh is refused up front
+    // (triangles round the pole cannot be written in longitude, latitude), and written in
+    // the raster's CRS with --geojson-source-crs.
+    let d = Dir::new();
+    write_projected(&d, "arctic", "EPSG:3413", -200_000.0, 200_000.0);
+    run_ok(
+        &d,
+        &[
+            "contour",
+            "arctic.vrt",
+            "--interval",
+            "10",
+            "-o",
+            "c.geojson",
+            "-q",
+        ],
+    );
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path("c.geojson")).unwrap()).unwrap();
+    let mut segments = 0;
+    for f in v["features"].as_array().unwrap() {
+        let g = &f["geometry"];
+        let parts: Vec<&serde_json::Value> = match g["type"].as_str().unwrap() {
+            "LineString" => vec![&g["coordinates"]],
+            _ => g["coordinates"].as_array().unwrap().iter().collect(),
+        };
+        for part in parts {
+            let p: Vec<[f64; 2]> = part
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|q| [q[0].as_f64().unwrap(), q[1].as_f64().unwrap()])
+                .collect();
+            for w in p.windows(2) {
+                assert!(w[0][0].abs() <= 180.0 && w[1][0].abs() <= 180.0);
+                assert!(
+                    (w[0][0] - w[1][0]).abs() < 90.0,
+                    "a jump {:?} -> {:?}",
+                    w[0],
+                    w[1]
+                );
+                segments += 1;
+            }
+        }
+    }
+    assert!(segments > 1000, "{segments} segments");
+
+    for args in [
+        &["--max-error", "1"][..],
+        &["--max-error", "1", "--tile-size", "16"],
+    ] {
+        let mut all = vec!["mesh", "arctic.vrt", "-o", "m.geojson"];
+        all.extend_from_slice(args);
+        assert_fails_naming(
+            &d.run(&all),
+            &["m.geojson", "north pole", "--geojson-source-crs"],
+        );
+        assert!(!d.path("m.geojson").exists());
+    }
+    run_ok(
+        &d,
+        &[
+            "mesh",
+            "arctic.vrt",
+            "-o",
+            "m.geojson",
+            "--max-error",
+            "1",
+            "--geojson-source-crs",
+            "-q",
+        ],
+    );
+    let o = d.run(&["verify", "arctic.vrt", "m.geojson", "--max-error", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn a_mercator_raster_past_the_antimeridian_is_not_written_as_wgs84_geojson() {
+    // Web Mercator eastings past 20037508 m: PROJ takes them back to the other side of
+    // the world, so WGS84 coordinates would not read back to their samples.
+    let d = Dir::new();
+    write_projected(&d, "merc", "EPSG:3857", 19_837_508.34, 1_000_000.0);
+    assert_fails_naming(
+        &d.run(&["mesh", "merc.vrt", "-o", "m.geojson", "--max-error", "1"]),
+        &["m.geojson", "comes back from WGS84", "--geojson-source-crs"],
+    );
+    assert!(!d.path("m.geojson").exists());
+    run_ok(
+        &d,
+        &["mesh", "merc.vrt", "-o", "m.fgb", "--max-error", "1", "-q"],
+    );
+    let o = d.run(&["verify", "merc.vrt", "m.fgb", "--max-error", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
 #[test]
 fn global_grids_with_both_edge_meridians_round_trip_through_wgs84_geojson() {
     // 5° global grids whose first and last columns are the same meridian (-180 and 180, or

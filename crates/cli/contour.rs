@@ -29,7 +29,7 @@ use tinsmith_raster::{Raster, RasterInfo};
 use tinsmith_tile::{mesh_tiles, MeshCollector, RasterSource, TileOptions};
 
 use crate::args::ContourArgs;
-use crate::export::file_crs;
+use crate::export::{file_crs, Pieces};
 use crate::georef::Georef;
 use crate::output::NamingFile;
 use crate::output::{check_distinct, check_writable_target};
@@ -140,6 +140,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         args.pixel_coords,
         wgs84,
         &mut points,
+        Pieces::Lines(&ends),
         &args.output,
         args.quiet,
     )?;

@@ -86,6 +86,10 @@ impl Plan {
         args: &MeshArgs,
     ) -> Result<Plan> {
         let max_error = args.max_error.unwrap_or(f64::INFINITY);
+        if format == MeshFormat::GeoJson && !args.export.geojson_source_crs && !args.pixel_coords {
+            // Before any work: what `write` would refuse for the raster as a whole.
+            check_wgs84_mesh_possible(info, out(args))?;
+        }
         if !format.is_float32() {
             return Ok(Plan {
                 format,
@@ -244,14 +248,19 @@ pub fn write(
 ) -> Result<()> {
     let path = out(args);
     let wgs84 = plan.format == MeshFormat::GeoJson && !args.export.geojson_source_crs;
+    let world = wgs84.then(|| vertices.clone());
     let crs = file_crs(
         info,
         args.pixel_coords,
         wgs84,
         &mut vertices,
+        Pieces::Mesh,
         path,
         args.quiet,
     )?;
+    if let (Some(world), Some(4326)) = (&world, crs.epsg) {
+        check_wgs84_maps_back(world, &vertices, info, path)?;
+    }
     if let Some(origin) = plan.origin {
         check_positions_map_back(&vertices, origin, info, args)?;
     }
@@ -277,6 +286,7 @@ pub fn file_crs<'r>(
     pixel_coords: bool,
     wgs84: bool,
     points: &mut [[f64; 3]],
+    pieces: Pieces<'_>,
     path: &Path,
     quiet: bool,
 ) -> Result<CrsRef<'r>> {
@@ -292,8 +302,16 @@ pub fn file_crs<'r>(
             tinsmith_raster::to_wgs84(wkt, points)
                 .with_context(|| format!("{}: cannot reproject to WGS84", path.display()))?;
             if !tinsmith_raster::is_geographic(wkt)? {
-                unwrap_around_centre(info, wkt, points)
-                    .with_context(|| format!("{}: cannot reproject to WGS84", path.display()))?;
+                let pole = pole_inside(info, wkt);
+                match (pole, pieces) {
+                    (None, _) => unwrap_around_centre(info, wkt, points).with_context(|| {
+                        format!("{}: cannot reproject to WGS84", path.display())
+                    })?,
+                    (Some(pole), Pieces::Mesh) => {
+                        bail!("{}: {}", path.display(), pole_message(pole))
+                    }
+                    (Some(_), Pieces::Lines(ends)) => unwrap_along_lines(points, ends),
+                }
             }
             snap_to_antimeridian(points);
             Ok(CrsRef::new(None, Some(4326)))
@@ -307,6 +325,50 @@ pub fn file_crs<'r>(
             }
             Ok(crs)
         }
+    }
+}
+
+/// What the points given to [`file_crs`] are.
+#[derive(Debug, Clone, Copy)]
+pub enum Pieces<'a> {
+    /// A mesh's vertices (shared by triangles).
+    Mesh,
+    /// Lines, one after the other: the end index of each in the points (and its level).
+    Lines(&'a [(usize, f64)]),
+}
+
+/// Which pole ("north" or "south") lies within the hull of a projected raster's sample
+/// centres, if any: its longitudes then go all the way round.
+fn pole_inside(info: &RasterInfo, wkt: &str) -> Option<&'static str> {
+    let transform = info.transform()?;
+    [(90.0, "north"), (-90.0, "south")]
+        .into_iter()
+        .find(|&(lat, _)| {
+            let mut pole = [[0.0, lat, 0.0]];
+            tinsmith_raster::from_wgs84(wkt, &mut pole).is_ok()
+                && pole[0].iter().all(|v| v.is_finite())
+                && transform
+                    .world_to_sample([pole[0][0], pole[0][1]])
+                    .is_some_and(|[x, y]| {
+                        (-0.5..=f64::from(info.width) - 0.5).contains(&x)
+                            && (-0.5..=f64::from(info.height) - 0.5).contains(&y)
+                    })
+        })
+        .map(|(_, name)| name)
+}
+
+/// Around a pole no frame of longitudes is continuous over the whole raster, but along a
+/// line each step is short: each point's longitude is moved by whole turns to within 180°
+/// of the point before it (the GeoJSON writer then cuts at the antimeridian).
+fn unwrap_along_lines(points: &mut [[f64; 3]], ends: &[(usize, f64)]) {
+    let mut start = 0;
+    for &(end, _) in ends {
+        for i in start + 1..end {
+            let previous = points[i - 1][0];
+            let p = &mut points[i][0];
+            *p = previous + (*p - previous + 180.0).rem_euclid(360.0) - 180.0;
+        }
+        start = end;
     }
 }
 
@@ -346,6 +408,81 @@ fn snap_to_antimeridian(points: &mut [[f64; 3]]) {
             p[0] = meridian;
         }
     }
+}
+
+/// Fails early when a mesh of the raster cannot be written as RFC 7946 GeoJSON: a pole in
+/// a projected raster (see [`file_crs`]), or a corner sample that does not come back from
+/// WGS84 (see [`check_wgs84_maps_back`]; `write` checks every vertex again).
+fn check_wgs84_mesh_possible(info: &RasterInfo, path: &Path) -> Result<()> {
+    let (Some(wkt), Some(transform)) = (info.crs_wkt.as_deref(), info.transform()) else {
+        return Ok(());
+    };
+    if info.epsg == Some(4326) || tinsmith_raster::is_geographic(wkt)? {
+        return Ok(());
+    }
+    if let Some(pole) = pole_inside(info, wkt) {
+        bail!("{}: {}", path.display(), pole_message(pole));
+    }
+    let (w, h) = (f64::from(info.width) - 1.0, f64::from(info.height) - 1.0);
+    let world: Vec<[f64; 3]> = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h), (w / 2.0, h / 2.0)]
+        .into_iter()
+        .map(|(x, y)| {
+            let [x, y] = transform.sample_centre(x, y);
+            [x, y, 0.0]
+        })
+        .collect();
+    let mut lon_lat = world.clone();
+    tinsmith_raster::to_wgs84(wkt, &mut lon_lat)
+        .with_context(|| format!("{}: cannot reproject to WGS84", path.display()))?;
+    check_wgs84_maps_back(&world, &lon_lat, info, path)
+}
+
+fn pole_message(pole: &str) -> String {
+    format!(
+        "the raster contains the {pole} pole, around which WGS84 longitudes wrap: RFC 7946 \
+         GeoJSON cannot hold the triangles there; write with --geojson-source-crs (the \
+         raster's CRS) or to .fgb"
+    )
+}
+
+/// The last gate for WGS84 GeoJSON from a projected raster: every vertex's longitude and
+/// latitude transform back to the sample it came from (`world`, in the raster's CRS), as
+/// `tinsmith verify` will transform them. A raster reaching past its CRS's valid area (Web
+/// Mercator x beyond the antimeridian) would come back elsewhere.
+fn check_wgs84_maps_back(
+    world: &[[f64; 3]],
+    lon_lat: &[[f64; 3]],
+    info: &RasterInfo,
+    path: &Path,
+) -> Result<()> {
+    let (Some(wkt), Some(transform)) = (info.crs_wkt.as_deref(), info.transform()) else {
+        return Ok(());
+    };
+    if info.epsg == Some(4326) || tinsmith_raster::is_geographic(wkt)? {
+        return Ok(());
+    }
+    let mut back = lon_lat.to_vec();
+    tinsmith_raster::from_wgs84(wkt, &mut back)
+        .with_context(|| format!("{}: cannot transform WGS84 back", path.display()))?;
+    for (w, b) in world.iter().zip(&back) {
+        let sample = |p: &[f64; 3]| transform.world_to_sample([p[0], p[1]]);
+        let (Some(s), Some(t)) = (sample(w), sample(b)) else {
+            continue;
+        };
+        if !((s[0] - t[0]).abs() <= 1e-3 && (s[1] - t[1]).abs() <= 1e-3) {
+            bail!(
+                "{}: the vertex at ({}, {}) comes back from WGS84 at ({}, {}): the raster \
+                 reaches beyond its CRS's valid area, so RFC 7946 GeoJSON could not be read \
+                 back; write with --geojson-source-crs (the raster's CRS) or to .fgb",
+                path.display(),
+                w[0],
+                w[1],
+                b[0],
+                b[1]
+            );
+        }
+    }
+    Ok(())
 }
 
 /// The last gate for float32 files: every stored position maps back to a sample centre

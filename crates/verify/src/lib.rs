@@ -46,6 +46,7 @@
 #![forbid(unsafe_code)]
 
 mod coverage;
+mod edges;
 mod error;
 mod grid;
 mod mesh;

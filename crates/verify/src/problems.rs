@@ -28,12 +28,16 @@ pub(crate) enum Kind {
     Uncovered,
     /// The mesh area differs from the domain area.
     AreaMismatch,
+    /// An edge inside the domain borders one triangle only.
+    OpenEdge,
+    /// An edge is shared by triangles on the same side, or by more than two.
+    OverlappingEdge,
     /// The maximum error exceeds the allowed one.
     ErrorExceeded,
 }
 
 impl Kind {
-    const ALL: [Kind; 11] = [
+    const ALL: [Kind; 13] = [
         Kind::BadIndex,
         Kind::VertexOutsideGrid,
         Kind::VertexOnNodata,
@@ -44,6 +48,8 @@ impl Kind {
         Kind::NodataCovered,
         Kind::Uncovered,
         Kind::AreaMismatch,
+        Kind::OpenEdge,
+        Kind::OverlappingEdge,
         Kind::ErrorExceeded,
     ];
 }
@@ -61,6 +67,8 @@ impl fmt::Display for Kind {
             Kind::NodataCovered => "triangles covering nodata",
             Kind::Uncovered => "uncovered domain samples",
             Kind::AreaMismatch => "area mismatches",
+            Kind::OpenEdge => "open edges inside the domain",
+            Kind::OverlappingEdge => "overlapping edges",
             Kind::ErrorExceeded => "error bound violations",
         })
     }

@@ -74,6 +74,12 @@ pub struct Report {
     pub domain_area_x2: u128,
     /// Sum over measured, non-degenerate triangles of twice their area, `|orient|`.
     pub mesh_area_x2: u128,
+    /// Edges used by one (measured, non-degenerate) triangle that do not lie on the
+    /// domain's outline with the domain on that triangle's side: holes, cracks,
+    /// T-junctions, a vertex repeated with another height.
+    pub open_edges: u64,
+    /// Edges shared by two triangles on the same side of them, or by more than two.
+    pub overlapping_edges: u64,
     /// One line per problem found, the first few of each kind, with positions.
     pub problems: Vec<String>,
 }
@@ -81,11 +87,10 @@ pub struct Report {
 impl Report {
     /// Whether the mesh is a valid triangulation of the domain: every vertex and index is
     /// good, no triangle is degenerate or flipped, no nodata sample is covered, every domain
-    /// sample is covered, and the mesh area equals the domain area.
-    ///
-    /// These are necessary for the mesh to tile the domain exactly. They are not a proof:
-    /// an overlap could in principle balance, in area, a triangle reaching past the domain
-    /// over cells that have a nodata corner but no nodata sample inside the triangle.
+    /// sample is covered, the mesh area equals the domain area, and the mesh conforms:
+    /// every edge inside the domain is shared by two triangles, one on each side, and
+    /// every other edge lies on the domain's outline. Consistently oriented triangles whose
+    /// only free edges are the outline, with the domain's area, cover it exactly once.
     pub fn mesh_is_valid(&self) -> bool {
         self.bad_vertices == 0
             && self.bad_indices == 0
@@ -95,6 +100,8 @@ impl Report {
             && self.nodata_covered_samples == 0
             && self.uncovered_samples == 0
             && self.mesh_area_x2 == self.domain_area_x2
+            && self.open_edges == 0
+            && self.overlapping_edges == 0
     }
 
     /// Whether the measured error respects [`Report::max_error_allowed`]; always true when
@@ -140,6 +147,8 @@ mod tests {
             bad_indices: 0,
             domain_area_x2: 2,
             mesh_area_x2: 2,
+            open_edges: 0,
+            overlapping_edges: 0,
             problems: Vec::new(),
         }
     }

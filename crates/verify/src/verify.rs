@@ -1,6 +1,7 @@
 //! The brute-force check itself: vertices, triangles, every covered sample, then coverage.
 
 use crate::coverage::Coverage;
+use crate::edges::check_edges;
 use crate::predicates::{interpolate, orient};
 use crate::problems::{Kind, ProblemLog};
 use crate::raster::rasterize;
@@ -17,7 +18,10 @@ use crate::{ErrorLocation, GridRef, MeshRef, Report, Result, VerifyError, Verify
 ///    error `|value - interpolation|` is measured, the interpolation using the mesh's own
 ///    heights; the largest is reported with its location;
 /// 4. every domain sample (a corner of a cell whose four corners are valid) is covered;
-/// 5. the triangles' doubled areas add up to twice the number of valid cells.
+/// 5. the triangles' doubled areas add up to twice the number of valid cells;
+/// 6. the mesh conforms: each edge inside the domain is shared by two triangles, one on
+///    each side, and every other edge lies on the domain's outline (vertices with the
+///    same position and height are welded first).
 ///
 /// Triangles with a bad index or a corner outside the grid are counted as unmeasured and
 /// otherwise skipped; degenerate triangles cover nothing; flipped triangles are still
@@ -30,7 +34,8 @@ use crate::{ErrorLocation, GridRef, MeshRef, Report, Result, VerifyError, Verify
 ///
 /// # Runtime
 /// Linear in the number of samples plus the total number of samples inside triangles
-/// (plus one step per triangle row). Memory: one bit per sample plus a few rows.
+/// (plus one step per triangle row), and a sort of the triangles' edges. Memory: one bit
+/// per sample plus a few rows, and about 50 bytes per triangle for the edges.
 pub fn verify(grid: GridRef<'_>, mesh: MeshRef<'_>, options: &VerifyOptions) -> Result<Report> {
     let expected = grid.sample_count();
     if u64::try_from(grid.values.len()) != Ok(expected) {
@@ -71,13 +76,15 @@ pub fn verify(grid: GridRef<'_>, mesh: MeshRef<'_>, options: &VerifyOptions) -> 
         bad_indices: 0,
         domain_area_x2: 0,
         mesh_area_x2: 0,
+        open_edges: 0,
+        overlapping_edges: 0,
         problems: Vec::new(),
     };
     let mut log = ProblemLog::default();
     let inside = check_vertices(grid, mesh, &mut report, &mut log);
     // Fits in usize: `values` has this many elements.
     let mut covered = Coverage::new(expected as usize);
-    check_triangles(
+    let measured = check_triangles(
         grid,
         mesh,
         options,
@@ -97,6 +104,7 @@ pub fn verify(grid: GridRef<'_>, mesh: MeshRef<'_>, options: &VerifyOptions) -> 
             )
         });
     }
+    check_edges(grid, mesh, &measured, &mut report, &mut log);
     if !report.within_bound() {
         log.push(Kind::ErrorExceeded, || {
             let at = report.max_error_at.map_or(String::new(), |at| {
@@ -154,6 +162,7 @@ fn check_vertices(
 }
 
 /// Checks 1 (indices), 2 and 3: orientation, then every sample inside each triangle.
+/// Returns which triangles were measured (corners in the grid, not degenerate).
 fn check_triangles(
     grid: GridRef<'_>,
     mesh: MeshRef<'_>,
@@ -162,8 +171,9 @@ fn check_triangles(
     covered: &mut Coverage,
     report: &mut Report,
     log: &mut ProblemLog,
-) {
+) -> Vec<bool> {
     let vertex_count = mesh.positions.len();
+    let mut measured = vec![false; mesh.triangles.len()];
     for (t, &corners) in mesh.triangles.iter().enumerate() {
         let mut measurable = true;
         for (corner, &v) in corners.iter().enumerate() {
@@ -208,6 +218,7 @@ fn check_triangles(
             });
         }
         report.mesh_area_x2 += area_x2.unsigned_abs();
+        measured[t] = true;
 
         let z = corners.map(|v| mesh.heights[v as usize]);
         let mut nodata_logged = false;
@@ -239,6 +250,7 @@ fn check_triangles(
             }
         });
     }
+    measured
 }
 
 /// Counts samples and cells, and checks 4 (coverage) and nodata coverage per sample.
@@ -485,6 +497,141 @@ mod tests {
         assert_eq!(report.uncovered_samples, 0);
         assert_eq!(report.mesh_area_x2, 7);
         assert!(!report.mesh_is_valid());
+    }
+
+    #[test]
+    fn a_hole_balanced_by_an_overlap_is_caught_by_the_edges() {
+        // Area and coverage agree (a half cell gone, another covered twice); only the
+        // edges tell: the hole's two inner sides border one triangle inside the domain
+        // (its third is on the outline), and the repeated triangle's three sides are
+        // each shared on the same side.
+        let values = vec![0.0; 9];
+        let positions = grid_positions_3x3();
+        let mut triangles = eight_triangles();
+        triangles.remove(7); // (1,1) (2,2) (1,2)
+        triangles.push([0, 1, 4]); // a second (0,0) (1,0) (1,1)
+        let report = run(
+            3,
+            3,
+            &values,
+            &positions,
+            &[0.0; 9],
+            &triangles,
+            VerifyOptions::new(),
+        );
+        assert_eq!(report.uncovered_samples, 0);
+        assert_eq!(report.mesh_area_x2, report.domain_area_x2);
+        assert_eq!(report.open_edges, 2);
+        assert_eq!(report.overlapping_edges, 3);
+        assert!(!report.mesh_is_valid());
+        assert!(report.problems.iter().any(|p| p.contains("overlap")));
+    }
+
+    #[test]
+    fn a_t_junction_and_a_repeated_vertex_are_open_edges() {
+        // 3x3 grid: the left cells split at (1,1), the right half as two triangles whose
+        // long edge (1,0)-(1,2) passes through (1,1): a T-junction.
+        let values = vec![0.0; 9];
+        let positions = grid_positions_3x3();
+        let triangles = vec![
+            [0, 1, 4],
+            [0, 4, 3],
+            [3, 4, 7],
+            [3, 7, 6],
+            [1, 2, 8],
+            [1, 8, 7],
+        ];
+        let report = run(
+            3,
+            3,
+            &values,
+            &positions,
+            &[0.0; 9],
+            &triangles,
+            VerifyOptions::new(),
+        );
+        assert_eq!(report.mesh_area_x2, report.domain_area_x2);
+        assert_eq!(report.open_edges, 3, "{:?}", report.problems);
+        assert!(!report.mesh_is_valid());
+
+        // The same grid with the centre vertex repeated at another height in the right
+        // cells: a step in the surface.
+        let mut positions = grid_positions_3x3();
+        positions.push([1, 1]);
+        let mut heights = vec![0.0; 9];
+        heights.push(0.25);
+        let mut triangles = eight_triangles();
+        for t in [3, 6, 7] {
+            for v in triangles[t].iter_mut().filter(|v| **v == 4) {
+                *v = 9;
+            }
+        }
+        let report = run(
+            3,
+            3,
+            &values,
+            &positions,
+            &heights,
+            &triangles,
+            VerifyOptions::new(),
+        );
+        assert!(report.open_edges > 0);
+        assert!(!report.mesh_is_valid());
+    }
+
+    #[test]
+    fn long_outline_edges_and_nodata_holes_conform() {
+        // A 5x4 grid with a nodata sample inside: the mesh is the ring of cells around the
+        // hole's four cells, its border edges long (several cells) on the raster's edge.
+        let (w, h) = (5u32, 4u32);
+        let mut values = vec![1.0; (w * h) as usize];
+        values[(w + 2) as usize] = f64::NAN; // (2, 1)
+        let p = |x: i64, y: i64| [x, y];
+        // Without the hole: two triangles over the whole rectangle.
+        let positions = vec![p(0, 0), p(4, 0), p(4, 3), p(0, 3)];
+        let all_valid = vec![1.0; (w * h) as usize];
+        let report = run(
+            w,
+            h,
+            &all_valid,
+            &positions,
+            &[1.0; 4],
+            &[[0, 1, 2], [0, 2, 3]],
+            VerifyOptions::new(),
+        );
+        assert!(report.passed(), "{:?}", report.problems);
+        // The hole: cells (1..3, 0..2) are invalid. Triangles around it, with the hole's
+        // outline edges used once and the domain on their side.
+        let positions = vec![
+            p(0, 0),
+            p(1, 0),
+            p(3, 0),
+            p(4, 0),
+            p(1, 2),
+            p(3, 2),
+            p(0, 3),
+            p(4, 3),
+        ];
+        let triangles = vec![
+            [0, 1, 4], // left strip, top
+            [0, 4, 6], // left strip
+            [4, 5, 7], // below the hole
+            [4, 7, 6],
+            [2, 3, 7], // right strip
+            [2, 7, 5],
+        ];
+        let report = run(
+            w,
+            h,
+            &values,
+            &positions,
+            &[1.0; 8],
+            &triangles,
+            VerifyOptions::new(),
+        );
+        assert_eq!(report.open_edges, 0, "{:?}", report.problems);
+        assert_eq!(report.overlapping_edges, 0);
+        assert!(report.passed(), "{:?}", report.problems);
     }
 
     #[test]

@@ -1,0 +1,129 @@
+//! Check 6, conformity: every edge inside the domain is shared by exactly two triangles,
+//! one on each side, and every edge used by one triangle lies on the domain's outline with
+//! the domain on that triangle's side. Together with the area check this rules out holes
+//! balanced by overlaps, cracks, T-junctions and repeated vertices with other heights.
+
+use std::collections::HashMap;
+
+use crate::predicates::orient;
+use crate::problems::{Kind, ProblemLog};
+use crate::{GridRef, MeshRef, Report};
+
+/// One side of one triangle: the edge between vertices `low < high` (welded ids), and on
+/// which side of the directed line `low -> high` the triangle lies.
+#[derive(Debug, Clone, Copy)]
+struct Side {
+    low: u32,
+    high: u32,
+    left: bool,
+}
+
+/// Checks conformity over the `measured` triangles (non-degenerate, corners in the grid),
+/// welding vertices that share a position and height first (formats without shared
+/// vertices repeat them).
+pub(crate) fn check_edges(
+    grid: GridRef<'_>,
+    mesh: MeshRef<'_>,
+    measured: &[bool],
+    report: &mut Report,
+    log: &mut ProblemLog,
+) {
+    let mut ids: HashMap<([i64; 2], u64), u32> = HashMap::with_capacity(mesh.positions.len());
+    let welded: Vec<u32> = mesh
+        .positions
+        .iter()
+        .zip(mesh.heights)
+        .enumerate()
+        .map(|(v, (&p, z))| *ids.entry((p, z.to_bits())).or_insert(v as u32))
+        .collect();
+    let mut sides: Vec<Side> = Vec::with_capacity(3 * mesh.triangles.len());
+    for (corners, _) in mesh.triangles.iter().zip(measured).filter(|(_, &m)| m) {
+        for k in 0..3 {
+            let (p, q, r) = (corners[k], corners[(k + 1) % 3], corners[(k + 2) % 3]);
+            let (a, b) = (welded[p as usize], welded[q as usize]);
+            let (low, high) = (a.min(b), a.max(b));
+            let [pl, ph, pr] = [low, high, r].map(|v| mesh.positions[v as usize]);
+            sides.push(Side {
+                low,
+                high,
+                left: orient(pl, ph, pr) > 0,
+            });
+        }
+    }
+    sides.sort_unstable_by_key(|s| (s.low, s.high, s.left));
+    for group in sides.chunk_by(|a, b| (a.low, a.high) == (b.low, b.high)) {
+        let [p, q] = [group[0].low, group[0].high].map(|v| mesh.positions[v as usize]);
+        match group {
+            [one] => {
+                if !on_outline(grid, p, q, one.left) {
+                    report.open_edges += 1;
+                    log.push(Kind::OpenEdge, || {
+                        format!(
+                            "edge ({}, {})-({}, {}) borders one triangle but is not on the \
+                             domain's outline (a hole, crack or T-junction)",
+                            p[0], p[1], q[0], q[1]
+                        )
+                    });
+                }
+            }
+            [a, b] if a.left != b.left => {}
+            _ => {
+                report.overlapping_edges += 1;
+                log.push(Kind::OverlappingEdge, || {
+                    format!(
+                        "edge ({}, {})-({}, {}) is shared by {} triangles, {} on one side \
+                         (they overlap)",
+                        p[0],
+                        p[1],
+                        q[0],
+                        q[1],
+                        group.len(),
+                        group
+                            .iter()
+                            .filter(|s| s.left)
+                            .count()
+                            .max(group.iter().filter(|s| !s.left).count())
+                    )
+                });
+            }
+        }
+    }
+}
+
+/// Whether segment `p -> q` runs along the domain's outline with the domain on its left
+/// (`left`) or right side: axis-parallel (the outline of a union of cells is), and at every
+/// unit step the cell on that side is valid and the cell on the other side is not.
+fn on_outline(grid: GridRef<'_>, p: [i64; 2], q: [i64; 2], left: bool) -> bool {
+    let (dx, dy) = ((q[0] - p[0]).signum(), (q[1] - p[1]).signum());
+    if dx != 0 && dy != 0 {
+        return false;
+    }
+    let steps = (q[0] - p[0]).abs().max((q[1] - p[1]).abs());
+    // The normal pointing to the left of the direction (dx, dy) in (x, y): (-dy, dx) has
+    // orient(p, q, p + normal) > 0.
+    let (nx, ny) = if left { (-dy, dx) } else { (dy, -dx) };
+    (0..steps).all(|s| {
+        let (x, y) = (p[0] + s * dx, p[1] + s * dy);
+        // The unit segment (x, y) -> (x + dx, y + dy); the cells beside it have their
+        // lowest corner at these positions.
+        let (sx, sy) = (x.min(x + dx), y.min(y + dy));
+        let (inner, outer) = if dx != 0 {
+            ((sx, sy + ny.min(0)), (sx, sy - ny.max(0)))
+        } else {
+            ((sx + nx.min(0), sy), (sx - nx.max(0), sy))
+        };
+        cell_is_valid(grid, inner) && !cell_is_valid(grid, outer)
+    })
+}
+
+/// Whether the cell with lowest corner `(x, y)` lies in the grid with four valid corners.
+fn cell_is_valid(grid: GridRef<'_>, (x, y): (i64, i64)) -> bool {
+    let inside = |x: i64, y: i64| {
+        x >= 0 && y >= 0 && x < i64::from(grid.width) && y < i64::from(grid.height)
+    };
+    inside(x, y)
+        && inside(x + 1, y + 1)
+        && [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]
+            .iter()
+            .all(|&(x, y)| grid.is_valid(x as u32, y as u32))
+}

@@ -80,7 +80,8 @@ pub fn read_mesh_file(path: &Path, raster: &Raster, georef: Georef) -> Result<Me
 
 /// Moves longitudes read from RFC 7946 GeoJSON (in [-180, 180]) by whole turns into a
 /// geographic raster's own frame (0..360 for many global grids), triangle by triangle:
-/// a corner outside the raster's extent into [west, west + 360), then, of the placements
+/// the whole triangle by the shift that puts it inside the raster's extent, counter-
+/// clockwise, when there is one; otherwise a corner outside the raster's extent into [west, west + 360), then, of the placements
 /// with corners a turn further east where that stays within the raster (the east edge of
 /// a grid whose first and last columns are the same meridian), the counter-clockwise one
 /// spanning the fewest degrees; corners are then welded again by position.
@@ -106,8 +107,31 @@ fn into_raster_frame(mesh: &mut Mesh, raster: &Raster, transform: tinsmith_core:
     };
     let mut welded: std::collections::HashMap<[u64; 3], u32> = Default::default();
     let mut vertices: Vec<[f64; 3]> = Vec::with_capacity(mesh.vertices.len());
+    let ccw = |lons: [f64; 3], corners: &[[f64; 3]; 3]| {
+        let [a, b, c] = [0, 1, 2].map(|k| [lons[k], corners[k][1]]);
+        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) > 0.0
+    };
     for triangle in &mut mesh.triangles {
         let corners = triangle.map(|i| mesh.vertices[i as usize]);
+        // The writers move each triangle (or cut part) as a whole by turns into
+        // [-180, 180]: the whole-turn shift that puts it back inside the raster is the
+        // one (a second would need a triangle no wider than the columns the raster
+        // repeats). Only when none fits are corners placed one by one.
+        let whole = [0.0, 1.0, -1.0, 2.0, -2.0]
+            .into_iter()
+            .map(|turns| corners.map(|v| v[0] + 360.0 * turns))
+            .find(|lons| lons.iter().all(|&l| l >= west && l <= east) && ccw(*lons, &corners));
+        if let Some(placed) = whole {
+            for (index, lon) in triangle.iter_mut().zip(placed) {
+                let v = mesh.vertices[*index as usize];
+                let p = [lon, v[1], v[2]];
+                *index = *welded.entry(p.map(f64::to_bits)).or_insert_with(|| {
+                    vertices.push(p);
+                    (vertices.len() - 1) as u32
+                });
+            }
+            continue;
+        }
         let lons = corners.map(|v| base(v[0]));
         // Of the placements (each corner as is, or a turn east if that stays within the
         // raster), the counter-clockwise one (as written) spanning the fewest degrees.

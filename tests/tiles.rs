@@ -402,6 +402,16 @@ fn every_format_is_written_from_tiles() {
         if !name.ends_with(".stl") && !name.ends_with(".glb") {
             assert_eq!(r["triangles_after"], base["triangles_after"], "{name}");
         }
+        // OBJ, STL and glTF carry the CRS in a .prj sidecar, streamed (OBJ) or not.
+        if [".obj", ".stl", ".glb"].iter().any(|e| name.ends_with(e)) {
+            let prj = d.path(name).with_extension("prj");
+            let wkt = std::fs::read_to_string(&prj).unwrap_or_default();
+            assert!(
+                wkt.contains("PROJCS") || wkt.contains("PROJCRS"),
+                "{name}: {wkt:?}"
+            );
+            std::fs::remove_file(prj).unwrap();
+        }
     }
 }
 

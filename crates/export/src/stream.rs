@@ -4,7 +4,7 @@ use std::fs::File;
 use std::io::{self, BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
 
-use crate::atomic::write_atomically;
+use crate::atomic::write_atomically_with_sidecar;
 use crate::error::{Error, Result};
 use crate::format::MeshFormat;
 use crate::mesh::MeshRef;
@@ -50,6 +50,8 @@ pub struct MeshStreamWriter {
     path: PathBuf,
     format: MeshFormat,
     crs_wkt: Option<String>,
+    /// The WKT as given, for the `.prj` sidecar of formats that have one (OBJ).
+    prj_wkt: Option<String>,
     vertices: Spool,
     triangles: Spool,
     vertex_count: usize,
@@ -96,6 +98,9 @@ impl MeshStreamWriter {
             path: path.to_path_buf(),
             format,
             crs_wkt: MeshRef::new(&[], &[]).with_crs_wkt(crs_wkt).crs_line(),
+            prj_wkt: crs_wkt
+                .filter(|w| !w.trim().is_empty() && format.uses_prj_sidecar())
+                .map(str::to_owned),
             vertices: spool()?,
             triangles: spool()?,
             vertex_count: 0,
@@ -210,7 +215,8 @@ impl MeshStreamWriter {
     }
 
     /// Writes the file: header, then every vertex, then every triangle, through a
-    /// temporary file renamed over the target. The spools are removed in any case.
+    /// temporary file renamed over the target, with the `.prj` sidecar as
+    /// [`crate::write_mesh`] writes it (OBJ). The spools are removed in any case.
     ///
     /// # Errors
     /// [`Error::Io`] as [`crate::write_mesh`]; the target is then untouched.
@@ -224,12 +230,21 @@ impl MeshStreamWriter {
             .rewind()
             .map_err(|source| self.io_error("write", source))?;
         let header = self.header();
-        write_atomically(&self.path, |w| {
-            w.write_all(header.as_bytes())?;
-            io::copy(&mut vertices, w)?;
-            io::copy(&mut triangles, w)?;
-            Ok(())
-        })
+        let prj = crate::prj_path(&self.path);
+        let sidecar = self
+            .prj_wkt
+            .as_deref()
+            .map(|wkt| (prj.as_path(), wkt.as_bytes()));
+        write_atomically_with_sidecar(
+            &self.path,
+            |w| {
+                w.write_all(header.as_bytes())?;
+                io::copy(&mut vertices, w)?;
+                io::copy(&mut triangles, w)?;
+                Ok(())
+            },
+            sidecar,
+        )
     }
 
     /// The header [`crate::write_mesh`] writes for a mesh of the counts so far.

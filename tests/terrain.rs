@@ -537,3 +537,28 @@ fn a_pyramid_across_the_antimeridian_wraps_its_columns() {
     }
     assert!(seams > 0, "no tile pair across 180 degrees");
 }
+
+#[test]
+fn a_level_far_finer_than_memory_allows_is_refused_up_front() {
+    // The 2-degree globe at level 24: its tile rows would span 2^25 tiles (petabytes of
+    // lattice). Refused before any work, naming the level, with nothing left behind.
+    let dir = Dir::new();
+    let o = dir.run(&[
+        "tiles",
+        &fixture("etopo5_2deg_i16.tif"),
+        "-o",
+        "deep",
+        "--max-zoom",
+        "24",
+        "-q",
+    ]);
+    crate::util::assert_fails_naming(&o, &["etopo5_2deg_i16.tif", "level 24", "--max-zoom"]);
+    let left: Vec<_> = std::fs::read_dir(dir.path("."))
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .filter(|n| {
+            n.to_string_lossy().contains("deep") || n.to_string_lossy().contains(".tinsmith")
+        })
+        .collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+}

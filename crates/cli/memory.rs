@@ -55,7 +55,7 @@ pub fn check_whole_raster_fits(
 }
 
 /// `MemAvailable` from `/proc/meminfo`, in bytes.
-fn available_bytes() -> Option<u64> {
+pub fn available_bytes() -> Option<u64> {
     let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
     let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;

@@ -16,6 +16,7 @@ pub fn run(args: &TilesArgs) -> Result<bool> {
         metadata: args.metadata,
         gzip: !args.no_gzip,
         threads: args.threads,
+        memory_limit: crate::memory::available_bytes(),
     };
     if let Some(report) = &args.report {
         crate::output::check_writable_target(report, &args.input)?;

@@ -65,7 +65,7 @@ pub use plan::{TileIndex, TilePlan, TileWindow};
 pub use sink::{FinishedTile, SinkError, TileSink};
 pub use source::{GridSource, RasterSource, ReadError, TileSource, WindowRead};
 pub use terrain::{
-    build_terrain, tile_rectangle, LevelReport, TerrainError, TerrainOptions, TerrainReport,
-    TerrainResult, LEVEL_ZERO_ERROR, MAX_LEVEL, METADATA_AVAILABILITY, TILE_CELLS,
+    build_terrain, streaming_bytes, tile_rectangle, LevelReport, TerrainError, TerrainOptions,
+    TerrainReport, TerrainResult, LEVEL_ZERO_ERROR, MAX_LEVEL, METADATA_AVAILABILITY, TILE_CELLS,
 };
 pub use welded::WeldedWriter;

@@ -146,6 +146,9 @@ pub struct TerrainOptions {
     pub gzip: bool,
     /// Worker threads (0: rayon's default).
     pub threads: usize,
+    /// Bytes the run may use; a level range whose streaming would need more (see
+    /// [`streaming_bytes`]) is refused before any work. `None`: no limit.
+    pub memory_limit: Option<u64>,
 }
 
 impl Default for TerrainOptions {
@@ -159,8 +162,23 @@ impl Default for TerrainOptions {
             metadata: false,
             gzip: true,
             threads: 0,
+            memory_limit: None,
         }
     }
+}
+
+/// About how many bytes streaming a pyramid over `bounds` down to `max_zoom` takes: the
+/// finest level's bands of whole tile rows (one per thread in the warp, a few held),
+/// 4 bytes a sample, with the coarser levels' rows (a third more). An estimate for
+/// refusing hopeless runs (a small raster at a far finer level than its own), not a bound.
+pub fn streaming_bytes(bounds: &GeoBounds, max_zoom: u8, threads: usize) -> u64 {
+    let width = LevelRows::new(bounds, max_zoom).width as u64;
+    let band = (width * u64::from(TILE_CELLS + 1)).max(1 << 22);
+    let bands = threads.max(1) as u64 + 3;
+    band.saturating_mul(bands)
+        .saturating_mul(4)
+        .saturating_mul(4)
+        / 3
 }
 
 /// What one level produced.
@@ -359,6 +377,26 @@ pub fn build_terrain(
             "zoom range {}..={max_zoom} is not within 0..={MAX_LEVEL}",
             options.min_zoom
         )));
+    }
+    if let Some(limit) = options.memory_limit {
+        let threads = match options.threads {
+            0 => rayon::current_num_threads(),
+            n => n,
+        };
+        let need = streaming_bytes(&bounds, max_zoom, threads);
+        if need > limit {
+            let natural = (0..MAX_LEVEL)
+                .find(|&l| step(l) <= bounds.resolution * (1.0 + 1e-9))
+                .unwrap_or(MAX_LEVEL);
+            return Err(TerrainError::Options(format!(
+                "level {max_zoom} would need about {:.1} GB in memory (its tile rows span \
+                 {} tiles) and {:.1} GB is available; choose a lower --max-zoom (the \
+                 raster's own resolution is level {natural})",
+                need as f64 / 1e9,
+                LevelRows::new(&bounds, max_zoom).tiles_x,
+                limit as f64 / 1e9
+            )));
+        }
     }
     // The warp works in f32: heights beyond it would be clamped or lost as nodata, so a
     // source that may hold them (Float64, or scaled) is scanned for them first.

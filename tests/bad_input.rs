@@ -484,6 +484,11 @@ fn a_pyramid_is_written_whole_or_not_at_all() {
     assert_fails_naming(&o, &["taken", "not an empty directory"]);
     let left: Vec<_> = std::fs::read_dir(d.path("taken")).unwrap().collect();
     assert_eq!(left.len(), 1);
+    // Nor a file in its place (said as such).
+    std::fs::write(d.path("afile"), "mine").unwrap();
+    let o = d.run(&["tiles", &dem(), "-o", "afile", "-q"]);
+    assert_fails_naming(&o, &["afile", "exists and is not a directory"]);
+    assert_eq!(std::fs::read(d.path("afile")).unwrap(), b"mine");
 
     // An empty directory (or a missing one, parents included) gets the whole pyramid.
     std::fs::create_dir(d.path("ready")).unwrap();

@@ -49,8 +49,8 @@ impl PerTileWriter {
             reason: reason.to_owned(),
             source,
         };
-        if is_occupied(dir) {
-            return Err(output("exists and is not an empty directory", None));
+        if let Some(reason) = occupied_reason(dir) {
+            return Err(output(reason, None));
         }
         let parent = match dir.parent() {
             Some(p) if !p.as_os_str().is_empty() => p,
@@ -120,10 +120,16 @@ impl TileSink for PerTileWriter {
     }
 }
 
-/// Whether `dir` exists as anything but an empty directory (a file, a link, a directory
-/// with entries): an output directory renamed into place must not replace it.
-pub(crate) fn is_occupied(dir: &Path) -> bool {
-    std::fs::symlink_metadata(dir).is_ok_and(|meta| {
-        !meta.is_dir() || std::fs::read_dir(dir).map_or(true, |mut e| e.next().is_some())
-    })
+/// Why `dir` cannot take a new output directory, if it exists as anything but an empty
+/// directory (a file, a link, a directory with entries): an output directory renamed
+/// into place must not replace it.
+pub(crate) fn occupied_reason(dir: &Path) -> Option<&'static str> {
+    let meta = std::fs::symlink_metadata(dir).ok()?;
+    if !meta.is_dir() {
+        Some("exists and is not a directory")
+    } else if std::fs::read_dir(dir).map_or(true, |mut e| e.next().is_some()) {
+        Some("exists and is not an empty directory")
+    } else {
+        None
+    }
 }

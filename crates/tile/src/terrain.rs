@@ -474,12 +474,11 @@ pub fn build_terrain(
 /// directory; its missing parents are created) to build the pyramid in.
 fn staging_dir(out_dir: &Path) -> TerrainResult<tempfile::TempDir> {
     let refuse = |reason: String| TerrainError::Options(format!("{}: {reason}", out_dir.display()));
-    if crate::per_tile::is_occupied(out_dir) {
-        return Err(refuse(
-            "exists and is not an empty directory; give a new directory (the pyramid is \
-             written whole, never mixed with other files)"
-                .into(),
-        ));
+    if let Some(reason) = crate::per_tile::occupied_reason(out_dir) {
+        return Err(refuse(format!(
+            "{reason}; give a new directory (the pyramid is written whole, never mixed \
+             with other files)"
+        )));
     }
     let parent = match out_dir.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,

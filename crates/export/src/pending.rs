@@ -34,19 +34,28 @@ impl Drop for PendingGuard {
 /// Removes every registered temporary file and directory (for a signal handler, just
 /// before the process exits), and from then on [`interrupted`] is true. Paths that are
 /// gone already are skipped.
+///
+/// Writers check [`interrupted`] before each file they add, but one may be between its
+/// check and its write when the flag goes up (and `create_dir_all` would make a removed
+/// directory again), so the paths are removed a second time after a short pause.
 pub fn remove_pending() {
     INTERRUPTED.store(true, Ordering::SeqCst);
     let paths = match PENDING.lock() {
         Ok(pending) => pending.clone(),
         Err(poisoned) => poisoned.into_inner().clone(),
     };
-    for path in paths {
-        if path.is_dir() {
-            let _ = std::fs::remove_dir_all(&path);
-        } else {
-            let _ = std::fs::remove_file(&path);
+    let remove_all = || {
+        for path in &paths {
+            if path.is_dir() {
+                let _ = std::fs::remove_dir_all(path);
+            } else {
+                let _ = std::fs::remove_file(path);
+            }
         }
-    }
+    };
+    remove_all();
+    std::thread::sleep(std::time::Duration::from_millis(150));
+    remove_all();
 }
 
 /// Whether [`remove_pending`] has run: the work still going on may fail on the files it

@@ -113,6 +113,10 @@ impl TileSink for PerTileWriter {
             .temp
             .path()
             .join(PerTileWriter::file_name(tile.index(), self.format));
+        if tinsmith_export::interrupted() {
+            // The temporary directory is being removed: add nothing to it.
+            return Err(std::io::Error::from(std::io::ErrorKind::Interrupted).into());
+        }
         let mesh =
             MeshRef::new(&self.vertices, &self.triangles).with_crs_wkt(self.crs_wkt.as_deref());
         write_mesh(&path, self.format, mesh)?;

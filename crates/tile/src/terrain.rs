@@ -706,6 +706,13 @@ impl LevelSink for TileWriter<'_> {
                 continue;
             };
             let dir = self.out_dir.join(z.to_string()).join(tile.x.to_string());
+            if tinsmith_export::interrupted() {
+                // The staging directory is being removed: add nothing to it.
+                return Err(TerrainError::Output {
+                    path: dir,
+                    source: std::io::Error::from(std::io::ErrorKind::Interrupted),
+                });
+            }
             std::fs::create_dir_all(&dir).map_err(|source| TerrainError::Output {
                 path: dir.clone(),
                 source,

@@ -459,6 +459,26 @@ fn simplify_keeps_a_subsequence_within_the_distance() {
 }
 
 #[test]
+fn levels_whose_lines_would_not_fit_in_memory_are_refused_up_front() {
+    // A 120 x 100 checkerboard of 0 and 99,000 contoured every 1: 99,000 levels, each
+    // crossing every triangle, about 2.3e9 segments (over 100 GB of lines). Refused
+    // before contouring, naming the file, with nothing written.
+    let d = Dir::new();
+    let mut asc = String::from("ncols 120\nnrows 100\nxllcorner 0\nyllcorner 0\ncellsize 1\n");
+    for row in 0..100 {
+        let values: Vec<&str> = (0..120)
+            .map(|col| if (row + col) % 2 == 0 { "0" } else { "99000" })
+            .collect();
+        asc.push_str(&values.join(" "));
+        asc.push('\n');
+    }
+    d.write("board.asc", &asc);
+    let o = d.run(&["contour", "board.asc", "-o", "c.fgb", "--interval", "1"]);
+    assert_fails_naming(&o, &["board.asc", "levels cross the TIN", "--interval"]);
+    assert!(!d.path("c.fgb").exists());
+}
+
+#[test]
 fn contour_bad_input_fails_cleanly() {
     let dem = fixture("tintn_valid_raster_3857.tif");
     let d = Dir::new();

@@ -36,6 +36,10 @@ use crate::output::{check_distinct, check_writable_target};
 use crate::verify::read_mesh_file;
 
 /// Builds the TIN, contours it and writes the lines; `Ok(true)` on success.
+/// Memory per line segment while contouring and writing: its point in the joiner, the
+/// polyline and the file coordinates (measured about 50 bytes on ETOPO5).
+const BYTES_PER_SEGMENT: u64 = 64;
+
 pub fn run(args: &ContourArgs) -> Result<bool> {
     let started = Instant::now();
     if args.offset.is_some() && args.interval.is_none() {
@@ -101,6 +105,22 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     };
     let georef = Georef::new(info.transform(), args.pixel_coords);
 
+    // The lines are held whole before writing: refuse levels that would not fit.
+    if let Some(available) = crate::memory::available_bytes() {
+        let segments = mesh.segment_count(&levels);
+        let needed = segments.saturating_mul(BYTES_PER_SEGMENT);
+        if needed > available {
+            bail!(
+                "{}: the {} levels cross the TIN about {segments} times; the lines would \
+                 need about {:.1} GB and {:.1} GB is available; give a larger --interval or \
+                 fewer --levels (or a larger --max-error)",
+                args.input.display(),
+                levels.len(),
+                needed as f64 / 1e9,
+                available as f64 / 1e9
+            );
+        }
+    }
     let polylines = contour(&mesh, &levels)
         .with_context(|| format!("{}: contouring failed", args.input.display()))?;
 

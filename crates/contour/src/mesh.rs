@@ -144,6 +144,23 @@ impl ContourMesh {
         range
     }
 
+    /// How many line segments contouring at `levels` (sorted ascending) makes, at most:
+    /// per triangle, the levels above its lowest corner and up to its highest (a corner
+    /// at a level counts as above it, as [`crate::contour`] has it). Cheap, for sizing the
+    /// output before making it.
+    pub fn segment_count(&self, levels: &[f64]) -> u64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let z = t.map(|v| self.vertices[v as usize][2]);
+                let (lo, hi) = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
+                let above_lo = levels.partition_point(|&l| l <= lo);
+                let up_to_hi = levels.partition_point(|&l| l <= hi);
+                up_to_hi.saturating_sub(above_lo) as u64
+            })
+            .sum()
+    }
+
     /// Number of triangles using the edge between vertices `a` and `b` (0, 1 or 2).
     pub fn edge_triangle_count(&self, a: u32, b: u32) -> usize {
         let mut count = 0;
@@ -217,6 +234,20 @@ fn build_twins(vertex_count: usize, triangles: &[[u32; 3]]) -> Result<Vec<u32>> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn segment_count_is_what_contouring_makes_on_a_generic_grid() {
+        // Heights off every level: each crossing is one segment.
+        let values: Vec<f64> = (0..49)
+            .map(|i| ((i % 7) as f64 * 1.3 + (i / 7) as f64 * 2.1).sin() * 10.0 + 0.05)
+            .collect();
+        let m = ContourMesh::from_grid(7, 7, &values).unwrap();
+        let levels: Vec<f64> = (-10..=10).map(f64::from).collect();
+        let lines = crate::contour(&m, &levels).unwrap();
+        let made: usize = lines.iter().map(|l| l.points().len() - 1).sum();
+        assert_eq!(m.segment_count(&levels), made as u64);
+        assert_eq!(m.segment_count(&[]), 0);
+    }
 
     #[test]
     fn grid_mesh_has_two_triangles_per_valid_cell() {

@@ -37,8 +37,11 @@ fn main() -> ExitCode {
     // Ctrl-C or SIGTERM: no half-written temporary file or directory may stay behind
     // (their owners' drops, which remove them on errors, do not run on a signal's exit).
     let _ = ctrlc::set_handler(|| {
-        tinsmith_export::remove_pending();
-        eprintln!("\ntinsmith: interrupted; unfinished output removed");
+        if tinsmith_export::remove_pending() > 0 {
+            eprintln!("\ntinsmith: interrupted; unfinished output removed");
+        } else {
+            eprintln!("\ntinsmith: interrupted");
+        }
         // SAFETY: `_exit` takes no pointers and never returns. Unlike `process::exit` it
         // runs no atexit handlers, which would tear GDAL's global state down under the
         // worker threads still reading (a segfault, seen in tests).

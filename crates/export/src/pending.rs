@@ -32,13 +32,13 @@ impl Drop for PendingGuard {
 }
 
 /// Removes every registered temporary file and directory (for a signal handler, just
-/// before the process exits), and from then on [`interrupted`] is true. Paths that are
-/// gone already are skipped.
+/// before the process exits), and from then on [`interrupted`] is true; returns how many
+/// were registered. Paths that are gone already are skipped.
 ///
 /// Writers check [`interrupted`] before each file they add, but one may be between its
 /// check and its write when the flag goes up (and `create_dir_all` would make a removed
 /// directory again), so the paths are removed a second time after a short pause.
-pub fn remove_pending() {
+pub fn remove_pending() -> usize {
     INTERRUPTED.store(true, Ordering::SeqCst);
     let paths = match PENDING.lock() {
         Ok(pending) => pending.clone(),
@@ -56,6 +56,7 @@ pub fn remove_pending() {
     remove_all();
     std::thread::sleep(std::time::Duration::from_millis(150));
     remove_all();
+    paths.len()
 }
 
 /// Whether [`remove_pending`] has run: the work still going on may fail on the files it

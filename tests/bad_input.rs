@@ -489,6 +489,10 @@ fn a_pyramid_is_written_whole_or_not_at_all() {
     let o = d.run(&["tiles", &dem(), "-o", "afile", "-q"]);
     assert_fails_naming(&o, &["afile", "exists and is not a directory"]);
     assert_eq!(std::fs::read(d.path("afile")).unwrap(), b"mine");
+    // Nor under a file.
+    let o = d.run(&["tiles", &dem(), "-o", "afile/sub", "-q"]);
+    assert_fails_naming(&o, &["afile/sub", "afile is a file"]);
+    assert_eq!(std::fs::read(d.path("afile")).unwrap(), b"mine");
 
     // An empty directory (or a missing one, parents included) gets the whole pyramid.
     std::fs::create_dir(d.path("ready")).unwrap();

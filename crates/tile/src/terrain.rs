@@ -484,6 +484,15 @@ fn staging_dir(out_dir: &Path) -> TerrainResult<tempfile::TempDir> {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
+    if let Some(file) = parent
+        .ancestors()
+        .find(|a| !a.as_os_str().is_empty() && a.exists() && !a.is_dir())
+    {
+        return Err(refuse(format!(
+            "{} is a file, so no directory can be made there",
+            file.display()
+        )));
+    }
     // Missing parents are created, as `mkdir -p` would.
     std::fs::create_dir_all(parent).map_err(|source| TerrainError::Output {
         path: out_dir.to_path_buf(),

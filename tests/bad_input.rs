@@ -168,6 +168,21 @@ fn a_pyramid_needs_a_crs_and_the_message_names_the_file_once() {
     let message = crate::util::stderr(&o);
     assert_eq!(message.matches("nocrs.asc").count(), 1, "{message}");
     assert_eq!(d.files(), vec!["nocrs.asc"]);
+
+    // Geographic, but beyond the north pole: said as such (it was "no tile with a 2x2
+    // block of valid samples").
+    d.write(
+        "north.asc",
+        "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 95\ncellsize 1\n1 2 3\n4 5 6\n7 8 9\n",
+    );
+    d.write(
+        "north.prj",
+        "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137,\
+         298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"Degree\",0.017453292519943295]]",
+    );
+    let o = d.run(&["tiles", "north.asc", "-o", "pyramid", "-q"]);
+    assert_fails_naming(&o, &["north.asc", "outside latitudes -90..90"]);
+    assert!(!d.path("pyramid").exists());
 }
 
 #[test]

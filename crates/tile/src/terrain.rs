@@ -366,6 +366,13 @@ pub fn build_terrain(
         )));
     }
     let bounds = geographic_bounds(input, options.band)?;
+    if bounds.south >= bounds.north {
+        return Err(TerrainError::Options(
+            "the raster lies outside latitudes -90..90 in EPSG:4326: no tile can hold it \
+             (is its georeferencing right?)"
+                .into(),
+        ));
+    }
     let max_zoom = match options.max_zoom {
         Some(z) => z,
         None => (0..MAX_LEVEL)

@@ -248,7 +248,12 @@ pub fn write(
 ) -> Result<()> {
     let path = out(args);
     let wgs84 = plan.format == MeshFormat::GeoJson && !args.export.geojson_source_crs;
-    let world = wgs84.then(|| vertices.clone());
+    // A projected raster's positions, to check they come back from WGS84.
+    let projected = match wgs84 {
+        true => projected_crs(info)?,
+        false => None,
+    };
+    let world = projected.map(|_| vertices.clone());
     let crs = file_crs(
         info,
         args.pixel_coords,
@@ -258,8 +263,8 @@ pub fn write(
         path,
         args.quiet,
     )?;
-    if let (Some(world), Some(4326)) = (&world, crs.epsg) {
-        check_wgs84_maps_back(world, &vertices, info, path)?;
+    if let (Some(world), Some(crs_of_raster), Some(4326)) = (&world, projected, crs.epsg) {
+        check_wgs84_maps_back(world, &vertices, crs_of_raster, path)?;
     }
     if let Some(origin) = plan.origin {
         check_positions_map_back(&vertices, origin, info, args)?;
@@ -414,12 +419,9 @@ fn snap_to_antimeridian(points: &mut [[f64; 3]]) {
 /// a projected raster (see [`file_crs`]), or a corner sample that does not come back from
 /// WGS84 (see [`check_wgs84_maps_back`]; `write` checks every vertex again).
 fn check_wgs84_mesh_possible(info: &RasterInfo, path: &Path) -> Result<()> {
-    let (Some(wkt), Some(transform)) = (info.crs_wkt.as_deref(), info.transform()) else {
+    let Some((wkt, transform)) = projected_crs(info)? else {
         return Ok(());
     };
-    if info.epsg == Some(4326) || tinsmith_raster::is_geographic(wkt)? {
-        return Ok(());
-    }
     if let Some(pole) = pole_inside(info, wkt) {
         bail!("{}: {}", path.display(), pole_message(pole));
     }
@@ -434,7 +436,17 @@ fn check_wgs84_mesh_possible(info: &RasterInfo, path: &Path) -> Result<()> {
     let mut lon_lat = world.clone();
     tinsmith_raster::to_wgs84(wkt, &mut lon_lat)
         .with_context(|| format!("{}: cannot reproject to WGS84", path.display()))?;
-    check_wgs84_maps_back(&world, &lon_lat, info, path)
+    check_wgs84_maps_back(&world, &lon_lat, (wkt, transform), path)
+}
+
+/// The raster's CRS (WKT) and geotransform when it is georeferenced in a projected CRS
+/// (not EPSG:4326 or another geographic one): whose positions WGS84 GeoJSON reprojects.
+fn projected_crs(info: &RasterInfo) -> Result<Option<(&str, tinsmith_core::GeoTransform)>> {
+    let (Some(wkt), Some(transform)) = (info.crs_wkt.as_deref(), info.transform()) else {
+        return Ok(None);
+    };
+    let geographic = info.epsg == Some(4326) || tinsmith_raster::is_geographic(wkt)?;
+    Ok((!geographic).then_some((wkt, transform)))
 }
 
 fn pole_message(pole: &str) -> String {
@@ -445,22 +457,17 @@ fn pole_message(pole: &str) -> String {
     )
 }
 
-/// The last gate for WGS84 GeoJSON from a projected raster: every vertex's longitude and
-/// latitude transform back to the sample it came from (`world`, in the raster's CRS), as
+/// The last gate for WGS84 GeoJSON from a projected raster (its CRS and geotransform):
+/// every vertex's longitude and latitude transform back to the sample it came from
+/// (`world`, in the raster's CRS), as
 /// `tinsmith verify` will transform them. A raster reaching past its CRS's valid area (Web
 /// Mercator x beyond the antimeridian) would come back elsewhere.
 fn check_wgs84_maps_back(
     world: &[[f64; 3]],
     lon_lat: &[[f64; 3]],
-    info: &RasterInfo,
+    (wkt, transform): (&str, tinsmith_core::GeoTransform),
     path: &Path,
 ) -> Result<()> {
-    let (Some(wkt), Some(transform)) = (info.crs_wkt.as_deref(), info.transform()) else {
-        return Ok(());
-    };
-    if info.epsg == Some(4326) || tinsmith_raster::is_geographic(wkt)? {
-        return Ok(());
-    }
     let mut back = lon_lat.to_vec();
     tinsmith_raster::from_wgs84(wkt, &mut back)
         .with_context(|| format!("{}: cannot transform WGS84 back", path.display()))?;

@@ -81,10 +81,11 @@ pub fn read_mesh_file(path: &Path, raster: &Raster, georef: Georef) -> Result<Me
 /// Moves longitudes read from RFC 7946 GeoJSON (in [-180, 180]) by whole turns into a
 /// geographic raster's own frame (0..360 for many global grids), triangle by triangle:
 /// the whole triangle by the shift that puts it inside the raster's extent, counter-
-/// clockwise, when there is one; otherwise a corner outside the raster's extent into [west, west + 360), then, of the placements
-/// with corners a turn further east where that stays within the raster (the east edge of
-/// a grid whose first and last columns are the same meridian), the counter-clockwise one
-/// spanning the fewest degrees; corners are then welded again by position.
+/// clockwise, when there is one; otherwise a corner outside the raster's extent into
+/// [west, west + 360), then, of the placements with corners a turn further east where that
+/// stays within the raster (the east edge of a grid whose first and last columns are the
+/// same meridian), the counter-clockwise one spanning the fewest degrees; corners are then
+/// welded again by position.
 fn into_raster_frame(mesh: &mut Mesh, raster: &Raster, transform: tinsmith_core::GeoTransform) {
     let (w, h) = (f64::from(raster.info.width), f64::from(raster.info.height));
     let xs: Vec<f64> = [
@@ -121,35 +122,25 @@ fn into_raster_frame(mesh: &mut Mesh, raster: &Raster, transform: tinsmith_core:
             .into_iter()
             .map(|turns| corners.map(|v| v[0] + 360.0 * turns))
             .find(|lons| lons.iter().all(|&l| l >= west && l <= east) && ccw(*lons, &corners));
-        if let Some(placed) = whole {
-            for (index, lon) in triangle.iter_mut().zip(placed) {
-                let v = mesh.vertices[*index as usize];
-                let p = [lon, v[1], v[2]];
-                *index = *welded.entry(p.map(f64::to_bits)).or_insert_with(|| {
-                    vertices.push(p);
-                    (vertices.len() - 1) as u32
-                });
+        let placed = whole.unwrap_or_else(|| {
+            let lons = corners.map(|v| base(v[0]));
+            // Of the placements (each corner as is, or a turn east if that stays within
+            // the raster), the counter-clockwise one (as written) spanning the fewest
+            // degrees.
+            let mut best: Option<(f64, [f64; 3])> = None;
+            for turns in 0..8u32 {
+                let placed = [0, 1, 2].map(|k| lons[k] + 360.0 * f64::from((turns >> k) & 1));
+                if placed.iter().any(|&lon| lon > east) || !ccw(placed, &corners) {
+                    continue;
+                }
+                let span = placed.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                    - placed.iter().copied().fold(f64::INFINITY, f64::min);
+                if best.is_none_or(|(s, _)| span < s) {
+                    best = Some((span, placed));
+                }
             }
-            continue;
-        }
-        let lons = corners.map(|v| base(v[0]));
-        // Of the placements (each corner as is, or a turn east if that stays within the
-        // raster), the counter-clockwise one (as written) spanning the fewest degrees.
-        let mut best: Option<(f64, [f64; 3])> = None;
-        for turns in 0..8u32 {
-            let placed = [0, 1, 2].map(|k| lons[k] + 360.0 * f64::from((turns >> k) & 1));
-            if placed.iter().any(|&lon| lon > east) {
-                continue;
-            }
-            let [a, b, c] = [0, 1, 2].map(|k| [placed[k], corners[k][1]]);
-            let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-            let span = placed.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-                - placed.iter().copied().fold(f64::INFINITY, f64::min);
-            if area > 0.0 && best.is_none_or(|(s, _)| span < s) {
-                best = Some((span, placed));
-            }
-        }
-        let placed = best.map_or(lons, |(_, placed)| placed);
+            best.map_or(lons, |(_, placed)| placed)
+        });
         for (index, lon) in triangle.iter_mut().zip(placed) {
             let v = mesh.vertices[*index as usize];
             let p = [lon, v[1], v[2]];

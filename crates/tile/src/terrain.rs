@@ -373,12 +373,11 @@ pub fn build_terrain(
                 .into(),
         ));
     }
-    let max_zoom = match options.max_zoom {
-        Some(z) => z,
-        None => (0..MAX_LEVEL)
-            .find(|&l| step(l) <= bounds.resolution * (1.0 + 1e-9))
-            .unwrap_or(MAX_LEVEL),
-    };
+    // The first level whose lattice is at least as fine as the raster.
+    let own_level = (0..MAX_LEVEL)
+        .find(|&l| step(l) <= bounds.resolution * (1.0 + 1e-9))
+        .unwrap_or(MAX_LEVEL);
+    let max_zoom = options.max_zoom.unwrap_or(own_level);
     if max_zoom > MAX_LEVEL || options.min_zoom > max_zoom {
         return Err(TerrainError::Options(format!(
             "zoom range {}..={max_zoom} is not within 0..={MAX_LEVEL}",
@@ -392,13 +391,10 @@ pub fn build_terrain(
         };
         let need = streaming_bytes(&bounds, max_zoom, threads);
         if need > limit {
-            let natural = (0..MAX_LEVEL)
-                .find(|&l| step(l) <= bounds.resolution * (1.0 + 1e-9))
-                .unwrap_or(MAX_LEVEL);
             return Err(TerrainError::Options(format!(
                 "level {max_zoom} would need about {:.1} GB in memory (its tile rows span \
                  {} tiles) and {:.1} GB is available; choose a lower --max-zoom (the \
-                 raster's own resolution is level {natural})",
+                 raster's own resolution is level {own_level})",
                 need as f64 / 1e9,
                 LevelRows::new(&bounds, max_zoom).tiles_x,
                 limit as f64 / 1e9

@@ -359,6 +359,21 @@ mod tests {
         verify(grid, mesh, &options).expect("consistent lengths")
     }
 
+    /// [`run`] on the flat 3x3 grid with its nine vertices (all heights 0) and
+    /// `triangles`.
+    fn flat_3x3(triangles: &[[u32; 3]]) -> Report {
+        let positions = grid_positions_3x3();
+        run(
+            3,
+            3,
+            &[0.0; 9],
+            &positions,
+            &[0.0; 9],
+            triangles,
+            VerifyOptions::new(),
+        )
+    }
+
     #[test]
     fn eight_triangles_on_a_plane_are_exact() {
         let values: Vec<f64> = (0..9)
@@ -481,19 +496,9 @@ mod tests {
 
     #[test]
     fn half_cell_missing_is_an_area_mismatch_without_uncovered_samples() {
-        let values = vec![0.0; 9];
-        let positions = grid_positions_3x3();
         let mut triangles = eight_triangles();
         triangles.remove(7); // (1,1) (2,2) (1,2): its corners stay covered.
-        let report = run(
-            3,
-            3,
-            &values,
-            &positions,
-            &[0.0; 9],
-            &triangles,
-            VerifyOptions::new(),
-        );
+        let report = flat_3x3(&triangles);
         assert_eq!(report.uncovered_samples, 0);
         assert_eq!(report.mesh_area_x2, 7);
         assert!(!report.mesh_is_valid());
@@ -505,20 +510,10 @@ mod tests {
         // edges tell: the hole's two inner sides border one triangle inside the domain
         // (its third is on the outline), and the repeated triangle's three sides are
         // each shared on the same side.
-        let values = vec![0.0; 9];
-        let positions = grid_positions_3x3();
         let mut triangles = eight_triangles();
         triangles.remove(7); // (1,1) (2,2) (1,2)
         triangles.push([0, 1, 4]); // a second (0,0) (1,0) (1,1)
-        let report = run(
-            3,
-            3,
-            &values,
-            &positions,
-            &[0.0; 9],
-            &triangles,
-            VerifyOptions::new(),
-        );
+        let report = flat_3x3(&triangles);
         assert_eq!(report.uncovered_samples, 0);
         assert_eq!(report.mesh_area_x2, report.domain_area_x2);
         assert_eq!(report.open_edges, 2);
@@ -532,7 +527,6 @@ mod tests {
         // 3x3 grid: the left cells split at (1,1), the right half as two triangles whose
         // long edge (1,0)-(1,2) passes through (1,1): a T-junction.
         let values = vec![0.0; 9];
-        let positions = grid_positions_3x3();
         let triangles = vec![
             [0, 1, 4],
             [0, 4, 3],
@@ -541,15 +535,7 @@ mod tests {
             [1, 2, 8],
             [1, 8, 7],
         ];
-        let report = run(
-            3,
-            3,
-            &values,
-            &positions,
-            &[0.0; 9],
-            &triangles,
-            VerifyOptions::new(),
-        );
+        let report = flat_3x3(&triangles);
         assert_eq!(report.mesh_area_x2, report.domain_area_x2);
         assert_eq!(report.open_edges, 3, "{:?}", report.problems);
         assert!(!report.mesh_is_valid());
@@ -636,19 +622,9 @@ mod tests {
 
     #[test]
     fn flipped_triangle_is_flagged() {
-        let values = vec![0.0; 9];
-        let positions = grid_positions_3x3();
         let mut triangles = eight_triangles();
         triangles[3].swap(1, 2);
-        let report = run(
-            3,
-            3,
-            &values,
-            &positions,
-            &[0.0; 9],
-            &triangles,
-            VerifyOptions::new(),
-        );
+        let report = flat_3x3(&triangles);
         assert_eq!(report.flipped_triangles, 1);
         assert_eq!(report.degenerate_triangles, 0);
         // Still measured: coverage and area are intact.
@@ -665,20 +641,10 @@ mod tests {
 
     #[test]
     fn degenerate_triangle_is_flagged() {
-        let values = vec![0.0; 9];
-        let positions = grid_positions_3x3();
         let mut triangles = eight_triangles();
         triangles.push([0, 4, 8]); // the main diagonal
         triangles.push([1, 1, 2]); // a repeated corner
-        let report = run(
-            3,
-            3,
-            &values,
-            &positions,
-            &[0.0; 9],
-            &triangles,
-            VerifyOptions::new(),
-        );
+        let report = flat_3x3(&triangles);
         assert_eq!(report.degenerate_triangles, 2);
         assert_eq!(report.flipped_triangles, 0);
         assert_eq!(report.mesh_area_x2, 8);
@@ -966,19 +932,9 @@ mod tests {
 
     #[test]
     fn overlapping_triangles_show_as_excess_area() {
-        let values = vec![0.0; 9];
-        let positions = grid_positions_3x3();
         let mut triangles = eight_triangles();
         triangles.push(triangles[0]);
-        let report = run(
-            3,
-            3,
-            &values,
-            &positions,
-            &[0.0; 9],
-            &triangles,
-            VerifyOptions::new(),
-        );
+        let report = flat_3x3(&triangles);
         assert_eq!(report.mesh_area_x2, 9);
         assert!(!report.mesh_is_valid());
     }

@@ -723,16 +723,17 @@ impl<'g> Remover<'g> {
         } else {
             m - 1
         };
-        let others: Vec<usize> = (0..m).filter(|&i| i != apex).collect();
+        // The other ring vertices, in order: the apex is the first or the last.
+        let others = if apex == 0 { 1..m } else { 0..m - 1 };
         self.new_triangles.clear();
-        for (pair, &slot) in others.windows(2).zip(&star.triangles) {
-            let [a, b, c] = [apex, pair[0], pair[1]].map(|i| self.points[i]);
+        for ((p, q), &slot) in others.clone().zip(others.skip(1)).zip(&star.triangles) {
+            let [a, b, c] = [apex, p, q].map(|i| self.points[i]);
             if crate::predicates::orient(&a, &b, &c) <= 0 {
                 return false;
             }
             let bound = crate::exact::triangle_error(self.rules.grid, &a, &b, &c, f64::INFINITY)
                 .expect("no limit");
-            let corners = [apex, pair[0], pair[1]].map(|i| star.ring[i]);
+            let corners = [apex, p, q].map(|i| star.ring[i]);
             self.new_triangles.push((slot, corners, bound));
         }
         true

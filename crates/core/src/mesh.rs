@@ -67,6 +67,9 @@ pub(crate) struct Star {
     pub ring: Vec<u32>,
     /// `triangles[i]` has corners `(centre, ring[i], ring[i + 1 mod len])`.
     pub triangles: Vec<u32>,
+    /// `outer[i]`: the triangle across ring edge `ring[i] -> ring[i + 1 mod len]` from
+    /// `triangles[i]`, outside the star, or [`NONE`] on the domain boundary.
+    pub outer: Vec<u32>,
     /// Whether the star is a half cycle (the vertex is on the domain boundary).
     pub open: bool,
 }
@@ -408,6 +411,7 @@ impl<'g> Mesh<'g> {
     pub(crate) fn star(&self, v: u32, star: &mut Star) {
         star.ring.clear();
         star.triangles.clear();
+        star.outer.clear();
         let start = self.vertex_triangle[v as usize];
         debug_assert_ne!(start, NONE);
         // Walk counter-clockwise from `start`; a closed fan comes back to it in one pass.
@@ -417,6 +421,7 @@ impl<'g> Mesh<'g> {
             let c = self.corners[t as usize];
             star.ring.push(c[(i + 1) % 3]);
             star.triangles.push(t);
+            star.outer.push(self.neighbours[t as usize][(i + 1) % 3]);
             let ccw = self.neighbours[t as usize][(i + 2) % 3];
             if ccw == NONE {
                 star.ring.push(c[(i + 2) % 3]);
@@ -427,6 +432,7 @@ impl<'g> Mesh<'g> {
                 // were measured with.
                 star.open = false;
                 star.triangles.rotate_left(1);
+                star.outer.rotate_left(1);
                 star.ring.rotate_left(1);
                 return;
             }
@@ -445,6 +451,7 @@ impl<'g> Mesh<'g> {
             let j = self.local(cw, v);
             star.ring.push(self.corners[cw as usize][(j + 1) % 3]);
             star.triangles.push(cw);
+            star.outer.push(self.neighbours[cw as usize][(j + 1) % 3]);
             t = cw;
         }
         // The clockwise part was appended nearest-first: rotate it to the front, reversed.
@@ -452,6 +459,8 @@ impl<'g> Mesh<'g> {
         if cw_triangles > 0 {
             star.triangles[ccw_triangles..].reverse();
             star.triangles.rotate_right(cw_triangles);
+            star.outer[ccw_triangles..].reverse();
+            star.outer.rotate_right(cw_triangles);
             let ring_ccw = ccw_triangles + 1;
             star.ring[ring_ccw..].reverse();
             star.ring.rotate_right(cw_triangles);
@@ -486,26 +495,16 @@ impl<'g> Mesh<'g> {
         star: &Star,
         new_triangles: &[(u32, [u32; 3], ErrorBound)],
     ) {
-        // Outer links of the ring edges, read before the star's slots are reused:
-        // ring edge i (ring[i] -> ring[i+1]) belongs to star triangle i.
-        let mut ring_edges: Vec<(u32, u32, u32)> = star
-            .triangles
-            .iter()
-            .map(|&t| {
-                let i = self.local(t, v);
-                let c = self.corners[t as usize];
-                (
-                    c[(i + 1) % 3],
-                    c[(i + 2) % 3],
-                    self.neighbours[t as usize][(i + 1) % 3],
-                )
-            })
-            .collect();
-        if star.open {
-            // The new domain edge that replaces the two boundary edges through `v`.
-            let last = *star.ring.last().expect("a star has neighbours");
-            ring_edges.push((last, star.ring[0], NONE));
-        }
+        // Ring edge i (ring[i] -> ring[i+1 mod m]) had star triangle i inside and
+        // `star.outer[i]` outside; for an open star, edge m - 1 is the new domain edge that
+        // replaces the two boundary edges through `v`.
+        let m = star.ring.len();
+        let outside_of = |a: u32, b: u32| {
+            (0..m)
+                .find(|&i| star.ring[i] == a && star.ring[(i + 1) % m] == b)
+                .map(|i| star.outer.get(i).copied().unwrap_or(NONE))
+                .expect("a hole edge is a ring edge or a shared diagonal")
+        };
         debug_assert!(new_triangles.len() < star.triangles.len());
         for &t in &star.triangles {
             self.corners[t as usize] = [NONE; 3];
@@ -531,11 +530,7 @@ impl<'g> Mesh<'g> {
                 let across = match twin {
                     Some(s2) => s2,
                     None => {
-                        let outside = ring_edges
-                            .iter()
-                            .find(|&&(ra, rb, _)| ra == a && rb == b)
-                            .map(|&(_, _, o)| o)
-                            .expect("a hole edge is a ring edge or a shared diagonal");
+                        let outside = outside_of(a, b);
                         if outside != NONE {
                             let k = self.edge_index(outside, b, a);
                             self.neighbours[outside as usize][k] = slot;

@@ -538,6 +538,102 @@ fn a_pyramid_across_the_antimeridian_wraps_its_columns() {
     assert!(seams > 0, "no tile pair across 180 degrees");
 }
 
+/// The share of the tile's square its triangles cover.
+fn covered(t: &Tile) -> f64 {
+    let doubled: i64 = t
+        .triangles
+        .iter()
+        .map(|&[a, b, c]| {
+            (t.u[b] - t.u[a]) * (t.v[c] - t.v[a]) - (t.v[b] - t.v[a]) * (t.u[c] - t.u[a])
+        })
+        .sum();
+    doubled as f64 / 2.0 / (32767.0 * 32767.0)
+}
+
+/// `input` relabelled as EPSG:4326 over `[west, north, east, south]` (`gdal_translate
+/// -a_ullr`).
+fn relabelled(dir: &Dir, input: &str, name: &str, ullr: [&str; 4]) -> String {
+    let out = dir.path(name);
+    let status = Command::new("gdal_translate")
+        .args(["-q", "-a_srs", "EPSG:4326", "-a_ullr"])
+        .args(ullr)
+        .arg(fixture(input))
+        .arg(&out)
+        .status()
+        .expect("gdal_translate runs");
+    assert!(status.success());
+    out.to_string_lossy().into_owned()
+}
+
+#[test]
+fn a_pyramid_wider_than_half_the_globe_keeps_its_data_at_every_level() {
+    // A raster over longitudes -10..300: at levels 0 and 1 its tiles go all the way round,
+    // and the coarse tile west of 0 degrees holds both its own part and the part past 180.
+    // (Each level used to stop at a full turn from its first tile, so level 0 lost the
+    // part past 180 that level 1 had: 0/0/0 covered 13 % of its square, not 40 %.)
+    let dir = Dir::new();
+    let input = relabelled(
+        &dir,
+        "becmodel_dem_bc_albers_50m.tif",
+        "wide.tif",
+        ["-10", "50", "300", "-50"],
+    );
+    pyramid(&dir, &input, "p", &["--max-zoom", "2", "-q"]);
+    let tiles = decode_pyramid(&dir.path("p"));
+    for (&(z, x, y), t) in tiles.range(..(2, 0, 0)) {
+        check_tile((z, x, y), t);
+        let children: f64 = [(0, 0), (1, 0), (0, 1), (1, 1)]
+            .iter()
+            .filter_map(|(dx, dy)| tiles.get(&(z + 1, 2 * x + dx, 2 * y + dy)))
+            .map(covered)
+            .sum();
+        assert!(
+            covered(t) >= 0.98 * children / 4.0,
+            "{z}/{x}/{y} covers {:.3} of its square, its children {:.3}",
+            covered(t),
+            children / 4.0
+        );
+    }
+    assert!(check_shared_edges(&tiles) > 0);
+}
+
+#[test]
+fn a_whole_turn_of_longitudes_is_a_globe_stitched_across_180_at_every_level() {
+    // A global grid in 0..360 longitudes whose extent comes out a rounding error short of
+    // 360 degrees (as ETOPO5's does): still the whole globe. Every tile is covered, and at
+    // every level the last column's east edge is the first column's west edge, vertex for
+    // vertex and height for height. (It used to be taken for a raster across the
+    // antimeridian just short of a turn: root tile 0/0/0 covered a sliver, and the coarse
+    // levels did not filter across 180 degrees, so the seam's heights differed.)
+    let dir = Dir::new();
+    let input = relabelled(
+        &dir,
+        "etopo5_2deg_i16.tif",
+        "globe360.tif",
+        ["-1", "90", "358.99999999999", "-90"],
+    );
+    pyramid(&dir, &input, "p", &["--max-zoom", "2", "-q"]);
+    let tiles = decode_pyramid(&dir.path("p"));
+    assert_eq!(tiles.len(), 2 + 8 + 32, "every tile of levels 0 to 2");
+    let mut seams = 0;
+    for (&(z, x, y), t) in &tiles {
+        check_tile((z, x, y), t);
+        assert!(covered(t) > 0.95, "{z}/{x}/{y} covers {:.3}", covered(t));
+        if x + 1 != 2 << z {
+            continue;
+        }
+        let first = &tiles[&(z, 0, y)];
+        assert_eq!(
+            edge(t, 2),
+            edge(first, 0),
+            "{z}/{x}/{y}: the seam at 180 degrees"
+        );
+        seams += 1;
+    }
+    assert_eq!(seams, 1 + 2 + 4);
+    assert!(check_shared_edges(&tiles) > 0);
+}
+
 #[test]
 fn a_level_far_finer_than_memory_allows_is_refused_up_front() {
     // The 2-degree globe at level 24: its tile rows would span 2^25 tiles (petabytes of

@@ -74,7 +74,10 @@ pub fn geographic_bounds(path: &Path, band: usize) -> Result<GeoBounds> {
         (b[0], b[2])
     };
     let resolution = ((east - west) / w).min((b[3] - b[1]) / h);
-    let (west, east) = if east - west >= 360.0 {
+    // A global grid's extent can come out a rounding error short of the whole circle
+    // (ETOPO5's 5' pixels from -0.041666666667: 3e-13 degrees short); a millionth of a
+    // sample is far below any gap a raster could mean.
+    let (west, east) = if east - west >= 360.0 - 1e-6 * resolution {
         // The whole circle of longitudes (a global grid, in any frame).
         (-180.0, 180.0)
     } else if west < -180.0 {

@@ -20,6 +20,11 @@ const TAPS: [(i64, f64); 5] = [(-2, 1.0), (-1, 4.0), (0, 6.0), (1, 4.0), (2, 1.0
 /// The samples of one level on its lattice, over whole tiles: global lattice column
 /// `217 tx0 + i`, row `217 ty0 + j` (row 0 the southernmost), NaN where there is no data.
 ///
+/// A level whose tiles go all the way round the globe ([`LevelRows::wraps`]) is periodic:
+/// its last column is its first one a turn east (and holds the same samples), and
+/// whatever reads past one side of it reads the other, so the tiles either side of the
+/// seam see the same edge, and coarser levels filter across it.
+///
 /// Rows arrive in increasing order ([`LevelRows::push`]) and leave from the bottom
 /// ([`LevelRows::drop_below`]); only rows `first..end()` are held. Every accessor takes
 /// level-wide coordinates and treats the level's own border (row or column outside
@@ -35,6 +40,8 @@ pub(super) struct LevelRows {
     pub(super) tiles_y: u32,
     /// Lattice columns and rows of the whole level.
     pub(super) width: usize,
+    /// Whether the tiles go all the way round (`2^(level+1)` columns).
+    wraps: bool,
     pub(super) height: usize,
     /// The first row held.
     first: usize,
@@ -55,6 +62,7 @@ impl LevelRows {
             tiles_y,
             width: tiles_x as usize * CELLS + 1,
             height: tiles_y as usize * CELLS + 1,
+            wraps: u64::from(tiles_x) == 2u64 << level,
             first: 0,
             values: Vec::new(),
         }
@@ -102,6 +110,22 @@ impl LevelRows {
             self.height
         );
         self.values.extend_from_slice(rows);
+        if self.wraps {
+            let start = self.values.len() - rows.len();
+            for row in self.values[start..].chunks_exact_mut(self.width) {
+                row[self.width - 1] = row[0];
+            }
+        }
+    }
+
+    /// Column `i` (which may lie outside the level), or `None` outside a level that does
+    /// not wrap; around a level that wraps, the column a whole turn away inside it.
+    fn column(&self, i: i64) -> Option<usize> {
+        if self.wraps {
+            Some(i.rem_euclid(self.width as i64 - 1) as usize)
+        } else {
+            (i >= 0 && i < self.width as i64).then_some(i as usize)
+        }
     }
 
     /// Drops the rows below `row` (all held rows if `row` is beyond them).
@@ -195,13 +219,16 @@ impl LevelRows {
         range
     }
 
-    /// Whether the cell with lower-left sample (i, j) lies in the level and has four
-    /// valid corners.
+    /// Whether the cell with lower-left sample (i, j) lies in the level (round it, when
+    /// it wraps) and has four valid corners.
     pub(super) fn cell_valid(&self, i: i64, j: i64) -> bool {
-        if i < 0 || j < 0 || i + 1 >= self.width as i64 || j + 1 >= self.height as i64 {
+        let Some(i) = self.column(i).filter(|&i| i + 1 < self.width) else {
+            return false;
+        };
+        if j < 0 || j + 1 >= self.height as i64 {
             return false;
         }
-        let (i, j) = (i as usize, j as usize);
+        let j = j as usize;
         [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]
             .iter()
             .all(|&(a, b)| self.at(a, b).is_finite())
@@ -231,7 +258,9 @@ impl LevelRows {
                     ((a - 1, b), (a, b))
                 };
                 let inside = |(x, y): (i64, i64)| {
-                    x >= 0 && y >= 0 && x + 1 < self.width as i64 && y + 1 < self.height as i64
+                    self.column(x).is_some_and(|x| x + 1 < self.width)
+                        && y >= 0
+                        && y + 1 < self.height as i64
                 };
                 [side1, side2]
                     .iter()
@@ -248,10 +277,11 @@ impl LevelRows {
         let d = step(self.level).to_radians();
         let z = self.at(i, j);
         let sample = |a: i64, b: i64| -> Option<f64> {
-            if a < 0 || b < 0 || a >= self.width as i64 || b >= self.height as i64 {
+            let a = self.column(a)?;
+            if b < 0 || b >= self.height as i64 {
                 return None;
             }
-            Some(self.at(a as usize, b as usize)).filter(|v| v.is_finite())
+            Some(self.at(a, b as usize)).filter(|v| v.is_finite())
         };
         let slope = |lo: Option<f64>, hi: Option<f64>, spacing: f64| match (lo, hi) {
             (Some(a), Some(b)) => (b - a) / (2.0 * spacing),
@@ -307,7 +337,9 @@ impl LevelRows {
 
     /// Rows `rows` of the next coarser level: lattice point (X, Y) there is this level's
     /// (2X, 2Y), low-pass filtered with the binomial [1 4 6 4 1] x [1 4 6 4 1] kernel over
-    /// the valid samples here; nodata only where all 25 are. The domain so grows by at most
+    /// the valid samples here; nodata only where all 25 are. Columns are matched round
+    /// the globe: a coarser level that wraps, or one that starts west of this one, reads
+    /// the samples a whole turn away where this level has them. The domain so grows by at most
     /// one coarse sample per level, which keeps small inputs visible at coarse levels.
     /// Rows are filtered in parallel; each sample's sum runs in the same order whatever
     /// the rows held, so the result depends only on the level's samples.
@@ -321,14 +353,16 @@ impl LevelRows {
         let cx0 = i64::from(coarser.tx0) * cells;
         let cy0 = i64::from(coarser.ty0) * cells;
         let width = coarser.width;
+        // Lattice columns in a whole turn of this level.
+        let turn = (2i64 << self.level) * cells;
         let mut out = vec![f32::NAN; width * rows.len()];
         out.par_chunks_mut(width).enumerate().for_each(|(k, row)| {
             let gy = 2 * (cy0 + (rows.start + k) as i64);
             let fine_rows = TAPS.map(|(dy, _)| self.row(gy + dy - fy0));
             let fine = |r: Option<&[f32]>, gx: i64| -> f32 {
-                let i = gx - fx0;
+                let i = (gx - fx0).rem_euclid(turn);
                 match r {
-                    Some(r) if i >= 0 && i < self.width as i64 => r[i as usize],
+                    Some(r) if i < self.width as i64 => r[i as usize],
                     _ => f32::NAN,
                 }
             };

@@ -634,6 +634,134 @@ fn a_whole_turn_of_longitudes_is_a_globe_stitched_across_180_at_every_level() {
     assert!(check_shared_edges(&tiles) > 0);
 }
 
+/// The `.terrain` files of a pyramid (not `layer.json`, which names its input).
+fn terrain_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut files = all_files(root);
+    files.retain(|p, _| p.extension().is_some_and(|e| e == "terrain"));
+    assert!(!files.is_empty(), "no tiles under {}", root.display());
+    files
+}
+
+/// A VRT over the 2-degree globe (EPSG:4326), with the given bands' XML.
+fn globe_vrt(dir: &Dir, name: &str, bands: &str) -> String {
+    let xml = format!(
+        "<VRTDataset rasterXSize=\"180\" rasterYSize=\"90\"><SRS>EPSG:4326</SRS>\
+         <GeoTransform>-180,2,0,90,0,-2</GeoTransform>{bands}</VRTDataset>"
+    );
+    dir.write(name, &xml).to_string_lossy().into_owned()
+}
+
+/// A VRT band `n` of type `kind` reading the 2-degree globe through `source_extra` (a
+/// `ComplexSource`'s scaling or lookup table), with `extra` before the source.
+fn globe_band(n: u32, kind: &str, extra: &str, source_extra: &str) -> String {
+    format!(
+        "<VRTRasterBand dataType=\"{kind}\" band=\"{n}\">{extra}<ComplexSource>\
+         <SourceFilename relativeToVRT=\"0\">{}</SourceFilename><SourceBand>1</SourceBand>\
+         {source_extra}</ComplexSource></VRTRasterBand>",
+        fixture("etopo5_2deg_i16.tif")
+    )
+}
+
+#[test]
+fn the_band_asked_for_is_the_band_tiled() {
+    // GDAL's warper warps band 1 of its source, so `--band 2` used to tile band 1.
+    let dir = Dir::new();
+    let doubled = "<ScaleOffset>1000</ScaleOffset><ScaleRatio>2</ScaleRatio>";
+    let two = globe_vrt(
+        &dir,
+        "two.vrt",
+        &(globe_band(1, "Float32", "", "") + &globe_band(2, "Float32", "", doubled)),
+    );
+    let second = globe_vrt(&dir, "second.vrt", &globe_band(1, "Float32", "", doubled));
+    for (input, band, out) in [
+        (&two, "2", "two2"),
+        (&two, "1", "two1"),
+        (&second, "1", "second"),
+    ] {
+        pyramid(&dir, input, out, &["--band", band, "--max-zoom", "1", "-q"]);
+    }
+    let band2 = terrain_files(&dir.path("two2"));
+    assert_eq!(band2, terrain_files(&dir.path("second")));
+    assert_ne!(band2, terrain_files(&dir.path("two1")));
+}
+
+#[test]
+fn nan_is_nodata_in_tiles_whether_declared_or_not() {
+    // The same grid with a block of NaN, once with NODATA_value nan and once without:
+    // the same tiles. (Undeclared, GDAL's bilinear warp spread the NaN to the samples
+    // beside the block, and those tiles lost them.)
+    let dir = Dir::new();
+    let mut rows = Vec::new();
+    for r in 0..30 {
+        let row: Vec<String> = (0..40)
+            .map(|c| {
+                if (10..16).contains(&r) && (12..20).contains(&c) {
+                    "nan".to_owned()
+                } else {
+                    let v = 100.0 + 3.0 * f64::from(c) + 0.5 * f64::from(r);
+                    format!("{:.3}", v + 10.0 * (f64::from(c) / 3.0).sin())
+                }
+            })
+            .collect();
+        rows.push(row.join(" "));
+    }
+    let header = "ncols 40\nnrows 30\nxllcorner 10.0\nyllcorner 40.0\ncellsize 0.01\n";
+    let wgs84 = "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],\
+                 PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]";
+    for (name, nodata) in [("undeclared", ""), ("declared", "NODATA_value nan\n")] {
+        dir.write(
+            &format!("{name}.asc"),
+            &format!("{header}{nodata}{}\n", rows.join("\n")),
+        );
+        dir.write(&format!("{name}.prj"), wgs84);
+        let input = format!("{name}.asc");
+        pyramid(
+            &dir,
+            &input,
+            name,
+            &["--min-zoom", "11", "--max-zoom", "11", "-q"],
+        );
+    }
+    assert_eq!(
+        terrain_files(&dir.path("undeclared")),
+        terrain_files(&dir.path("declared"))
+    );
+}
+
+#[test]
+fn an_alpha_band_of_any_type_masks_tiles_as_a_mask_band_does() {
+    // The globe with its oceans masked: by a Float32 alpha band of 0 and 1 (as gdalwarp
+    // -dstalpha can write), and by a mask band of 0 and 255. Same tiles. (The warper took
+    // the alpha band's 1 for 1/255 and lost every sample.)
+    let dir = Dir::new();
+    let land = "<LUT>-100000:0,-0.5:0,0:1,100000:1</LUT>";
+    let alpha = globe_vrt(
+        &dir,
+        "alpha.vrt",
+        &(globe_band(1, "Float32", "", "")
+            + &globe_band(2, "Float32", "<ColorInterp>Alpha</ColorInterp>", land)),
+    );
+    let mask = globe_band(
+        1,
+        "Byte",
+        "",
+        "<LUT>-100000:0,-0.5:0,0:255,100000:255</LUT>",
+    )
+    .replace(" band=\"1\"", "");
+    let band = globe_band(1, "Float32", "", "").replace(
+        "</VRTRasterBand>",
+        &format!("<MaskBand>{mask}</MaskBand></VRTRasterBand>"),
+    );
+    let masked = globe_vrt(&dir, "masked.vrt", &band);
+    for (input, out) in [(&alpha, "alpha"), (&masked, "masked")] {
+        pyramid(&dir, input, out, &["--max-zoom", "1", "-q"]);
+    }
+    assert_eq!(
+        terrain_files(&dir.path("alpha")),
+        terrain_files(&dir.path("masked"))
+    );
+}
+
 #[test]
 fn a_level_far_finer_than_memory_allows_is_refused_up_front() {
     // The 2-degree globe at level 24: its tile rows would span 2^25 tiles (petabytes of

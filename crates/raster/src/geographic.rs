@@ -5,10 +5,10 @@ use std::path::Path;
 
 use gdal::raster::reproject;
 use gdal::spatial_ref::{AxisMappingStrategy, CoordTransform, SpatialRef};
-use gdal::DriverManager;
+use gdal::{Dataset, DriverManager};
 
 use crate::error::{gdal_reason, Error, Result};
-use crate::read::OpenBand;
+use crate::read::{MaskSource, OpenBand};
 
 /// Where a raster lies in EPSG:4326 (degrees), and how fine it is. `west` is in
 /// `[-180, 180]` and `east` after it: beyond 180 when the raster crosses the antimeridian.
@@ -144,7 +144,8 @@ fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
 pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Result<Vec<f32>> {
     let opened = OpenBand::open(path, band)?;
     let b = raw_bounds(path, &opened)?;
-    let mut values = warp_pass(path, &opened, lattice, 0.0)?;
+    let view = band_view(path, &opened)?;
+    let mut values = warp_pass(path, &opened, &view, lattice, 0.0)?;
     // Sources in 0..360 (or -360..0) longitudes: the part beyond the antimeridian is
     // warped again with the lattice shifted by a full turn, filling what is still empty.
     for shift in [360.0, -360.0] {
@@ -154,7 +155,7 @@ pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Res
             b[0] < -180.0
         };
         if beyond && values.iter().any(|v| v.is_nan()) {
-            let more = warp_pass(path, &opened, lattice, shift)?;
+            let more = warp_pass(path, &opened, &view, lattice, shift)?;
             for (v, m) in values.iter_mut().zip(more) {
                 if v.is_nan() {
                     *v = m;
@@ -165,7 +166,64 @@ pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Res
     Ok(values)
 }
 
-fn warp_pass(path: &Path, opened: &OpenBand, lattice: &GeoLattice, shift: f64) -> Result<Vec<f32>> {
+/// The band alone, as GDAL's warper must see it: an in-memory VRT whose band 1 is the
+/// band (GDALReprojectImage warps band 1 of its source, whatever band was asked for), with
+/// NaN declared as nodata on a float band that declares none (the warper would otherwise
+/// blend NaN into its valid neighbours), and the band's mask (a mask band, or an alpha
+/// band of any type: nonzero is valid) as an alpha band, which the warper honours.
+fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
+    let info = &opened.info;
+    let escape = |text: &str| {
+        text.replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;")
+            .replace('"', "&quot;")
+    };
+    let source = escape(&path.to_string_lossy());
+    let gdal_type = opened.band()?.band_type().name();
+    let nodata = match info.nodata {
+        Some(v) => format!("<NoDataValue>{v:?}</NoDataValue>"),
+        None if gdal_type.starts_with("Float") => "<NoDataValue>nan</NoDataValue>".to_owned(),
+        None => String::new(),
+    };
+    let gt = info
+        .geo_transform
+        .map(|g| g.map(|v| format!("{v:?}")).join(","))
+        .unwrap_or_default();
+    let srs = info.crs_wkt.as_deref().map(escape).unwrap_or_default();
+    let alpha = match opened.mask_source {
+        None => String::new(),
+        Some(MaskSource::Gdal(_)) => format!(
+            "<VRTRasterBand dataType=\"Byte\" band=\"2\"><ColorInterp>Alpha</ColorInterp>\
+             <SimpleSource><SourceFilename relativeToVRT=\"0\">{source}</SourceFilename>\
+             <SourceBand>mask,{}</SourceBand></SimpleSource></VRTRasterBand>",
+            info.band
+        ),
+        // Any nonzero value is valid: 0 stays 0, the smallest positive double and up 255.
+        Some(MaskSource::Alpha(b)) => format!(
+            "<VRTRasterBand dataType=\"Byte\" band=\"2\"><ColorInterp>Alpha</ColorInterp>\
+             <ComplexSource><SourceFilename relativeToVRT=\"0\">{source}</SourceFilename>\
+             <SourceBand>{b}</SourceBand><LUT>0:0,5e-324:255</LUT></ComplexSource>\
+             </VRTRasterBand>"
+        ),
+    };
+    let xml = format!(
+        "<VRTDataset rasterXSize=\"{}\" rasterYSize=\"{}\"><SRS>{srs}</SRS>\
+         <GeoTransform>{gt}</GeoTransform><VRTRasterBand dataType=\"{gdal_type}\" band=\"1\">\
+         {nodata}<SimpleSource><SourceFilename relativeToVRT=\"0\">{source}</SourceFilename>\
+         <SourceBand>{}</SourceBand></SimpleSource></VRTRasterBand>{alpha}</VRTDataset>",
+        info.width, info.height, info.band
+    );
+    Dataset::open(Path::new(&xml)).map_err(|e| warp_error(path, e))
+}
+
+fn warp_pass(
+    path: &Path,
+    opened: &OpenBand,
+    view: &Dataset,
+    lattice: &GeoLattice,
+    shift: f64,
+) -> Result<Vec<f32>> {
     let info = &opened.info;
     let (width, height) = (lattice.width as usize, lattice.height as usize);
     let driver = DriverManager::get_driver_by_name("MEM").map_err(|e| warp_error(path, e))?;
@@ -187,7 +245,7 @@ fn warp_pass(path: &Path, opened: &OpenBand, lattice: &GeoLattice, shift: f64) -
             .map_err(|e| warp_error(path, e))?;
         rb.fill(f64::NAN, None).map_err(|e| warp_error(path, e))?;
     }
-    reproject(opened.dataset(), &target).map_err(|e| warp_error(path, e))?;
+    reproject(view, &target).map_err(|e| warp_error(path, e))?;
     let buffer = target
         .rasterband(1)
         .and_then(|rb| rb.read_as::<f32>((0, 0), (width, height), (width, height), None))

@@ -109,12 +109,12 @@ pub(crate) struct OpenBand {
     /// Metadata; the statistics are still zero.
     pub(crate) info: RasterInfo,
     decoder: SampleDecoder,
-    mask_source: Option<MaskSource>,
+    pub(crate) mask_source: Option<MaskSource>,
 }
 
 /// Where the band's validity mask comes from, besides its nodata value.
 #[derive(Debug, Clone, Copy)]
-enum MaskSource {
+pub(crate) enum MaskSource {
     /// GDAL's mask band (per-dataset, per-band or a Byte alpha band), of this kind.
     Gdal(&'static str),
     /// An alpha band (by number) of a type GDAL does not take as a mask.

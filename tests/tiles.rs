@@ -319,6 +319,25 @@ fn per_tile_refuses_a_non_empty_directory_and_leaves_nothing() {
 }
 
 #[test]
+fn per_tile_refuses_options_of_formats_it_does_not_write() {
+    // --per-tile writes PLY or OBJ (--tile-format); these were silently ignored.
+    let dem = fixture("tintn_valid_raster_3857.tif");
+    let d = Dir::new();
+    for (extra, option) in [
+        (&["--format", "glb"][..], "--format"),
+        (&["--base", "-100"][..], "--base"),
+        (&["--normals"][..], "--normals"),
+        (&["--geojson-source-crs"][..], "--geojson-source-crs"),
+    ] {
+        let mut args = vec!["mesh", &dem, "--per-tile", "tiles", "--max-error", "1"];
+        args.extend_from_slice(extra);
+        let o = d.run(&args);
+        assert_fails_naming(&o, &[option, "--per-tile"]);
+        assert!(d.files().is_empty(), "{option}: left {:?}", d.files());
+    }
+}
+
+#[test]
 fn count_targets_run_untiled_whatever_the_tile_size() {
     let dem = fixture("becmodel_dem_bc_albers_50m.tif");
     let d = Dir::new();

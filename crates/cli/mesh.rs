@@ -37,6 +37,26 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
              format follows -o's extension (or --format)"
         );
     }
+    if args.per_tile.is_some() {
+        let export = &args.export;
+        let ignored = [
+            (
+                export.format.is_some(),
+                "--format (use --tile-format ply or obj)",
+            ),
+            (export.base.is_some(), "--base (STL only)"),
+            (export.normals, "--normals (glTF only)"),
+            (
+                export.geojson_source_crs,
+                "--geojson-source-crs (GeoJSON only)",
+            ),
+        ];
+        if let Some((_, option)) = ignored.iter().find(|(given, _)| *given) {
+            bail!(
+                "{option} does not apply to --per-tile, which writes PLY or OBJ files                  (--tile-format)"
+            );
+        }
+    }
     let Some(output) = crate::tiled::untiled_output(args)? else {
         return crate::tiled::run(args);
     };

@@ -395,6 +395,28 @@ fn check_pyramid(input: &str, quality: f64) {
     }
     assert_eq!(listed, tiles.len());
 
+    // With metadataAvailability CesiumJS requests both root tiles: the one the raster
+    // does not reach is flat at height 0, with no tile below it.
+    let flat: Vec<_> = [(0, 0, 0), (0, 1, 0)]
+        .iter()
+        .map(|key| {
+            let t = tiles
+                .get(key)
+                .unwrap_or_else(|| panic!("{key:?} is missing"));
+            (key, t.h.iter().all(|&h| h == 0.0))
+        })
+        .filter(|(_, flat)| *flat)
+        .collect();
+    assert_eq!(flat.len(), 1, "a regional raster reaches one root tile");
+    let below = &tiles[flat[0].0].metadata["available"];
+    assert!(
+        below
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|level| level.as_array().unwrap().is_empty()),
+        "a flat root lists tiles below it: {below}"
+    );
     for (&key, t) in &tiles {
         check_tile(key, t);
         assert_eq!(t.normals.as_ref().map(|n| n.len()), Some(2 * t.u.len()));
@@ -760,6 +782,26 @@ fn an_alpha_band_of_any_type_masks_tiles_as_a_mask_band_does() {
         terrain_files(&dir.path("alpha")),
         terrain_files(&dir.path("masked"))
     );
+}
+
+#[test]
+fn metadata_without_level_zero_is_refused() {
+    // CesiumJS learns availability from the level-0 tiles' metadata: without them it
+    // would find no tile at all.
+    let dir = Dir::new();
+    let input = fixture("etopo5_2deg_i16.tif");
+    let o = dir.run(&[
+        "tiles",
+        &input,
+        "-o",
+        "p",
+        "--metadata",
+        "--min-zoom",
+        "1",
+        "-q",
+    ]);
+    crate::util::assert_fails_naming(&o, &["--metadata", "--min-zoom 0"]);
+    assert!(!dir.path("p").exists());
 }
 
 #[test]

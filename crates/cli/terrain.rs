@@ -25,8 +25,12 @@ pub fn run(args: &TilesArgs) -> Result<bool> {
         if args.quiet {
             return;
         }
+        let flat = match level.flat_tiles {
+            0 => String::new(),
+            n => format!(" ({n} flat: a root tile without data, for --metadata)"),
+        };
         eprintln!(
-            "level {:>2}: {} tiles, {} bytes, bound {:.3} m, measured {:.3} m, {:.2} s",
+            "level {:>2}: {} tiles{flat}, {} bytes, bound {:.3} m, measured {:.3} m, {:.2} s",
             level.level,
             level.tiles,
             level.bytes,

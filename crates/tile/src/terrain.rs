@@ -200,6 +200,10 @@ pub struct LevelReport {
     pub tiles: u64,
     /// Tiles with data in range but no valid cell, not written.
     pub empty_tiles: u64,
+    /// Of `tiles`, at level 0 with `--metadata` only: root tiles the raster does not
+    /// reach, written flat at height 0 (the ellipsoid), since CesiumJS then takes both
+    /// roots to exist.
+    pub flat_tiles: u64,
     /// Bytes written (as stored, gzipped or not).
     pub bytes: u64,
     /// Vertices over all tiles.
@@ -378,6 +382,13 @@ pub fn build_terrain(
         .find(|&l| step(l) <= bounds.resolution * (1.0 + 1e-9))
         .unwrap_or(MAX_LEVEL);
     let max_zoom = options.max_zoom.unwrap_or(own_level);
+    if options.metadata && options.min_zoom > 0 {
+        return Err(TerrainError::Options(format!(
+            "--metadata needs --min-zoom 0 (got {}): CesiumJS learns which tiles exist from \
+             the metadata of the level-0 tiles",
+            options.min_zoom
+        )));
+    }
     if max_zoom > MAX_LEVEL || options.min_zoom > max_zoom {
         return Err(TerrainError::Options(format!(
             "zoom range {}..={max_zoom} is not within 0..={MAX_LEVEL}",
@@ -434,7 +445,7 @@ pub fn build_terrain(
         options,
         progress,
     )?;
-    if levels.iter().all(|l| l.tiles == 0) {
+    if levels.iter().all(|l| l.tiles == l.flat_tiles) {
         let hint = if options.max_zoom.is_some() {
             " (at this --max-zoom the tile samples may be too far apart for the raster's \
              extent: try a larger one)"
@@ -672,6 +683,7 @@ impl<'a> TileWriter<'a> {
                 measured_max_error: 0.0,
                 tiles: 0,
                 empty_tiles: 0,
+                flat_tiles: 0,
                 bytes: 0,
                 vertices: 0,
                 triangles: 0,
@@ -711,42 +723,64 @@ impl LevelSink for TileWriter<'_> {
                 .map(|&(x, y)| build_tile(level, x, y, budget, options, metadata_available))
                 .collect()
         });
-        let report = &mut self.reports[usize::from(z)];
         for result in results {
-            let Some(tile) = result? else {
-                report.empty_tiles += 1;
-                continue;
-            };
-            let dir = self.out_dir.join(z.to_string()).join(tile.x.to_string());
-            if tinsmith_export::interrupted() {
-                // The staging directory is being removed: add nothing to it.
-                return Err(TerrainError::Output {
-                    path: dir,
-                    source: std::io::Error::from(std::io::ErrorKind::Interrupted),
-                });
+            match result? {
+                Some(tile) => self.write(z, &tile)?,
+                None => self.reports[usize::from(z)].empty_tiles += 1,
             }
-            std::fs::create_dir_all(&dir).map_err(|source| TerrainError::Output {
-                path: dir.clone(),
-                source,
-            })?;
-            write_atomic(&dir.join(format!("{}.terrain", tile.y)), &tile.bytes)?;
-            self.available[usize::from(z)].insert((tile.x, tile.y));
-            report.tiles += 1;
-            report.bytes += tile.bytes.len() as u64;
-            report.vertices += tile.vertices as u64;
-            report.triangles += tile.triangles as u64;
-            report.measured_max_error = report.measured_max_error.max(tile.max_error);
         }
-        report.seconds += t.elapsed().as_secs_f64();
+        self.reports[usize::from(z)].seconds += t.elapsed().as_secs_f64();
         Ok(())
     }
 
     fn level_done(&mut self, level: u8, seconds: f64) -> TerrainResult<()> {
         let z = usize::from(level);
+        if level == 0 && self.options.metadata {
+            // With metadataAvailability CesiumJS ignores `available` and requests both
+            // root tiles: one the raster does not reach is written flat (no subtree).
+            for x in 0..2 {
+                if self.available[0].contains(&(x, 0)) {
+                    continue;
+                }
+                let flat = LevelRows::flat_tile(0, x, 0);
+                let budget = &self.budgets[0];
+                let tile = build_tile(&flat, x, 0, budget, self.options, Some(&self.available))?
+                    .expect("a flat tile has cells");
+                self.write(0, &tile)?;
+                self.reports[0].flat_tiles += 1;
+            }
+        }
         let report = &mut self.reports[z];
         report.seconds += seconds + self.stats_seconds[z];
         (self.progress)(report);
         self.finished.push(report.clone());
+        Ok(())
+    }
+}
+
+impl TileWriter<'_> {
+    /// Writes a tile of level `z` into the staging directory and counts it.
+    fn write(&mut self, z: u8, tile: &TileOut) -> TerrainResult<()> {
+        let dir = self.out_dir.join(z.to_string()).join(tile.x.to_string());
+        if tinsmith_export::interrupted() {
+            // The staging directory is being removed: add nothing to it.
+            return Err(TerrainError::Output {
+                path: dir,
+                source: std::io::Error::from(std::io::ErrorKind::Interrupted),
+            });
+        }
+        std::fs::create_dir_all(&dir).map_err(|source| TerrainError::Output {
+            path: dir.clone(),
+            source,
+        })?;
+        write_atomic(&dir.join(format!("{}.terrain", tile.y)), &tile.bytes)?;
+        self.available[usize::from(z)].insert((tile.x, tile.y));
+        let report = &mut self.reports[usize::from(z)];
+        report.tiles += 1;
+        report.bytes += tile.bytes.len() as u64;
+        report.vertices += tile.vertices as u64;
+        report.triangles += tile.triangles as u64;
+        report.measured_max_error = report.measured_max_error.max(tile.max_error);
         Ok(())
     }
 }

@@ -68,6 +68,24 @@ impl LevelRows {
         }
     }
 
+    /// Tile `x`, `y` of `level` alone, at height 0 everywhere (the ellipsoid), every row
+    /// held: a root tile CesiumJS expects that the raster does not reach (`--metadata`).
+    pub(super) fn flat_tile(level: u8, x: u32, y: u32) -> LevelRows {
+        let side = CELLS + 1;
+        LevelRows {
+            level,
+            tx0: x,
+            ty0: y,
+            tiles_x: 1,
+            tiles_y: 1,
+            width: side,
+            height: side,
+            wraps: false,
+            first: 0,
+            values: vec![0.0; side * side],
+        }
+    }
+
     /// One past the last row held: the number of rows pushed so far.
     pub(super) fn end(&self) -> usize {
         self.first + self.values.len() / self.width

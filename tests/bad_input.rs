@@ -588,3 +588,32 @@ fn info_and_verify_end_quietly_when_stdout_is_closed() {
         assert!(err.is_empty(), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn commands_that_write_files_finish_when_stderr_is_closed() {
+    // `tinsmith mesh ... 2>&1 | head -1`: the summary goes to a closed pipe. It used to
+    // panic (exit 101); the file is the result, the notes are not.
+    let d = Dir::new();
+    for (args, output) in [
+        (
+            vec!["mesh", &dem(), "--max-error", "2", "-o", "m.ply"],
+            "m.ply",
+        ),
+        (
+            vec!["contour", &dem(), "--interval", "100", "-o", "c.geojson"],
+            "c.geojson",
+        ),
+    ] {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+            .args(&args)
+            .current_dir(d.path("."))
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("run tinsmith");
+        drop(child.stderr.take());
+        let status = child.wait().expect("wait");
+        assert!(status.success(), "{args:?}: {status}");
+        assert!(d.path(output).exists(), "{args:?}: no {output}");
+    }
+}

@@ -199,7 +199,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     }
 
     if !args.quiet {
-        eprintln!(
+        note!(
             "{}: {} lines ({} closed), {} segments{} at {} levels from the {} ({} triangles) in {:.2} s",
             args.output.display(),
             lines.len(),

@@ -323,7 +323,7 @@ pub fn file_crs<'r>(
         }
         None => {
             if !quiet {
-                eprintln!(
+                note!(
                     "{}: no CRS, so the coordinates are written as they are, with \"crs\": null",
                     path.display()
                 );

@@ -3,6 +3,15 @@
 //! Exit codes: 0 success; 1 the verifier found the mesh outside the bound or invalid;
 //! 2 bad input or any other error (the message names the file and the problem).
 
+/// `eprintln!` for notes (summaries, warnings, the final error): a closed stderr (`2>&1 |
+/// head`) is not an error, and must not panic in the middle of writing output files.
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 mod args;
 mod contour;
 mod export;
@@ -38,9 +47,9 @@ fn main() -> ExitCode {
     // (their owners' drops, which remove them on errors, do not run on a signal's exit).
     let _ = ctrlc::set_handler(|| {
         if tinsmith_export::remove_pending() > 0 {
-            eprintln!("\ntinsmith: interrupted; unfinished output removed");
+            note!("\ntinsmith: interrupted; unfinished output removed");
         } else {
-            eprintln!("\ntinsmith: interrupted");
+            note!("\ntinsmith: interrupted");
         }
         // SAFETY: `_exit` takes no pointers and never returns. Unlike `process::exit` it
         // runs no atexit handlers, which would tear GDAL's global state down under the
@@ -74,7 +83,7 @@ fn main() -> ExitCode {
             if is_broken_pipe(&err) {
                 return ExitCode::SUCCESS;
             }
-            eprintln!("tinsmith: {}", one_line(&err));
+            note!("tinsmith: {}", one_line(&err));
             ExitCode::from(EXIT_ERROR)
         }
     }

@@ -164,7 +164,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         report.summary.print("");
         if let Some(origin) = plan.origin {
             let [x, y, z] = origin.offset();
-            eprintln!(
+            note!(
                 "{}: float32 positions relative to the local origin ({x}, {y}, {z}); \
                  heights round by at most {}",
                 output.display(),

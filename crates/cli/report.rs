@@ -95,7 +95,7 @@ impl<'a> MeshSummary<'a> {
     /// The one-line summary on stderr: triangles before and after, measured error and bound,
     /// with `how` (e.g. the tiling) after the percentage.
     pub fn print(&self, how: &str) {
-        eprintln!(
+        note!(
             "{}: {} -> {} triangles ({:.1}% decimated){how}, measured max error {} <= {}",
             self.output.display(),
             self.triangles_before,
@@ -119,14 +119,14 @@ impl<'a> MeshSummary<'a> {
                         "the domain's outline needs them (its corners are never removed)".into()
                     }
                 };
-                eprintln!(
+                note!(
                     "{}: note: {reached} is above {flag} {target}: {why}",
                     self.output.display()
                 );
             }
         }
         if self.band_count > 1 {
-            eprintln!(
+            note!(
                 "{}: note: meshed band {} of {} (--band picks another)",
                 self.input.display(),
                 self.band,
@@ -134,7 +134,7 @@ impl<'a> MeshSummary<'a> {
             );
         }
         if self.isolated_samples > 0 {
-            eprintln!(
+            note!(
                 "{}: note: {} valid samples are in no 2x2 block of valid samples, so no \
                  triangle can hold them; they are not in the mesh",
                 self.input.display(),

@@ -29,7 +29,7 @@ pub fn run(args: &TilesArgs) -> Result<bool> {
             0 => String::new(),
             n => format!(" ({n} flat: a root tile without data, for --metadata)"),
         };
-        eprintln!(
+        note!(
             "level {:>2}: {} tiles{flat}, {} bytes, bound {:.3} m, measured {:.3} m, {:.2} s",
             level.level,
             level.tiles,
@@ -47,7 +47,7 @@ pub fn run(args: &TilesArgs) -> Result<bool> {
         return Ok(true);
     }
     let tiles: u64 = report.levels.iter().map(|l| l.tiles).sum();
-    eprintln!(
+    note!(
         "{tiles} tiles, levels {}..={}, in {}{}",
         report.min_zoom,
         report.max_zoom,

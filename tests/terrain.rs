@@ -785,6 +785,50 @@ fn an_alpha_band_of_any_type_masks_tiles_as_a_mask_band_does() {
 }
 
 #[test]
+fn zoom_and_quality_out_of_range_are_refused_saying_why() {
+    let dir = Dir::new();
+    let input = fixture("etopo5_2deg_i16.tif");
+    for (extra, names) in [
+        // The bound would overflow (it left tiles undecimated, with a bound of null).
+        (
+            &["--quality", "1e305"][..],
+            &["--quality", "1e6", "1e305"][..],
+        ),
+        // The raster's own level is 0: the message says --max-zoom defaulted to it.
+        (
+            &["--min-zoom", "3"][..],
+            &["--min-zoom 3", "default --max-zoom 0"][..],
+        ),
+    ] {
+        let mut args = vec!["tiles", &input, "-o", "p", "-q"];
+        args.extend_from_slice(extra);
+        let o = dir.run(&args);
+        crate::util::assert_fails_naming(&o, names);
+        assert!(!dir.path("p").exists());
+    }
+}
+
+#[test]
+fn layer_json_ends_at_the_deepest_level_with_tiles() {
+    // A 3 x 1 raster has no cell at its own level: the coarser levels' filter spreads it
+    // into cells. layer.json's maxzoom named the empty level (available: []).
+    let dir = Dir::new();
+    dir.write(
+        "row.asc",
+        "ncols 3\nnrows 1\nxllcorner 10\nyllcorner 40\ncellsize 0.01\n1 2 3\n",
+    );
+    dir.write("row.prj", "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]");
+    pyramid(&dir, "row.asc", "p", &["-q"]);
+    let layer: Value =
+        serde_json::from_slice(&std::fs::read(dir.path("p/layer.json")).unwrap()).unwrap();
+    let available = layer["available"].as_array().unwrap();
+    let deepest = available.len() - 1;
+    assert_eq!(layer["maxzoom"].as_u64(), Some(deepest as u64));
+    assert!(!available[deepest].as_array().unwrap().is_empty());
+    assert!(dir.path(&format!("p/{deepest}")).is_dir());
+}
+
+#[test]
 fn metadata_without_level_zero_is_refused() {
     // CesiumJS learns availability from the level-0 tiles' metadata: without them it
     // would find no tile at all.

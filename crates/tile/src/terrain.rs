@@ -37,6 +37,10 @@ const U_PER_CELL: u32 = QUANTIZED_MAX as u32 / TILE_CELLS;
 /// Levels whose tiles carry the metadata extension: 0, N, 2N, ... (`metadataAvailability`).
 pub const METADATA_AVAILABILITY: u8 = 10;
 
+/// The largest `--quality`: the level-0 bound is then 7.7e10 m, beyond any height; larger
+/// values only risk overflowing the bounds.
+pub const MAX_QUALITY: f64 = 1e6;
+
 /// The finest level [`build_terrain`] will go to.
 pub const MAX_LEVEL: u8 = 24;
 
@@ -363,9 +367,9 @@ pub fn build_terrain(
     options: &TerrainOptions,
     progress: &mut dyn FnMut(&LevelReport),
 ) -> TerrainResult<TerrainReport> {
-    if !(options.quality > 0.0 && options.quality.is_finite()) {
+    if !(options.quality > 0.0 && options.quality <= MAX_QUALITY) {
         return Err(TerrainError::Options(format!(
-            "--quality must be a positive number, got {}",
+            "--quality must be a positive number up to {MAX_QUALITY:e}, got {:?}",
             options.quality
         )));
     }
@@ -389,6 +393,13 @@ pub fn build_terrain(
             options.min_zoom
         )));
     }
+    if options.max_zoom.is_none() && options.min_zoom > max_zoom {
+        return Err(TerrainError::Options(format!(
+            "--min-zoom {} is above the default --max-zoom {max_zoom} (the raster's own \
+             resolution); give --max-zoom too",
+            options.min_zoom
+        )));
+    }
     if max_zoom > MAX_LEVEL || options.min_zoom > max_zoom {
         return Err(TerrainError::Options(format!(
             "zoom range {}..={max_zoom} is not within 0..={MAX_LEVEL}",
@@ -401,6 +412,14 @@ pub fn build_terrain(
             n => n,
         };
         let need = streaming_bytes(&bounds, max_zoom, threads);
+        if need > limit && streaming_bytes(&bounds, max_zoom, 1) <= limit {
+            return Err(TerrainError::Options(format!(
+                "{threads} threads would need about {:.1} GB in memory (each warps a band of \
+                 level {max_zoom}) and {:.1} GB is available; use fewer --threads",
+                need as f64 / 1e9,
+                limit as f64 / 1e9
+            )));
+        }
         if need > limit {
             return Err(TerrainError::Options(format!(
                 "level {max_zoom} would need about {:.1} GB in memory (its tile rows span \
@@ -1056,7 +1075,12 @@ fn write_layer_json(
         extensions.push(serde_json::json!("metadata"));
     }
     let all = [0, u32::MAX];
-    let available: Vec<serde_json::Value> = available
+    // The deepest level that has tiles (a tiny raster's finest levels may have none).
+    let max_zoom = available
+        .iter()
+        .rposition(|tiles| !tiles.is_empty())
+        .map_or(max_zoom, |z| z as u8);
+    let available: Vec<serde_json::Value> = available[..=usize::from(max_zoom)]
         .iter()
         .map(|tiles| {
             rectangles(tiles, all, all)

@@ -829,6 +829,22 @@ fn layer_json_ends_at_the_deepest_level_with_tiles() {
 }
 
 #[test]
+fn a_failed_pyramid_leaves_no_directory_it_made() {
+    // The missing parents of -o are made (as mkdir -p); a run that then fails (here: no
+    // valid sample at all) removes them again. They used to stay.
+    let dir = Dir::new();
+    dir.write("void.asc", "ncols 4\nnrows 4\nxllcorner 10\nyllcorner 40\ncellsize 0.01\nNODATA_value -9999\n-9999 -9999 -9999 -9999\n-9999 -9999 -9999 -9999\n-9999 -9999 -9999 -9999\n-9999 -9999 -9999 -9999\n");
+    dir.write("void.prj", "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]");
+    std::fs::create_dir(dir.path("kept")).unwrap();
+    for out in ["made/deeper/p", "kept/made/p"] {
+        let o = dir.run(&["tiles", "void.asc", "-o", out, "-q"]);
+        crate::util::assert_fails_naming(&o, &["void.asc", "no terrain"]);
+    }
+    assert!(!dir.path("made").exists());
+    assert!(dir.path("kept").is_dir() && !dir.path("kept/made").exists());
+}
+
+#[test]
 fn metadata_without_level_zero_is_refused() {
     // CesiumJS learns availability from the level-0 tiles' metadata: without them it
     // would find no tile at all.

@@ -319,6 +319,25 @@ fn per_tile_refuses_a_non_empty_directory_and_leaves_nothing() {
 }
 
 #[test]
+fn per_tile_names_what_is_in_the_way() {
+    let dem = fixture("tintn_valid_raster_3857.tif");
+    let d = Dir::new();
+    d.write("afile", "x");
+    std::fs::create_dir(d.path("empty")).unwrap();
+    std::os::unix::fs::symlink("empty", d.path("link")).unwrap();
+    for (dir, names) in [
+        // It said "parent directory afile does not exist".
+        ("afile/sub", &["afile/sub", "afile is a file"][..]),
+        // It said "exists and is not a directory".
+        ("link", &["link", "symbolic link"][..]),
+    ] {
+        let o = d.run(&["mesh", &dem, "--per-tile", dir, "--max-error", "1"]);
+        assert_fails_naming(&o, names);
+    }
+    assert_eq!(d.files(), vec!["afile", "empty", "link"]);
+}
+
+#[test]
 fn per_tile_refuses_options_of_formats_it_does_not_write() {
     // --per-tile writes PLY or OBJ (--tile-format); these were silently ignored.
     let dem = fixture("tintn_valid_raster_3857.tif");

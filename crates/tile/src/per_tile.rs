@@ -56,6 +56,18 @@ impl PerTileWriter {
             Some(p) if !p.as_os_str().is_empty() => p,
             _ => Path::new("."),
         };
+        if let Some(file) = parent
+            .ancestors()
+            .find(|a| !a.as_os_str().is_empty() && a.exists() && !a.is_dir())
+        {
+            return Err(output(
+                &format!(
+                    "{} is a file, so no directory can be made there",
+                    file.display()
+                ),
+                None,
+            ));
+        }
         if !parent.is_dir() {
             return Err(output(
                 &format!("parent directory {} does not exist", parent.display()),
@@ -129,7 +141,9 @@ impl TileSink for PerTileWriter {
 /// into place must not replace it.
 pub(crate) fn occupied_reason(dir: &Path) -> Option<&'static str> {
     let meta = std::fs::symlink_metadata(dir).ok()?;
-    if !meta.is_dir() {
+    if meta.is_symlink() {
+        Some("is a symbolic link (give the directory it points to, or a new path)")
+    } else if !meta.is_dir() {
         Some("exists and is not a directory")
     } else if std::fs::read_dir(dir).map_or(true, |mut e| e.next().is_some()) {
         Some("exists and is not an empty directory")

@@ -448,8 +448,7 @@ pub fn build_terrain(
     }
     // All or nothing: the pyramid is built in a temporary directory beside `out_dir` and
     // renamed into place at the end; a failure (or nothing to write) leaves no trace.
-    let staging = staging_dir(out_dir)?;
-    let _pending = tinsmith_export::track_pending(staging.path());
+    let mut staging = Staging::new(out_dir)?;
     let source = Warp {
         path: input,
         band: options.band,
@@ -487,14 +486,7 @@ pub fn build_terrain(
         max_zoom,
         &available,
     )?;
-    let staged = staging.keep();
-    std::fs::rename(&staged, out_dir).map_err(|source| {
-        let _ = std::fs::remove_dir_all(&staged);
-        TerrainError::Output {
-            path: out_dir.to_path_buf(),
-            source,
-        }
-    })?;
+    staging.finish(out_dir)?;
     Ok(TerrainReport {
         bounds: bounds_array(&bounds),
         min_zoom: options.min_zoom,
@@ -503,38 +495,112 @@ pub fn build_terrain(
     })
 }
 
-/// A temporary directory beside `out_dir` (which must not exist, or be an empty
-/// directory; its missing parents are created) to build the pyramid in.
-fn staging_dir(out_dir: &Path) -> TerrainResult<tempfile::TempDir> {
-    let refuse = |reason: String| TerrainError::Options(format!("{}: {reason}", out_dir.display()));
-    if let Some(reason) = crate::per_tile::occupied_reason(out_dir) {
-        return Err(refuse(format!(
-            "{reason}; give a new directory (the pyramid is written whole, never mixed \
-             with other files)"
-        )));
+/// The temporary directory a pyramid is built in, beside `out_dir` (which must not exist,
+/// or be an empty directory), and the missing parents made for it, as `mkdir -p` would.
+/// Dropped unfinished (an error), it removes the directory and the parents it made; on a
+/// signal, the pending-output registry removes both.
+struct Staging {
+    temp: Option<tempfile::TempDir>,
+    _pending: tinsmith_export::PendingGuard,
+    /// Where `temp` is: `out_dir`'s parent.
+    parent: PathBuf,
+    /// The highest parent directory made here, and its registration.
+    made: Option<(PathBuf, tinsmith_export::PendingGuard)>,
+}
+
+impl Staging {
+    fn new(out_dir: &Path) -> TerrainResult<Staging> {
+        let refuse =
+            |reason: String| TerrainError::Options(format!("{}: {reason}", out_dir.display()));
+        if let Some(reason) = crate::per_tile::occupied_reason(out_dir) {
+            return Err(refuse(format!(
+                "{reason}; give a new directory (the pyramid is written whole, never mixed \
+                 with other files)"
+            )));
+        }
+        let parent = match out_dir.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        if let Some(file) = parent
+            .ancestors()
+            .find(|a| !a.as_os_str().is_empty() && a.exists() && !a.is_dir())
+        {
+            return Err(refuse(format!(
+                "{} is a file, so no directory can be made there",
+                file.display()
+            )));
+        }
+        let output = |source| TerrainError::Output {
+            path: out_dir.to_path_buf(),
+            source,
+        };
+        let made = parent
+            .ancestors()
+            .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+            .last()
+            .map(Path::to_path_buf);
+        std::fs::create_dir_all(parent).map_err(output)?;
+        let made = made.map(|root| {
+            let guard = tinsmith_export::track_pending(&root);
+            (root, guard)
+        });
+        let temp = match tinsmith_export::output_temp_dir(parent) {
+            Ok(temp) => temp,
+            Err(source) => {
+                remove_made(parent, made.as_ref().map(|m| m.0.as_path()));
+                return Err(output(source));
+            }
+        };
+        Ok(Staging {
+            _pending: tinsmith_export::track_pending(temp.path()),
+            temp: Some(temp),
+            parent: parent.to_path_buf(),
+            made,
+        })
     }
-    let parent = match out_dir.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    if let Some(file) = parent
-        .ancestors()
-        .find(|a| !a.as_os_str().is_empty() && a.exists() && !a.is_dir())
-    {
-        return Err(refuse(format!(
-            "{} is a file, so no directory can be made there",
-            file.display()
-        )));
+
+    fn path(&self) -> &Path {
+        self.temp.as_ref().expect("not finished").path()
     }
-    // Missing parents are created, as `mkdir -p` would.
-    std::fs::create_dir_all(parent).map_err(|source| TerrainError::Output {
-        path: out_dir.to_path_buf(),
-        source,
-    })?;
-    tinsmith_export::output_temp_dir(parent).map_err(|source| TerrainError::Output {
-        path: out_dir.to_path_buf(),
-        source,
-    })
+
+    /// Renames the directory to `out_dir`; on failure it is removed (with the parents
+    /// made for it, when dropped).
+    fn finish(&mut self, out_dir: &Path) -> TerrainResult<()> {
+        let staged = self.temp.take().expect("finished once").keep();
+        match std::fs::rename(&staged, out_dir) {
+            Ok(()) => {
+                self.made = None;
+                Ok(())
+            }
+            Err(source) => {
+                let _ = std::fs::remove_dir_all(&staged);
+                Err(TerrainError::Output {
+                    path: out_dir.to_path_buf(),
+                    source,
+                })
+            }
+        }
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        drop(self.temp.take());
+        if let Some((root, _)) = &self.made {
+            remove_made(&self.parent, Some(root));
+        }
+    }
+}
+
+/// Removes the empty directories from `dir` up to `root` (made by [`Staging::new`]).
+fn remove_made(dir: &Path, root: Option<&Path>) {
+    let Some(root) = root else { return };
+    for d in dir.ancestors() {
+        if std::fs::remove_dir(d).is_err() || d == root {
+            break;
+        }
+    }
 }
 
 /// The tiles of [`build_terrain`] from `source`, its finest level read in bands of

@@ -15,10 +15,12 @@ fn fixture(dir: &str, name: &str) -> PathBuf {
 /// Each malformed fixture and a piece of the message it must produce.
 const MALFORMED: &[(&str, &str)] = &[
     ("ascii_short_record.ply", "fewer values"),
+    ("ascii_trailing_record.ply", "data after the last record"),
     ("ascii_truncated.ply", "truncated"),
     ("bad_number.obj", "`O` is not a number"),
     ("binary_noise.obj", "not text"),
     ("binary_noise.ply", "header line 2 is not text"),
+    ("binary_trailing_bytes.ply", "data after the last record"),
     ("empty.obj", "the file is empty"),
     ("empty.ply", "the file is empty"),
     ("garbage.obj", "unknown statement `this`"),

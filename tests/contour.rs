@@ -1033,3 +1033,79 @@ fn a_column_a_hair_off_180_is_put_on_it_in_wgs84_geojson() {
     let o = d.run(&["verify", "hair.asc", "m.geojson", "--max-error", "0"]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// An ESRI ASCII grid `n x n` of `f(column, row)` (`None`: nodata), in pixel units.
+fn ascii_grid(d: &Dir, name: &str, n: usize, f: impl Fn(usize, usize) -> Option<f64>) {
+    let mut text =
+        format!("ncols {n}\nnrows {n}\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n");
+    for r in 0..n {
+        let row: Vec<String> = (0..n)
+            .map(|c| f(c, r).map_or("-9999".to_owned(), |v| v.to_string()))
+            .collect();
+        text.push_str(&row.join(" "));
+        text.push('\n');
+    }
+    d.write(name, &text);
+}
+
+#[test]
+fn a_mesh_file_must_be_the_rasters() {
+    // A mesh of a tilted plane (two triangles at a bound of 1), contoured with rasters it
+    // was not written from: a hole under its triangles, or other heights at its vertices.
+    // Both used to give lines that are not the raster's (through the hole, or at the
+    // mesh's own heights), exit 0.
+    let d = Dir::new();
+    let plane = |c: usize, r: usize| 2.0 * c as f64 + r as f64;
+    ascii_grid(&d, "plane.asc", 20, |c, r| Some(plane(c, r)));
+    let holed =
+        |c: usize, r: usize| (!(8..12).contains(&c) || !(8..12).contains(&r)).then(|| plane(c, r));
+    ascii_grid(&d, "holed.asc", 20, holed);
+    ascii_grid(&d, "raised.asc", 20, |c, r| Some(plane(c, r) + 1.0));
+    run_ok(
+        &d,
+        &[
+            "mesh",
+            "plane.asc",
+            "-o",
+            "plane.ply",
+            "--max-error",
+            "1",
+            "-q",
+        ],
+    );
+    let contour = |input: &str| {
+        d.run(&[
+            "contour",
+            input,
+            "--mesh",
+            "plane.ply",
+            "-o",
+            "c.geojson",
+            "--interval",
+            "5",
+        ])
+    };
+    assert_fails_naming(
+        &contour("holed.asc"),
+        &["plane.ply", "not a valid triangulation", "nodata"],
+    );
+    assert_fails_naming(
+        &contour("raised.asc"),
+        &["plane.ply", "vertex", "not written from this raster"],
+    );
+    assert!(!d.path("c.geojson").exists());
+    run_ok(
+        &d,
+        &[
+            "contour",
+            "plane.asc",
+            "--mesh",
+            "plane.ply",
+            "-o",
+            "c.geojson",
+            "--interval",
+            "5",
+            "-q",
+        ],
+    );
+}

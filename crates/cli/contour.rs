@@ -27,13 +27,14 @@ use tinsmith_core::{decimate, DecimationOptions, Grid};
 use tinsmith_export::LineFormat;
 use tinsmith_raster::{Raster, RasterInfo};
 use tinsmith_tile::{mesh_tiles, MeshCollector, RasterSource, TileOptions};
+use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
 use crate::args::ContourArgs;
 use crate::export::{file_crs, Pieces};
 use crate::georef::Georef;
 use crate::output::NamingFile;
 use crate::output::{check_distinct, check_writable_target};
-use crate::verify::read_mesh_file;
+use crate::verify::{expected_orientation, read_mesh_file};
 
 /// Builds the TIN, contours it and writes the lines; `Ok(true)` on success.
 /// Memory per line segment while contouring and writing: its point in the joiner, the
@@ -242,7 +243,7 @@ fn untiled_tin(
     let grid = &raster.grid;
     if let Some(path) = &args.mesh {
         let georef = Georef::new(raster.info.transform(), args.pixel_coords);
-        let mesh = mesh_from_file(path, raster, georef)?;
+        let mesh = mesh_from_file(path, raster, georef, args.band)?;
         let levels = levels_for(args, mesh.height_range())?;
         return Ok((mesh, "mesh file".to_owned(), levels));
     }
@@ -313,10 +314,21 @@ fn nothing_to_contour(args: &ContourArgs) -> anyhow::Error {
 /// Reads a mesh file written from `raster` (as `tinsmith verify` reads it: GeoJSON in
 /// WGS84 back to the raster's CRS) and maps its vertices back to grid positions; heights
 /// are the file's.
-fn mesh_from_file(path: &Path, raster: &Raster, georef: Georef) -> Result<ContourMesh> {
+///
+/// The mesh must be one `tinsmith mesh` could have written from this raster and band:
+/// every vertex's height is its sample's (in `f64`, or rounded to `f32` as STL and glTF
+/// store it), and the verifier finds it a valid triangulation of the domain (no triangle
+/// over nodata, no gap, no overlap). Otherwise its lines would not be the raster's.
+fn mesh_from_file(
+    path: &Path,
+    raster: &Raster,
+    georef: Georef,
+    band: usize,
+) -> Result<ContourMesh> {
     let grid: &Grid = &raster.grid;
     let file = read_mesh_file(path, raster, georef)?;
     let mut vertices = Vec::with_capacity(file.vertices.len());
+    let mut positions = Vec::with_capacity(file.vertices.len());
     for (i, v) in file.vertices.iter().enumerate() {
         let [x, y] = georef
             .sample_at([v[0], v[1]])
@@ -329,10 +341,44 @@ fn mesh_from_file(path: &Path, raster: &Raster, georef: Georef) -> Result<Contou
                 grid.height()
             );
         }
+        let sample = grid.values()[y as usize * grid.width() as usize + x as usize];
+        if v[2] != sample && v[2] != f64::from(sample as f32) {
+            bail!(
+                "{}: vertex {i} at column {x}, row {y} has height {}, but band {band} of {} \
+                 has {} there: the mesh was not written from this raster and band{}",
+                path.display(),
+                v[2],
+                raster.info.path.display(),
+                sample,
+                if matches!(georef, Georef::Pixel) {
+                    " (or it was written without --pixel-coords)"
+                } else {
+                    " (or it was written with --pixel-coords)"
+                }
+            );
+        }
+        positions.push([x, y]);
         vertices.push([x as f64, y as f64, v[2]]);
     }
     if file.triangles.is_empty() {
         bail!("{}: the mesh has no triangles", path.display());
+    }
+    let heights: Vec<f64> = vertices.iter().map(|v| v[2]).collect();
+    let options = VerifyOptions::new().with_orientation(expected_orientation(&georef));
+    let report = tinsmith_verify::verify(
+        GridRef::new(grid.width(), grid.height(), grid.values()),
+        MeshRef::new(&positions, &heights, &file.triangles),
+        &options,
+    )
+    .with_context(|| format!("{}: cannot check the mesh", path.display()))?;
+    if !report.mesh_is_valid() {
+        bail!(
+            "{}: not a valid triangulation of band {band} of {}'s domain ({}); see \
+             `tinsmith verify`",
+            path.display(),
+            raster.info.path.display(),
+            report.problems.join("; ")
+        );
     }
     ContourMesh::new(vertices, file.triangles)
         .with_context(|| format!("{}: cannot contour this mesh", path.display()))

@@ -1109,3 +1109,19 @@ fn a_mesh_file_must_be_the_rasters() {
         ],
     );
 }
+
+#[test]
+fn no_line_at_all_is_a_readable_empty_layer() {
+    // A level above every height: zero features. The FlatGeobuf announced a spatial index
+    // over no feature, which GDAL refused to open ("Number of items must be greater than 0").
+    let d = Dir::new();
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    for out in ["none.fgb", "none.geojson"] {
+        run_ok(
+            &d,
+            &["contour", &dem, "-o", out, "--levels", "100000", "-q"],
+        );
+        let info = ogrinfo(&d.path(out));
+        assert!(info.contains("Feature Count: 0"), "{out}: {info}");
+    }
+}

@@ -255,7 +255,8 @@ fn write_fgb<W: Write, P: LinePoint>(
 ) -> io::Result<()> {
     let multi = lines.iter().any(|(parts, _)| parts.len() > 1);
     let options = FgbWriterOptions {
-        write_index: true,
+        // GDAL cannot open a file whose header announces an index over no feature.
+        write_index: !lines.is_empty(),
         detect_type: false,
         promote_to_multi: false,
         has_z: P::HAS_Z,

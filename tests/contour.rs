@@ -1125,3 +1125,61 @@ fn no_line_at_all_is_a_readable_empty_layer() {
         assert!(info.contains("Feature Count: 0"), "{out}: {info}");
     }
 }
+
+#[test]
+fn geojson_is_refused_for_a_raster_past_the_pole_and_numbers_read_well() {
+    let d = Dir::new();
+    // Sample centres up to latitude 91.5 in EPSG:4326: written as such before, exit 0.
+    let mut text = "ncols 30\nnrows 20\nxllcorner -10\nyllcorner 72\ncellsize 1\n".to_owned();
+    for r in 0..20 {
+        let row: Vec<String> = (0..30).map(|c| (3 * c + 2 * r).to_string()).collect();
+        text.push_str(&row.join(" "));
+        text.push('\n');
+    }
+    d.write("north.asc", &text);
+    d.write("north.prj", "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]");
+    let o = d.run(&[
+        "contour",
+        "north.asc",
+        "-o",
+        "c.geojson",
+        "--interval",
+        "10",
+    ]);
+    assert_fails_naming(&o, &["c.geojson", "latitude 91.5", ".fgb"]);
+    let o = d.run(&["mesh", "north.asc", "-o", "m.geojson", "--max-error", "1"]);
+    assert_fails_naming(&o, &["m.geojson", "latitude 91.5"]);
+    run_ok(
+        &d,
+        &[
+            "contour",
+            "north.asc",
+            "-o",
+            "c.fgb",
+            "--interval",
+            "10",
+            "-q",
+        ],
+    );
+    // Numbers in messages: an exponent rather than three hundred digits; a negative
+    // interval refused as a value (clap took "-10" for a flag before).
+    let o = d.run(&[
+        "contour",
+        "north.asc",
+        "-o",
+        "x.fgb",
+        "--interval",
+        "1e-300",
+    ]);
+    assert_fails_naming(&o, &["interval 1e-300", "levels"]);
+    assert!(stderr(&o).len() < 300, "{}", stderr(&o));
+    let o = d.run(&["contour", "north.asc", "-o", "x.fgb", "--interval", "-10"]);
+    assert_fails_naming(&o, &["--interval", "-10", "> 0"]);
+    assert_eq!(
+        d.files()
+            .iter()
+            .filter(|f| f.starts_with(['c', 'm', 'x']))
+            .count(),
+        1
+    );
+}

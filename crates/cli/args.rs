@@ -162,7 +162,7 @@ pub struct MeshArgs {
     /// Shape the TIN for contour lines every I (plus --contour-offset) over the raster's
     /// heights, as `tinsmith contour --max-error` does: `contour --mesh` then draws lines
     /// with fewer segments. The error bound holds either way.
-    #[arg(long, value_name = "I", value_parser = parse_interval, conflicts_with = "contour_levels")]
+    #[arg(long, value_name = "I", value_parser = parse_interval, allow_negative_numbers = true, conflicts_with = "contour_levels")]
     pub contour_interval: Option<f64>,
     /// Shift of the --contour-interval levels: offset + k * interval.
     #[arg(long, value_name = "O", requires = "contour_interval", value_parser = parse_finite, allow_negative_numbers = true)]
@@ -256,7 +256,7 @@ pub struct ContourArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Contour every multiple of this (plus --offset) within the TIN's height range.
-    #[arg(long, value_parser = parse_interval)]
+    #[arg(long, value_parser = parse_interval, allow_negative_numbers = true)]
     pub interval: Option<f64>,
     /// Shift of the --interval levels: levels are offset + k * interval.
     /// (Default 0.)
@@ -275,7 +275,7 @@ pub struct ContourArgs {
     /// Simplify each line (Douglas-Peucker) within this distance, in the output's map
     /// units (pixels with --pixel-coords): lines move up to D sideways and are no longer
     /// exact contours of the TIN.
-    #[arg(long, value_name = "D", value_parser = parse_interval)]
+    #[arg(long, value_name = "D", value_parser = parse_interval, allow_negative_numbers = true)]
     pub simplify: Option<f64>,
     /// Band to read (1-based).
     #[arg(long, default_value_t = 1)]

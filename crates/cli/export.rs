@@ -318,6 +318,15 @@ pub fn file_crs<'r>(
                     (Some(_), Pieces::Lines(ends)) => unwrap_along_lines(points, ends),
                 }
             }
+            if let Some(p) = points.iter().find(|p| p[1].abs() > 90.0 + 1e-9) {
+                bail!(
+                    "{}: the raster reaches latitude {}, beyond the pole (is its \
+                     georeferencing right?): RFC 7946 GeoJSON cannot hold it; write to .fgb \
+                     or another format",
+                    path.display(),
+                    p[1]
+                );
+            }
             snap_to_antimeridian(points);
             Ok(CrsRef::new(None, Some(4326)))
         }

@@ -10,6 +10,16 @@ use anyhow::{bail, Context, Result};
 pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
     check_not_input(path, input)?;
     let dir = parent_dir(path);
+    if let Some(file) = dir
+        .ancestors()
+        .find(|a| !a.as_os_str().is_empty() && a.exists() && !a.is_dir())
+    {
+        bail!(
+            "{}: {} is a file, not a directory",
+            path.display(),
+            file.display()
+        );
+    }
     if !dir.is_dir() {
         bail!(
             "{}: output directory {} does not exist",

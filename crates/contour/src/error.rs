@@ -61,10 +61,15 @@ pub enum Error {
         actual: usize,
     },
     /// A contour level is NaN or infinite.
-    #[error("contour level {0} is not a finite number")]
+    #[error("contour level {} is not a finite number", num(.0))]
     InvalidLevel(f64),
     /// The contour interval is zero, negative, NaN or infinite, or the offset is not finite.
-    #[error("contour interval must be a finite number > 0 and the offset finite, got interval {interval}, offset {offset}")]
+    #[error(
+        "contour interval must be a finite number > 0 and the offset finite, got interval {}, \
+         offset {}",
+        num(.interval),
+        num(.offset)
+    )]
     InvalidInterval {
         /// The interval given.
         interval: f64,
@@ -74,9 +79,13 @@ pub enum Error {
     /// The levels `offset + k * interval` over the heights cannot be told apart in `f64`:
     /// the interval is below the resolution of numbers that large.
     #[error(
-        "interval {interval} with offset {offset} over heights {min}..{max}: the levels are \
-         closer than f64 can tell apart at that magnitude; give a larger interval, an offset \
-         nearer the heights, or explicit --levels"
+        "interval {} with offset {} over heights {}..{}: the levels are closer than f64 can \
+         tell apart at that magnitude; give a larger interval, an offset nearer the heights, \
+         or explicit --levels",
+        num(.interval),
+        num(.offset),
+        num(.min),
+        num(.max)
     )]
     IntervalBelowResolution {
         /// The interval given.
@@ -90,7 +99,11 @@ pub enum Error {
     },
     /// The interval is so small for the height range that there would be too many levels.
     #[error(
-        "interval {interval} over heights {min}..{max} gives {count} levels (at most {max_levels})"
+        "interval {} over heights {}..{} gives {} levels (at most {max_levels})",
+        num(.interval),
+        num(.min),
+        num(.max),
+        num(.count)
     )]
     TooManyLevels {
         /// The interval given.
@@ -117,3 +130,14 @@ pub enum Error {
 
 /// Result of the contouring crate's fallible functions.
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// A number as people read it: with an exponent when very large or very small (`1e-300`,
+/// not three hundred zeros), as written otherwise.
+fn num(x: &f64) -> String {
+    let magnitude = x.abs();
+    if magnitude != 0.0 && magnitude.is_finite() && !(1e-5..1e16).contains(&magnitude) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}

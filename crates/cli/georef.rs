@@ -75,11 +75,16 @@ impl Georef {
         let r = [s[0].round(), s[1].round()];
         if !((s[0] - r[0]).abs() <= 1e-3 && (s[1] - r[1]).abs() <= 1e-3) {
             bail!(
-                "({}, {}) is not on a sample centre (grid position {:.4}, {:.4})",
+                "({}, {}) is not on a sample centre (grid position {:.4}, {:.4}): was the \
+                 mesh written from this raster, {}?",
                 p[0],
                 p[1],
                 s[0],
-                s[1]
+                s[1],
+                match self {
+                    Georef::Pixel => "in (column, row) coordinates as --pixel-coords reads it",
+                    Georef::World(_) => "in its CRS (not with --pixel-coords)",
+                }
             );
         }
         Ok([r[0] as i64, r[1] as i64])

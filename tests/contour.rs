@@ -1183,3 +1183,34 @@ fn geojson_is_refused_for_a_raster_past_the_pole_and_numbers_read_well() {
         1
     );
 }
+
+#[test]
+fn a_float32_mesh_file_of_fractional_heights_is_the_rasters() {
+    // STL and glTF store heights as float32 offsets from a local origin: read back they
+    // are neither the sample nor its float32 rounding, and were refused.
+    let d = Dir::new();
+    ascii_grid(&d, "hill.asc", 30, |c, r| {
+        let (x, y) = (c as f64 - 14.3, r as f64 - 15.7);
+        Some(3019.244384765625 + 40.0 * (-(x * x + y * y) / 60.0).exp() + 0.01 * x)
+    });
+    for mesh in ["hill.stl", "hill.glb"] {
+        run_ok(
+            &d,
+            &["mesh", "hill.asc", "-o", mesh, "--max-error", "0.5", "-q"],
+        );
+        run_ok(
+            &d,
+            &[
+                "contour",
+                "hill.asc",
+                "--mesh",
+                mesh,
+                "-o",
+                "c.fgb",
+                "--interval",
+                "5",
+                "-q",
+            ],
+        );
+    }
+}

@@ -713,9 +713,9 @@ fn the_band_asked_for_is_the_band_tiled() {
 
 #[test]
 fn nan_is_nodata_in_tiles_whether_declared_or_not() {
-    // The same grid with a block of NaN, once with NODATA_value nan and once without:
-    // the same tiles. (Undeclared, GDAL's bilinear warp spread the NaN to the samples
-    // beside the block, and those tiles lost them.)
+    // The same grid with a block of NaN, with NODATA_value nan, without, and with
+    // NODATA_value -9999 (half the block -9999, half NaN): the same tiles. (A NaN the warp
+    // did not know as nodata spread to the samples beside it, and those tiles lost them.)
     let dir = Dir::new();
     let mut rows = Vec::new();
     for r in 0..30 {
@@ -734,7 +734,22 @@ fn nan_is_nodata_in_tiles_whether_declared_or_not() {
     let header = "ncols 40\nnrows 30\nxllcorner 10.0\nyllcorner 40.0\ncellsize 0.01\n";
     let wgs84 = "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],\
                  PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]";
-    for (name, nodata) in [("undeclared", ""), ("declared", "NODATA_value nan\n")] {
+    let mixed: Vec<String> = rows
+        .iter()
+        .enumerate()
+        .map(|(r, row)| {
+            if r < 13 {
+                row.replace("nan", "-9999")
+            } else {
+                row.clone()
+            }
+        })
+        .collect();
+    for (name, nodata, rows) in [
+        ("undeclared", "", &rows),
+        ("declared", "NODATA_value nan\n", &rows),
+        ("mixed", "NODATA_value -9999\n", &mixed),
+    ] {
         dir.write(
             &format!("{name}.asc"),
             &format!("{header}{nodata}{}\n", rows.join("\n")),
@@ -748,25 +763,27 @@ fn nan_is_nodata_in_tiles_whether_declared_or_not() {
             &["--min-zoom", "11", "--max-zoom", "11", "-q"],
         );
     }
-    assert_eq!(
-        terrain_files(&dir.path("undeclared")),
-        terrain_files(&dir.path("declared"))
-    );
+    let declared = terrain_files(&dir.path("declared"));
+    assert_eq!(terrain_files(&dir.path("undeclared")), declared);
+    assert_eq!(terrain_files(&dir.path("mixed")), declared);
 }
 
 #[test]
 fn an_alpha_band_of_any_type_masks_tiles_as_a_mask_band_does() {
-    // The globe with its oceans masked: by a Float32 alpha band of 0 and 1 (as gdalwarp
-    // -dstalpha can write), and by a mask band of 0 and 255. Same tiles. (The warper took
-    // the alpha band's 1 for 1/255 and lost every sample.)
+    // The globe with its oceans masked: by a Float32 or Byte alpha band of 0 and 1 (as
+    // gdalwarp -dstalpha can write), and by a mask band of 0 and 255. Same tiles. (The
+    // warper took an alpha of 1 for 1/255 and lost every sample.)
     let dir = Dir::new();
     let land = "<LUT>-100000:0,-0.5:0,0:1,100000:1</LUT>";
-    let alpha = globe_vrt(
-        &dir,
-        "alpha.vrt",
-        &(globe_band(1, "Float32", "", "")
-            + &globe_band(2, "Float32", "<ColorInterp>Alpha</ColorInterp>", land)),
-    );
+    let alpha = |kind: &str| {
+        globe_vrt(
+            &dir,
+            &format!("alpha_{kind}.vrt"),
+            &(globe_band(1, "Float32", "", "")
+                + &globe_band(2, kind, "<ColorInterp>Alpha</ColorInterp>", land)),
+        )
+    };
+    let (float_alpha, byte_alpha) = (alpha("Float32"), alpha("Byte"));
     let mask = globe_band(
         1,
         "Byte",
@@ -779,13 +796,16 @@ fn an_alpha_band_of_any_type_masks_tiles_as_a_mask_band_does() {
         &format!("<MaskBand>{mask}</MaskBand></VRTRasterBand>"),
     );
     let masked = globe_vrt(&dir, "masked.vrt", &band);
-    for (input, out) in [(&alpha, "alpha"), (&masked, "masked")] {
+    for (input, out) in [
+        (&float_alpha, "float"),
+        (&byte_alpha, "byte"),
+        (&masked, "masked"),
+    ] {
         pyramid(&dir, input, out, &["--max-zoom", "1", "-q"]);
     }
-    assert_eq!(
-        terrain_files(&dir.path("alpha")),
-        terrain_files(&dir.path("masked"))
-    );
+    let masked = terrain_files(&dir.path("masked"));
+    assert_eq!(terrain_files(&dir.path("float")), masked);
+    assert_eq!(terrain_files(&dir.path("byte")), masked);
 }
 
 #[test]

@@ -351,7 +351,7 @@ fn per_tile_refuses_options_of_formats_it_does_not_write() {
         let mut args = vec!["mesh", &dem, "--per-tile", "tiles", "--max-error", "1"];
         args.extend_from_slice(extra);
         let o = d.run(&args);
-        assert_fails_naming(&o, &[option, "--per-tile"]);
+        assert_fails_naming(&o, &[option, "--per-tile", "OBJ files (--tile-format)"]);
         assert!(d.files().is_empty(), "{option}: left {:?}", d.files());
     }
 }

@@ -316,9 +316,10 @@ fn nothing_to_contour(args: &ContourArgs) -> anyhow::Error {
 /// are the file's.
 ///
 /// The mesh must be one `tinsmith mesh` could have written from this raster and band:
-/// every vertex's height is its sample's (in `f64`, or rounded to `f32` as STL and glTF
-/// store it), and the verifier finds it a valid triangulation of the domain (no triangle
-/// over nodata, no gap, no overlap). Otherwise its lines would not be the raster's.
+/// every vertex's height is its sample's (STL and glTF store `f32` offsets from a local
+/// origin, so within 2^-20 of the sample's magnitude plus the mesh's height range), and
+/// the verifier finds it a valid triangulation of the domain (no triangle over nodata, no
+/// gap, no overlap). Otherwise its lines would not be the raster's.
 fn mesh_from_file(
     path: &Path,
     raster: &Raster,
@@ -327,6 +328,13 @@ fn mesh_from_file(
 ) -> Result<ContourMesh> {
     let grid: &Grid = &raster.grid;
     let file = read_mesh_file(path, raster, georef)?;
+    let (lo, hi) = file
+        .vertices
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v[2]), hi.max(v[2]))
+        });
+    let range = if hi >= lo { hi - lo } else { 0.0 };
     let mut vertices = Vec::with_capacity(file.vertices.len());
     let mut positions = Vec::with_capacity(file.vertices.len());
     for (i, v) in file.vertices.iter().enumerate() {
@@ -342,7 +350,10 @@ fn mesh_from_file(
             );
         }
         let sample = grid.values()[y as usize * grid.width() as usize + x as usize];
-        if v[2] != sample && v[2] != f64::from(sample as f32) {
+        let tolerance = (sample.abs() + range) / f64::from(1u32 << 20);
+        // False for a NaN sample (nodata under a vertex) too.
+        let matches = (v[2] - sample).abs() <= tolerance;
+        if !matches {
             bail!(
                 "{}: vertex {i} at column {x}, row {y} has height {}, but band {band} of {} \
                  has {} there: the mesh was not written from this raster and band{}",

@@ -53,7 +53,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         ];
         if let Some((_, option)) = ignored.iter().find(|(given, _)| *given) {
             bail!(
-                "{option} does not apply to --per-tile, which writes PLY or OBJ files                  (--tile-format)"
+                "{option} does not apply to --per-tile, which writes PLY or OBJ files (--tile-format)"
             );
         }
     }

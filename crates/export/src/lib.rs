@@ -79,7 +79,9 @@ pub use lines::{write_lines, write_multilines, CrsRef, LineFormat, LinePoint};
 pub use mesh::{Mesh, MeshRef};
 pub use options::WriteOptions;
 pub use origin::LocalOrigin;
-pub use pending::{interrupted, remove_pending, track_pending, PendingGuard};
+pub use pending::{
+    interrupted, remove_pending, track_made_dirs, track_pending, MadeDirsGuard, PendingGuard,
+};
 pub use quantized_mesh::{
     geodetic_to_ecef, gzip, oct_encode, surface_normal, EncodeError, GeoRectangle,
     QuantizedMeshTile, EXTENSION_METADATA, EXTENSION_NORMALS, HEADER_BYTES, MAX_16BIT_VERTICES,

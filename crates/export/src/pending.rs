@@ -7,6 +7,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+static MADE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
 /// Registers `path` (a temporary file or directory) until the returned guard is dropped.
@@ -26,6 +27,32 @@ impl Drop for PendingGuard {
         if let Ok(mut pending) = PENDING.lock() {
             if let Some(i) = pending.iter().rposition(|p| p == &self.0) {
                 pending.swap_remove(i);
+            }
+        }
+    }
+}
+
+/// Registers directories made for an output (deepest first) until the returned guard is
+/// dropped: [`remove_pending`] removes those that are empty then, and only those (another
+/// program may have put files there meanwhile).
+pub fn track_made_dirs(dirs: &[PathBuf]) -> MadeDirsGuard {
+    if let Ok(mut made) = MADE.lock() {
+        made.extend_from_slice(dirs);
+    }
+    MadeDirsGuard(dirs.to_vec())
+}
+
+/// Unregisters its directories when dropped.
+#[derive(Debug)]
+pub struct MadeDirsGuard(Vec<PathBuf>);
+
+impl Drop for MadeDirsGuard {
+    fn drop(&mut self) {
+        if let Ok(mut made) = MADE.lock() {
+            for dir in &self.0 {
+                if let Some(i) = made.iter().rposition(|p| p == dir) {
+                    made.remove(i);
+                }
             }
         }
     }
@@ -56,6 +83,13 @@ pub fn remove_pending() -> usize {
     remove_all();
     std::thread::sleep(std::time::Duration::from_millis(150));
     remove_all();
+    let made = match MADE.lock() {
+        Ok(made) => made.clone(),
+        Err(poisoned) => poisoned.into_inner().clone(),
+    };
+    for dir in &made {
+        let _ = std::fs::remove_dir(dir);
+    }
     paths.len()
 }
 

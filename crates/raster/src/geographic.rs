@@ -167,10 +167,15 @@ pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Res
 }
 
 /// The band alone, as GDAL's warper must see it: an in-memory VRT whose band 1 is the
-/// band (GDALReprojectImage warps band 1 of its source, whatever band was asked for), with
-/// NaN declared as nodata on a float band that declares none (the warper would otherwise
-/// blend NaN into its valid neighbours), and the band's mask (a mask band, or an alpha
-/// band of any type: nonzero is valid) as an alpha band, which the warper honours.
+/// band (GDALReprojectImage warps band 1 of its source, whatever band was asked for), and
+/// whose band 2, when the band has a mask (a mask band, or an alpha band of any type), is
+/// that mask as an alpha band of 0 and 255 (nonzero is valid, as the reader has it), which
+/// the warper honours.
+///
+/// A float band's nodata is NaN in the view, its declared nodata value (if any) turned into
+/// NaN as well: the warper takes one nodata value, and a NaN it did not know as nodata
+/// would be blended into its valid neighbours. An integer band keeps its nodata value,
+/// written as an integer (GDAL reads an Int64 nodata with `strtoll`).
 fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
     let info = &opened.info;
     let escape = |text: &str| {
@@ -181,38 +186,53 @@ fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
     };
     let source = escape(&path.to_string_lossy());
     let gdal_type = opened.band()?.band_type().name();
-    let nodata = match info.nodata {
-        Some(v) => format!("<NoDataValue>{v:?}</NoDataValue>"),
-        None if gdal_type.starts_with("Float") => "<NoDataValue>nan</NoDataValue>".to_owned(),
-        None => String::new(),
+    let file = format!("<SourceFilename relativeToVRT=\"0\">{source}</SourceFilename>");
+    let band = if gdal_type.starts_with("Float") {
+        // Where the source equals NODATA the view keeps its initial value, NaN.
+        let skip = match info.nodata {
+            Some(v) if !v.is_nan() => format!("<NODATA>{v:?}</NODATA>"),
+            _ => String::new(),
+        };
+        format!(
+            "<NoDataValue>nan</NoDataValue><ComplexSource>{file}<SourceBand>{}</SourceBand>\
+             {skip}</ComplexSource>",
+            info.band
+        )
+    } else {
+        let nodata = match info.nodata {
+            Some(v) if v < 0.0 => format!("<NoDataValue>{}</NoDataValue>", v as i64),
+            Some(v) => format!("<NoDataValue>{}</NoDataValue>", v as u64),
+            None => String::new(),
+        };
+        format!(
+            "{nodata}<SimpleSource>{file}<SourceBand>{}</SourceBand></SimpleSource>",
+            info.band
+        )
     };
     let gt = info
         .geo_transform
         .map(|g| g.map(|v| format!("{v:?}")).join(","))
         .unwrap_or_default();
     let srs = info.crs_wkt.as_deref().map(escape).unwrap_or_default();
-    let alpha = match opened.mask_source {
-        None => String::new(),
-        Some(MaskSource::Gdal(_)) => format!(
-            "<VRTRasterBand dataType=\"Byte\" band=\"2\"><ColorInterp>Alpha</ColorInterp>\
-             <SimpleSource><SourceFilename relativeToVRT=\"0\">{source}</SourceFilename>\
-             <SourceBand>mask,{}</SourceBand></SimpleSource></VRTRasterBand>",
-            info.band
-        ),
-        // Any nonzero value is valid: 0 stays 0, the smallest positive double and up 255.
-        Some(MaskSource::Alpha(b)) => format!(
-            "<VRTRasterBand dataType=\"Byte\" band=\"2\"><ColorInterp>Alpha</ColorInterp>\
-             <ComplexSource><SourceFilename relativeToVRT=\"0\">{source}</SourceFilename>\
-             <SourceBand>{b}</SourceBand><LUT>0:0,5e-324:255</LUT></ComplexSource>\
-             </VRTRasterBand>"
-        ),
+    let mask_band = match opened.mask_source {
+        None => None,
+        Some(MaskSource::Gdal(_)) => Some(format!("mask,{}", info.band)),
+        Some(MaskSource::Alpha(b)) => Some(b.to_string()),
     };
+    // Any nonzero value is valid: 0 stays 0, everything else (negative too) becomes 255.
+    let alpha = mask_band.map_or(String::new(), |mask| {
+        format!(
+            "<VRTRasterBand dataType=\"Byte\" band=\"2\"><ColorInterp>Alpha</ColorInterp>\
+             <ComplexSource>{file}<SourceBand>{mask}</SourceBand>\
+             <LUT>-1.7976931348623157e308:255,-5e-324:255,0:0,5e-324:255</LUT>\
+             </ComplexSource></VRTRasterBand>"
+        )
+    });
     let xml = format!(
         "<VRTDataset rasterXSize=\"{}\" rasterYSize=\"{}\"><SRS>{srs}</SRS>\
          <GeoTransform>{gt}</GeoTransform><VRTRasterBand dataType=\"{gdal_type}\" band=\"1\">\
-         {nodata}<SimpleSource><SourceFilename relativeToVRT=\"0\">{source}</SourceFilename>\
-         <SourceBand>{}</SourceBand></SimpleSource></VRTRasterBand>{alpha}</VRTDataset>",
-        info.width, info.height, info.band
+         {band}</VRTRasterBand>{alpha}</VRTDataset>",
+        info.width, info.height
     );
     Dataset::open(Path::new(&xml)).map_err(|e| warp_error(path, e))
 }

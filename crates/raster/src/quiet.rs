@@ -11,9 +11,14 @@ use gdal::errors::CplErrType;
 /// process-wide handler alone); calling it again is harmless. It replaces any error handler
 /// installed before through `gdal::config::set_error_handler`.
 pub fn silence_gdal_errors() {
-    gdal::config::set_error_handler(|class, _number, msg| match class {
-        CplErrType::Warning => eprintln!("GDAL warning: {msg}"),
-        CplErrType::Debug => eprintln!("GDAL debug: {msg}"),
-        CplErrType::None | CplErrType::Failure | CplErrType::Fatal => {}
+    // Called from C: a closed stderr must not panic here (that would abort the process).
+    gdal::config::set_error_handler(|class, _number, msg| {
+        use std::io::Write as _;
+        let prefix = match class {
+            CplErrType::Warning => "GDAL warning",
+            CplErrType::Debug => "GDAL debug",
+            CplErrType::None | CplErrType::Failure | CplErrType::Fatal => return,
+        };
+        let _ = writeln!(std::io::stderr(), "{prefix}: {msg}");
     });
 }

@@ -497,15 +497,14 @@ pub fn build_terrain(
 
 /// The temporary directory a pyramid is built in, beside `out_dir` (which must not exist,
 /// or be an empty directory), and the missing parents made for it, as `mkdir -p` would.
-/// Dropped unfinished (an error), it removes the directory and the parents it made; on a
-/// signal, the pending-output registry removes both.
+/// Dropped unfinished (an error), it removes the directory and the parents it made while
+/// they are empty; on a signal, the pending-output registry does the same.
 struct Staging {
     temp: Option<tempfile::TempDir>,
     _pending: tinsmith_export::PendingGuard,
-    /// Where `temp` is: `out_dir`'s parent.
-    parent: PathBuf,
-    /// The highest parent directory made here, and its registration.
-    made: Option<(PathBuf, tinsmith_export::PendingGuard)>,
+    /// The parent directories made here, deepest first, and their registration; `None`
+    /// once the pyramid is in place.
+    made: Option<(Vec<PathBuf>, tinsmith_export::MadeDirsGuard)>,
 }
 
 impl Staging {
@@ -535,28 +534,22 @@ impl Staging {
             path: out_dir.to_path_buf(),
             source,
         };
-        let made = parent
+        let made: Vec<PathBuf> = parent
             .ancestors()
             .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
-            .last()
-            .map(Path::to_path_buf);
-        std::fs::create_dir_all(parent).map_err(output)?;
-        let made = made.map(|root| {
-            let guard = tinsmith_export::track_pending(&root);
-            (root, guard)
-        });
-        let temp = match tinsmith_export::output_temp_dir(parent) {
-            Ok(temp) => temp,
-            Err(source) => {
-                remove_made(parent, made.as_ref().map(|m| m.0.as_path()));
-                return Err(output(source));
-            }
-        };
+            .map(Path::to_path_buf)
+            .collect();
+        let guard = tinsmith_export::track_made_dirs(&made);
+        let temp = std::fs::create_dir_all(parent)
+            .and_then(|()| tinsmith_export::output_temp_dir(parent))
+            .map_err(|source| {
+                remove_empty(&made);
+                output(source)
+            })?;
         Ok(Staging {
             _pending: tinsmith_export::track_pending(temp.path()),
             temp: Some(temp),
-            parent: parent.to_path_buf(),
-            made,
+            made: Some((made, guard)),
         })
     }
 
@@ -587,17 +580,16 @@ impl Staging {
 impl Drop for Staging {
     fn drop(&mut self) {
         drop(self.temp.take());
-        if let Some((root, _)) = &self.made {
-            remove_made(&self.parent, Some(root));
+        if let Some((made, _)) = &self.made {
+            remove_empty(made);
         }
     }
 }
 
-/// Removes the empty directories from `dir` up to `root` (made by [`Staging::new`]).
-fn remove_made(dir: &Path, root: Option<&Path>) {
-    let Some(root) = root else { return };
-    for d in dir.ancestors() {
-        if std::fs::remove_dir(d).is_err() || d == root {
+/// Removes directories `made` (deepest first) while they are empty.
+fn remove_empty(made: &[PathBuf]) {
+    for dir in made {
+        if std::fs::remove_dir(dir).is_err() {
             break;
         }
     }

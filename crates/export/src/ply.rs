@@ -83,15 +83,12 @@ pub(crate) fn read<R: BufRead>(mut r: R, file_len: Option<u64>) -> Result<Mesh, 
             }
         }
     }
-    // Data past the last record means the header's counts do not describe the file (a
-    // truncated header, two files run together): not a mesh to vouch for.
+    // Data past the last record means the header's counts do not describe the file (two
+    // files run together, a wrong count): not a mesh to vouch for.
     let mut rest = Vec::new();
     r.take(1 << 16).read_to_end(&mut rest)?;
-    let trailing = match header.encoding {
-        Encoding::Ascii => rest.iter().any(|b| !b.is_ascii_whitespace()),
-        Encoding::Binary(_) => !rest.is_empty(),
-    };
-    if trailing {
+    // Line ends after the data (some writers add one) are not data.
+    if rest.iter().any(|b| !b.is_ascii_whitespace()) {
         return Err(Problem::malformed(
             "data after the last record the header declares (do its counts match the file?)",
         ));

@@ -176,5 +176,6 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         let json = serde_json::to_vec_pretty(&report)?;
         write_atomically(path, &json)?;
     }
+    tinsmith_export::mark_finished();
     Ok(true)
 }

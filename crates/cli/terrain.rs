@@ -43,6 +43,7 @@ pub fn run(args: &TilesArgs) -> Result<bool> {
     if let Some(path) = &args.report {
         crate::output::write_atomically(path, &serde_json::to_vec_pretty(&report)?)?;
     }
+    tinsmith_export::mark_finished();
     if args.quiet {
         return Ok(true);
     }

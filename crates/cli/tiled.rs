@@ -273,6 +273,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     if let Some(path) = &args.report {
         write_atomically(path, &serde_json::to_vec_pretty(&json)?)?;
     }
+    tinsmith_export::mark_finished();
     Ok(true)
 }
 

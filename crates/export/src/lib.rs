@@ -80,7 +80,8 @@ pub use mesh::{Mesh, MeshRef};
 pub use options::WriteOptions;
 pub use origin::LocalOrigin;
 pub use pending::{
-    interrupted, remove_pending, track_made_dirs, track_pending, MadeDirsGuard, PendingGuard,
+    finished, interrupted, mark_finished, remove_pending, track_made_dirs, track_pending,
+    MadeDirsGuard, PendingGuard,
 };
 pub use quantized_mesh::{
     geodetic_to_ecef, gzip, oct_encode, surface_normal, EncodeError, GeoRectangle,

@@ -9,6 +9,18 @@ use std::sync::Mutex;
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 static MADE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+static FINISHED: AtomicBool = AtomicBool::new(false);
+
+/// Records that every output of the run is complete and in place: a signal from now on
+/// (the process tearing its memory down) interrupts nothing.
+pub fn mark_finished() {
+    FINISHED.store(true, Ordering::SeqCst);
+}
+
+/// Whether [`mark_finished`] was called.
+pub fn finished() -> bool {
+    FINISHED.load(Ordering::SeqCst)
+}
 
 /// Registers `path` (a temporary file or directory) until the returned guard is dropped.
 pub fn track_pending(path: &Path) -> PendingGuard {

@@ -809,6 +809,46 @@ fn an_alpha_band_of_any_type_masks_tiles_as_a_mask_band_does() {
 }
 
 #[test]
+fn a_rounded_float32_nodata_tag_masks_tiles_as_it_masks_meshes() {
+    // Oceans filled with -FLT_MAX under a nodata tag of -3.40282e+38 (as gdalinfo prints
+    // it): GDAL's statistics and every other command take the fill as nodata, and so do
+    // tiles now, the same tiles as with the oceans masked. (The warp compared exactly and
+    // took the fill for heights: "beyond what quantized-mesh tiles can hold".)
+    let dir = Dir::new();
+    let fill =
+        "<LUT>-100000:-3.4028234663852886e38,-0.5:-3.4028234663852886e38,0:0,100000:100000</LUT>";
+    let filled = globe_vrt(
+        &dir,
+        "filled.vrt",
+        &globe_band(
+            1,
+            "Float32",
+            "<NoDataValue>-3.40282e+38</NoDataValue>",
+            fill,
+        ),
+    );
+    let mask = globe_band(
+        1,
+        "Byte",
+        "",
+        "<LUT>-100000:0,-0.5:0,0:255,100000:255</LUT>",
+    )
+    .replace(" band=\"1\"", "");
+    let band = globe_band(1, "Float32", "", "").replace(
+        "</VRTRasterBand>",
+        &format!("<MaskBand>{mask}</MaskBand></VRTRasterBand>"),
+    );
+    let masked = globe_vrt(&dir, "masked.vrt", &band);
+    for (input, out) in [(&filled, "filled"), (&masked, "masked")] {
+        pyramid(&dir, input, out, &["--max-zoom", "1", "-q"]);
+    }
+    assert_eq!(
+        terrain_files(&dir.path("filled")),
+        terrain_files(&dir.path("masked"))
+    );
+}
+
+#[test]
 fn zoom_and_quality_out_of_range_are_refused_saying_why() {
     let dir = Dir::new();
     let input = fixture("etopo5_2deg_i16.tif");

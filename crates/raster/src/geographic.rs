@@ -173,8 +173,9 @@ pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Res
 /// the warper honours.
 ///
 /// A float band's nodata is NaN in the view, its declared nodata value (if any) turned into
-/// NaN as well: the warper takes one nodata value, and a NaN it did not know as nodata
-/// would be blended into its valid neighbours. An integer band keeps its nodata value,
+/// NaN as well, and masked by GDAL's nodata mask too (which has GDAL's tolerance): the
+/// warper takes one nodata value, and a NaN it did not know as nodata would be blended
+/// into its valid neighbours. An integer band keeps its nodata value,
 /// written as an integer (GDAL reads an Int64 nodata with `strtoll`).
 fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
     let info = &opened.info;
@@ -215,6 +216,12 @@ fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
         .unwrap_or_default();
     let srs = info.crs_wkt.as_deref().map(escape).unwrap_or_default();
     let mask_band = match opened.mask_source {
+        // GDAL's nodata mask compares in the band's type with its tolerance (a Float32
+        // nodata of -3.4e38 masks -FLT_MAX samples, as the reader does); NODATA above
+        // compares in f64, exactly.
+        None if gdal_type.starts_with("Float") && info.nodata.is_some_and(|v| !v.is_nan()) => {
+            Some(format!("mask,{}", info.band))
+        }
         None => None,
         Some(MaskSource::Gdal(_)) => Some(format!("mask,{}", info.band)),
         Some(MaskSource::Alpha(b)) => Some(b.to_string()),

@@ -200,11 +200,16 @@ fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
             info.band
         )
     } else {
-        let nodata = match info.nodata {
-            Some(v) if v < 0.0 => format!("<NoDataValue>{}</NoDataValue>", v as i64),
-            Some(v) => format!("<NoDataValue>{}</NoDataValue>", v as u64),
-            None => String::new(),
+        // Exactly, for the 64-bit types too (beyond 2^53 the f64 in `info` is rounded).
+        let rb = opened.band()?;
+        let nodata = match (gdal_type.as_str(), info.nodata) {
+            ("Int64", _) => rb.no_data_value_i64().map(|v| v.to_string()),
+            ("UInt64", _) => rb.no_data_value_u64().map(|v| v.to_string()),
+            (_, Some(v)) if v < 0.0 => Some((v as i64).to_string()),
+            (_, Some(v)) => Some((v as u64).to_string()),
+            (_, None) => None,
         };
+        let nodata = nodata.map_or(String::new(), |v| format!("<NoDataValue>{v}</NoDataValue>"));
         format!(
             "{nodata}<SimpleSource>{file}<SourceBand>{}</SourceBand></SimpleSource>",
             info.band

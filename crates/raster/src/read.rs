@@ -182,7 +182,12 @@ impl OpenBand {
             MaskSource::Gdal(kind) => kind.to_owned(),
             MaskSource::Alpha(b) => format!("alpha band {b}"),
         });
-        let nodata = rb.no_data_value();
+        // The 64-bit integer types have their own getters (the f64 one warns on stderr).
+        let nodata = match gdal_type.as_str() {
+            "Int64" => rb.no_data_value_i64().map(|v| v as f64),
+            "UInt64" => rb.no_data_value_u64().map(|v| v as f64),
+            _ => rb.no_data_value(),
+        };
         let scale = rb.scale().filter(|s| s.is_finite()).unwrap_or(1.0);
         let offset = rb.offset().filter(|o| o.is_finite()).unwrap_or(0.0);
         let decoder = SampleDecoder::new(sample_type, nodata, scale, offset);

@@ -166,6 +166,14 @@ fn info_reports_nodata_and_crs() {
     assert_eq!(j["height"], 80);
     assert_eq!(j["nodata_samples"], 970);
     assert_eq!(j["epsg"], 3857);
+    // A NaN nodata is a string in JSON (a NaN number would be null, "none declared").
+    d.write(
+        "nan.asc",
+        "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value nan\n1 2\n3 4\n",
+    );
+    let o = d.run(&["info", "nan.asc", "--json", "-q"]);
+    let j: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(j["nodata"], "NaN");
 }
 
 #[test]

@@ -41,7 +41,7 @@ pub enum Error {
     /// Some |height| exceeds [`crate::MAX_ABS_HEIGHT`]: errors between such heights could
     /// not be stored or measured.
     #[error(
-        "heights reach {0:e}; decimation takes heights within ±1e37 (errors are kept as float32)"
+        "heights reach {0:e} in magnitude; decimation takes heights within ±1e37 (errors are kept as float32)"
     )]
     HeightsTooLarge(f64),
     /// The maximum error is negative, NaN or infinite.

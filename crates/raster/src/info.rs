@@ -26,7 +26,10 @@ pub struct RasterInfo {
     /// GDAL's name of the band's data type (`Byte`, `Int16`, `Float32`, ...). A Byte band
     /// marked `PIXELTYPE=SIGNEDBYTE` is reported as `Int8`.
     pub data_type: String,
-    /// The band's declared nodata value, as GDAL reports it (before scale and offset).
+    /// The band's declared nodata value, as GDAL reports it (before scale and offset). In
+    /// JSON a number, or `"NaN"`, `"inf"`, `"-inf"` (JSON numbers cannot be those), or
+    /// `null` when none is declared.
+    #[serde(serialize_with = "nodata_json")]
     pub nodata: Option<f64>,
     /// The band's scale: heights are `sample * scale + offset` (1 when the band has none).
     pub scale: f64,
@@ -81,4 +84,15 @@ pub struct Raster {
     pub grid: Grid,
     /// What was read, with statistics matching `grid`.
     pub info: RasterInfo,
+}
+
+/// [`RasterInfo::nodata`] in JSON: non-finite values as strings, so a NaN nodata is not
+/// `null` (which means none).
+fn nodata_json<S: serde::Serializer>(nodata: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    match nodata {
+        None => s.serialize_none(),
+        Some(v) if v.is_nan() => s.serialize_str("NaN"),
+        Some(v) if v.is_infinite() => s.serialize_str(if *v > 0.0 { "inf" } else { "-inf" }),
+        Some(v) => s.serialize_f64(*v),
+    }
 }

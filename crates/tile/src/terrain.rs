@@ -60,7 +60,7 @@ pub enum TerrainError {
     /// Heights (largest magnitude, widest range of a tile) beyond what quantized-mesh
     /// tiles, whose height ranges are stored in `f32`, can hold.
     #[error(
-        "heights up to {max_abs:e} (tiles spanning up to {widest:e}) are beyond what \
+        "heights up to {max_abs:e} in magnitude (tiles spanning up to {widest:e}) are beyond what \
          quantized-mesh tiles can hold (their height range is stored in f32)"
     )]
     HeightsBeyondF32 {
@@ -440,8 +440,8 @@ pub fn build_terrain(
             let max_abs = lo.abs().max(hi.abs());
             if max_abs >= f64::from(f32::MAX) / 2.0 {
                 return Err(TerrainError::Options(format!(
-                    "heights up to {max_abs:e} are beyond what quantized-mesh tiles can hold \
-                     (their height range is stored in f32)"
+                    "heights up to {max_abs:e} in magnitude are beyond what quantized-mesh \
+                     tiles can hold (their height range is stored in f32)"
                 )));
             }
         }

@@ -517,14 +517,8 @@ impl Staging {
                  with other files)"
             )));
         }
-        let parent = match out_dir.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
-        };
-        if let Some(file) = parent
-            .ancestors()
-            .find(|a| !a.as_os_str().is_empty() && a.exists() && !a.is_dir())
-        {
+        let (parent, file_in_the_way) = crate::per_tile::parent_of(out_dir);
+        if let Some(file) = file_in_the_way {
             return Err(refuse(format!(
                 "{} is a file, so no directory can be made there",
                 file.display()

@@ -236,20 +236,6 @@ fn every_tin_format_reads_back_and_verifies() {
         &["-o", "epsg", &d.path("m.prj").to_string_lossy()],
     );
     assert!(srs.contains("EPSG:3857"), "{srs}");
-    // Written again without a CRS (pixel coordinates, untiled and tiled): the old .prj
-    // would give it one, and goes. (It stayed.)
-    for tile_size in ["100000", "40"] {
-        mesh(&d, &dem, "m.stl", E, &[]);
-        assert!(d.path("m.prj").exists());
-        mesh(
-            &d,
-            &dem,
-            "m.stl",
-            E,
-            &["--pixel-coords", "--tile-size", tile_size],
-        );
-        assert!(!d.path("m.prj").exists(), "tiles of {tile_size}");
-    }
 }
 
 #[test]

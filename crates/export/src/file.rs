@@ -104,17 +104,7 @@ pub fn write_mesh_with(
             MeshFormat::LandXml => landxml::write(w, mesh),
         },
         sidecar,
-    )?;
-    if sidecar.is_none() && format.uses_prj_sidecar() {
-        remove_stale_prj(path);
-    }
-    Ok(())
-}
-
-/// Removes the `.prj` beside `path` after a file without a CRS was written there: a `.prj`
-/// left from an earlier file of that name would give the new one a CRS it does not have.
-pub(crate) fn remove_stale_prj(path: &Path) {
-    let _ = std::fs::remove_file(prj_path(path));
+    )
 }
 
 /// Checks that every vertex is finite relative to `origin` in float32.

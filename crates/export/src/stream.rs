@@ -244,11 +244,7 @@ impl MeshStreamWriter {
                 Ok(())
             },
             sidecar,
-        )?;
-        if sidecar.is_none() && self.format.uses_prj_sidecar() {
-            crate::file::remove_stale_prj(&self.path);
-        }
-        Ok(())
+        )
     }
 
     /// The header [`crate::write_mesh`] writes for a mesh of the counts so far.

@@ -11,7 +11,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
-use crate::util::{fixture, gdaltransform, stderr, stdout, Dir};
+use crate::util::{assert_fails_naming, fixture, gdaltransform, stderr, stdout, Dir};
 
 /// The small DEM most tests use: 100 x 80 Float32, EPSG:3857, nodata.
 const DEM: &str = "tintn_valid_raster_3857.tif";
@@ -590,4 +590,34 @@ fn float32_formats_refuse_rasters_too_wide_for_float32_positions() {
     // Double-precision formats are fine.
     mesh(&d, &asc, "w.fgb", "1", &["--tile-size", "40000"]);
     verify(&d, &asc, "w.fgb", "1", &[]);
+}
+
+#[test]
+fn an_inputs_prj_is_never_replaced_by_a_meshs() {
+    // An ESRI ASCII grid keeps its CRS in x.prj; OBJ, STL and glTF write their CRS to the
+    // .prj beside them. `-o x.obj` would overwrite the input's CRS file: refused. In pixel
+    // coordinates no .prj is written, and the input's stays.
+    let d = Dir::new();
+    d.write(
+        "x.asc",
+        "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n4 5 6\n7 8 9\n",
+    );
+    let wkt = "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]";
+    d.write("x.prj", wkt);
+    for out in ["x.obj", "x.stl", "x.glb"] {
+        let o = d.run(&["mesh", "x.asc", "-o", out, "--max-error", "0.1"]);
+        assert_fails_naming(&o, &[out, "x.prj", "input"]);
+    }
+    let o = d.run(&[
+        "mesh",
+        "x.asc",
+        "-o",
+        "x.stl",
+        "--max-error",
+        "0.1",
+        "--pixel-coords",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(d.path("x.prj")).unwrap(), wkt);
 }

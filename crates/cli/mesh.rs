@@ -63,6 +63,9 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let total = Instant::now();
     let format = crate::export::format(args)?;
     check_writable_target(output, &args.input)?;
+    if !args.pixel_coords {
+        crate::output::check_sidecar_not_input(output, &args.input, format)?;
+    }
     if let Some(report) = &args.report {
         check_writable_target(report, &args.input)?;
         check_distinct(output, report, "the output")?;

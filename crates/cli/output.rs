@@ -4,6 +4,7 @@ use std::io::Write;
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
+use tinsmith_export::MeshFormat;
 
 /// Fails early, before long work, when `path`'s directory is missing, `path` is a
 /// directory, or `path` is the `input` file.
@@ -29,6 +30,29 @@ pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
     }
     if path.is_dir() {
         bail!("{}: is a directory, not an output file", path.display());
+    }
+    Ok(())
+}
+
+/// Fails when the `.prj` sidecar a georeferenced mesh in `format` writes beside `output`
+/// is the input's own `.prj` (an ESRI ASCII grid keeps its CRS there): writing it would
+/// replace the input's CRS file. (With `--pixel-coords` no sidecar is written.)
+pub fn check_sidecar_not_input(output: &Path, input: &Path, format: MeshFormat) -> Result<()> {
+    if !format.uses_prj_sidecar() {
+        return Ok(());
+    }
+    let ours = tinsmith_export::prj_path(output);
+    let theirs = tinsmith_export::prj_path(input);
+    if let (Ok(a), Ok(b)) = (std::fs::canonicalize(&ours), std::fs::canonicalize(&theirs)) {
+        if a == b {
+            bail!(
+                "{}: its CRS would go to {}, which belongs to the input {}; choose another \
+                 output name",
+                output.display(),
+                ours.display(),
+                input.display()
+            );
+        }
     }
     Ok(())
 }

@@ -36,8 +36,11 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
         return Ok(None);
     }
     // Checks the untiled path makes first, so that errors come in the same order.
-    crate::export::format(args)?;
+    let format = crate::export::format(args)?;
     check_writable_target(output, &args.input)?;
+    if !args.pixel_coords {
+        crate::output::check_sidecar_not_input(output, &args.input, format)?;
+    }
     let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
     let fits = reader.width() <= args.tile_size && reader.height() <= args.tile_size;
     let count_target = args.max_triangles.is_some() || args.max_vertices.is_some();
@@ -126,6 +129,9 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         Some(output) => {
             let format = crate::export::format(args)?;
             check_writable_target(output, &args.input)?;
+            if !args.pixel_coords {
+                crate::output::check_sidecar_not_input(output, &args.input, format)?;
+            }
             Some(format)
         }
         None => None,

@@ -317,8 +317,8 @@ fn nothing_to_contour(args: &ContourArgs) -> anyhow::Error {
 /// are the file's.
 ///
 /// The mesh must be one `tinsmith mesh` could have written from this raster and band:
-/// every vertex's height is its sample's (STL and glTF store `f32` offsets from a local
-/// origin, so within 2^-20 of the sample's magnitude plus the mesh's height range), and
+/// every vertex's height is its sample's (for STL and glTF, which store `f32` offsets from
+/// a local origin, within 2^-23 of the mesh's height range), and
 /// the verifier finds it a valid triangulation of the domain (no triangle over nodata, no
 /// gap, no overlap). Otherwise its lines would not be the raster's.
 fn mesh_from_file(
@@ -335,7 +335,19 @@ fn mesh_from_file(
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(v[2]), hi.max(v[2]))
         });
+    // STL and glTF store heights as float32 offsets from a local origin within the mesh's
+    // height range: off by up to range * 2^-24 (twice that allowed). The other formats
+    // store the samples exactly.
+    let float32 = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| ["stl", "glb", "gltf"].contains(&e.to_ascii_lowercase().as_str()));
     let range = if hi >= lo { hi - lo } else { 0.0 };
+    let slack = if float32 {
+        range / f64::from(1u32 << 23)
+    } else {
+        0.0
+    };
     let mut vertices = Vec::with_capacity(file.vertices.len());
     let mut positions = Vec::with_capacity(file.vertices.len());
     for (i, v) in file.vertices.iter().enumerate() {
@@ -351,7 +363,7 @@ fn mesh_from_file(
             );
         }
         let sample = grid.values()[y as usize * grid.width() as usize + x as usize];
-        let tolerance = (sample.abs() + range) / f64::from(1u32 << 20);
+        let tolerance = slack + sample.abs() * f64::EPSILON;
         // False for a NaN sample (nodata under a vertex) too.
         let matches = (v[2] - sample).abs() <= tolerance;
         if !matches {

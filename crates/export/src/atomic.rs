@@ -176,6 +176,12 @@ where
     let mut temp = output_temp_file(dir)
         .map_err(io_error("create a temporary file in the output directory"))?;
     let pending = crate::track_pending(temp.path());
+    if crate::interrupted() {
+        // The signal handler may have passed already: the temporary file goes now.
+        return Err(io_error("write")(io::Error::from(
+            io::ErrorKind::Interrupted,
+        )));
+    }
 
     {
         let mut writer = BufWriter::with_capacity(BUFFER_SIZE, temp.as_file_mut());

@@ -79,12 +79,15 @@ impl Drop for MadeDirsGuard {
 /// directory again), so the paths are removed a second time after a short pause.
 pub fn remove_pending() -> usize {
     INTERRUPTED.store(true, Ordering::SeqCst);
-    let paths = match PENDING.lock() {
+    // Read again for the second pass: a path registered meanwhile (its owner was
+    // between creating it and registering it) is removed too.
+    let paths = || match PENDING.lock() {
         Ok(pending) => pending.clone(),
         Err(poisoned) => poisoned.into_inner().clone(),
     };
+    let count = paths().len();
     let remove_all = || {
-        for path in &paths {
+        for path in &paths() {
             if path.is_dir() {
                 let _ = std::fs::remove_dir_all(path);
             } else {
@@ -102,7 +105,7 @@ pub fn remove_pending() -> usize {
     for dir in &made {
         let _ = std::fs::remove_dir(dir);
     }
-    paths.len()
+    count
 }
 
 /// Whether [`remove_pending`] has run: the work still going on may fail on the files it
@@ -116,20 +119,24 @@ mod tests {
     use super::*;
 
     #[test]
-    fn registered_paths_are_removed_until_their_guard_drops() {
+    fn paths_are_registered_until_their_guard_drops() {
+        // Inspects the registry rather than calling `remove_pending`, which would flag the
+        // whole test process as interrupted and remove other tests' temporary files.
         let dir = tempfile::tempdir().expect("temp dir");
         let (a, b) = (dir.path().join("a.tmp"), dir.path().join("b.tmp"));
-        std::fs::write(&a, b"a").unwrap();
-        std::fs::create_dir(&b).unwrap();
-        std::fs::write(b.join("inner"), b"x").unwrap();
+        let registered = |p: &Path| PENDING.lock().unwrap().iter().any(|q| q == p);
         let guard_a = track_pending(&a);
         {
             let _guard_b = track_pending(&b);
+            assert!(registered(&b));
         }
-        // b's guard is gone: b is kept; a is removed.
-        remove_pending();
-        assert!(!a.exists());
-        assert!(b.join("inner").exists());
+        assert!(registered(&a) && !registered(&b));
         drop(guard_a);
+        assert!(!registered(&a));
+        let made = [dir.path().join("m")];
+        let guard = track_made_dirs(&made);
+        assert!(MADE.lock().unwrap().contains(&made[0]));
+        drop(guard);
+        assert!(!MADE.lock().unwrap().contains(&made[0]));
     }
 }

@@ -205,6 +205,8 @@ fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
         let nodata = match (gdal_type.as_str(), info.nodata) {
             ("Int64", _) => rb.no_data_value_i64().map(|v| v.to_string()),
             ("UInt64", _) => rb.no_data_value_u64().map(|v| v.to_string()),
+            // A fractional nodata matches no sample of an integer band (as the reader has it).
+            (_, Some(v)) if v.fract() != 0.0 => None,
             (_, Some(v)) if v < 0.0 => Some((v as i64).to_string()),
             (_, Some(v)) => Some((v as u64).to_string()),
             (_, None) => None,

@@ -540,11 +540,18 @@ impl Staging {
                 remove_empty(&made);
                 output(source)
             })?;
-        Ok(Staging {
+        let staging = Staging {
             _pending: tinsmith_export::track_pending(temp.path()),
             temp: Some(temp),
             made: Some((made, guard)),
-        })
+        };
+        if tinsmith_export::interrupted() {
+            // The signal handler may have passed already: dropping `staging` removes it.
+            return Err(output(std::io::Error::from(
+                std::io::ErrorKind::Interrupted,
+            )));
+        }
+        Ok(staging)
     }
 
     fn path(&self) -> &Path {

@@ -10,11 +10,8 @@ use tinsmith_export::MeshFormat;
 /// directory, or `path` is the `input` file.
 pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
     check_not_input(path, input)?;
-    let dir = parent_dir(path);
-    if let Some(file) = dir
-        .ancestors()
-        .find(|a| !a.as_os_str().is_empty() && a.exists() && !a.is_dir())
-    {
+    let (dir, file_in_the_way) = tinsmith_export::output_parent(path);
+    if let Some(file) = file_in_the_way {
         bail!(
             "{}: {} is a file, not a directory",
             path.display(),

@@ -74,6 +74,19 @@ impl Staged {
     }
 }
 
+/// The directory an output at `path` goes in (`.` for a bare name), and the first of that
+/// directory's ancestors that exists as a file, if any: nothing can be made under it.
+pub fn output_parent(path: &Path) -> (&Path, Option<&Path>) {
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let file = parent
+        .ancestors()
+        .find(|a| !a.as_os_str().is_empty() && a.exists() && !a.is_dir());
+    (parent, file)
+}
+
 /// Where writing `path` lands: when `path` is a symbolic link, the file it points to (so
 /// the link stays a link, as when a program opens it for writing), else `path`.
 pub fn resolve_output(path: &Path) -> PathBuf {

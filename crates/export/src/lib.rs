@@ -71,7 +71,9 @@ mod stream;
 mod weld;
 
 pub use antimeridian::cut_at_antimeridian;
-pub use atomic::{is_special_file, output_temp_dir, output_temp_file, resolve_output};
+pub use atomic::{
+    is_special_file, output_parent, output_temp_dir, output_temp_file, resolve_output,
+};
 pub use error::{Error, Result};
 pub use file::{prj_path, read_mesh, read_mesh_as, write_mesh, write_mesh_with};
 pub use format::MeshFormat;

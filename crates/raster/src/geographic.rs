@@ -186,7 +186,8 @@ fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
             .replace('"', "&quot;")
     };
     let source = escape(&path.to_string_lossy());
-    let gdal_type = opened.band()?.band_type().name();
+    let rb = opened.band()?;
+    let gdal_type = rb.band_type().name();
     let file = format!("<SourceFilename relativeToVRT=\"0\">{source}</SourceFilename>");
     let band = if gdal_type.starts_with("Float") {
         // Where the source equals NODATA the view keeps its initial value, NaN.
@@ -201,7 +202,6 @@ fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
         )
     } else {
         // Exactly, for the 64-bit types too (beyond 2^53 the f64 in `info` is rounded).
-        let rb = opened.band()?;
         let nodata = match (gdal_type.as_str(), info.nodata) {
             ("Int64", _) => rb.no_data_value_i64().map(|v| v.to_string()),
             ("UInt64", _) => rb.no_data_value_u64().map(|v| v.to_string()),

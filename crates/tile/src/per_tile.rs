@@ -52,7 +52,7 @@ impl PerTileWriter {
         if let Some(reason) = occupied_reason(dir) {
             return Err(output(reason, None));
         }
-        let (parent, file_in_the_way) = parent_of(dir);
+        let (parent, file_in_the_way) = tinsmith_export::output_parent(dir);
         if let Some(file) = file_in_the_way {
             return Err(output(
                 &format!(
@@ -128,19 +128,6 @@ impl TileSink for PerTileWriter {
         write_mesh(&path, self.format, mesh)?;
         Ok(())
     }
-}
-
-/// The directory `dir` goes in (`.` for a bare name), and the first of its ancestors that
-/// exists as a file, if any: no directory can be made under that.
-pub(crate) fn parent_of(dir: &Path) -> (&Path, Option<&Path>) {
-    let parent = match dir.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let file = parent
-        .ancestors()
-        .find(|a| !a.as_os_str().is_empty() && a.exists() && !a.is_dir());
-    (parent, file)
 }
 
 /// Why `dir` cannot take a new output directory, if it exists as anything but an empty

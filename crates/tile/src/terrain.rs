@@ -517,7 +517,7 @@ impl Staging {
                  with other files)"
             )));
         }
-        let (parent, file_in_the_way) = crate::per_tile::parent_of(out_dir);
+        let (parent, file_in_the_way) = tinsmith_export::output_parent(out_dir);
         if let Some(file) = file_in_the_way {
             return Err(refuse(format!(
                 "{} is a file, so no directory can be made there",

@@ -620,4 +620,26 @@ fn an_inputs_prj_is_never_replaced_by_a_meshs() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(std::fs::read_to_string(d.path("x.prj")).unwrap(), wkt);
+    // Untiled and tiled, a mesh written without a CRS says that the .prj beside it was
+    // left as it is (a reader would take it for the mesh's CRS), and leaves it.
+    for tile_size in ["512", "2"] {
+        let o = d.run(&[
+            "mesh",
+            "x.asc",
+            "-o",
+            "x.obj",
+            "--max-error",
+            "0.1",
+            "--pixel-coords",
+            "--tile-size",
+            tile_size,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let said = stderr(&o);
+        assert!(
+            said.contains("x.obj: written without a CRS") && said.contains("x.prj"),
+            "{said}"
+        );
+        assert_eq!(std::fs::read_to_string(d.path("x.prj")).unwrap(), wkt);
+    }
 }

@@ -277,6 +277,8 @@ pub fn write(
         .with_crs_wkt(crs.wkt)
         .with_epsg(crs.epsg);
     tinsmith_export::write_mesh_with(path, plan.format, mesh, &options)?;
+    let crs_written = crs.wkt.is_some_and(|w| !w.trim().is_empty());
+    crate::output::note_prj_left_beside(path, plan.format, crs_written, args.quiet);
     Ok(())
 }
 

@@ -54,6 +54,23 @@ pub fn check_sidecar_not_input(output: &Path, input: &Path, format: MeshFormat) 
     Ok(())
 }
 
+/// Notes on stderr (unless `quiet`) that the `.prj` beside `output` was left as it is,
+/// when a mesh in a sidecar format (OBJ, STL, glTF) was written there without a CRS:
+/// readers would take that file for the mesh's CRS. It is never removed, since it may
+/// belong to another file (the input's grid, a shapefile of the same name).
+pub fn note_prj_left_beside(output: &Path, format: MeshFormat, crs_written: bool, quiet: bool) {
+    let prj = tinsmith_export::prj_path(output);
+    if quiet || crs_written || !format.uses_prj_sidecar() || !prj.is_file() {
+        return;
+    }
+    note!(
+        "{}: written without a CRS, but {} is beside it and was left as it is; readers \
+         may take it for this mesh's CRS (remove it if it came from an earlier run)",
+        output.display(),
+        prj.display()
+    );
+}
+
 /// Fails when `output` is the file `input` (the same file by any path, links included):
 /// writing would destroy the input.
 pub fn check_not_input(output: &Path, input: &Path) -> Result<()> {

@@ -216,6 +216,8 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             )?;
             let t = Instant::now();
             writer.finish()?;
+            let crs_written = crs.is_some_and(|w| !w.trim().is_empty());
+            crate::output::note_prj_left_beside(output, format, crs_written, args.quiet);
             let write = report.seconds_sink + t.elapsed().as_secs_f64();
             (report, output.as_path(), write)
         }

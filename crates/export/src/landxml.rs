@@ -249,6 +249,22 @@ pub(crate) fn read<R: BufRead>(r: R) -> Result<Mesh, Problem> {
                 }
             }
             Event::Text(t) if inside != Inside::Nothing => text.push_str(&t),
+            Event::CData(t) if inside != Inside::Nothing => text.push_str(&t),
+            // A character reference (`&#32;`) or one of XML's five entities in the text.
+            Event::GeneralRef(r) if inside != Inside::Nothing => {
+                match r.resolve_char_ref() {
+                    Ok(Some(c)) => text.push(c),
+                    _ => match quick_xml::escape::resolve_predefined_entity(&r) {
+                        Some(s) => text.push_str(s),
+                        None => {
+                            return Err(Problem::malformed(format_args!(
+                                "unknown reference &{}; near byte {position}",
+                                &*r
+                            )))
+                        }
+                    },
+                }
+            }
             Event::End(_) => {
                 path.pop();
                 match inside {
@@ -393,6 +409,25 @@ mod tests {
             vec![[0.0, 0.0, 1.0], [1.0, 0.0, 2.0], [1.0, 1.0, 3.0]]
         );
         assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
+        Ok(())
+    }
+
+    #[test]
+    fn cdata_and_references_in_text_are_read_as_xml_means_them() -> Result<(), Problem> {
+        let text = "<LandXML><Surfaces><Surface><Definition surfType=\"TIN\"><Pnts>\
+            <P id=\"1\"><![CDATA[0 0 1]]></P><P id=\"2\">0&#32;1&#x20;2</P>\
+            <P id=\"3\">1 1 &#51;</P></Pnts><Faces><F>1 2 3</F></Faces></Definition>\
+            </Surface></Surfaces></LandXML>";
+        let mesh = read(text.as_bytes())?;
+        assert_eq!(
+            mesh.vertices,
+            vec![[0.0, 0.0, 1.0], [1.0, 0.0, 2.0], [1.0, 1.0, 3.0]]
+        );
+        let unknown = text.replace("&#51;", "&three;");
+        match read(unknown.as_bytes()) {
+            Err(Problem::Malformed(reason)) => assert!(reason.contains("&three;"), "{reason}"),
+            other => panic!("{other:?}"),
+        }
         Ok(())
     }
 

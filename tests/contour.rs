@@ -1091,7 +1091,7 @@ fn a_mesh_file_must_be_the_rasters() {
     );
     assert_fails_naming(
         &contour("raised.asc"),
-        &["plane.ply", "vertex", "not written from this raster"],
+        &["plane.ply", "vertex", "needs a TIN of this raster"],
     );
     assert!(!d.path("c.geojson").exists());
     run_ok(

@@ -5,6 +5,7 @@ mod util;
 mod bad_input;
 mod cesium;
 mod contour;
+mod foreign;
 mod formats;
 mod mesh_and_verify;
 mod serve;

@@ -313,14 +313,16 @@ fn nothing_to_contour(args: &ContourArgs) -> anyhow::Error {
 }
 
 /// Reads a mesh file written from `raster` (as `tinsmith verify` reads it: GeoJSON in
-/// WGS84 back to the raster's CRS) and maps its vertices back to grid positions; heights
-/// are the file's.
+/// WGS84 back to the raster's CRS) and maps its vertices back to grid positions, one
+/// vertex per position, with its sample's height.
 ///
-/// The mesh must be one `tinsmith mesh` could have written from this raster and band:
-/// every vertex's height is its sample's (for STL and glTF, which store `f32` offsets from
-/// a local origin, within 2^-23 of the mesh's height range), and
-/// the verifier finds it a valid triangulation of the domain (no triangle over nodata, no
-/// gap, no overlap). Otherwise its lines would not be the raster's.
+/// The mesh must be a TIN of this raster and band: every vertex's height is its sample's
+/// (within a millionth of the sample's magnitude or the mesh's height range, for text
+/// rounded by other tools; for STL and glTF, which store `f32` offsets from a local
+/// origin, within 2^-23 of the range more), and the verifier finds it a valid
+/// triangulation of the domain (no triangle over nodata, no gap, no overlap; GeoJSON and
+/// FlatGeobuf triangles may be wound either way). Otherwise its lines would not be the
+/// raster's.
 fn mesh_from_file(
     path: &Path,
     raster: &Raster,
@@ -336,8 +338,10 @@ fn mesh_from_file(
             (lo.min(v[2]), hi.max(v[2]))
         });
     // STL and glTF store heights as float32 offsets from a local origin within the mesh's
-    // height range: off by up to range * 2^-24 (twice that allowed). The other formats
-    // store the samples exactly.
+    // height range: off by up to range * 2^-24 (twice that allowed). Text written by
+    // other tools may round to about six decimals or significant digits: a millionth of
+    // the sample's magnitude or of the range is allowed for that, far below any DEM's
+    // precision. A vertex within it takes its sample's height.
     let float32 = path
         .extension()
         .and_then(|e| e.to_str())
@@ -348,8 +352,8 @@ fn mesh_from_file(
     } else {
         0.0
     };
-    let mut vertices = Vec::with_capacity(file.vertices.len());
-    let mut positions = Vec::with_capacity(file.vertices.len());
+    // Each file vertex's sample, as its row-major index.
+    let mut samples: Vec<u64> = Vec::with_capacity(file.vertices.len());
     for (i, v) in file.vertices.iter().enumerate() {
         let [x, y] = georef
             .sample_at([v[0], v[1]])
@@ -363,35 +367,66 @@ fn mesh_from_file(
             );
         }
         let sample = grid.values()[y as usize * grid.width() as usize + x as usize];
-        let tolerance = slack + sample.abs() * f64::EPSILON;
+        let tolerance = slack + 1e-6 * sample.abs().max(range);
         // False for a NaN sample (nodata under a vertex) too.
         let matches = (v[2] - sample).abs() <= tolerance;
         if !matches {
             bail!(
                 "{}: vertex {i} at column {x}, row {y} has height {}, but band {band} of {} \
-                 has {} there: the mesh was not written from this raster and band{}",
+                 has {} there (more than {:.2e} apart): `contour --mesh` needs a TIN of this \
+                 raster and band{}",
                 path.display(),
                 v[2],
                 raster.info.path.display(),
                 sample,
+                tolerance,
                 if matches!(georef, Georef::Pixel) {
-                    " (or it was written without --pixel-coords)"
+                    " (or was it written without --pixel-coords?)"
                 } else {
-                    " (or it was written with --pixel-coords)"
+                    " (or was it written with --pixel-coords?)"
                 }
             );
         }
-        positions.push([x, y]);
-        vertices.push([x as f64, y as f64, v[2]]);
+        samples.push(y as u64 * u64::from(grid.width()) + x as u64);
     }
     if file.triangles.is_empty() {
         bail!("{}: the mesh has no triangles", path.display());
     }
+    // One vertex per sample, numbered in row-major order: files that repeat a vertex for
+    // every triangle using it (unindexed glTF, STL, a PLY written triangle by triangle)
+    // share it again, so lines join across every edge, and the lines come out the same
+    // whatever order the file lists its vertices in.
+    let mut used = samples.clone();
+    used.sort_unstable();
+    used.dedup();
+    let width = u64::from(grid.width());
+    let positions: Vec<[i64; 2]> = used
+        .iter()
+        .map(|&s| [(s % width) as i64, (s / width) as i64])
+        .collect();
+    let vertices: Vec<[f64; 3]> = used
+        .iter()
+        .map(|&s| {
+            let [x, y] = [s % width, s / width];
+            [x as f64, y as f64, grid.values()[s as usize]]
+        })
+        .collect();
+    let index: Vec<u32> = samples
+        .iter()
+        .map(|s| used.binary_search(s).expect("every sample is listed") as u32)
+        .collect();
+    let mut triangles: Vec<[u32; 3]> = file
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| index[v as usize]))
+        .collect();
+    let orientation = expected_orientation(&georef);
+    crate::verify::orient_polygon_triangles(path, &positions, &mut triangles, orientation);
     let heights: Vec<f64> = vertices.iter().map(|v| v[2]).collect();
-    let options = VerifyOptions::new().with_orientation(expected_orientation(&georef));
+    let options = VerifyOptions::new().with_orientation(orientation);
     let report = tinsmith_verify::verify(
         GridRef::new(grid.width(), grid.height(), grid.values()),
-        MeshRef::new(&positions, &heights, &file.triangles),
+        MeshRef::new(&positions, &heights, &triangles),
         &options,
     )
     .with_context(|| format!("{}: cannot check the mesh", path.display()))?;
@@ -404,6 +439,6 @@ fn mesh_from_file(
             report.problems.join("; ")
         );
     }
-    ContourMesh::new(vertices, file.triangles)
+    ContourMesh::new(vertices, triangles)
         .with_context(|| format!("{}: cannot contour this mesh", path.display()))
 }

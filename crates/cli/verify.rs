@@ -34,14 +34,17 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
         positions.push(p);
     }
     let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();
+    let orientation = expected_orientation(&georef);
+    let mut triangles = mesh.triangles;
+    orient_polygon_triangles(&args.mesh, &positions, &mut triangles, orientation);
     let grid = &raster.grid;
-    let mut options = VerifyOptions::new().with_orientation(expected_orientation(&georef));
+    let mut options = VerifyOptions::new().with_orientation(orientation);
     if let Some(e) = args.max_error {
         options = options.with_max_error(e);
     }
     let report = tinsmith_verify::verify(
         GridRef::new(grid.width(), grid.height(), grid.values()),
-        MeshRef::new(&positions, &heights, &mesh.triangles),
+        MeshRef::new(&positions, &heights, &triangles),
         &options,
     )
     .with_context(|| format!("{}: cannot verify", args.mesh.display()))?;
@@ -151,6 +154,37 @@ fn into_raster_frame(mesh: &mut Mesh, raster: &Raster, transform: tinsmith_core:
         }
     }
     mesh.vertices = vertices;
+}
+
+/// Turns each triangle of a GeoJSON or FlatGeobuf mesh (`positions` on the grid) to
+/// `orientation`: those formats hold triangles as polygons, whose winding says nothing
+/// (RFC 7946 asks readers not to reject rings against its right-hand rule; shapefiles wind
+/// them clockwise), so a triangle wound the other way is the same triangle. Other formats
+/// are left as they are: their winding says which way a face points.
+pub fn orient_polygon_triangles(
+    path: &Path,
+    positions: &[[i64; 2]],
+    triangles: &mut [[u32; 3]],
+    orientation: Orientation,
+) {
+    if !matches!(
+        tinsmith_export::MeshFormat::from_path(path),
+        Ok(tinsmith_export::MeshFormat::GeoJson | tinsmith_export::MeshFormat::FlatGeobuf)
+    ) {
+        return;
+    }
+    let wanted = match orientation {
+        Orientation::CounterClockwise => 1,
+        Orientation::Clockwise => -1,
+    };
+    for t in triangles {
+        let [a, b, c] = t.map(|v| positions[v as usize]);
+        let [a, b, c] = [a, b, c].map(|p| p.map(i128::from));
+        let area_x2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        if area_x2.signum() == -wanted {
+            t.swap(1, 2);
+        }
+    }
 }
 
 /// Mesh files hold triangles counter-clockwise in file coordinates (normals up), which is

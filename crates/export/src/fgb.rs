@@ -105,16 +105,23 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
     let header = reader.header();
     let mut mesh = Mesh::default();
     if let Some(crs) = header.crs() {
-        mesh.epsg = u32::try_from(crs.code()).ok().filter(|&c| c > 0);
+        mesh.epsg = u32::try_from(crs.code())
+            .ok()
+            .filter(|&c| c > 0)
+            .map(crate::wgs84_code);
         mesh.crs_wkt = crs.wkt().map(str::to_owned).filter(|w| !w.is_empty());
     }
     let kind = header.geometry_type();
     if !matches!(
         kind,
-        GeometryType::Triangle | GeometryType::Polygon | GeometryType::TIN | GeometryType::Unknown
+        GeometryType::Triangle
+            | GeometryType::Polygon
+            | GeometryType::MultiPolygon
+            | GeometryType::TIN
+            | GeometryType::Unknown
     ) {
         return Err(Problem::unsupported(format_args!(
-            "{kind:?} geometries; only Triangle, Polygon and TIN are read"
+            "{kind:?} geometries; only Triangle, Polygon, MultiPolygon and TIN are read"
         )));
     }
     let mut features = reader.select_all_seq().map_err(Problem::malformed)?;

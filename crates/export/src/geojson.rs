@@ -195,10 +195,11 @@ fn ring_positions(f: usize, ring: &[Vec<f64>], cut: bool) -> Result<Vec<[f64; 3]
         .collect()
 }
 
-/// The EPSG code in a CRS name such as `urn:ogc:def:crs:EPSG::3005` or `EPSG:3005`, or
-/// 4326 for OGC's CRS84.
+/// The EPSG code in a CRS name such as `urn:ogc:def:crs:EPSG::3005` or `EPSG:3005`; 4326
+/// for WGS84 longitude, latitude, which OGC calls CRS84 (CRS84h with ellipsoidal heights)
+/// and ogr2ogr labels EPSG 4979 when the positions have a z (see [`crate::wgs84_code`]).
 fn epsg_of_name(name: &str) -> Option<u32> {
-    if name.ends_with("CRS84") {
+    if name.ends_with("CRS84") || name.ends_with("CRS84h") {
         return Some(4326);
     }
     let upper = name.to_ascii_uppercase();
@@ -207,7 +208,7 @@ fn epsg_of_name(name: &str) -> Option<u32> {
             .strip_prefix("URN:OGC:DEF:CRS:EPSG:")
             .map(|rest| rest.rsplit(':').next().unwrap_or(rest))
     })?;
-    code.trim().parse().ok()
+    code.trim().parse().ok().map(crate::wgs84_code)
 }
 
 /// Reads a GeoJSON `FeatureCollection` of triangle `Polygon` Z features (closed rings of
@@ -266,6 +267,13 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
                 let positions = ring_positions(f, ring, false)?;
                 [positions[0], positions[1], positions[2]]
             }
+            // A MultiPolygon of one triangle (as ogr2ogr -nlt MULTIPOLYGON writes them).
+            ("MultiPolygon", Coordinates::MultiPolygon(polygons))
+                if polygons.len() == 1 && polygons[0].len() == 1 =>
+            {
+                let positions = ring_positions(f, &polygons[0][0], false)?;
+                [positions[0], positions[1], positions[2]]
+            }
             ("MultiPolygon", Coordinates::MultiPolygon(polygons)) if rfc7946 => {
                 let parts = match polygons.as_slice() {
                     [west, east] if west.len() == 1 && east.len() == 1 => [
@@ -285,8 +293,8 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
             }
             (kind, _) => {
                 return Err(Problem::unsupported(format_args!(
-                    "feature {f} is a {kind}; only Polygon triangles (and, in WGS84, \
-                     MultiPolygon triangles cut at the antimeridian) are read"
+                    "feature {f} is a {kind}; only Polygon triangles, MultiPolygons of one \
+                     triangle and, in WGS84, triangles cut in two at the antimeridian are read"
                 )))
             }
         };
@@ -436,6 +444,9 @@ mod tests {
         );
         assert_eq!(epsg_of_name("EPSG:2056"), Some(2056));
         assert_eq!(epsg_of_name("urn:ogc:def:crs:OGC:1.3:CRS84"), Some(4326));
+        // ogr2ogr's label for WGS84 positions with a z, and OGC's.
+        assert_eq!(epsg_of_name("urn:ogc:def:crs:EPSG::4979"), Some(4326));
+        assert_eq!(epsg_of_name("urn:ogc:def:crs:OGC::CRS84h"), Some(4326));
         assert_eq!(epsg_of_name("PROJCS[\"x\"]"), None);
     }
 

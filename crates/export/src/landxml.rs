@@ -251,20 +251,18 @@ pub(crate) fn read<R: BufRead>(r: R) -> Result<Mesh, Problem> {
             Event::Text(t) if inside != Inside::Nothing => text.push_str(&t),
             Event::CData(t) if inside != Inside::Nothing => text.push_str(&t),
             // A character reference (`&#32;`) or one of XML's five entities in the text.
-            Event::GeneralRef(r) if inside != Inside::Nothing => {
-                match r.resolve_char_ref() {
-                    Ok(Some(c)) => text.push(c),
-                    _ => match quick_xml::escape::resolve_predefined_entity(&r) {
-                        Some(s) => text.push_str(s),
-                        None => {
-                            return Err(Problem::malformed(format_args!(
-                                "unknown reference &{}; near byte {position}",
-                                &*r
-                            )))
-                        }
-                    },
-                }
-            }
+            Event::GeneralRef(r) if inside != Inside::Nothing => match r.resolve_char_ref() {
+                Ok(Some(c)) => text.push(c),
+                _ => match quick_xml::escape::resolve_predefined_entity(&r) {
+                    Some(s) => text.push_str(s),
+                    None => {
+                        return Err(Problem::malformed(format_args!(
+                            "unknown reference &{}; near byte {position}",
+                            &*r
+                        )))
+                    }
+                },
+            },
             Event::End(_) => {
                 path.pop();
                 match inside {

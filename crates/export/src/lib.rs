@@ -91,3 +91,14 @@ pub use quantized_mesh::{
     QUANTIZED_MAX, WGS84_A, WGS84_B,
 };
 pub use stream::MeshStreamWriter;
+
+/// EPSG 4326 for EPSG 4979 (WGS84 with ellipsoidal heights, as ogr2ogr labels WGS84 files
+/// whose positions have a z): in GeoJSON and FlatGeobuf both are longitude, latitude in
+/// degrees, and a mesh's heights are its raster's values either way. Other codes as given.
+pub(crate) fn wgs84_code(code: u32) -> u32 {
+    if code == 4979 {
+        4326
+    } else {
+        code
+    }
+}

@@ -34,7 +34,8 @@ pub(crate) fn check_edges(
         .iter()
         .zip(mesh.heights)
         .enumerate()
-        .map(|(v, (&p, z))| *ids.entry((p, z.to_bits())).or_insert(v as u32))
+        // +0.0 and -0.0 are the same height.
+        .map(|(v, (&p, z))| *ids.entry((p, (z + 0.0).to_bits())).or_insert(v as u32))
         .collect();
     let mut sides: Vec<Side> = Vec::with_capacity(3 * mesh.triangles.len());
     for (corners, _) in mesh.triangles.iter().zip(measured).filter(|(_, &m)| m) {

@@ -121,6 +121,15 @@ pub fn verify(grid: GridRef<'_>, mesh: MeshRef<'_>, options: &VerifyOptions) -> 
         });
     }
     report.problems = log.finish();
+    let measured_count = measured.iter().filter(|&&m| m).count() as u64;
+    if report.flipped_triangles > 1 && report.flipped_triangles == measured_count {
+        report.problems.insert(
+            0,
+            "every triangle is wound the other way round (the mesh faces down); reverse \
+             each triangle's corners"
+                .to_owned(),
+        );
+    }
     Ok(report)
 }
 
@@ -209,7 +218,7 @@ fn check_triangles(
             report.flipped_triangles += 1;
             log.push(Kind::Flipped, || {
                 format!(
-                    "triangle {t} is flipped: {} {} {} is not {}",
+                    "triangle {t} is flipped: {} {} {} is not {} (columns, rows)",
                     at(a),
                     at(b),
                     at(c),
@@ -637,6 +646,48 @@ mod tests {
             "{:?}",
             report.problems
         );
+    }
+
+    #[test]
+    fn a_mesh_wound_the_other_way_round_is_named_as_such() {
+        let triangles: Vec<[u32; 3]> = eight_triangles()
+            .into_iter()
+            .map(|[a, b, c]| [a, c, b])
+            .collect();
+        let report = flat_3x3(&triangles);
+        assert_eq!(report.flipped_triangles, 8);
+        assert!(
+            report.problems[0].starts_with("every triangle is wound the other way round"),
+            "{:?}",
+            report.problems
+        );
+    }
+
+    #[test]
+    fn heights_of_zero_and_minus_zero_are_one_vertex() {
+        // Two copies of the centre vertex, one at -0.0: welded, no crack between them.
+        let (w, h) = (3, 3);
+        let values = vec![0.0; 9];
+        let mut positions: Vec<[i64; 2]> = (0..9).map(|i| [i % 3, i / 3]).collect();
+        positions.push([1, 1]);
+        let mut heights = vec![0.0; 9];
+        heights.push(-0.0);
+        let mut triangles = eight_triangles();
+        for t in triangles.iter_mut().step_by(2) {
+            for v in t.iter_mut().filter(|v| **v == 4) {
+                *v = 9;
+            }
+        }
+        let report = run(
+            w,
+            h,
+            &values,
+            &positions,
+            &heights,
+            &triangles,
+            VerifyOptions::new(),
+        );
+        assert!(report.passed(), "{:?}", report.problems);
     }
 
     #[test]

@@ -323,3 +323,34 @@ fn max_edge_length_caps_every_edge_untiled_and_tiled() {
         assert!(longest >= 16.0, "the cap should bind on this DEM at 20 m");
     }
 }
+
+#[test]
+fn a_scaling_vrt_is_read_as_its_band_type_holds_it() {
+    // GDAL hands out a VRT's scaled values unrounded when asked for f64; the band's own
+    // type (what gdal_translate writes, what rasterio reads) rounds them. The mesh must
+    // hold the band's values: verified at 0 against GDAL's own GeoTIFF copy of the VRT.
+    let d = Dir::new();
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    for (ty, scale_to) in [("Int16", "1000.7"), ("Float32", "1000.7")] {
+        let vrt = format!("{ty}.vrt");
+        let tif = format!("{ty}.tif");
+        let scaling = [
+            "-of", "VRT", "-ot", ty, "-scale_1", "350", "2583", "0", scale_to, "-srcwin", "0", "0",
+            "120", "90", &input, &vrt,
+        ];
+        for args in [&scaling[..], &["-of", "GTiff", &vrt, &tif]] {
+            let o = std::process::Command::new("gdal_translate")
+                .current_dir(d.path(""))
+                .arg("-q")
+                .args(args)
+                .output()
+                .expect("gdal_translate (Debian gdal-bin) must be on PATH");
+            assert!(o.status.success(), "{}", crate::util::stderr(&o));
+        }
+        let mesh = format!("{ty}.ply");
+        let o = d.run(&["mesh", &vrt, "-o", &mesh, "--max-error", "0", "-q"]);
+        assert!(o.status.success(), "{}", crate::util::stderr(&o));
+        let v = d.run(&["verify", &tif, &mesh, "--max-error", "0"]);
+        assert!(v.status.success(), "{ty}: {}", stdout(&v));
+    }
+}

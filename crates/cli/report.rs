@@ -96,15 +96,15 @@ impl<'a> MeshSummary<'a> {
     /// with `how` (e.g. the tiling) after the percentage.
     pub fn print(&self, how: &str) {
         note!(
-            "{}: {} -> {} triangles ({:.1}% decimated){how}, measured max error {} <= {}",
+            "{}: {} -> {} triangles ({:.1}% decimated){how}, measured max error {}{}",
             self.output.display(),
             self.triangles_before,
             self.triangles_after,
             self.decimation_percent,
             readable(self.measured_max_error),
             match self.max_error {
-                Some(e) => readable(e),
-                None => "(no bound asked)".into(),
+                Some(e) => format!(" <= {}", readable(e)),
+                None => " (no bound asked)".into(),
             }
         );
         let short = [
@@ -113,9 +113,18 @@ impl<'a> MeshSummary<'a> {
         ];
         for (flag, target, reached) in short {
             if let Some(target) = target.filter(|&t| reached > t as u64) {
-                let why = match self.max_error {
-                    Some(e) => format!("--max-error {} stopped the decimation first", readable(e)),
-                    None => {
+                let why = match (self.max_error, self.max_edge_length) {
+                    (Some(e), None) => {
+                        format!("--max-error {} stopped the decimation first", readable(e))
+                    }
+                    (Some(e), Some(l)) => format!(
+                        "--max-error {} or --max-edge-length {l} stopped the decimation first",
+                        readable(e)
+                    ),
+                    (None, Some(l)) => {
+                        format!("--max-edge-length {l} keeps them (no edge may be longer)")
+                    }
+                    (None, None) => {
                         "the domain's outline needs them (its corners are never removed)".into()
                     }
                 };

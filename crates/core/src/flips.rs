@@ -15,8 +15,9 @@ const FLIP_GAIN: f64 = 0.9;
 /// One pass over the interior edges in triangle slot order: flips an edge into the other
 /// diagonal of its strictly convex quadrilateral when both new triangles' exact errors are
 /// within the limit, within the longest edge allowed, and below [`FLIP_GAIN`] times the
-/// larger bound of the two old triangles. Each triangle flips at most once per pass. The
-/// largest bound never grows. Returns the number of flips.
+/// larger bound of the two old triangles (never where it is 0). Each triangle flips at most
+/// once per pass. The largest bound never grows, and every flip lowers the larger of its
+/// two, so rounds come to an end. Returns the number of flips.
 pub(crate) fn flip_for_error(mesh: &mut Mesh<'_>, rules: &Rules<'_>) -> usize {
     let mut flips = 0;
     for t in 0..mesh.triangle_slots() as u32 {
@@ -32,6 +33,9 @@ pub(crate) fn flip_for_error(mesh: &mut Mesh<'_>, rules: &Rules<'_>) -> usize {
             }
             let points = quad.map(|v| mesh.point(v));
             let old = mesh.bound(t).max().max(mesh.bound(u).max());
+            if old <= 0.0 {
+                continue; // nothing to gain; flipping would only undo itself next round
+            }
             if !flip_within(
                 mesh,
                 rules,

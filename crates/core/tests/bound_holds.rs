@@ -354,6 +354,23 @@ fn flip_rounds_keep_the_bound_with_fewer_triangles() {
 }
 
 #[test]
+fn flip_rounds_stop_when_nothing_improves() {
+    // A flat square: two triangles of error 0, whose diagonal gains nothing by flipping.
+    // Every round flipped it back and forth, so the output depended on the round count
+    // and a large count never settled (an even count undid an odd one).
+    let spec = GridSpec {
+        width: 40,
+        height: 40,
+        values: vec![7.5; 1600],
+    };
+    let once = check_with(&spec, &DecimationOptions::new(0.0).with_flip_rounds(1)).unwrap();
+    let many = DecimationOptions::new(0.0).with_flip_rounds(1000);
+    assert_eq!(check_with(&spec, &many).unwrap(), once);
+    let plain = check_with(&spec, &DecimationOptions::new(0.0)).unwrap();
+    assert_eq!(plain, once);
+}
+
+#[test]
 fn extended_holes_keep_the_bound_with_fewer_triangles() {
     let spec = tinsmith_testkit::with_nodata_disc(
         tinsmith_testkit::terrain(120, 90, 4.0, 5),

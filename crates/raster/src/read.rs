@@ -103,6 +103,22 @@ pub fn read_grid(path: &Path, band: usize) -> Result<Raster> {
     })
 }
 
+/// Reads the `size` window at `at` of `rb` as `T` into `dst`, widened by `widen`.
+fn read_widened<T: gdal::raster::GdalType + Copy + Default>(
+    rb: &RasterBand<'_>,
+    at: (isize, isize),
+    size: (usize, usize),
+    dst: &mut [f64],
+    widen: fn(T) -> f64,
+) -> gdal::errors::Result<()> {
+    let mut native = vec![T::default(); dst.len()];
+    rb.read_into_slice::<T>(at, size, size, &mut native, None)?;
+    for (d, &n) in dst.iter_mut().zip(&native) {
+        *d = widen(n);
+    }
+    Ok(())
+}
+
 /// An open dataset with a checked band and everything known before reading samples.
 pub(crate) struct OpenBand {
     dataset: Dataset,
@@ -253,14 +269,21 @@ impl OpenBand {
         size: (usize, usize),
         dst: &mut [f64],
     ) -> Result<()> {
-        rb.read_into_slice::<f64>(
-            (origin.0 as isize, origin.1 as isize),
-            size,
-            size,
-            dst,
-            None,
-        )
-        .map_err(|e| self.read_error(e))?;
+        let at = (origin.0 as isize, origin.1 as isize);
+        // Read as the band's own type, then widened: GDAL computes some bands (a VRT that
+        // scales its source) for the buffer's type, so an f64 read can give other values
+        // than every reader of the band's type (gdal_translate, rasterio) sees.
+        let read = match self.info.data_type.as_str() {
+            "Byte" => read_widened::<u8>(rb, at, size, dst, f64::from),
+            "UInt16" => read_widened::<u16>(rb, at, size, dst, f64::from),
+            "Int16" => read_widened::<i16>(rb, at, size, dst, f64::from),
+            "UInt32" => read_widened::<u32>(rb, at, size, dst, f64::from),
+            "Int32" => read_widened::<i32>(rb, at, size, dst, f64::from),
+            "Float32" => read_widened::<f32>(rb, at, size, dst, f64::from),
+            // Float64, and 64-bit integers (beyond 2^53 they lose precision either way).
+            _ => rb.read_into_slice::<f64>(at, size, size, dst, None),
+        };
+        read.map_err(|e| self.read_error(e))?;
         for v in dst.iter_mut() {
             *v = self.decoder.decode(*v);
         }

@@ -100,3 +100,119 @@ fn serves_tiles_with_content_type_encoding_and_cors() {
         std::thread::sleep(Duration::from_millis(20));
     }
 }
+
+/// A server that is killed when the test ends, passed or not (a failed assertion must not
+/// leave it waiting for requests, holding the test's output open).
+struct Server(std::process::Child);
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// Starts `tinsmith serve DIR` in `dir` for `requests` requests; returns it and its port.
+fn start(dir: &Dir, served: &str, requests: u32) -> (Server, u16) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+        .args(["serve", served, "--port", "0", "--max-requests"])
+        .arg(requests.to_string())
+        .current_dir(dir.tmp.path())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let port = line
+        .trim()
+        .rsplit(':')
+        .next()
+        .unwrap()
+        .trim_end_matches('/')
+        .parse()
+        .unwrap_or_else(|_| panic!("no port in {line:?}"));
+    (Server(child), port)
+}
+
+/// Sends `raw` bytes as the request; returns the whole response.
+fn raw_request(port: u16, raw: &[u8]) -> Vec<u8> {
+    let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+    s.write_all(raw).unwrap();
+    let mut out = Vec::new();
+    s.read_to_end(&mut out).unwrap();
+    out
+}
+
+#[test]
+fn only_real_gzip_is_sent_as_gzip_and_odd_requests_get_answers() {
+    let dir = Dir::new();
+    let input = fixture("tintn_valid_raster_3857.tif");
+    let o = dir.run(&[
+        "tiles",
+        &input,
+        "-o",
+        "raw",
+        "--max-zoom",
+        "12",
+        "--no-gzip",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // An uncompressed tile starts with its centre's x as a little-endian f64, whose low
+    // bytes can be gzip's magic 1f 8b (about one tile in 65,536). Such a tile (here made
+    // by moving the centre by a hair) must not be sent with Content-Encoding: gzip.
+    let tile = "/12/1308/2906.terrain";
+    let path = dir.path(&format!("raw{tile}"));
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes[..3].copy_from_slice(&[0x1f, 0x8b, 0x08]);
+    bytes[3] = 0;
+    std::fs::write(&path, &bytes).unwrap();
+
+    let (mut child, port) = start(&dir, "raw", 6);
+    let (status, headers, body) = get(port, "GET", tile);
+    assert_eq!(status, "HTTP/1.1 200 OK");
+    assert_eq!(header(&headers, "content-encoding"), None);
+    assert_eq!(body, bytes);
+    // HEAD: the length, no body.
+    let (status, headers, body) = get(port, "HEAD", tile);
+    assert_eq!(status, "HTTP/1.1 200 OK");
+    assert_eq!(
+        header(&headers, "content-length"),
+        Some(bytes.len().to_string().as_str())
+    );
+    assert!(body.is_empty());
+    // 405 sends the body it announces, and which methods are allowed.
+    let (status, headers, body) = get(port, "POST", tile);
+    assert!(status.contains("405"), "{status}");
+    assert_eq!(header(&headers, "allow"), Some("GET, HEAD, OPTIONS"));
+    assert_eq!(
+        header(&headers, "content-length"),
+        Some(body.len().to_string().as_str())
+    );
+    // A header value that is not UTF-8, and a target in absolute form, are served.
+    let answer = raw_request(
+        port,
+        b"GET /layer.json HTTP/1.1\r\nHost: localhost\r\nX-Name: caf\xe9\r\n\r\n",
+    );
+    assert!(
+        answer.starts_with(b"HTTP/1.1 200 OK"),
+        "{:?}",
+        String::from_utf8_lossy(&answer)
+    );
+    let answer = raw_request(
+        port,
+        format!("GET http://127.0.0.1:{port}/layer.json HTTP/1.1\r\n\r\n").as_bytes(),
+    );
+    assert!(
+        answer.starts_with(b"HTTP/1.1 200 OK"),
+        "{:?}",
+        String::from_utf8_lossy(&answer)
+    );
+    // A 204 carries no Content-Length.
+    let (status, headers, _) = get(port, "OPTIONS", tile);
+    assert!(status.contains("204"), "{status}");
+    assert_eq!(header(&headers, "content-length"), None);
+    assert!(child.0.wait().unwrap().success());
+}

@@ -6,33 +6,77 @@
 //! no dependency to keep up to date. Not meant to face a network (see docs/serving.md for
 //! nginx and Apache).
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::fs::File;
+use std::io::{BufReader, ErrorKind, Read, Write};
 use std::net::{Ipv4Addr, TcpListener, TcpStream};
 use std::path::{Component, Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 
 use crate::args::ServeArgs;
 
 /// The longest request head read.
 const MAX_HEAD: usize = 16 * 1024;
+/// The time a client has to send its whole request head.
+const HEAD_DEADLINE: Duration = Duration::from_secs(10);
+/// The time one write of the response may stall (a client that stops reading).
+const WRITE_TIMEOUT: Duration = Duration::from_secs(30);
+/// Connections served at once; more are closed at once (a local viewer opens a few).
+const MAX_CONNECTIONS: usize = 256;
+/// Gzip files up to this size are checked whole before being sent as gzip (tiles are a
+/// few kB); larger ones by their header.
+const GZIP_CHECK_BYTES: u64 = 16 << 20;
 
 pub fn run(args: &ServeArgs) -> Result<bool> {
+    if !args.dir.exists() {
+        bail!("{}: no such directory", args.dir.display());
+    }
     anyhow::ensure!(args.dir.is_dir(), "{}: not a directory", args.dir.display());
+    let has_layer = |dir: &Path| dir.join("layer.json").is_file();
+    let pyramid_below = std::fs::read_dir(&args.dir).is_ok_and(|entries| {
+        entries
+            .flatten()
+            .any(|e| e.path().is_dir() && has_layer(&e.path()))
+    });
+    if !has_layer(&args.dir) && !pyramid_below {
+        note!(
+            "{}: note: no layer.json here, so CesiumJS will not load it as a terrain \
+             pyramid (serve the directory `tinsmith tiles -o` made)",
+            args.dir.display()
+        );
+    }
     let listener = TcpListener::bind((Ipv4Addr::LOCALHOST, args.port))
         .with_context(|| format!("cannot listen on 127.0.0.1:{}", args.port))?;
     let addr = listener.local_addr()?;
-    println!("serving {} at http://{addr}/", args.dir.display());
-    std::io::stdout().flush()?;
+    // A closed stdout only loses the announcement; the server still serves.
+    let mut stdout = std::io::stdout();
+    let _ = writeln!(stdout, "serving {} at http://{addr}/", args.dir.display());
+    let _ = stdout.flush();
+    let open = Arc::new(AtomicUsize::new(0));
     let mut handlers = Vec::new();
     for (served, stream) in listener.incoming().enumerate() {
         let Ok(stream) = stream else { continue };
-        let root = args.dir.clone();
-        handlers.push(std::thread::spawn(move || {
-            // A failed connection only concerns its client.
-            let _ = handle(stream, &root);
-        }));
-        handlers.retain(|h| !h.is_finished());
+        handlers.retain(|h: &std::thread::JoinHandle<()>| !h.is_finished());
+        // Over the cap (or when no thread can be started) the connection is closed
+        // unanswered: it only concerns its client.
+        if open.load(Ordering::Acquire) < MAX_CONNECTIONS {
+            open.fetch_add(1, Ordering::AcqRel);
+            let root = args.dir.clone();
+            let count = Arc::clone(&open);
+            let spawned = std::thread::Builder::new().spawn(move || {
+                let _ = handle(stream, &root);
+                count.fetch_sub(1, Ordering::AcqRel);
+            });
+            match spawned {
+                Ok(handler) => handlers.push(handler),
+                Err(_) => {
+                    open.fetch_sub(1, Ordering::AcqRel);
+                }
+            }
+        }
         if args
             .max_requests
             .is_some_and(|max| served as u64 + 1 >= max)
@@ -52,56 +96,94 @@ struct Head {
     headers: Vec<(&'static str, String)>,
 }
 
+/// What follows a response's head.
+enum Body {
+    /// No body, and no `Content-Length` (204).
+    Nothing,
+    /// A short text.
+    Text(&'static str),
+    /// A file, streamed, of this length.
+    File(File, u64),
+}
+
 fn handle(stream: TcpStream, root: &Path) -> std::io::Result<()> {
-    stream.set_read_timeout(Some(std::time::Duration::from_secs(10)))?;
-    let mut reader = BufReader::new(stream.try_clone()?);
-    let mut request_line = String::new();
-    reader
-        .by_ref()
-        .take(MAX_HEAD as u64)
-        .read_line(&mut request_line)?;
-    // Skip the rest of the head.
-    let mut read = request_line.len();
-    loop {
-        let mut line = String::new();
-        let n = reader.by_ref().take(MAX_HEAD as u64).read_line(&mut line)?;
-        read += n;
-        if n == 0 || line == "\r\n" || line == "\n" || read > MAX_HEAD {
-            break;
-        }
-    }
+    let Some(request_line) = read_head(&stream)? else {
+        return Ok(());
+    };
+    let request_line = String::from_utf8_lossy(&request_line);
     let mut parts = request_line.split_whitespace();
     let (method, target) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
     let (head, body) = respond(method, target, root);
-    let mut out = std::io::BufWriter::new(stream);
+    stream.set_write_timeout(Some(WRITE_TIMEOUT))?;
+    let mut out = std::io::BufWriter::new(&stream);
     write!(out, "HTTP/1.1 {}\r\n", head.status)?;
     for (name, value) in &head.headers {
         write!(out, "{name}: {value}\r\n")?;
     }
-    let length = body.as_ref().map_or(0, |b| b.len());
+    match &body {
+        Body::Nothing => {}
+        Body::Text(text) => write!(out, "Content-Length: {}\r\n", text.len())?,
+        Body::File(_, length) => write!(out, "Content-Length: {length}\r\n")?,
+    }
     write!(
         out,
-        "Content-Length: {length}\r\nConnection: close\r\n\
+        "Connection: close\r\n\
          Access-Control-Allow-Origin: *\r\n\
          Access-Control-Allow-Methods: GET, HEAD, OPTIONS\r\n\
          Access-Control-Allow-Headers: *\r\n\r\n"
     )?;
-    if method == "GET" {
-        if let Some(body) = body {
-            out.write_all(&body)?;
+    if method != "HEAD" {
+        match body {
+            Body::Nothing => {}
+            Body::Text(text) => out.write_all(text.as_bytes())?,
+            Body::File(file, _) => {
+                std::io::copy(&mut BufReader::new(file), &mut out)?;
+            }
         }
     }
     out.flush()
 }
 
-fn respond(method: &str, target: &str, root: &Path) -> (Head, Option<Vec<u8>>) {
-    let plain = |status, text: &str| {
+/// Reads the request head within [`HEAD_DEADLINE`] and [`MAX_HEAD`] bytes (as bytes: a
+/// header may hold any octet); returns its first line, or `None` when the client sent
+/// none in time.
+fn read_head(mut stream: &TcpStream) -> std::io::Result<Option<Vec<u8>>> {
+    let deadline = Instant::now() + HEAD_DEADLINE;
+    let mut head: Vec<u8> = Vec::new();
+    let mut chunk = [0u8; 4096];
+    loop {
+        let left = deadline.saturating_duration_since(Instant::now());
+        if left.is_zero() {
+            break;
+        }
+        stream.set_read_timeout(Some(left))?;
+        let n = match stream.read(&mut chunk) {
+            Ok(n) => n,
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => break,
+            Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        head.extend_from_slice(&chunk[..n]);
+        let text = head.trim_ascii_start();
+        let ended =
+            text.windows(4).any(|w| w == b"\r\n\r\n") || text.windows(2).any(|w| w == b"\n\n");
+        if n == 0 || ended || head.len() >= MAX_HEAD {
+            break;
+        }
+    }
+    let text = head.trim_ascii_start();
+    let first = text.split(|&b| b == b'\n').next().unwrap_or(&[]);
+    Ok((!first.is_empty()).then(|| first.to_vec()))
+}
+
+fn respond(method: &str, target: &str, root: &Path) -> (Head, Body) {
+    let plain = |status, text: &'static str| {
         (
             Head {
                 status,
                 headers: vec![("Content-Type", "text/plain; charset=utf-8".into())],
             },
-            Some(text.as_bytes().to_vec()),
+            Body::Text(text),
         )
     };
     match method {
@@ -112,10 +194,15 @@ fn respond(method: &str, target: &str, root: &Path) -> (Head, Option<Vec<u8>>) {
                     status: "204 No Content",
                     headers: vec![],
                 },
-                None,
+                Body::Nothing,
             )
         }
-        _ => return plain("405 Method Not Allowed", "method not allowed\n"),
+        "" => return plain("400 Bad Request", "bad request\n"),
+        _ => {
+            let (mut head, body) = plain("405 Method Not Allowed", "method not allowed\n");
+            head.headers.push(("Allow", "GET, HEAD, OPTIONS".into()));
+            return (head, body);
+        }
     }
     let Some(path) = file_path(root, target) else {
         return plain("400 Bad Request", "bad path\n");
@@ -125,29 +212,61 @@ fn respond(method: &str, target: &str, root: &Path) -> (Head, Option<Vec<u8>>) {
     } else {
         path
     };
-    let Ok(bytes) = std::fs::read(&path) else {
+    // Regular files only (following links): a FIFO would block the thread for good.
+    let file = match std::fs::metadata(&path) {
+        Ok(m) if m.is_file() => File::open(&path).ok().map(|f| (f, m.len())),
+        _ => None,
+    };
+    let Some((file, length)) = file else {
         return plain("404 Not Found", "not found\n");
     };
     let mut headers = vec![("Content-Type", content_type(&path).to_string())];
-    if bytes.starts_with(&[0x1f, 0x8b]) && !has_extension(&path, "gz") {
+    if !has_extension(&path, "gz") && is_gzip(&path, length) {
         headers.push(("Content-Encoding", "gzip".into()));
-    }
-    if has_extension(&path, "terrain") {
-        headers.push(("Vary", "Accept".into()));
     }
     (
         Head {
             status: "200 OK",
             headers,
         },
-        Some(bytes),
+        Body::File(file, length),
     )
+}
+
+/// Whether the file is gzip: its header names deflate with no reserved flags, and (up to
+/// [`GZIP_CHECK_BYTES`]) the whole member decompresses with a matching checksum. An
+/// uncompressed tile (`tiles --no-gzip`) begins with an `f64` whose low bytes are
+/// arbitrary and can match gzip's two magic bytes; it must not be sent as gzip.
+fn is_gzip(path: &Path, length: u64) -> bool {
+    let Ok(mut file) = File::open(path) else {
+        return false;
+    };
+    let mut header = [0u8; 4];
+    if file.read_exact(&mut header).is_err()
+        || header[..3] != [0x1f, 0x8b, 0x08]
+        || header[3] & 0xe0 != 0
+    {
+        return false;
+    }
+    if length > GZIP_CHECK_BYTES {
+        return true;
+    }
+    let Ok(file) = File::open(path) else {
+        return false;
+    };
+    let mut decoder = flate2::read::GzDecoder::new(file);
+    std::io::copy(&mut decoder, &mut std::io::sink()).is_ok()
 }
 
 /// The file a request target names under `root`: query dropped, `%XX` decoded, and
 /// refused when it would leave `root` (`..`, absolute parts).
 fn file_path(root: &Path, target: &str) -> Option<PathBuf> {
     let path = target.split(['?', '#']).next()?;
+    // The absolute form (`http://host:port/path`), which servers must accept.
+    let path = match path.split_once("://") {
+        Some((scheme, rest)) if scheme.eq_ignore_ascii_case("http") => &rest[rest.find('/')?..],
+        _ => path,
+    };
     let path = path.strip_prefix('/')?;
     let decoded = percent_decode(path)?;
     let relative = Path::new(&decoded);
@@ -222,5 +341,10 @@ mod tests {
         assert_eq!(file_path(root, "/../etc/passwd"), None);
         assert_eq!(file_path(root, "/%2e%2e/etc/passwd"), None);
         assert_eq!(file_path(root, "relative"), None);
+        assert_eq!(
+            file_path(root, "http://127.0.0.1:8000/layer.json"),
+            Some(PathBuf::from("/srv/t/layer.json"))
+        );
+        assert_eq!(file_path(root, "http://127.0.0.1:8000"), None);
     }
 }

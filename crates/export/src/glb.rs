@@ -220,9 +220,10 @@ fn u32_at(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])
 }
 
-/// Reads a GLB file: every node with a mesh (translation only; no rotation, scale or
-/// matrix), every triangle primitive, positions mapped back to world axes through the
-/// node's translation. Vertices of several primitives are concatenated.
+/// Reads a GLB file: the meshes of the default scene's nodes (translations only, through
+/// parent nodes; an identity rotation, scale or matrix is allowed), every triangle
+/// primitive, positions mapped back to world axes through the translations. Vertices of
+/// several primitives are concatenated.
 pub(crate) fn read<R: Read>(mut r: R, file_len: Option<u64>) -> Result<Mesh, Problem> {
     let mut header = [0u8; 20];
     r.read_exact(&mut header).map_err(|error| match file_len {
@@ -292,14 +293,59 @@ fn usize_of(value: &Value, what: &str) -> Result<usize, Problem> {
         .ok_or_else(|| Problem::malformed(format_args!("{what} is not a non-negative integer")))
 }
 
+/// Node `n`'s translation. A rotation, scale or matrix is refused unless it is the
+/// identity (a matrix may translate): tinsmith meshes are placed by translation alone.
+fn translation_of(node: &Value, n: usize) -> Result<[f64; 3], Problem> {
+    let numbers = |key: &str, len: usize| -> Result<Option<Vec<f64>>, Problem> {
+        let Some(values) = node[key].as_array() else {
+            return match node[key] {
+                Value::Null => Ok(None),
+                _ => Err(Problem::malformed(format_args!("node {n}: bad {key}"))),
+            };
+        };
+        let numbers: Option<Vec<f64>> = values
+            .iter()
+            .map(|v| v.as_f64().filter(|c| c.is_finite()))
+            .collect();
+        match numbers {
+            Some(numbers) if numbers.len() == len => Ok(Some(numbers)),
+            _ => Err(Problem::malformed(format_args!("node {n}: bad {key}"))),
+        }
+    };
+    let refuse = |key: &str| {
+        Problem::unsupported(format_args!(
+            "node {n} has a {key} other than the identity; only translations are read"
+        ))
+    };
+    if numbers("rotation", 4)?.is_some_and(|q| q[..3] != [0.0; 3] || q[3].abs() != 1.0) {
+        return Err(refuse("rotation"));
+    }
+    if numbers("scale", 3)?.is_some_and(|s| s != [1.0; 3]) {
+        return Err(refuse("scale"));
+    }
+    let mut t = numbers("translation", 3)?.map_or([0.0; 3], |t| [t[0], t[1], t[2]]);
+    if let Some(m) = numbers("matrix", 16)? {
+        // Column-major: the identity in the first three columns, the translation in the
+        // fourth.
+        let linear = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+        if m[..12] != linear || m[15] != 1.0 {
+            return Err(refuse("matrix"));
+        }
+        t = [0, 1, 2].map(|k| t[k] + m[12 + k]);
+    }
+    Ok(t)
+}
+
 impl Gltf<'_> {
+    /// The meshes of the default scene's nodes (or, without scenes, of every node no
+    /// other node has as a child), each moved by its own and its ancestors' translations.
     fn mesh(&self) -> Result<Mesh, Problem> {
         let mut mesh = Mesh::default();
         let nodes = self.root["nodes"]
             .as_array()
             .map(Vec::as_slice)
             .unwrap_or(&[]);
-        for (n, node) in nodes.iter().enumerate() {
+        for node in nodes {
             if let Some(extras) = node["extras"].as_object() {
                 if mesh.crs_wkt.is_none() {
                     mesh.crs_wkt = extras
@@ -314,35 +360,73 @@ impl Gltf<'_> {
                         .and_then(|e| u32::try_from(e).ok());
                 }
             }
-            if node["mesh"].is_null() {
-                continue;
+        }
+        let roots: Vec<usize> = match self.root["scenes"].as_array() {
+            Some(scenes) if !scenes.is_empty() => {
+                let scene = match &self.root["scene"] {
+                    Value::Null => 0,
+                    index => usize_of(index, "the scene")?,
+                };
+                let scene = scenes
+                    .get(scene)
+                    .ok_or_else(|| Problem::malformed(format_args!("no scene {scene}")))?;
+                scene["nodes"]
+                    .as_array()
+                    .map(Vec::as_slice)
+                    .unwrap_or(&[])
+                    .iter()
+                    .map(|n| usize_of(n, "a scene's node"))
+                    .collect::<Result<_, _>>()?
             }
-            for key in ["rotation", "scale", "matrix"] {
-                if !node[key].is_null() {
-                    return Err(Problem::unsupported(format_args!(
-                        "node {n} has a {key}; only translations are read"
-                    )));
+            _ => {
+                let mut child = vec![false; nodes.len()];
+                for node in nodes {
+                    for c in node["children"]
+                        .as_array()
+                        .map(Vec::as_slice)
+                        .unwrap_or(&[])
+                    {
+                        if let Some(flag) = c.as_u64().and_then(|c| child.get_mut(c as usize)) {
+                            *flag = true;
+                        }
+                    }
+                }
+                (0..nodes.len()).filter(|&n| !child[n]).collect()
+            }
+        };
+        // Depth first; a node met twice (a cycle, or a node used twice) is refused.
+        let mut seen = vec![false; nodes.len()];
+        let mut stack: Vec<(usize, [f64; 3])> =
+            roots.into_iter().rev().map(|n| (n, [0.0; 3])).collect();
+        while let Some((n, parent)) = stack.pop() {
+            let node = nodes
+                .get(n)
+                .ok_or_else(|| Problem::malformed(format_args!("no node {n}")))?;
+            if std::mem::replace(&mut seen[n], true) {
+                return Err(Problem::unsupported(format_args!(
+                    "node {n} is reached twice; each node is read once"
+                )));
+            }
+            let own = translation_of(node, n)?;
+            let t = [0, 1, 2].map(|k| parent[k] + own[k]);
+            if !node["mesh"].is_null() {
+                let m = usize_of(&node["mesh"], "a node's mesh")?;
+                let primitives =
+                    self.root["meshes"][m]["primitives"]
+                        .as_array()
+                        .ok_or_else(|| {
+                            Problem::malformed(format_args!("mesh {m} has no primitives"))
+                        })?;
+                for primitive in primitives {
+                    self.primitive(primitive, t, &mut mesh)?;
                 }
             }
-            let mut t = [0.0f64; 3];
-            if let Some(values) = node["translation"].as_array() {
-                if values.len() != 3 {
-                    return Err(Problem::malformed(format_args!(
-                        "node {n}: bad translation"
-                    )));
-                }
-                for (c, v) in t.iter_mut().zip(values) {
-                    *c = v.as_f64().filter(|c| c.is_finite()).ok_or_else(|| {
-                        Problem::malformed(format_args!("node {n}: bad translation"))
-                    })?;
-                }
-            }
-            let m = usize_of(&node["mesh"], "a node's mesh")?;
-            let primitives = self.root["meshes"][m]["primitives"]
+            let children = node["children"]
                 .as_array()
-                .ok_or_else(|| Problem::malformed(format_args!("mesh {m} has no primitives")))?;
-            for primitive in primitives {
-                self.primitive(primitive, t, &mut mesh)?;
+                .map(Vec::as_slice)
+                .unwrap_or(&[]);
+            for c in children.iter().rev() {
+                stack.push((usize_of(c, "a node's child")?, t));
             }
         }
         Ok(mesh)
@@ -520,6 +604,85 @@ mod tests {
             assert!((length - 1.0).abs() < 1e-6);
             assert!(n[2] > 0.9, "{n:?}");
         }
+    }
+
+    /// The JSON and BIN chunks of a GLB.
+    fn unpack(bytes: &[u8]) -> (Value, Vec<u8>) {
+        let json_len = u32_at(bytes, 12) as usize;
+        let root = serde_json::from_slice(&bytes[20..20 + json_len]).expect("JSON");
+        let bin_at = 20 + json_len;
+        let bin_len = u32_at(bytes, bin_at) as usize;
+        (root, bytes[bin_at + 8..bin_at + 8 + bin_len].to_vec())
+    }
+
+    /// A GLB of `root` and `bin`.
+    fn pack(root: &Value, bin: &[u8]) -> Vec<u8> {
+        let mut json = serde_json::to_vec(root).expect("JSON");
+        while json.len() % 4 != 0 {
+            json.push(b' ');
+        }
+        let total = 12 + 8 + json.len() + 8 + bin.len();
+        let mut out = Vec::new();
+        for word in [MAGIC, 2, total as u32, json.len() as u32, CHUNK_JSON] {
+            out.extend_from_slice(&word.to_le_bytes());
+        }
+        out.extend_from_slice(&json);
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
+        out.extend_from_slice(bin);
+        out
+    }
+
+    #[test]
+    fn translations_through_parents_and_identity_transforms_are_read() -> Result<(), Problem> {
+        let origin = LocalOrigin::of_points(&VERTICES);
+        let bytes = write_to_vec(MeshRef::new(&VERTICES, &TRIANGLES), origin, false);
+        let expected = read(bytes.as_slice(), None)?;
+        let (root, bin) = unpack(&bytes);
+        let node = root["nodes"][0].clone();
+        let t = node["translation"].clone();
+        let half = |k: usize| t[k].as_f64().unwrap() / 2.0;
+        let mut child = node.clone();
+        child.as_object_mut().unwrap().remove("translation");
+        child["scale"] = json!([1.0, 1.0, 1.0]);
+        child["rotation"] = json!([0.0, 0.0, 0.0, 1.0]);
+        child["matrix"] = json!([
+            1.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            1.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            1.0,
+            0.0,
+            half(0),
+            half(1),
+            half(2),
+            1.0
+        ]);
+        let parent = json!({ "children": [1], "translation": [half(0), half(1), half(2)] });
+        // Node 2 uses the mesh too but is in no scene: not read.
+        let mut moved = root.clone();
+        moved["nodes"] = json!([parent, child, node]);
+        moved["scenes"] = json!([{ "nodes": [0] }]);
+        let back = read(pack(&moved, &bin).as_slice(), None)?;
+        assert_eq!(back.vertices, expected.vertices);
+        assert_eq!(back.triangles, expected.triangles);
+        // A real scale, or a node reached twice, is refused.
+        let mut scaled = moved.clone();
+        scaled["nodes"][1]["scale"] = json!([2.0, 1.0, 1.0]);
+        assert!(matches!(
+            read(pack(&scaled, &bin).as_slice(), None),
+            Err(Problem::Unsupported(reason)) if reason.contains("scale")
+        ));
+        let mut cycle = moved.clone();
+        cycle["nodes"][1]["children"] = json!([0]);
+        assert!(read(pack(&cycle, &bin).as_slice(), None).is_err());
+        Ok(())
     }
 
     #[test]

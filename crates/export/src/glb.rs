@@ -618,7 +618,7 @@ mod tests {
     /// A GLB of `root` and `bin`.
     fn pack(root: &Value, bin: &[u8]) -> Vec<u8> {
         let mut json = serde_json::to_vec(root).expect("JSON");
-        while json.len() % 4 != 0 {
+        while !json.len().is_multiple_of(4) {
             json.push(b' ');
         }
         let total = 12 + 8 + json.len() + 8 + bin.len();

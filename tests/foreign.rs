@@ -167,7 +167,7 @@ fn gis_rewrites_of_a_geojson_mesh_verify_and_contour() {
             ],
         );
     }
-    // A PLY wound the other way round is not the same mesh (its faces point down), and
+    // An OBJ wound the other way round is not the same mesh (its faces point down), and
     // the message says so.
     passes(
         &d,
@@ -242,4 +242,68 @@ fn contour_takes_heights_rounded_to_six_decimals_as_the_samples() {
     assert!(
         std::fs::read(d.path("a.geojson")).unwrap() == std::fs::read(d.path("b.geojson")).unwrap()
     );
+}
+
+#[test]
+fn a_global_mesh_wound_clockwise_verifies_across_the_seam() {
+    // A 1° WGS84 grid whose first and last columns are the same meridian (-180 and 180):
+    // placing triangles around the seam relied on their counter-clockwise winding, so a
+    // shapefile round trip (clockwise rings, WGS84 as WKT alone) failed to verify.
+    let d = Dir::new();
+    let mut asc =
+        String::from("ncols 361\nnrows 181\nxllcorner -180.5\nyllcorner -90.5\ncellsize 1\n");
+    for row in 0..181 {
+        let lat = f64::from(90 - row);
+        let line: Vec<String> = (0..361)
+            .map(|col| {
+                let lon = f64::from(col - 180);
+                let z = 1000.0 * lon.to_radians().sin() * lat.to_radians().cos()
+                    + 200.0 * (3.0 * lat).to_radians().cos();
+                format!("{z:.3}")
+            })
+            .collect();
+        asc.push_str(&line.join(" "));
+        asc.push('\n');
+    }
+    d.write("g.asc", &asc);
+    d.write(
+        "g.prj",
+        "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]",
+    );
+    passes(
+        &d,
+        &[
+            "mesh",
+            "g.asc",
+            "-o",
+            "g.geojson",
+            "--max-error",
+            "50",
+            "-q",
+        ],
+    );
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path("g.geojson")).unwrap()).unwrap();
+    for feature in json["features"].as_array_mut().unwrap() {
+        let geometry = &mut feature["geometry"];
+        let polygons = match geometry["type"].as_str().unwrap() {
+            "Polygon" => vec![&mut geometry["coordinates"]],
+            _ => geometry["coordinates"]
+                .as_array_mut()
+                .unwrap()
+                .iter_mut()
+                .collect(),
+        };
+        for polygon in polygons {
+            for ring in polygon.as_array_mut().unwrap() {
+                ring.as_array_mut().unwrap().reverse();
+            }
+        }
+    }
+    d.write("cw.geojson", &json.to_string());
+    ogr2ogr(&d, &["-f", "ESRI Shapefile", "shp", "g.geojson"]);
+    ogr2ogr(&d, &["-f", "FlatGeobuf", "shp.fgb", "shp/g.shp"]);
+    for mesh in ["g.geojson", "cw.geojson", "shp.fgb"] {
+        passes(&d, &["verify", "g.asc", mesh, "--max-error", "50"]);
+    }
 }

@@ -331,7 +331,12 @@ fn a_scaling_vrt_is_read_as_its_band_type_holds_it() {
     // hold the band's values: verified at 0 against GDAL's own GeoTIFF copy of the VRT.
     let d = Dir::new();
     let input = fixture("becmodel_dem_bc_albers_50m.tif");
-    for (ty, scale_to) in [("Int16", "1000.7"), ("Float32", "1000.7")] {
+    for (ty, scale_to) in [
+        ("Int16", "1000.7"),
+        ("UInt32", "70000.3"),
+        ("Int64", "70000.3"),
+        ("Float32", "1000.7"),
+    ] {
         let vrt = format!("{ty}.vrt");
         let tif = format!("{ty}.tif");
         let scaling = [

@@ -63,6 +63,17 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
 /// are moved by whole turns into the raster's own range (0..360 for many global grids).
 pub fn read_mesh_file(path: &Path, raster: &Raster, georef: Georef) -> Result<Mesh> {
     let mut mesh = tinsmith_export::read_mesh(path)?;
+    let polygons = is_polygon_format(path);
+    // A GIS rewrite may keep WGS84 as WKT alone (a shapefile's GCS_WGS_1984).
+    if polygons
+        && mesh.epsg.is_none()
+        && mesh
+            .crs_wkt
+            .as_deref()
+            .is_some_and(tinsmith_raster::is_wgs84_lon_lat)
+    {
+        mesh.epsg = Some(4326);
+    }
     if let (Some(4326), Georef::World(transform), Some(wkt)) =
         (mesh.epsg, georef, raster.info.crs_wkt.as_deref())
     {
@@ -75,6 +86,11 @@ pub fn read_mesh_file(path: &Path, raster: &Raster, georef: Georef) -> Result<Me
             })?;
         }
         if tinsmith_raster::is_geographic(wkt)? {
+            if polygons {
+                // Placing triangles around the raster's seam needs them counter-clockwise
+                // in longitude, latitude, as tinsmith writes them.
+                counter_clockwise_in_lon_lat(&mut mesh);
+            }
             into_raster_frame(&mut mesh, raster, transform);
         }
     }
@@ -156,6 +172,37 @@ fn into_raster_frame(mesh: &mut Mesh, raster: &Raster, transform: tinsmith_core:
     mesh.vertices = vertices;
 }
 
+/// Whether `path` is GeoJSON or FlatGeobuf: triangles stored as polygons, whose winding
+/// says nothing (see [`orient_polygon_triangles`]).
+fn is_polygon_format(path: &Path) -> bool {
+    matches!(
+        tinsmith_export::MeshFormat::from_path(path),
+        Ok(tinsmith_export::MeshFormat::GeoJson | tinsmith_export::MeshFormat::FlatGeobuf)
+    )
+}
+
+/// Reverses every triangle when most are clockwise in longitude, latitude as written (a
+/// file wound the other way round, as shapefiles wind polygons). Triangle by triangle the
+/// winding cannot be told near the raster's seam or a pole, where a triangle may span
+/// more than half a turn; across the file it can.
+fn counter_clockwise_in_lon_lat(mesh: &mut Mesh) {
+    let (mut cw, mut ccw) = (0usize, 0usize);
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|v| mesh.vertices[v as usize]);
+        let area_x2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        if area_x2 < 0.0 {
+            cw += 1;
+        } else if area_x2 > 0.0 {
+            ccw += 1;
+        }
+    }
+    if cw > ccw {
+        for t in &mut mesh.triangles {
+            t.swap(1, 2);
+        }
+    }
+}
+
 /// Turns each triangle of a GeoJSON or FlatGeobuf mesh (`positions` on the grid) to
 /// `orientation`: those formats hold triangles as polygons, whose winding says nothing
 /// (RFC 7946 asks readers not to reject rings against its right-hand rule; shapefiles wind
@@ -167,10 +214,7 @@ pub fn orient_polygon_triangles(
     triangles: &mut [[u32; 3]],
     orientation: Orientation,
 ) {
-    if !matches!(
-        tinsmith_export::MeshFormat::from_path(path),
-        Ok(tinsmith_export::MeshFormat::GeoJson | tinsmith_export::MeshFormat::FlatGeobuf)
-    ) {
+    if !is_polygon_format(path) {
         return;
     }
     let wanted = match orientation {

@@ -15,7 +15,7 @@ const FLIP_GAIN: f64 = 0.9;
 /// One pass over the interior edges in triangle slot order: flips an edge into the other
 /// diagonal of its strictly convex quadrilateral when both new triangles' exact errors are
 /// within the limit, within the longest edge allowed, and below [`FLIP_GAIN`] times the
-/// larger bound of the two old triangles (never where it is 0). Each triangle flips at most
+/// larger bound of the two old triangles (never where it is 0 or subnormal). Each triangle flips at most
 /// once per pass. The largest bound never grows, and every flip lowers the larger of its
 /// two, so rounds come to an end. Returns the number of flips.
 pub(crate) fn flip_for_error(mesh: &mut Mesh<'_>, rules: &Rules<'_>) -> usize {
@@ -33,8 +33,10 @@ pub(crate) fn flip_for_error(mesh: &mut Mesh<'_>, rules: &Rules<'_>) -> usize {
             }
             let points = quad.map(|v| mesh.point(v));
             let old = mesh.bound(t).max().max(mesh.bound(u).max());
-            if old <= 0.0 {
-                continue; // nothing to gain; flipping would only undo itself next round
+            if old < f64::MIN_POSITIVE {
+                // Nothing to gain at 0, and below the normal range 0.9 x old can round
+                // back to old: flipping would only undo itself next round.
+                continue;
             }
             if !flip_within(
                 mesh,

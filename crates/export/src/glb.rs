@@ -391,7 +391,13 @@ impl Gltf<'_> {
                         }
                     }
                 }
-                (0..nodes.len()).filter(|&n| !child[n]).collect()
+                let roots: Vec<usize> = (0..nodes.len()).filter(|&n| !child[n]).collect();
+                if roots.is_empty() && !nodes.is_empty() {
+                    return Err(Problem::malformed(
+                        "every node is another's child (a cycle), so no node is a root",
+                    ));
+                }
+                roots
             }
         };
         // Depth first; a node met twice (a cycle, or a node used twice) is refused.
@@ -681,6 +687,11 @@ mod tests {
         ));
         let mut cycle = moved.clone();
         cycle["nodes"][1]["children"] = json!([0]);
+        assert!(read(pack(&cycle, &bin).as_slice(), None).is_err());
+        // Without scenes the roots are the nodes no node has as a child: none in a cycle.
+        cycle.as_object_mut().unwrap().remove("scenes");
+        let two = json!([cycle["nodes"][0].clone(), cycle["nodes"][1].clone()]);
+        cycle["nodes"] = two;
         assert!(read(pack(&cycle, &bin).as_slice(), None).is_err());
         Ok(())
     }

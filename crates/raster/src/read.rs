@@ -125,6 +125,8 @@ pub(crate) struct OpenBand {
     /// Metadata; the statistics are still zero.
     pub(crate) info: RasterInfo,
     decoder: SampleDecoder,
+    /// GDAL's name of the band's type (`Byte` for a signed Byte band too), read as such.
+    gdal_type: String,
     pub(crate) mask_source: Option<MaskSource>,
 }
 
@@ -242,6 +244,7 @@ impl OpenBand {
             dataset,
             info,
             decoder,
+            gdal_type,
             mask_source,
         })
     }
@@ -273,14 +276,17 @@ impl OpenBand {
         // Read as the band's own type, then widened: GDAL computes some bands (a VRT that
         // scales its source) for the buffer's type, so an f64 read can give other values
         // than every reader of the band's type (gdal_translate, rasterio) sees.
-        let read = match self.info.data_type.as_str() {
+        let read = match self.gdal_type.as_str() {
+            // A signed Byte band too: the decoder reinterprets 128..=255.
             "Byte" => read_widened::<u8>(rb, at, size, dst, f64::from),
             "UInt16" => read_widened::<u16>(rb, at, size, dst, f64::from),
             "Int16" => read_widened::<i16>(rb, at, size, dst, f64::from),
             "UInt32" => read_widened::<u32>(rb, at, size, dst, f64::from),
             "Int32" => read_widened::<i32>(rb, at, size, dst, f64::from),
+            // Beyond 2^53 they round to the nearest f64, as the decoder documents.
+            "UInt64" => read_widened::<u64>(rb, at, size, dst, |v| v as f64),
+            "Int64" => read_widened::<i64>(rb, at, size, dst, |v| v as f64),
             "Float32" => read_widened::<f32>(rb, at, size, dst, f64::from),
-            // Float64, and 64-bit integers (beyond 2^53 they lose precision either way).
             _ => rb.read_into_slice::<f64>(at, size, size, dst, None),
         };
         read.map_err(|e| self.read_error(e))?;

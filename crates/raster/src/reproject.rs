@@ -98,6 +98,29 @@ pub fn from_wgs84(target_wkt: &str, points: &mut [[f64; 3]]) -> Result<()> {
     transform(&wgs84()?, &spatial_ref(target_wkt)?, points)
 }
 
+/// Whether `wkt` is longitude, latitude in degrees that WGS84 takes as they are (WGS84
+/// itself, its 3D form, CRS84, or a CRS given only as WKT, such as a shapefile's
+/// `GCS_WGS_1984`): a geographic CRS whose transformation to WGS84 leaves test points
+/// within 1e-9 degrees. False for anything GDAL cannot read or transform.
+pub fn is_wgs84_lon_lat(wkt: &str) -> bool {
+    let Ok(srs) = spatial_ref(wkt) else {
+        return false;
+    };
+    if !srs.is_geographic() {
+        return false;
+    }
+    let test = [[10.0, 20.0, 0.0], [-120.5, -45.25, 0.0], [179.0, 80.0, 0.0]];
+    let mut points = test;
+    let Ok(wgs84) = wgs84() else {
+        return false;
+    };
+    transform(&srs, &wgs84, &mut points).is_ok()
+        && points
+            .iter()
+            .zip(&test)
+            .all(|(p, q)| (p[0] - q[0]).abs() <= 1e-9 && (p[1] - q[1]).abs() <= 1e-9)
+}
+
 /// Whether the CRS given as WKT (or anything GDAL's `SetFromUserInput` takes) is
 /// geographic: its x is a longitude in degrees.
 ///
@@ -110,6 +133,17 @@ pub fn is_geographic(wkt: &str) -> Result<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn wgs84_lon_lat_is_recognised_in_any_spelling() {
+        let esri = "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137.0,298.257223563]],PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]]";
+        for wkt in ["EPSG:4326", "EPSG:4979", "OGC:CRS84", esri] {
+            assert!(is_wgs84_lon_lat(wkt), "{wkt}");
+        }
+        for wkt in ["EPSG:32633", "EPSG:3857", "not a CRS"] {
+            assert!(!is_wgs84_lon_lat(wkt), "{wkt}");
+        }
+    }
 
     #[test]
     fn utm_to_wgs84_and_back() -> Result<()> {

@@ -1,11 +1,10 @@
 //! `tinsmith serve`: real HTTP over loopback, a bounded number of requests.
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::net::TcpStream;
-use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::util::{fixture, stderr, Dir};
+use crate::util::{fixture, port_of, serve, stderr, Dir};
 
 /// Sends one request and returns (status line, lower-cased headers, body).
 fn get(port: u16, method: &str, target: &str) -> (String, Vec<(String, String)>, Vec<u8>) {
@@ -43,24 +42,8 @@ fn serves_tiles_with_content_type_encoding_and_cors() {
     let tile = "/12/1308/2906.terrain";
     assert!(dir.path(&format!("pyramid{tile}")).exists());
 
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tinsmith"))
-        .args(["serve", "pyramid", "--port", "0", "--max-requests", "5"])
-        .current_dir(dir.tmp.path())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let port: u16 = line
-        .trim()
-        .rsplit(':')
-        .next()
-        .unwrap()
-        .trim_end_matches('/')
-        .parse()
-        .unwrap_or_else(|_| panic!("no port in {line:?}"));
+    let (mut child, base) = serve(&dir, &["pyramid", "--max-requests", "5"]);
+    let port = port_of(&base);
 
     let (status, headers, body) = get(port, "GET", "/layer.json");
     assert_eq!(status, "HTTP/1.1 200 OK");
@@ -89,51 +72,16 @@ fn serves_tiles_with_content_type_encoding_and_cors() {
     // Five requests served: the server stops by itself.
     let start = Instant::now();
     loop {
-        if let Some(status) = child.try_wait().unwrap() {
+        if let Some(status) = child.0.try_wait().unwrap() {
             assert!(status.success());
             break;
         }
         if start.elapsed() > Duration::from_secs(20) {
-            child.kill().unwrap();
+            child.0.kill().unwrap();
             panic!("server did not stop after its requests");
         }
         std::thread::sleep(Duration::from_millis(20));
     }
-}
-
-/// A server that is killed when the test ends, passed or not (a failed assertion must not
-/// leave it waiting for requests, holding the test's output open).
-struct Server(std::process::Child);
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-/// Starts `tinsmith serve DIR` in `dir` for `requests` requests; returns it and its port.
-fn start(dir: &Dir, served: &str, requests: u32) -> (Server, u16) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tinsmith"))
-        .args(["serve", served, "--port", "0", "--max-requests"])
-        .arg(requests.to_string())
-        .current_dir(dir.tmp.path())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let port = line
-        .trim()
-        .rsplit(':')
-        .next()
-        .unwrap()
-        .trim_end_matches('/')
-        .parse()
-        .unwrap_or_else(|_| panic!("no port in {line:?}"));
-    (Server(child), port)
 }
 
 /// Sends `raw` bytes as the request; returns the whole response.
@@ -170,7 +118,8 @@ fn only_real_gzip_is_sent_as_gzip_and_odd_requests_get_answers() {
     bytes[3] = 0;
     std::fs::write(&path, &bytes).unwrap();
 
-    let (mut child, port) = start(&dir, "raw", 6);
+    let (mut child, base) = serve(&dir, &["raw", "--max-requests", "6"]);
+    let port = port_of(&base);
     let (status, headers, body) = get(port, "GET", tile);
     assert_eq!(status, "HTTP/1.1 200 OK");
     assert_eq!(header(&headers, "content-encoding"), None);

@@ -111,3 +111,50 @@ pub fn gdaltransform(from: &str, to: &str, points: &[[f64; 3]]) -> Vec<[f64; 3]>
     assert_eq!(transformed.len(), points.len(), "gdaltransform output");
     transformed
 }
+
+/// A `tinsmith serve` process, killed when the test ends, however it ends (a failed
+/// assertion must not leave it waiting for requests, holding the test's output open).
+pub struct Server(pub std::process::Child);
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// Starts `tinsmith serve ARGS...` in `dir` on a free port; returns the server and the
+/// base URL it printed (`http://127.0.0.1:PORT/`).
+pub fn serve(dir: &Dir, args: &[&str]) -> (Server, String) {
+    use std::io::BufRead;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+        .arg("serve")
+        .args(args)
+        .args(["--port", "0"])
+        .current_dir(dir.tmp.path())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("tinsmith serve starts");
+    let stdout = child.stdout.take().expect("piped stdout");
+    let server = Server(child);
+    let mut line = String::new();
+    std::io::BufReader::new(stdout)
+        .read_line(&mut line)
+        .expect("the address line");
+    let base = line
+        .trim()
+        .rsplit(' ')
+        .next()
+        .unwrap_or_else(|| panic!("no address in {line:?}"))
+        .to_string();
+    (server, base)
+}
+
+/// The port of a base URL `http://127.0.0.1:PORT/`.
+pub fn port_of(base: &str) -> u16 {
+    base.trim_end_matches('/')
+        .rsplit(':')
+        .next()
+        .and_then(|p| p.parse().ok())
+        .unwrap_or_else(|| panic!("no port in {base:?}"))
+}

@@ -8,7 +8,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
-use crate::util::{fixture, stderr, Dir};
+use crate::util::{assert_fails_naming, fixture, stderr, Dir};
 
 const CELLS: i64 = 217;
 const U_STEP: i64 = 151;
@@ -930,19 +930,19 @@ fn metadata_without_level_zero_is_refused() {
 
 #[test]
 fn a_level_far_finer_than_memory_allows_is_refused_up_front() {
-    // The 2-degree globe at level 24: its tile rows would span 2^25 tiles (petabytes of
-    // lattice). Refused before any work, naming the level, with nothing left behind.
+    // A globe of 16 M x 8 M samples (a VRT that resamples the 2-degree one, read by no
+    // one): its own level's tile rows span 131072 tiles, hundreds of GB. Refused
+    // before any work, naming the level, with nothing left behind.
     let dir = Dir::new();
-    let o = dir.run(&[
-        "tiles",
-        &fixture("etopo5_2deg_i16.tif"),
-        "-o",
-        "deep",
-        "--max-zoom",
-        "24",
-        "-q",
-    ]);
-    crate::util::assert_fails_naming(&o, &["etopo5_2deg_i16.tif", "level 24", "--max-zoom"]);
+    let o = Command::new("gdal_translate")
+        .args(["-q", "-of", "VRT", "-outsize", "16777216", "8388608"])
+        .arg(fixture("etopo5_2deg_i16.tif"))
+        .arg(dir.path("huge.vrt"))
+        .output()
+        .expect("gdal_translate (Debian gdal-bin) must be on PATH");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = dir.run(&["tiles", "huge.vrt", "-o", "deep", "-q"]);
+    assert_fails_naming(&o, &["huge.vrt", "level 16", "in memory", "--max-zoom"]);
     let left: Vec<_> = std::fs::read_dir(dir.path("."))
         .unwrap()
         .map(|e| e.unwrap().file_name())
@@ -951,4 +951,33 @@ fn a_level_far_finer_than_memory_allows_is_refused_up_front() {
         })
         .collect();
     assert!(left.is_empty(), "left behind: {left:?}");
+}
+
+#[test]
+fn a_max_zoom_far_finer_than_the_raster_is_refused_with_one_that_works() {
+    // A 6 x 6 raster of 0.5° cells asked for level 20: 305 M tiles of interpolation. It
+    // was not refused, and its tile records grew to 18 GB before any tile was written.
+    let dir = Dir::new();
+    let mut asc = String::from("ncols 6\nnrows 6\nxllcorner 10\nyllcorner 40\ncellsize 0.5\n");
+    for row in 0..6 {
+        let line: Vec<String> = (0..6).map(|col| (100 * row + col).to_string()).collect();
+        asc.push_str(&line.join(" "));
+        asc.push('\n');
+    }
+    dir.write("small.asc", &asc);
+    dir.write("small.prj", "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]");
+    let o = dir.run(&["tiles", "small.asc", "-o", "p", "--max-zoom", "20"]);
+    assert_fails_naming(&o, &["small.asc", "--max-zoom 20", "own resolution"]);
+    assert!(!dir.path("p").exists());
+    // The level it suggests is accepted (checked up front; level 6 is built to show it).
+    let said = stderr(&o);
+    let suggested: u8 = said
+        .split("choose --max-zoom ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no suggestion in {said}"));
+    assert!((6..20).contains(&suggested), "{said}");
+    pyramid(&dir, "small.asc", "p", &["--max-zoom", "6", "-q"]);
+    assert!(dir.path("p/6").is_dir());
 }

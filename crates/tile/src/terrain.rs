@@ -173,17 +173,27 @@ impl Default for TerrainOptions {
 
 /// About how many bytes streaming a pyramid over `bounds` down to `max_zoom` takes: the
 /// finest level's bands of whole tile rows (one per thread in the warp, a few held),
-/// 4 bytes a sample, with the coarser levels' rows (a third more). An estimate for
+/// 4 bytes a sample, with the coarser levels' rows (a third more), and the record of every
+/// tile written (for `layer.json`'s availability, about 48 bytes a tile). An estimate for
 /// refusing hopeless runs (a small raster at a far finer level than its own), not a bound.
 pub fn streaming_bytes(bounds: &GeoBounds, max_zoom: u8, threads: usize) -> u64 {
-    let width = LevelRows::new(bounds, max_zoom).width as u64;
-    let band = (width * u64::from(TILE_CELLS + 1)).max(1 << 22);
+    let finest = LevelRows::new(bounds, max_zoom);
+    let band = (finest.width as u64 * u64::from(TILE_CELLS + 1)).max(1 << 22);
     let bands = threads.max(1) as u64 + 3;
-    band.saturating_mul(bands)
-        .saturating_mul(4)
+    let rows = band.saturating_mul(bands).saturating_mul(4);
+    let tiles = u64::from(finest.tiles_x) * u64::from(finest.tiles_y);
+    rows.saturating_add(tiles.saturating_mul(48))
         .saturating_mul(4)
         / 3
 }
+
+/// Levels finer than the raster's own resolution a pyramid may go before its tile count
+/// is limited by [`OVERZOOM_TILES`]: beyond, tiles only interpolate between samples.
+const OVERZOOM_LEVELS: u8 = 4;
+
+/// The most tiles a level more than [`OVERZOOM_LEVELS`] finer than the raster's own
+/// resolution may have.
+const OVERZOOM_TILES: u64 = 1_000_000;
 
 /// What one level produced.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -404,6 +414,28 @@ pub fn build_terrain(
         return Err(TerrainError::Options(format!(
             "zoom range {}..={max_zoom} is not within 0..={MAX_LEVEL}",
             options.min_zoom
+        )));
+    }
+    let tiles_at = |level: u8| {
+        let rows = LevelRows::new(&bounds, level);
+        u64::from(rows.tiles_x) * u64::from(rows.tiles_y)
+    };
+    let allowed = |level: u8| {
+        level <= own_level.saturating_add(OVERZOOM_LEVELS) || tiles_at(level) <= OVERZOOM_TILES
+    };
+    if !allowed(max_zoom) {
+        let finest_tiles = tiles_at(max_zoom);
+        let suggested = (0..max_zoom)
+            .rev()
+            .find(|&l| allowed(l))
+            .unwrap_or(own_level);
+        return Err(TerrainError::Options(format!(
+            "--max-zoom {max_zoom} would write about {finest_tiles} tiles at that level, {} \
+             levels finer than the raster's own resolution (level {own_level}): they would \
+             only interpolate between its samples, and CesiumJS draws the finest level up \
+             close by itself; choose --max-zoom {} or lower",
+            max_zoom - own_level,
+            suggested
         )));
     }
     if let Some(limit) = options.memory_limit {

@@ -981,3 +981,17 @@ fn a_max_zoom_far_finer_than_the_raster_is_refused_with_one_that_works() {
     pyramid(&dir, "small.asc", "p", &["--max-zoom", "6", "-q"]);
     assert!(dir.path("p/6").is_dir());
 }
+
+#[test]
+fn a_raster_without_a_crs_is_refused_saying_what_is_missing() {
+    // An ESRI grid without its .prj has a geotransform but no CRS; the message said "no
+    // CRS or geotransform".
+    let dir = Dir::new();
+    dir.write(
+        "nocrs.asc",
+        "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n4 5 6\n7 8 9\n",
+    );
+    let o = dir.run(&["tiles", "nocrs.asc", "-o", "p"]);
+    assert_fails_naming(&o, &["nocrs.asc: no CRS,", "-a_srs"]);
+    assert!(!dir.path("p").exists());
+}

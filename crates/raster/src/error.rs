@@ -124,10 +124,14 @@ pub enum Error {
         raster_height: u32,
     },
     /// The raster has no CRS or no geotransform, so it cannot be placed on the globe.
-    #[error("{}: no CRS or geotransform, cannot reproject to EPSG:4326", path.display())]
+    #[error("{}: {missing}, so it cannot be placed on the globe (EPSG:4326); {hint}", path.display())]
     NotGeoreferenced {
         /// The file.
         path: PathBuf,
+        /// What is missing: "no CRS", "no geotransform" or both.
+        missing: &'static str,
+        /// How to give it.
+        hint: &'static str,
     },
     /// GDAL failed to reproject the raster to EPSG:4326.
     #[error("{}: reprojecting to EPSG:4326 failed ({reason})", path.display())]

@@ -109,8 +109,25 @@ pub fn heights_may_exceed_f32(path: &Path, band: usize) -> Result<bool> {
 fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
     let info = &opened.info;
     let (Some(gt), Some(_)) = (info.geo_transform, info.crs_wkt.as_ref()) else {
+        let (missing, hint) = match (info.geo_transform, &info.crs_wkt) {
+            (Some(_), _) => (
+                "no CRS",
+                "assign one, e.g. `gdal_translate -of VRT -a_srs EPSG:4326 IN OUT.vrt`",
+            ),
+            (None, Some(_)) => (
+                "no geotransform",
+                "assign one, e.g. `gdal_translate -of VRT -a_ullr ULX ULY LRX LRY IN OUT.vrt`",
+            ),
+            (None, None) => (
+                "no CRS and no geotransform",
+                "assign both, e.g. `gdal_translate -of VRT -a_srs EPSG:4326 -a_ullr ULX ULY \
+                 LRX LRY IN OUT.vrt`",
+            ),
+        };
         return Err(Error::NotGeoreferenced {
             path: path.to_path_buf(),
+            missing,
+            hint,
         });
     };
     let (w, h) = (f64::from(info.width), f64::from(info.height));

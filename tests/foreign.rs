@@ -307,3 +307,53 @@ fn a_global_mesh_wound_clockwise_verifies_across_the_seam() {
         passes(&d, &["verify", "g.asc", mesh, "--max-error", "50"]);
     }
 }
+
+#[test]
+fn a_mesh_on_another_geographic_datum_is_not_taken_for_wgs84() {
+    // A raster whose CRS is ED50 given as WKT alone (no EPSG code): its FlatGeobuf and
+    // source-CRS GeoJSON meshes carry that WKT and must read back as they are. Taking it
+    // for WGS84 (PROJ passes far-away test points through ED50 unchanged) moved every
+    // vertex by the datum shift.
+    let d = Dir::new();
+    let mut asc =
+        String::from("ncols 40\nnrows 30\nxllcorner 6.0\nyllcorner 49.5\ncellsize 0.01\n");
+    for row in 0..30 {
+        let line: Vec<String> = (0..40)
+            .map(|col| {
+                format!(
+                    "{:.2}",
+                    300.0
+                        + 50.0 * (f64::from(col) / 6.0).sin()
+                        + 30.0 * (f64::from(row) / 4.0).cos()
+                )
+            })
+            .collect();
+        asc.push_str(&line.join(" "));
+        asc.push('\n');
+    }
+    d.write("ed.asc", &asc);
+    d.write(
+        "ed.prj",
+        "GEOGCS[\"my ED50\",DATUM[\"European_Datum_1950\",SPHEROID[\"International 1924\",6378388,297]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]",
+    );
+    passes(
+        &d,
+        &["mesh", "ed.asc", "-o", "ed.fgb", "--max-error", "2", "-q"],
+    );
+    passes(
+        &d,
+        &[
+            "mesh",
+            "ed.asc",
+            "-o",
+            "ed.geojson",
+            "--max-error",
+            "2",
+            "--geojson-source-crs",
+            "-q",
+        ],
+    );
+    for mesh in ["ed.fgb", "ed.geojson"] {
+        passes(&d, &["verify", "ed.asc", mesh, "--max-error", "2"]);
+    }
+}

@@ -67,6 +67,7 @@ pub fn read_mesh_file(path: &Path, raster: &Raster, georef: Georef) -> Result<Me
     // A GIS rewrite may keep WGS84 as WKT alone (a shapefile's GCS_WGS_1984).
     if polygons
         && mesh.epsg.is_none()
+        && mesh.crs_wkt != raster.info.crs_wkt
         && mesh
             .crs_wkt
             .as_deref()

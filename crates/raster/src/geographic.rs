@@ -112,7 +112,8 @@ fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
         let (missing, hint) = match (info.geo_transform, &info.crs_wkt) {
             (Some(_), _) => (
                 "no CRS",
-                "assign one, e.g. `gdal_translate -of VRT -a_srs EPSG:4326 IN OUT.vrt`",
+                "assign the CRS its coordinates are in, e.g. `gdal_translate -of VRT -a_srs \
+                 EPSG:<code> IN OUT.vrt`",
             ),
             (None, Some(_)) => (
                 "no geotransform",
@@ -120,7 +121,7 @@ fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
             ),
             (None, None) => (
                 "no CRS and no geotransform",
-                "assign both, e.g. `gdal_translate -of VRT -a_srs EPSG:4326 -a_ullr ULX ULY \
+                "assign both, e.g. `gdal_translate -of VRT -a_srs EPSG:<code> -a_ullr ULX ULY \
                  LRX LRY IN OUT.vrt`",
             ),
         };

@@ -98,10 +98,11 @@ pub fn from_wgs84(target_wkt: &str, points: &mut [[f64; 3]]) -> Result<()> {
     transform(&wgs84()?, &spatial_ref(target_wkt)?, points)
 }
 
-/// Whether `wkt` is longitude, latitude in degrees that WGS84 takes as they are (WGS84
-/// itself, its 3D form, CRS84, or a CRS given only as WKT, such as a shapefile's
-/// `GCS_WGS_1984`): a geographic CRS whose transformation to WGS84 leaves test points
-/// within 1e-9 degrees. False for anything GDAL cannot read or transform.
+/// Whether `wkt` is WGS84 longitude, latitude in degrees, by its definition: a geographic
+/// CRS on the WGS 84 datum (in any spelling: `WGS_1984`, `D_WGS_1984`, `World Geodetic
+/// System 1984`, its ensemble; 2D or 3D), the Greenwich meridian and degrees. False for
+/// anything else or anything GDAL cannot read (other datums are not WGS84, even where
+/// PROJ has no transformation for a point and passes it through unchanged).
 pub fn is_wgs84_lon_lat(wkt: &str) -> bool {
     let Ok(srs) = spatial_ref(wkt) else {
         return false;
@@ -109,16 +110,27 @@ pub fn is_wgs84_lon_lat(wkt: &str) -> bool {
     if !srs.is_geographic() {
         return false;
     }
-    let test = [[10.0, 20.0, 0.0], [-120.5, -45.25, 0.0], [179.0, 80.0, 0.0]];
-    let mut points = test;
-    let Ok(wgs84) = wgs84() else {
-        return false;
-    };
-    transform(&srs, &wgs84, &mut points).is_ok()
-        && points
-            .iter()
-            .zip(&test)
-            .all(|(p, q)| (p[0] - q[0]).abs() <= 1e-9 && (p[1] - q[1]).abs() <= 1e-9)
+    let datum: String = srs
+        .get_attr_value("DATUM", 0)
+        .ok()
+        .flatten()
+        .unwrap_or_default()
+        .chars()
+        .filter(char::is_ascii_alphanumeric)
+        .collect::<String>()
+        .to_ascii_lowercase();
+    let wgs84_datum = matches!(
+        datum.trim_start_matches('d'),
+        "wgs1984" | "wgs84" | "worldgeodeticsystem1984" | "worldgeodeticsystem1984ensemble"
+    );
+    let greenwich = srs
+        .get_attr_value("PRIMEM", 1)
+        .ok()
+        .flatten()
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .is_some_and(|v| v == 0.0);
+    let degrees = (srs.angular_units() - std::f64::consts::PI / 180.0).abs() < 1e-12;
+    wgs84_datum && greenwich && degrees
 }
 
 /// Whether the CRS given as WKT (or anything GDAL's `SetFromUserInput` takes) is
@@ -140,7 +152,17 @@ mod tests {
         for wkt in ["EPSG:4326", "EPSG:4979", "OGC:CRS84", esri] {
             assert!(is_wgs84_lon_lat(wkt), "{wkt}");
         }
-        for wkt in ["EPSG:32633", "EPSG:3857", "not a CRS"] {
+        let ed50 = "GEOGCS[\"my ED50\",DATUM[\"European_Datum_1950\",SPHEROID[\"International 1924\",6378388,297]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]";
+        let paris = "GEOGCS[\"WGS 84 Paris\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Paris\",2.33722917],UNIT[\"degree\",0.0174532925199433]]";
+        for wkt in [
+            "EPSG:32633",
+            "EPSG:3857",
+            "EPSG:4230",
+            "EPSG:4267",
+            ed50,
+            paris,
+            "not a CRS",
+        ] {
             assert!(!is_wgs84_lon_lat(wkt), "{wkt}");
         }
     }

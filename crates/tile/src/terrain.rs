@@ -420,29 +420,41 @@ pub fn build_terrain(
         let rows = LevelRows::new(&bounds, level);
         u64::from(rows.tiles_x) * u64::from(rows.tiles_y)
     };
-    let allowed = |level: u8| {
+    let threads = match options.threads {
+        0 => rayon::current_num_threads(),
+        n => n,
+    };
+    let fits = |level: u8| {
+        options
+            .memory_limit
+            .is_none_or(|limit| streaming_bytes(&bounds, level, threads) <= limit)
+    };
+    let not_overzoomed = |level: u8| {
         level <= own_level.saturating_add(OVERZOOM_LEVELS) || tiles_at(level) <= OVERZOOM_TILES
     };
-    if !allowed(max_zoom) {
-        let finest_tiles = tiles_at(max_zoom);
-        let suggested = (0..max_zoom)
-            .rev()
-            .find(|&l| allowed(l))
-            .unwrap_or(own_level);
+    // The finest level from --min-zoom up that would run, to name in a refusal.
+    let suggestion = || match (options.min_zoom..max_zoom)
+        .rev()
+        .find(|&l| not_overzoomed(l) && fits(l))
+    {
+        Some(level) => format!("choose --max-zoom {level} or lower"),
+        None => format!(
+            "no level from --min-zoom {} up would run here",
+            options.min_zoom
+        ),
+    };
+    if !not_overzoomed(max_zoom) {
         return Err(TerrainError::Options(format!(
-            "--max-zoom {max_zoom} would write about {finest_tiles} tiles at that level, {} \
-             levels finer than the raster's own resolution (level {own_level}): they would \
-             only interpolate between its samples, and CesiumJS draws the finest level up \
-             close by itself; choose --max-zoom {} or lower",
+            "--max-zoom {max_zoom} would write about {} tiles at that level, {} levels finer \
+             than the raster's own resolution (level {own_level}): they would only \
+             interpolate between its samples, and CesiumJS draws the finest level up close \
+             by itself; {}",
+            tiles_at(max_zoom),
             max_zoom - own_level,
-            suggested
+            suggestion()
         )));
     }
     if let Some(limit) = options.memory_limit {
-        let threads = match options.threads {
-            0 => rayon::current_num_threads(),
-            n => n,
-        };
         let need = streaming_bytes(&bounds, max_zoom, threads);
         if need > limit && streaming_bytes(&bounds, max_zoom, 1) <= limit {
             return Err(TerrainError::Options(format!(
@@ -455,11 +467,12 @@ pub fn build_terrain(
         if need > limit {
             return Err(TerrainError::Options(format!(
                 "level {max_zoom} would need about {:.1} GB in memory (its tile rows span \
-                 {} tiles) and {:.1} GB is available; choose a lower --max-zoom (the \
-                 raster's own resolution is level {own_level})",
+                 {} tiles) and {:.1} GB is available (the raster's own resolution is level \
+                 {own_level}); {}",
                 need as f64 / 1e9,
                 LevelRows::new(&bounds, max_zoom).tiles_x,
-                limit as f64 / 1e9
+                limit as f64 / 1e9,
+                suggestion()
             )));
         }
     }

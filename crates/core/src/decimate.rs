@@ -9,7 +9,8 @@ use crate::mesh::{Mesh, Star, VertexClass};
 use crate::predicates::Point;
 use crate::rtin::{rtin_for_count, rtin_triangles};
 use crate::{
-    DecimationOptions, Error, ErrorBound, Grid, InitialMesh, Order, Result, Tin, TinVertex,
+    DecimationOptions, Error, ErrorBound, ErrorModel, Grid, InitialMesh, Order, Result, Tin,
+    TinVertex,
 };
 
 /// Relative slack kept below the requested bound so that `f64` rounding in the bound
@@ -65,7 +66,9 @@ pub struct DecimationReport {
 /// `max_error - max_error * 2^-40 - max|z| * 2^-40`, a slack that covers the rounding of
 /// the bound arithmetic; so the true error, measured in `f64`, never exceeds `max_error`.
 /// With `max_error` below that slack only vertices whose whole star is flat (every
-/// neighbour has the same value) are removed, which is exact.
+/// neighbour has the same value) are removed, which is exact; on a grid of
+/// [`Grid::integral_heights`] under the exact model an error of 0 is measured exactly, so
+/// any exactly planar star may go.
 ///
 /// # Determinism
 /// The result depends only on `grid` and `options`.
@@ -168,8 +171,12 @@ fn run(
 
     let started = Instant::now();
     // Below the slack only exactly flat stars may go (see `Remover::plan`); the RTIN's
-    // measured errors are not exact enough for that, so it starts from the full grid. In
-    // border mode the RTIN keeps half cells along the border (see `remove_border`).
+    // measured errors are not exact enough for that, so it starts from the full grid,
+    // except on integer heights under the exact model, which are measured exactly at 0
+    // (see `Grid::integral_heights`). In border mode the RTIN keeps half cells along the
+    // border (see `remove_border`).
+    let exact_zero = options.error_model == ErrorModel::Exact && grid.integral_heights();
+    let rtin_ok = limit > 0.0 || exact_zero;
     let mut count_start_bound = None;
     let mut mesh = match options.initial_mesh {
         InitialMesh::Rtin if count_target && limit > 0.0 => {
@@ -191,7 +198,7 @@ fn run(
                 Mesh::from_triangles(grid, corners, bounds)
             }
         }
-        InitialMesh::Rtin if limit > 0.0 => {
+        InitialMesh::Rtin if rtin_ok => {
             let (corners, bounds) = rtin_triangles(
                 grid,
                 limit,
@@ -760,9 +767,13 @@ impl<'g> Remover<'g> {
         self.points.clear();
         self.points.extend(star.ring.iter().map(|&u| mesh.point(u)));
         let centre = mesh.point(v);
-        if self.rules.limit == 0.0 && self.points.iter().any(|p| p.z != centre.z) {
+        if self.rules.limit == 0.0
+            && !(self.rules.model == ErrorModel::Exact && self.rules.grid.integral_heights())
+            && self.points.iter().any(|p| p.z != centre.z)
+        {
             // Below the rounding slack only exactly flat stars go: their bound arithmetic
-            // is exact (all differences are zero).
+            // is exact (all differences are zero). Integer heights under the exact model
+            // are measured exactly at 0 (see `Grid::integral_heights`), so any star may.
             return None;
         }
         // Any retriangulation interpolates the centre from ring values, so a centre further

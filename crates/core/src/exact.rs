@@ -19,6 +19,10 @@ pub(crate) fn triangle_error(
     limit: f64,
 ) -> Option<ErrorBound> {
     debug_assert!(orient(a, b, c) > 0);
+    if limit == 0.0 && grid.integral_heights() {
+        // Error 0 asked of integer heights: decided exactly, not within f64 rounding.
+        return all_on_plane(grid, a, b, c).then_some(ErrorBound::default());
+    }
     if orient(a, b, c) == 1 {
         // Doubled area 1: by Pick's theorem the corners are the only samples.
         return error_at(a, b, c, [a, b, c], limit);
@@ -30,27 +34,11 @@ pub(crate) fn triangle_error(
     let y1 = a.y.max(b.y).max(c.y);
     let x_lo = a.x.min(b.x).min(c.x);
     let x_hi = a.x.max(b.x).max(c.x);
-    let edges = [(a, b), (b, c), (c, a)];
     let (mut above, mut below) = (0.0f64, 0.0f64);
     for y in y0..=y1 {
-        // Each edge function E(x) = e0 + s * x must be >= 0.
-        let (mut lo, mut hi) = (x_lo, x_hi);
-        for (p, q) in edges {
-            let s = p.y - q.y;
-            let e0 = (q.x - p.x) * (y - p.y) + (q.y - p.y) * p.x;
-            match s.cmp(&0) {
-                std::cmp::Ordering::Greater => lo = lo.max(div_ceil(-e0, s)),
-                std::cmp::Ordering::Less => hi = hi.min(div_floor(e0, -s)),
-                std::cmp::Ordering::Equal => {
-                    if e0 < 0 {
-                        hi = lo - 1;
-                    }
-                }
-            }
-        }
-        if lo > hi {
+        let Some((lo, hi)) = row_span(a, b, c, y, x_lo, x_hi) else {
             continue;
-        }
+        };
         let row = &values[y as usize * width..][..width];
         let base = a.z + g[1] * (y - a.y) as f64;
         for x in lo..=hi {
@@ -88,6 +76,56 @@ pub(crate) fn error_at<'p>(
         below = below.max(-d);
     }
     (above <= limit && below <= limit).then_some(ErrorBound { above, below })
+}
+
+/// The columns `lo..=hi` of row `y` inside the closed counter-clockwise triangle `abc`
+/// (within `x_lo..=x_hi`, its bounding box), decided exactly; `None` when there are none.
+#[inline]
+fn row_span(a: &Point, b: &Point, c: &Point, y: i64, x_lo: i64, x_hi: i64) -> Option<(i64, i64)> {
+    // Each edge function E(x) = e0 + s * x must be >= 0.
+    let (mut lo, mut hi) = (x_lo, x_hi);
+    for (p, q) in [(a, b), (b, c), (c, a)] {
+        let s = p.y - q.y;
+        let e0 = (q.x - p.x) * (y - p.y) + (q.y - p.y) * p.x;
+        match s.cmp(&0) {
+            std::cmp::Ordering::Greater => lo = lo.max(div_ceil(-e0, s)),
+            std::cmp::Ordering::Less => hi = hi.min(div_floor(e0, -s)),
+            std::cmp::Ordering::Equal => {
+                if e0 < 0 {
+                    return None;
+                }
+            }
+        }
+    }
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// Whether every sample of the closed counter-clockwise triangle `abc` lies exactly on the
+/// plane through its corners, for a grid of [`Grid::integral_heights`]: the normal
+/// `(b - a) x (c - a)` and each sample's offset from `a` are integers, and their dot
+/// product is computed exactly in `i128`.
+fn all_on_plane(grid: &Grid, a: &Point, b: &Point, c: &Point) -> bool {
+    let z = |p: &Point| p.z as i128;
+    let (ux, uy, uz) = ((b.x - a.x) as i128, (b.y - a.y) as i128, z(b) - z(a));
+    let (vx, vy, vz) = ((c.x - a.x) as i128, (c.y - a.y) as i128, z(c) - z(a));
+    let normal = [uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx];
+    let width = grid.width() as usize;
+    let values = grid.values();
+    let (x_lo, x_hi) = (a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
+    for y in a.y.min(b.y).min(c.y)..=a.y.max(b.y).max(c.y) {
+        let Some((lo, hi)) = row_span(a, b, c, y, x_lo, x_hi) else {
+            continue;
+        };
+        let row = &values[y as usize * width..][..width];
+        let dy = normal[1] * (y - a.y) as i128;
+        for x in lo..=hi {
+            let dz = row[x as usize] as i128 - z(a);
+            if normal[0] * (x - a.x) as i128 + dy + normal[2] * dz != 0 {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 fn div_floor(n: i64, d: i64) -> i64 {

@@ -12,7 +12,13 @@ pub struct Grid {
     width: u32,
     height: u32,
     values: Vec<f64>,
+    /// See [`Grid::integral_heights`].
+    integral_heights: bool,
 }
+
+/// `width x height x max|value|` below this keeps an integer grid's plane arithmetic exact
+/// in `f64` (see [`Grid::integral_heights`]).
+const INTEGRAL_PRODUCT_LIMIT: f64 = (1u64 << 50) as f64;
 
 impl Grid {
     /// Wraps row-major `values`; fails if `values.len() != width * height`, if either
@@ -30,11 +36,27 @@ impl Grid {
         if expected as u64 >= u32::MAX as u64 {
             return Err(Error::GridTooLarge { width, height });
         }
+        let max_abs = values
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let integral_heights = values.iter().all(|v| !v.is_finite() || v.fract() == 0.0)
+            && expected as f64 * max_abs.max(1.0) < INTEGRAL_PRODUCT_LIMIT;
         Ok(Grid {
             width,
             height,
             values,
+            integral_heights,
         })
+    }
+
+    /// Whether every valid sample is an integer and `width x height x max|value|` is below
+    /// 2^50. Then whether a sample lies on the plane through three others is decided
+    /// exactly by an integer determinant, and a verifier interpolating such a plane in
+    /// `f64` with integer barycentric weights gets the sample exactly: an error of exactly
+    /// 0 can be promised and checked (integer DEMs at `max_error` 0).
+    pub fn integral_heights(&self) -> bool {
+        self.integral_heights
     }
 
     /// Number of columns.

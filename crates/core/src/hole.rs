@@ -352,7 +352,11 @@ impl Retriangulator {
         }
         let bound = match rules.model {
             ErrorModel::Bounds => self.triangle_bound(a, b, c, edges),
-            ErrorModel::Exact if self.unit_hole && in_hole => {
+            // (At a cap of 0 on integer heights the measurement is exact; see
+            // `Grid::integral_heights`.)
+            ErrorModel::Exact
+                if self.unit_hole && in_hole && !(cap == 0.0 && rules.grid.integral_heights()) =>
+            {
                 let centre = self.centre.expect("hole loaded");
                 let inside = in_closed_triangle(pa, pb, pc, &centre);
                 let samples = [pa, pb, pc, &centre];

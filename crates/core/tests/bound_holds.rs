@@ -252,6 +252,36 @@ fn constant_grid_decimates_even_at_zero_error() {
 }
 
 #[test]
+fn integer_heights_decimate_exactly_at_zero_error() {
+    // A tilted integer plane: below the rounding slack only exactly flat stars used to go,
+    // so at 0 it kept every sample. Integer heights are measured exactly (an integer
+    // determinant), and the independent verifier checks the result at 0.
+    let (w, h) = (30u32, 20u32);
+    let ramp = GridSpec {
+        width: w,
+        height: h,
+        values: (0..w * h)
+            .map(|i| f64::from(3 * (i % w)) - f64::from(2 * (i / w)) + 7.0)
+            .collect(),
+    };
+    for initial in [InitialMesh::Full, InitialMesh::Rtin] {
+        let options = DecimationOptions::new(0.0).with_initial_mesh(initial);
+        let tin = check_with(&ramp, &options).unwrap();
+        assert_eq!(tin.triangles().len(), 2, "{initial:?}");
+    }
+    // Rough integer terrain: only what is exactly planar goes, and nothing else.
+    let mut rough = tinsmith_testkit::terrain(60, 45, 4.0, 9);
+    for v in &mut rough.values {
+        *v = (*v * 3.0).round();
+    }
+    for initial in [InitialMesh::Full, InitialMesh::Rtin] {
+        let options = DecimationOptions::new(0.0).with_initial_mesh(initial);
+        let tin = check_with(&rough, &options).unwrap();
+        assert!(tin.triangles().len() < 2 * 59 * 44, "{initial:?}");
+    }
+}
+
+#[test]
 fn a_single_spike_is_kept_and_the_rest_goes() {
     let mut values = vec![0.0; 121];
     values[5 * 11 + 5] = 50.0;

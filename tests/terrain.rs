@@ -768,6 +768,23 @@ fn nan_is_nodata_in_tiles_whether_declared_or_not() {
     assert_eq!(terrain_files(&dir.path("mixed")), declared);
 }
 
+/// `masked.vrt` in `dir`: the Float32 globe with its oceans (heights below 0) masked by a
+/// GDAL mask band of 0 and 255.
+fn masked_globe(dir: &Dir) -> String {
+    let mask = globe_band(
+        1,
+        "Byte",
+        "",
+        "<LUT>-100000:0,-0.5:0,0:255,100000:255</LUT>",
+    )
+    .replace(" band=\"1\"", "");
+    let band = globe_band(1, "Float32", "", "").replace(
+        "</VRTRasterBand>",
+        &format!("<MaskBand>{mask}</MaskBand></VRTRasterBand>"),
+    );
+    globe_vrt(dir, "masked.vrt", &band)
+}
+
 #[test]
 fn an_alpha_band_of_any_type_masks_tiles_as_a_mask_band_does() {
     // The globe with its oceans masked: by a Float32 or Byte alpha band of 0 and 1 (as
@@ -784,18 +801,7 @@ fn an_alpha_band_of_any_type_masks_tiles_as_a_mask_band_does() {
         )
     };
     let (float_alpha, byte_alpha) = (alpha("Float32"), alpha("Byte"));
-    let mask = globe_band(
-        1,
-        "Byte",
-        "",
-        "<LUT>-100000:0,-0.5:0,0:255,100000:255</LUT>",
-    )
-    .replace(" band=\"1\"", "");
-    let band = globe_band(1, "Float32", "", "").replace(
-        "</VRTRasterBand>",
-        &format!("<MaskBand>{mask}</MaskBand></VRTRasterBand>"),
-    );
-    let masked = globe_vrt(&dir, "masked.vrt", &band);
+    let masked = masked_globe(&dir);
     for (input, out) in [
         (&float_alpha, "float"),
         (&byte_alpha, "byte"),
@@ -827,18 +833,7 @@ fn a_rounded_float32_nodata_tag_masks_tiles_as_it_masks_meshes() {
             fill,
         ),
     );
-    let mask = globe_band(
-        1,
-        "Byte",
-        "",
-        "<LUT>-100000:0,-0.5:0,0:255,100000:255</LUT>",
-    )
-    .replace(" band=\"1\"", "");
-    let band = globe_band(1, "Float32", "", "").replace(
-        "</VRTRasterBand>",
-        &format!("<MaskBand>{mask}</MaskBand></VRTRasterBand>"),
-    );
-    let masked = globe_vrt(&dir, "masked.vrt", &band);
+    let masked = masked_globe(&dir);
     for (input, out) in [(&filled, "filled"), (&masked, "masked")] {
         pyramid(&dir, input, out, &["--max-zoom", "1", "-q"]);
     }

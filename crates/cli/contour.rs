@@ -34,7 +34,7 @@ use crate::export::{file_crs, Pieces};
 use crate::georef::Georef;
 use crate::output::NamingFile;
 use crate::output::{check_distinct, check_writable_target};
-use crate::verify::{expected_orientation, read_mesh_file};
+use crate::verify::{expected_orientation, read_mesh_file, sample_positions};
 
 /// Builds the TIN, contours it and writes the lines; `Ok(true)` on success.
 /// Memory per line segment while contouring and writing: its point in the joiner, the
@@ -342,10 +342,7 @@ fn mesh_from_file(
     // other tools may round to about six decimals or significant digits: a millionth of
     // the sample's magnitude or of the range is allowed for that, far below any DEM's
     // precision. A vertex within it takes its sample's height.
-    let float32 = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| ["stl", "glb", "gltf"].contains(&e.to_ascii_lowercase().as_str()));
+    let float32 = tinsmith_export::MeshFormat::from_path(path).is_ok_and(|f| f.is_float32());
     let range = if hi >= lo { hi - lo } else { 0.0 };
     let slack = if float32 {
         range / f64::from(1u32 << 23)
@@ -354,10 +351,8 @@ fn mesh_from_file(
     };
     // Each file vertex's sample, as its row-major index.
     let mut samples: Vec<u64> = Vec::with_capacity(file.vertices.len());
-    for (i, v) in file.vertices.iter().enumerate() {
-        let [x, y] = georef
-            .sample_at([v[0], v[1]])
-            .with_context(|| format!("{}: vertex {i}", path.display()))?;
+    let at = sample_positions(path, &file, georef)?;
+    for (i, (v, &[x, y])) in file.vertices.iter().zip(&at).enumerate() {
         if !(0..grid.width() as i64).contains(&x) || !(0..grid.height() as i64).contains(&y) {
             bail!(
                 "{}: vertex {i} is at column {x}, row {y}, outside the {} x {} raster",
@@ -404,13 +399,7 @@ fn mesh_from_file(
         .iter()
         .map(|&s| [(s % width) as i64, (s / width) as i64])
         .collect();
-    let vertices: Vec<[f64; 3]> = used
-        .iter()
-        .map(|&s| {
-            let [x, y] = [s % width, s / width];
-            [x as f64, y as f64, grid.values()[s as usize]]
-        })
-        .collect();
+    let heights: Vec<f64> = used.iter().map(|&s| grid.values()[s as usize]).collect();
     let index: Vec<u32> = samples
         .iter()
         .map(|s| used.binary_search(s).expect("every sample is listed") as u32)
@@ -422,7 +411,6 @@ fn mesh_from_file(
         .collect();
     let orientation = expected_orientation(&georef);
     crate::verify::orient_polygon_triangles(path, &positions, &mut triangles, orientation);
-    let heights: Vec<f64> = vertices.iter().map(|v| v[2]).collect();
     let options = VerifyOptions::new().with_orientation(orientation);
     let report = tinsmith_verify::verify(
         GridRef::new(grid.width(), grid.height(), grid.values()),
@@ -439,6 +427,11 @@ fn mesh_from_file(
             report.problems.join("; ")
         );
     }
+    let vertices = positions
+        .iter()
+        .zip(&heights)
+        .map(|(&[x, y], &z)| [x as f64, y as f64, z])
+        .collect();
     ContourMesh::new(vertices, triangles)
         .with_context(|| format!("{}: cannot contour this mesh", path.display()))
 }

@@ -7,7 +7,7 @@
 //! nginx and Apache).
 
 use std::fs::File;
-use std::io::{BufReader, ErrorKind, Read, Write};
+use std::io::{BufReader, ErrorKind, Read, Seek, Write};
 use std::net::{Ipv4Addr, TcpListener, TcpStream};
 use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -217,11 +217,15 @@ fn respond(method: &str, target: &str, root: &Path) -> (Head, Body) {
         Ok(m) if m.is_file() => File::open(&path).ok().map(|f| (f, m.len())),
         _ => None,
     };
-    let Some((file, length)) = file else {
+    let Some((mut file, length)) = file else {
         return plain("404 Not Found", "not found\n");
     };
     let mut headers = vec![("Content-Type", content_type(&path).to_string())];
-    if !has_extension(&path, "gz") && is_gzip(&path, length) {
+    let gzip = !has_extension(&path, "gz") && is_gzip(&mut file, length);
+    if file.rewind().is_err() {
+        return plain("404 Not Found", "not found\n");
+    }
+    if gzip {
         headers.push(("Content-Encoding", "gzip".into()));
     }
     (
@@ -233,14 +237,12 @@ fn respond(method: &str, target: &str, root: &Path) -> (Head, Body) {
     )
 }
 
-/// Whether the file is gzip: its header names deflate with no reserved flags, and (up to
-/// [`GZIP_CHECK_BYTES`]) the whole member decompresses with a matching checksum. An
-/// uncompressed tile (`tiles --no-gzip`) begins with an `f64` whose low bytes are
-/// arbitrary and can match gzip's two magic bytes; it must not be sent as gzip.
-fn is_gzip(path: &Path, length: u64) -> bool {
-    let Ok(mut file) = File::open(path) else {
-        return false;
-    };
+/// Whether `file` (read from its start; the caller rewinds it after) is gzip: its header
+/// names deflate with no reserved flags, and (up to [`GZIP_CHECK_BYTES`]) the whole
+/// member decompresses with a matching checksum. An uncompressed tile (`tiles --no-gzip`)
+/// begins with an `f64` whose low bytes are arbitrary and can match gzip's two magic
+/// bytes; it must not be sent as gzip.
+fn is_gzip(file: &mut File, length: u64) -> bool {
     let mut header = [0u8; 4];
     if file.read_exact(&mut header).is_err()
         || header[..3] != [0x1f, 0x8b, 0x08]
@@ -251,9 +253,9 @@ fn is_gzip(path: &Path, length: u64) -> bool {
     if length > GZIP_CHECK_BYTES {
         return true;
     }
-    let Ok(file) = File::open(path) else {
+    if file.rewind().is_err() {
         return false;
-    };
+    }
     let mut decoder = flate2::read::GzDecoder::new(file);
     std::io::copy(&mut decoder, &mut std::io::sink()).is_ok()
 }

@@ -26,13 +26,7 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
     let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
     let georef = Georef::new(raster.info.transform(), args.pixel_coords);
     let mesh = read_mesh_file(&args.mesh, &raster, georef)?;
-    let mut positions = Vec::with_capacity(mesh.vertices.len());
-    for (i, v) in mesh.vertices.iter().enumerate() {
-        let p = georef
-            .sample_at([v[0], v[1]])
-            .with_context(|| format!("{}: vertex {i}", args.mesh.display()))?;
-        positions.push(p);
-    }
+    let positions = sample_positions(&args.mesh, &mesh, georef)?;
     let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();
     let orientation = expected_orientation(&georef);
     let mut triangles = mesh.triangles;
@@ -96,6 +90,20 @@ pub fn read_mesh_file(path: &Path, raster: &Raster, georef: Georef) -> Result<Me
         }
     }
     Ok(mesh)
+}
+
+/// The sample (column, row) under each vertex of `mesh`, read from `path`; fails naming
+/// the first vertex that is not on a sample centre.
+pub fn sample_positions(path: &Path, mesh: &Mesh, georef: Georef) -> Result<Vec<[i64; 2]>> {
+    mesh.vertices
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            georef
+                .sample_at([v[0], v[1]])
+                .with_context(|| format!("{}: vertex {i}", path.display()))
+        })
+        .collect()
 }
 
 /// Moves longitudes read from RFC 7946 GeoJSON (in [-180, 180]) by whole turns into a
@@ -218,15 +226,10 @@ pub fn orient_polygon_triangles(
     if !is_polygon_format(path) {
         return;
     }
-    let wanted = match orientation {
-        Orientation::CounterClockwise => 1,
-        Orientation::Clockwise => -1,
-    };
     for t in triangles {
-        let [a, b, c] = t.map(|v| positions[v as usize]);
-        let [a, b, c] = [a, b, c].map(|p| p.map(i128::from));
+        let [a, b, c] = t.map(|v| positions[v as usize].map(i128::from));
         let area_x2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-        if area_x2.signum() == -wanted {
+        if area_x2.signum() == -orientation.sign() {
             t.swap(1, 2);
         }
     }

@@ -12,6 +12,8 @@ pub struct Grid {
     width: u32,
     height: u32,
     values: Vec<f64>,
+    /// Largest absolute valid value (0 without valid samples).
+    max_abs: f64,
     /// See [`Grid::integral_heights`].
     integral_heights: bool,
 }
@@ -36,16 +38,19 @@ impl Grid {
         if expected as u64 >= u32::MAX as u64 {
             return Err(Error::GridTooLarge { width, height });
         }
-        let max_abs = values
+        let (max_abs, integers) = values
             .iter()
             .filter(|v| v.is_finite())
-            .fold(0.0f64, |m, v| m.max(v.abs()));
-        let integral_heights = values.iter().all(|v| !v.is_finite() || v.fract() == 0.0)
-            && expected as f64 * max_abs.max(1.0) < INTEGRAL_PRODUCT_LIMIT;
+            .fold((0.0f64, true), |(m, integers), v| {
+                (m.max(v.abs()), integers && v.fract() == 0.0)
+            });
+        let integral_heights =
+            integers && expected as f64 * max_abs.max(1.0) < INTEGRAL_PRODUCT_LIMIT;
         Ok(Grid {
             width,
             height,
             values,
+            max_abs,
             integral_heights,
         })
     }
@@ -131,9 +136,6 @@ impl Grid {
 
     /// Largest absolute valid value (0 for a grid without valid samples).
     pub(crate) fn max_abs_value(&self) -> f64 {
-        self.values
-            .iter()
-            .filter(|v| v.is_finite())
-            .fold(0.0, |m, v| m.max(v.abs()))
+        self.max_abs
     }
 }

@@ -20,8 +20,9 @@ pub enum Orientation {
 }
 
 impl Orientation {
-    /// Sign of `orient(a, b, c)` for a triangle with this orientation.
-    pub(crate) fn sign(self) -> i128 {
+    /// Sign of `orient(a, b, c)` (twice the signed area) for a triangle with this
+    /// orientation: 1 or -1.
+    pub fn sign(self) -> i128 {
         match self {
             Orientation::CounterClockwise => 1,
             Orientation::Clockwise => -1,

@@ -141,6 +141,52 @@ fn welded_mesh_keeps_the_bound_and_has_no_cracks() {
 }
 
 #[test]
+fn netcdf4_tiles_print_nothing_but_the_summary() {
+    // HDF5 keeps "print error stacks" per thread and the netCDF library turns it off only
+    // in the thread that opens first: every tile worker printed pages of HDF5-DIAG stacks
+    // for attributes GDAL's driver merely probes, -q or not.
+    let d = Dir::new();
+    let o = std::process::Command::new("gdal_translate")
+        .current_dir(d.path(""))
+        .args(["-q", "-of", "netCDF", "-co", "FORMAT=NC4"])
+        .args([&fixture("becmodel_dem_bc_albers_50m.tif"), "dem.nc"])
+        .output()
+        .expect("gdal_translate (Debian gdal-bin) must be on PATH");
+    assert!(o.status.success(), "{}", stderr(&o));
+    for args in [
+        &[
+            "mesh",
+            "dem.nc",
+            "-o",
+            "t.ply",
+            "--max-error",
+            "3",
+            "--tile-size",
+            "128",
+        ][..],
+        &[
+            "contour",
+            "dem.nc",
+            "-o",
+            "c.fgb",
+            "--interval",
+            "50",
+            "--max-error",
+            "5",
+            "--tile-size",
+            "128",
+        ],
+        &["tiles", "dem.nc", "-o", "pyramid", "--max-zoom", "9"],
+    ] {
+        let args = [args, &["-q"]].concat();
+        let o = d.run(&args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        assert_eq!(stderr(&o), "", "{args:?} printed on stderr");
+    }
+    verify(&d, "dem.nc", "t.ply", "3", false);
+}
+
+#[test]
 fn raster_not_a_multiple_of_the_tile_size() {
     // 430 x 516: with 108 the last tile column is 2 samples wide; with 100 neither
     // dimension is a multiple.

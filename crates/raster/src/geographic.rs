@@ -266,6 +266,7 @@ fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
          {band}</VRTRasterBand>{alpha}</VRTDataset>",
         info.width, info.height
     );
+    crate::quiet::silence_hdf5_on_this_thread();
     Dataset::open(Path::new(&xml)).map_err(|e| warp_error(path, e))
 }
 

@@ -366,6 +366,7 @@ fn open_dataset(path: &Path) -> Result<Dataset> {
             path: path.to_path_buf(),
         });
     }
+    crate::quiet::silence_hdf5_on_this_thread();
     let options = DatasetOptions {
         open_flags: GdalOpenFlags::GDAL_OF_RASTER
             | GdalOpenFlags::GDAL_OF_READONLY

@@ -990,3 +990,57 @@ fn a_raster_without_a_crs_is_refused_saying_what_is_missing() {
     assert_fails_naming(&o, &["nocrs.asc: no CRS,", "-a_srs"]);
     assert!(!dir.path("p").exists());
 }
+
+#[test]
+fn a_rotated_raster_is_tiled_whole() {
+    // A geotransform rotated by 30 degrees: the extent came from two opposite corners
+    // only, so layer.json's bounds missed the other two and the finest level lost more
+    // than half of the samples, silently (and its level came out two finer).
+    let dir = Dir::new();
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let o = Command::new("gdal_translate")
+        .args(["-q", "-of", "VRT", &dem])
+        .arg(dir.path("plain.vrt"))
+        .output()
+        .expect("gdal_translate runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let plain = std::fs::read_to_string(dir.path("plain.vrt")).expect("vrt");
+    let (x0, y0) = (1443887.5, 491087.5);
+    let (c, s) = (
+        50.0 * 30f64.to_radians().cos(),
+        50.0 * 30f64.to_radians().sin(),
+    );
+    let start = plain.find("<GeoTransform>").expect("a geotransform");
+    let end = plain.find("</GeoTransform>").expect("its end") + "</GeoTransform>".len();
+    let rotated = format!(
+        "{}<GeoTransform>{x0:?}, {c:?}, {s:?}, {y0:?}, {s:?}, {:?}</GeoTransform>{}",
+        &plain[..start],
+        -c,
+        &plain[end..]
+    );
+    dir.write("rotated.vrt", &rotated);
+    pyramid(&dir, "plain.vrt", "plain", &[]);
+    pyramid(&dir, "rotated.vrt", "rotated", &[]);
+    let layer = |name: &str| -> Value {
+        serde_json::from_slice(&std::fs::read(dir.path(name).join("layer.json")).unwrap()).unwrap()
+    };
+    let (plain, rotated) = (layer("plain"), layer("rotated"));
+    assert_eq!(rotated["maxzoom"], plain["maxzoom"]);
+    let bounds: Vec<f64> = rotated["bounds"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let (w, h) = (430.0, 516.0);
+    let corners: Vec<[f64; 3]> = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
+        .iter()
+        .map(|&(col, row)| [x0 + col * c + row * s, y0 + col * s - row * c, 0.0])
+        .collect();
+    for [lon, lat, _] in crate::util::gdaltransform("EPSG:3005", "EPSG:4326", &corners) {
+        assert!(
+            bounds[0] <= lon && lon <= bounds[2] && bounds[1] <= lat && lat <= bounds[3],
+            "corner ({lon}, {lat}) outside layer.json bounds {bounds:?}"
+        );
+    }
+}

@@ -8,6 +8,7 @@ use gdal::spatial_ref::{AxisMappingStrategy, CoordTransform, SpatialRef};
 use gdal::{Dataset, DriverManager};
 
 use crate::error::{gdal_reason, Error, Result};
+use crate::info::RasterInfo;
 use crate::read::{MaskSource, OpenBand};
 
 /// Where a raster lies in EPSG:4326 (degrees), and how fine it is. `west` is in
@@ -65,7 +66,7 @@ fn warp_error(path: &Path, source: gdal::errors::GdalError) -> Error {
 pub fn geographic_bounds(path: &Path, band: usize) -> Result<GeoBounds> {
     let opened = OpenBand::open(path, band)?;
     let b = raw_bounds(path, &opened)?;
-    let (w, h) = (f64::from(opened.info.width), f64::from(opened.info.height));
+    let (w, h) = samples_across(&opened.info);
     // PROJ gives west > east for an extent across the antimeridian (a projected raster
     // over 180 degrees): count east on past 180 instead.
     let (west, east) = if b[0] > b[2] {
@@ -105,6 +106,22 @@ pub fn heights_may_exceed_f32(path: &Path, band: usize) -> Result<bool> {
     Ok(info.data_type == "Float64" || info.scale.abs() > 1.0 || info.offset.abs() > 1e30)
 }
 
+/// How many samples at the raster's own spacing span its extent's width and height in its
+/// CRS: its columns and rows, or more when the geotransform is rotated (the extent is then
+/// the box around the rotated raster, wider and taller than its sides).
+fn samples_across(info: &RasterInfo) -> (f64, f64) {
+    let (w, h) = (f64::from(info.width), f64::from(info.height));
+    match info.geo_transform {
+        Some(gt) if gt[2] != 0.0 || gt[4] != 0.0 => {
+            let spacing = gt[1].hypot(gt[4]).min(gt[2].hypot(gt[5]));
+            let span_x = (w * gt[1]).abs() + (h * gt[2]).abs();
+            let span_y = (w * gt[4]).abs() + (h * gt[5]).abs();
+            (span_x / spacing, span_y / spacing)
+        }
+        _ => (w, h),
+    }
+}
+
 /// The raster's extent in EPSG:4326 as PROJ gives it, longitudes not wrapped.
 fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
     let info = &opened.info;
@@ -132,8 +149,18 @@ fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
         });
     };
     let (w, h) = (f64::from(info.width), f64::from(info.height));
-    let xs = [gt[0], gt[0] + w * gt[1] + h * gt[2]];
-    let ys = [gt[3], gt[3] + w * gt[4] + h * gt[5]];
+    // All four corners: with a rotated geotransform two opposite ones do not bound it.
+    let corners = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)];
+    let xs = corners.map(|(c, r)| gt[0] + c * gt[1] + r * gt[2]);
+    let ys = corners.map(|(c, r)| gt[3] + c * gt[4] + r * gt[5]);
+    let (x_min, x_max) = (
+        xs.iter().copied().fold(f64::INFINITY, f64::min),
+        xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    );
+    let (y_min, y_max) = (
+        ys.iter().copied().fold(f64::INFINITY, f64::min),
+        ys.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    );
     let mut source = opened
         .dataset()
         .spatial_ref()
@@ -141,15 +168,7 @@ fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
     source.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
     let transform = CoordTransform::new(&source, &wgs84()?).map_err(|e| warp_error(path, e))?;
     transform
-        .transform_bounds(
-            &[
-                xs[0].min(xs[1]),
-                ys[0].min(ys[1]),
-                xs[0].max(xs[1]),
-                ys[0].max(ys[1]),
-            ],
-            21,
-        )
+        .transform_bounds(&[x_min, y_min, x_max, y_max], 21)
         .map_err(|e| warp_error(path, e))
 }
 

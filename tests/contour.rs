@@ -1214,3 +1214,64 @@ fn a_float32_mesh_file_of_fractional_heights_is_the_rasters() {
         );
     }
 }
+
+/// A Float64 raster (raw samples behind a VRT, UTM 32N, 1 m pixels at easting 500,000)
+/// written into `d` as `name.vrt`; `values` row-major, `width` per row.
+fn float64_utm(d: &Dir, name: &str, width: usize, values: &[f64]) -> String {
+    let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(d.path(&format!("{name}.raw")), bytes).unwrap();
+    let height = values.len() / width;
+    d.write(
+        &format!("{name}.vrt"),
+        &format!(
+            "<VRTDataset rasterXSize=\"{width}\" rasterYSize=\"{height}\"><SRS>EPSG:32632</SRS>\
+             <GeoTransform>500000, 1, 0, 5000000, 0, -1</GeoTransform>\
+             <VRTRasterBand dataType=\"Float64\" band=\"1\" subClass=\"VRTRawRasterBand\">\
+             <SourceFilename relativeToVRT=\"1\">{name}.raw</SourceFilename>\
+             <ImageOffset>0</ImageOffset><PixelOffset>8</PixelOffset>\
+             <LineOffset>{}</LineOffset><ByteOrder>LSB</ByteOrder></VRTRasterBand></VRTDataset>",
+            8 * width
+        ),
+    );
+    format!("{name}.vrt")
+}
+
+#[test]
+fn lines_have_no_repeated_points_in_map_coordinates() {
+    // Crossings within ~1e-14 of a sample are distinct in the grid but land on the same
+    // map coordinate 500,000 m from the origin: a pit one ulp below the level gave a ring
+    // of 7 identical points (length 0, invalid), and a bowl whose heights were summed in
+    // steps of 0.1 gave rings with dozens of zero-length segments.
+    let d = Dir::new();
+    let mut pit = vec![101.0; 25];
+    pit[12] = 100f64.next_down();
+    let pit = float64_utm(&d, "pit", 5, &pit);
+    let mut bowl = Vec::new();
+    for y in 0..40 {
+        for x in 0..40 {
+            let r = f64::hypot(f64::from(x) - 19.5, f64::from(y) - 19.5);
+            let mut h = 98.0;
+            for _ in 0..(r * 3.0).round() as usize {
+                h += 0.1;
+            }
+            bowl.push(h);
+        }
+    }
+    let bowl = float64_utm(&d, "bowl", 40, &bowl);
+    for (input, levels, rings) in [(&bowl, "100,101,102", 3), (&pit, "100", 0)] {
+        for crs in [&["--geojson-source-crs"][..], &[]] {
+            let mut args = vec!["contour", input, "-o", "c.geojson", "--levels", levels];
+            args.extend_from_slice(crs);
+            run_ok(&d, &args);
+            let lines = features(&d.path("c.geojson"));
+            assert_eq!(lines.len(), rings, "{input} {crs:?}");
+            for (level, points) in lines {
+                assert!(
+                    points.windows(2).all(|w| w[0] != w[1]),
+                    "{input} {crs:?}: a repeated point at level {level}: {points:?}"
+                );
+                assert!(points.len() >= 4 && points[0] == points[points.len() - 1]);
+            }
+        }
+    }
+}

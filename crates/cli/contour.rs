@@ -129,7 +129,6 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     // --simplify. A north-up raster flips orientation; reverse so the high ground stays on
     // the left in file coordinates.
     let flip = georef.flips_orientation();
-    let closed = polylines.iter().filter(|l| l.is_closed()).count();
     let mut points: Vec<[f64; 3]> =
         Vec::with_capacity(polylines.iter().map(|l| l.points().len()).sum());
     let mut ends = Vec::with_capacity(polylines.len());
@@ -138,6 +137,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             line.reverse();
         }
         let level = line.level();
+        let closed = line.is_closed();
         let start = points.len();
         points.extend(line.points().iter().map(|&p| {
             let [x, y] = georef.file_point(p);
@@ -153,23 +153,25 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             }
             points.truncate(start + count);
         }
-        ends.push((points.len(), level));
+        ends.push((points.len(), level, closed));
     }
     let wgs84 = format == LineFormat::GeoJson && !args.geojson_source_crs;
+    let line_ends: Vec<(usize, f64)> = ends.iter().map(|&(end, level, _)| (end, level)).collect();
     let crs = file_crs(
         &info,
         args.pixel_coords,
         wgs84,
         &mut points,
-        Pieces::Lines(&ends),
+        Pieces::Lines(&line_ends),
         &args.output,
         args.quiet,
     )?;
-    let points: Vec<[f64; 2]> = points.iter().map(|p| [p[0], p[1]]).collect();
+    let (points, ends) = without_repeated_points(&points, &ends);
+    let closed = ends.iter().filter(|&&(_, _, closed)| closed).count();
     let mut start = 0;
     let lines: Vec<(&[[f64; 2]], f64)> = ends
         .iter()
-        .map(|&(end, level)| {
+        .map(|&(end, level, _)| {
             let line = (&points[start..end], level);
             start = end;
             line
@@ -217,6 +219,37 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         );
     }
     Ok(true)
+}
+
+/// The lines (`ends`: each line's end in `points`, its level, whether it is a closed ring)
+/// in the file's coordinates without consecutive repeated points: crossings a hair's breadth
+/// apart in the grid (a sample within rounding of a level) can land on the same map
+/// coordinate. A line left with fewer than two points, or a ring with fewer than three
+/// distinct ones, is dropped (gdal_contour writes none there either).
+fn without_repeated_points(
+    points: &[[f64; 3]],
+    ends: &[(usize, f64, bool)],
+) -> (Vec<[f64; 2]>, Vec<(usize, f64, bool)>) {
+    let mut kept: Vec<[f64; 2]> = Vec::with_capacity(points.len());
+    let mut kept_ends = Vec::with_capacity(ends.len());
+    let mut start = 0;
+    for &(end, level, closed) in ends {
+        let first = kept.len();
+        for p in &points[start..end] {
+            let p = [p[0], p[1]];
+            if kept.len() == first || kept[kept.len() - 1] != p {
+                kept.push(p);
+            }
+        }
+        let count = kept.len() - first;
+        if count >= if closed { 4 } else { 2 } {
+            kept_ends.push((kept.len(), level, closed));
+        } else {
+            kept.truncate(first);
+        }
+        start = end;
+    }
+    (kept, kept_ends)
 }
 
 /// The levels to contour: `--levels`, or `--interval` levels over the height range `lo,

@@ -221,15 +221,16 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     Ok(true)
 }
 
+/// A line's end (one past its last point) in a shared point buffer, its level, and whether
+/// it is a closed ring.
+type LineEnd = (usize, f64, bool);
+
 /// The lines (`ends`: each line's end in `points`, its level, whether it is a closed ring)
 /// in the file's coordinates without consecutive repeated points: crossings a hair's breadth
 /// apart in the grid (a sample within rounding of a level) can land on the same map
 /// coordinate. A line left with fewer than two points, or a ring with fewer than three
 /// distinct ones, is dropped (gdal_contour writes none there either).
-fn without_repeated_points(
-    points: &[[f64; 3]],
-    ends: &[(usize, f64, bool)],
-) -> (Vec<[f64; 2]>, Vec<(usize, f64, bool)>) {
+fn without_repeated_points(points: &[[f64; 3]], ends: &[LineEnd]) -> (Vec<[f64; 2]>, Vec<LineEnd>) {
     let mut kept: Vec<[f64; 2]> = Vec::with_capacity(points.len());
     let mut kept_ends = Vec::with_capacity(ends.len());
     let mut start = 0;

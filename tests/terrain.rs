@@ -1044,3 +1044,32 @@ fn a_rotated_raster_is_tiled_whole() {
         );
     }
 }
+
+#[test]
+fn layer_bounds_are_longitudes_in_range_for_a_raster_east_of_180() {
+    // A 0..360 grid's part past 180 alone: layer.json's west was 185 (not a longitude),
+    // and west > east read as a crossing of the antimeridian it does not make.
+    let dir = Dir::new();
+    let input = relabelled(
+        &dir,
+        "becmodel_dem_bc_albers_50m.tif",
+        "east.tif",
+        ["185", "-30", "195", "-40"],
+    );
+    pyramid(&dir, &input, "p", &["-q", "--max-zoom", "3"]);
+    let layer: Value =
+        serde_json::from_slice(&std::fs::read(dir.path("p/layer.json")).unwrap()).unwrap();
+    let bounds: Vec<f64> = layer["bounds"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let expected = [-175.0, -40.0, -165.0, -30.0];
+    for (got, want) in bounds.iter().zip(expected) {
+        assert!(
+            (got - want).abs() < 1e-9,
+            "bounds {bounds:?}, expected {expected:?}"
+        );
+    }
+}

@@ -270,15 +270,17 @@ fn max_edge_length(level: u8, bound: f64) -> Option<u32> {
     }
 }
 
-/// `[west, south, east, north]` in degrees; across the antimeridian `east` is wrapped back
-/// below 180, so west > east (as GeoJSON and TileJSON bounding boxes have it).
+/// `[west, south, east, north]` in degrees, longitudes in [-180, 180]: across the
+/// antimeridian `east` is wrapped back below 180, so west > east (as GeoJSON and TileJSON
+/// bounding boxes have it); a raster wholly east of 180 has both wrapped.
 fn bounds_array(bounds: &GeoBounds) -> [f64; 4] {
-    let east = if bounds.east > 180.0 {
-        bounds.east - 360.0
-    } else {
-        bounds.east
-    };
-    [bounds.west, bounds.south, east, bounds.north]
+    let wrap = |lon: f64| if lon > 180.0 { lon - 360.0 } else { lon };
+    [
+        wrap(bounds.west),
+        bounds.south,
+        wrap(bounds.east),
+        bounds.north,
+    ]
 }
 
 /// The tile column of lattice tile column `x` (which is past the last column across the

@@ -1073,3 +1073,31 @@ fn layer_bounds_are_longitudes_in_range_for_a_raster_east_of_180() {
         );
     }
 }
+
+#[test]
+fn a_raster_placed_only_by_gcps_is_refused_and_noted_saying_so() {
+    // GCPs without a geotransform: tiles said "no CRS and no geotransform" and suggested
+    // `-a_ullr`, which would throw the GCP fit away; mesh wrote pixel coordinates silently.
+    let dir = Dir::new();
+    let status = Command::new("gdal_translate")
+        .args(["-q", "-a_srs", "EPSG:32611"])
+        .args(["-gcp", "0", "0", "500000", "4000000"])
+        .args(["-gcp", "430", "0", "521500", "4000000"])
+        .args(["-gcp", "0", "516", "500000", "3974200"])
+        .arg(fixture("becmodel_dem_bc_albers_50m.tif"))
+        .arg(dir.path("gcps.tif"))
+        .status()
+        .expect("gdal_translate runs");
+    assert!(status.success());
+    let o = dir.run(&["tiles", "gcps.tif", "-o", "p"]);
+    assert_fails_naming(&o, &["gcps.tif", "ground control points", "gdalwarp"]);
+    assert!(!dir.path("p").exists());
+    let o = dir.run(&["mesh", "gcps.tif", "-o", "m.ply", "--max-error", "5"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("gcps.tif: georeferenced only by 3 ground control points")
+            && stderr(&o).contains("pixel (column, row) coordinates"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -105,6 +105,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         (mesh, raster.info, source, levels)
     };
     let georef = Georef::new(info.transform(), args.pixel_coords);
+    crate::output::note_gcps_unused(&info, args.pixel_coords, args.quiet);
 
     // The lines are held whole before writing: refuse levels that would not fit.
     if let Some(available) = crate::memory::available_bytes() {

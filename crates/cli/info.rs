@@ -48,6 +48,11 @@ pub fn run(args: &InfoArgs) -> Result<bool> {
     }
     match info.geo_transform {
         Some(g) => println!("geotransform:  {g:?}"),
+        None if info.gcp_count > 0 => println!(
+            "geotransform:  none (pixel coordinates); {} GCPs, not used: warp onto a grid \
+             first, e.g. `gdalwarp IN OUT.tif`",
+            info.gcp_count
+        ),
         None => println!("geotransform:  none (pixel coordinates)"),
     }
     Ok(true)

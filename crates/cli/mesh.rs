@@ -74,6 +74,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let t = Instant::now();
     let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
     let read_seconds = t.elapsed().as_secs_f64();
+    crate::output::note_gcps_unused(&raster.info, args.pixel_coords, args.quiet);
     let grid = &raster.grid;
     if grid.valid_cell_count() == 0 {
         bail!(

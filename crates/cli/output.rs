@@ -71,6 +71,22 @@ pub fn note_prj_left_beside(output: &Path, format: MeshFormat, crs_written: bool
     );
 }
 
+/// Notes on stderr (unless `quiet` or `pixel_coords`) that a raster placed only by ground
+/// control points is written in pixel coordinates: tinsmith does not georeference by GCPs.
+pub fn note_gcps_unused(info: &tinsmith_raster::RasterInfo, pixel_coords: bool, quiet: bool) {
+    if quiet || pixel_coords || info.geo_transform.is_some() || info.gcp_count == 0 {
+        return;
+    }
+    note!(
+        "{}: georeferenced only by {} ground control points (GCPs), which tinsmith does not \
+         use: the output is in pixel (column, row) coordinates; for world coordinates warp \
+         it onto a grid first, e.g. `gdalwarp {} warped.tif`",
+        info.path.display(),
+        info.gcp_count,
+        info.path.display()
+    );
+}
+
 /// Fails when `output` is the file `input` (the same file by any path, links included):
 /// writing would destroy the input.
 pub fn check_not_input(output: &Path, input: &Path) -> Result<()> {

@@ -148,6 +148,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     tinsmith_raster::limit_block_cache(TILED_BLOCK_CACHE_MB);
     let t = Instant::now();
     let info = crate::progress::scan_raster(&args.input, args.band, args.quiet)?;
+    crate::output::note_gcps_unused(&info, args.pixel_coords, args.quiet);
     let source = RasterSource::new(&info)?;
     let scan_seconds = t.elapsed().as_secs_f64();
     let bar = progress_bar(args.quiet);

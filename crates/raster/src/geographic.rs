@@ -127,6 +127,10 @@ fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
     let info = &opened.info;
     let (Some(gt), Some(_)) = (info.geo_transform, info.crs_wkt.as_ref()) else {
         let (missing, hint) = match (info.geo_transform, &info.crs_wkt) {
+            (None, _) if info.gcp_count > 0 => (
+                "only ground control points (GCPs), no geotransform",
+                "warp it onto a grid in the GCPs' CRS first, e.g. `gdalwarp IN OUT.tif`",
+            ),
             (Some(_), _) => (
                 "no CRS",
                 "assign the CRS its coordinates are in, e.g. `gdal_translate -of VRT -a_srs \

@@ -43,6 +43,9 @@ pub struct RasterInfo {
     /// The dataset's geotransform (GDAL's six coefficients), or `None` when the dataset has
     /// none (GDAL then reports a failure and an identity default, which is not returned).
     pub geo_transform: Option<[f64; 6]>,
+    /// How many ground control points (GCPs) the dataset has. tinsmith does not georeference
+    /// by them: a raster placed only by GCPs is in pixel coordinates until it is warped.
+    pub gcp_count: usize,
     /// The kind of GDAL mask the band has besides its nodata value (`"alpha band"`,
     /// `"per-dataset mask"` or `"mask band"`), whose zero samples count as nodata; `None`
     /// when it has none.

@@ -219,6 +219,7 @@ impl OpenBand {
         let epsg = srs.and_then(epsg_code);
         // GDAL fails (and fills in an identity) when the dataset has no geotransform.
         let geo_transform = dataset.geo_transform().ok();
+        let gcp_count = dataset.gcps().len();
 
         let info = RasterInfo {
             path: path.to_path_buf(),
@@ -234,6 +235,7 @@ impl OpenBand {
             crs_wkt,
             epsg,
             geo_transform,
+            gcp_count,
             mask,
             valid_samples: 0,
             nodata_samples: 0,

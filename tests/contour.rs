@@ -479,6 +479,25 @@ fn levels_whose_lines_would_not_fit_in_memory_are_refused_up_front() {
 }
 
 #[test]
+fn a_memory_ulimit_counts_as_what_is_available() {
+    // The check read only /proc/meminfo: under `ulimit -v` (or a container's cgroup limit)
+    // the sample DEM contoured every 0.1 m (88 M segments, ~5.7 GB) aborted with
+    // "memory allocation failed" instead of being refused.
+    let d = Dir::new();
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 1500000 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_tinsmith"))
+        .args(["contour", &dem, "-o", "c.fgb", "--interval", "0.1"])
+        .current_dir(d.path(""))
+        .output()
+        .expect("sh runs");
+    assert_fails_naming(&o, &["becmodel", "levels cross the TIN", "GB is available"]);
+    assert!(!d.path("c.fgb").exists());
+}
+
+#[test]
 fn contour_bad_input_fails_cleanly() {
     let dem = fixture("tintn_valid_raster_3857.tif");
     let d = Dir::new();

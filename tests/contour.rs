@@ -1294,3 +1294,76 @@ fn lines_have_no_repeated_points_in_map_coordinates() {
         }
     }
 }
+
+#[test]
+fn empty_output_says_why_and_a_mesh_of_another_band_suggests_band() {
+    // A level outside the heights succeeded silently with no line (a typo looked like
+    // success); a --mesh written from band 2 and contoured with band 1 hinted only at
+    // --pixel-coords.
+    let d = Dir::new();
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    for (levels, why) in [
+        (
+            &["--levels", "10000"][..],
+            "the levels miss the TIN's heights, 350 .. 2583",
+        ),
+        (
+            &["--interval", "5000"],
+            "no level of the --interval lies within the TIN's heights",
+        ),
+    ] {
+        let o = d.run(&[&["contour", &dem, "-o", "c.geojson"], levels].concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(stderr(&o).contains(why), "{levels:?}: {}", stderr(&o));
+    }
+    let o = d.run(&["contour", &dem, "-o", "c.geojson", "--interval", "1e300"]);
+    assert!(stderr(&o).contains("at 0 levels") && stderr(&o).len() < 400);
+    let o = d.run(&[
+        "contour",
+        &dem,
+        "-o",
+        "c.geojson",
+        "--interval",
+        "100",
+        "--max-error",
+        "1e300",
+    ]);
+    assert!(stderr(&o).contains("TIN within 1e300"), "{}", stderr(&o));
+
+    let vrt = format!(
+        "<VRTDataset rasterXSize=\"430\" rasterYSize=\"516\">\
+         <VRTRasterBand dataType=\"Float32\" band=\"1\"><SimpleSource><SourceFilename>{dem}\
+         </SourceFilename><SourceBand>1</SourceBand></SimpleSource></VRTRasterBand>\
+         <VRTRasterBand dataType=\"Float32\" band=\"2\"><ComplexSource><SourceFilename>{dem}\
+         </SourceFilename><SourceBand>1</SourceBand><ScaleOffset>5</ScaleOffset>\
+         </ComplexSource></VRTRasterBand></VRTDataset>"
+    );
+    d.write("two.vrt", &vrt);
+    run_ok(
+        &d,
+        &[
+            "mesh",
+            "two.vrt",
+            "--band",
+            "2",
+            "-o",
+            "b2.ply",
+            "--max-error",
+            "5",
+            "--pixel-coords",
+            "-q",
+        ],
+    );
+    let o = d.run(&[
+        "contour",
+        "two.vrt",
+        "-o",
+        "c.fgb",
+        "--interval",
+        "100",
+        "--mesh",
+        "b2.ply",
+        "--pixel-coords",
+    ]);
+    assert_fails_naming(&o, &["b2.ply", "band 1 of", "--band"]);
+}

@@ -32,6 +32,7 @@ use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 use crate::args::ContourArgs;
 use crate::export::{file_crs, Pieces};
 use crate::georef::Georef;
+use crate::number::readable;
 use crate::output::NamingFile;
 use crate::output::{check_distinct, check_writable_target};
 use crate::verify::{expected_orientation, read_mesh_file, sample_positions};
@@ -68,7 +69,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         let info = crate::progress::scan_raster(&args.input, args.band, args.quiet)?;
         let levels = levels_for(args, info.min.zip(info.max))?;
         let (mesh, tiles) = tiled_tin(args, e, &info, &levels)?;
-        let source = format!("TIN within {e} ({tiles} tiles)");
+        let source = format!("TIN within {} ({tiles} tiles)", readable(e));
         (mesh, info, source, levels)
     } else {
         let (need, what, instead) = match &args.mesh {
@@ -211,13 +212,28 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             closed,
             segments,
             args.simplify
-                .map(|d| format!(" (simplified within {d})"))
+                .map(|d| format!(" (simplified within {})", readable(d)))
                 .unwrap_or_default(),
             levels.len(),
             source,
             mesh.triangles().len(),
             started.elapsed().as_secs_f64()
         );
+        if lines.is_empty() {
+            if let Some((lo, hi)) = mesh.height_range() {
+                note!(
+                    "{}: no line: {} the TIN's heights, {} .. {}",
+                    args.output.display(),
+                    if levels.is_empty() {
+                        "no level of the --interval lies within"
+                    } else {
+                        "the levels miss"
+                    },
+                    readable(lo),
+                    readable(hi)
+                );
+            }
+        }
     }
     Ok(true)
 }
@@ -301,7 +317,7 @@ fn untiled_tin(
         .collect();
     let mesh = ContourMesh::new(vertices, tin.triangles().to_vec())
         .with_context(|| format!("{}: decimated TIN", args.input.display()))?;
-    Ok((mesh, format!("TIN within {e}"), levels))
+    Ok((mesh, format!("TIN within {}", readable(e)), levels))
 }
 
 /// The TIN to contour from a raster larger than `--tile-size`: decimated within `e` and
@@ -404,12 +420,17 @@ fn mesh_from_file(
             bail!(
                 "{}: vertex {i} at column {x}, row {y} has height {}, but band {band} of {} \
                  has {} there (more than {:.2e} apart): `contour --mesh` needs a TIN of this \
-                 raster and band{}",
+                 raster and band{}{}",
                 path.display(),
                 v[2],
                 raster.info.path.display(),
                 sample,
                 tolerance,
+                if raster.info.band_count > 1 {
+                    " (written from another band? give that one with --band)"
+                } else {
+                    ""
+                },
                 if matches!(georef, Georef::Pixel) {
                     " (or was it written without --pixel-coords?)"
                 } else {

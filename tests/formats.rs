@@ -643,3 +643,53 @@ fn an_inputs_prj_is_never_replaced_by_a_meshs() {
         assert_eq!(std::fs::read_to_string(d.path("x.prj")).unwrap(), wkt);
     }
 }
+
+#[test]
+fn wgs84_geojson_refuses_triangles_that_fold_around_a_pole() {
+    // Antarctic polar stereographic stopping short of the pole: two triangles' straight
+    // edges pass around it, and in longitude/latitude they came out wound clockwise,
+    // overlapping their neighbours, in a file `verify` passed (it maps back first).
+    let d = Dir::new();
+    let status = std::process::Command::new("gdalwarp")
+        .args([
+            "-q",
+            "-t_srs",
+            "EPSG:3031",
+            "-te",
+            "-1000000",
+            "-1000000",
+            "1000000",
+        ])
+        .args(["-100000", "-ts", "200", "90", "-r", "bilinear"])
+        .arg(fixture("etopo5_2deg_i16.tif"))
+        .arg(d.path("south.tif"))
+        .status()
+        .expect("gdalwarp (Debian gdal-bin) must be on PATH");
+    assert!(status.success());
+    for tiles in ["4096", "64"] {
+        let args = [
+            "mesh",
+            "south.tif",
+            "-o",
+            "m.geojson",
+            "--max-error",
+            "50",
+            "--tile-size",
+            tiles,
+        ];
+        let o = d.run(&args);
+        assert_fails_naming(&o, &["m.geojson", "fold over", "--geojson-source-crs"]);
+        assert!(!d.path("m.geojson").exists());
+    }
+    // The same mesh in the raster's CRS is written.
+    let o = d.run(&[
+        "mesh",
+        "south.tif",
+        "-o",
+        "m.geojson",
+        "--max-error",
+        "50",
+        "--geojson-source-crs",
+    ]);
+    assert!(o.status.success(), "{}", crate::util::stderr(&o));
+}

@@ -265,6 +265,7 @@ pub fn write(
     )?;
     if let (Some(world), Some(crs_of_raster), Some(4326)) = (&world, projected, crs.epsg) {
         check_wgs84_maps_back(world, &vertices, crs_of_raster, path)?;
+        check_no_fold_in_lon_lat(&vertices, triangles, path)?;
     }
     if let Some(origin) = plan.origin {
         check_positions_map_back(&vertices, origin, info, args)?;
@@ -499,6 +500,48 @@ fn check_wgs84_maps_back(
                 b[1]
             );
         }
+    }
+    Ok(())
+}
+
+/// Fails when some triangle, reprojected to longitude, latitude, is wound against the
+/// others: near a pole a straight edge of the raster's CRS can pass around it, and the
+/// triangle then folds over its neighbours in the plane RFC 7946 GeoJSON is read in (found
+/// on polar stereographic rasters whose extent stops short of the pole). Triangles thinner
+/// than rounding are not counted.
+fn check_no_fold_in_lon_lat(
+    lon_lat: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    path: &Path,
+) -> Result<()> {
+    let signed = |t: &[u32; 3]| -> f64 {
+        let [a, b, c] = t.map(|v| lon_lat[v as usize]);
+        let (u, w) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
+        let cross = u[0] * w[1] - u[1] * w[0];
+        let scale = u[0].hypot(u[1]) * w[0].hypot(w[1]);
+        if cross.abs() > 1e-9 * scale {
+            cross.signum()
+        } else {
+            0.0
+        }
+    };
+    let (positive, negative) =
+        triangles
+            .iter()
+            .fold((0usize, 0usize), |(p, n), t| match signed(t) {
+                s if s > 0.0 => (p + 1, n),
+                s if s < 0.0 => (p, n + 1),
+                _ => (p, n),
+            });
+    let folded = positive.min(negative);
+    if folded > 0 {
+        bail!(
+            "{}: {folded} of {} triangles fold over their neighbours in longitude/latitude \
+             (their edges pass close around a pole), so RFC 7946 GeoJSON cannot hold the \
+             mesh; write with --geojson-source-crs (the raster's CRS) or to .fgb",
+            path.display(),
+            triangles.len()
+        );
     }
     Ok(())
 }

@@ -291,6 +291,8 @@ impl LevelRows {
     /// Unit ECEF normal at sample (i, j) from central differences of the level's samples
     /// (one-sided at nodata or the level's border): the same for every tile that has the
     /// sample, so normals are continuous across tile edges. Reads rows `j - 1 ..= j + 1`.
+    /// On a pole's row, where every sample is the same point, the east-west difference is
+    /// left out: its spacing is zero, and it made normals up to 90 degrees off vertical.
     pub(super) fn normal(&self, i: usize, j: usize, lon: f64, lat: f64) -> [f64; 3] {
         let d = step(self.level).to_radians();
         let z = self.at(i, j);
@@ -310,7 +312,11 @@ impl LevelRows {
         let (ii, jj) = (i as i64, j as i64);
         let dx = tinsmith_export::WGS84_A * d * lat.to_radians().cos().max(1e-6);
         let dy = tinsmith_export::WGS84_A * d;
-        let ge = slope(sample(ii - 1, jj), sample(ii + 1, jj), dx);
+        let at_pole = lat.abs() >= 90.0 - 1e-9;
+        let ge = match at_pole {
+            true => 0.0,
+            false => slope(sample(ii - 1, jj), sample(ii + 1, jj), dx),
+        };
         let gn = slope(sample(ii, jj - 1), sample(ii, jj + 1), dy);
         let (e, n, u) = (-ge, -gn, 1.0);
         let len = (e * e + n * n + u * u).sqrt();

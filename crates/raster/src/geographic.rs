@@ -231,16 +231,22 @@ fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
     let gdal_type = rb.band_type().name();
     let file = format!("<SourceFilename relativeToVRT=\"0\">{source}</SourceFilename>");
     let band = if gdal_type.starts_with("Float") {
-        // Where the source equals NODATA the view keeps its initial value, NaN.
-        let skip = match info.nodata {
-            Some(v) if !v.is_nan() => format!("<NODATA>{v:?}</NODATA>"),
-            _ => String::new(),
-        };
-        format!(
-            "<NoDataValue>nan</NoDataValue><ComplexSource>{file}<SourceBand>{}</SourceBand>\
-             {skip}</ComplexSource>",
-            info.band
-        )
+        match info.nodata {
+            // Where the source equals NODATA the view keeps its initial value, NaN.
+            Some(v) if !v.is_nan() => format!(
+                "<NoDataValue>nan</NoDataValue><ComplexSource>{file}<SourceBand>{}</SourceBand>\
+                 <NODATA>{v:?}</NODATA></ComplexSource>",
+                info.band
+            ),
+            // Nothing to turn into NaN: a simple source gives the same values, and GDAL
+            // copies it without the complex source's per-sample pass in f64 (which took
+            // most of a coarse level's warp from a large raster).
+            _ => format!(
+                "<NoDataValue>nan</NoDataValue><SimpleSource>{file}<SourceBand>{}</SourceBand>\
+                 </SimpleSource>",
+                info.band
+            ),
+        }
     } else {
         // Exactly, for the 64-bit types too (beyond 2^53 the f64 in `info` is rounded).
         let nodata = match (gdal_type.as_str(), info.nodata) {

@@ -316,6 +316,19 @@ fn pyramid(dir: &Dir, input: &str, out: &str, extra: &[&str]) {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
+/// `DIR/layer.json` of a pyramid, and its `bounds` as numbers.
+fn layer_json(root: &Path) -> (Value, Vec<f64>) {
+    let layer: Value =
+        serde_json::from_slice(&std::fs::read(root.join("layer.json")).unwrap()).unwrap();
+    let bounds = layer["bounds"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    (layer, bounds)
+}
+
 fn all_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     let mut out = BTreeMap::new();
     let mut stack = vec![root.to_path_buf()];
@@ -522,14 +535,7 @@ fn a_pyramid_across_the_antimeridian_wraps_its_columns() {
 
     let dir = Dir::new();
     pyramid(&dir, &input, "p", &["-q"]);
-    let layer: Value =
-        serde_json::from_slice(&std::fs::read(dir.path("p/layer.json")).unwrap()).unwrap();
-    let bounds: Vec<f64> = layer["bounds"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let (layer, bounds) = layer_json(&dir.path("p"));
     assert!(bounds[0] > 179.0 && bounds[2] < -179.0, "bounds {bounds:?}");
     let tiles = decode_pyramid(&dir.path("p"));
     let max_zoom = layer["maxzoom"].as_u64().unwrap() as u32;
@@ -1021,17 +1027,9 @@ fn a_rotated_raster_is_tiled_whole() {
     dir.write("rotated.vrt", &rotated);
     pyramid(&dir, "plain.vrt", "plain", &[]);
     pyramid(&dir, "rotated.vrt", "rotated", &[]);
-    let layer = |name: &str| -> Value {
-        serde_json::from_slice(&std::fs::read(dir.path(name).join("layer.json")).unwrap()).unwrap()
-    };
-    let (plain, rotated) = (layer("plain"), layer("rotated"));
+    let (plain, _) = layer_json(&dir.path("plain"));
+    let (rotated, bounds) = layer_json(&dir.path("rotated"));
     assert_eq!(rotated["maxzoom"], plain["maxzoom"]);
-    let bounds: Vec<f64> = rotated["bounds"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
     let (w, h) = (430.0, 516.0);
     let corners: Vec<[f64; 3]> = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
         .iter()
@@ -1057,14 +1055,7 @@ fn layer_bounds_are_longitudes_in_range_for_a_raster_east_of_180() {
         ["185", "-30", "195", "-40"],
     );
     pyramid(&dir, &input, "p", &["-q", "--max-zoom", "3"]);
-    let layer: Value =
-        serde_json::from_slice(&std::fs::read(dir.path("p/layer.json")).unwrap()).unwrap();
-    let bounds: Vec<f64> = layer["bounds"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let (_, bounds) = layer_json(&dir.path("p"));
     let expected = [-175.0, -40.0, -165.0, -30.0];
     for (got, want) in bounds.iter().zip(expected) {
         assert!(
@@ -1121,23 +1112,7 @@ fn normals_at_a_pole_point_up_on_flat_ground() {
     // one point, and the east-west difference over its zero spacing tilted normals up to
     // 86 degrees off vertical on the flat plateau, at every coarse level.
     let dir = Dir::new();
-    let status = Command::new("gdalwarp")
-        .args([
-            "-q",
-            "-t_srs",
-            "EPSG:3031",
-            "-te",
-            "-1000000",
-            "-1000000",
-            "1000000",
-        ])
-        .args(["1000000", "-ts", "100", "100", "-r", "bilinear"])
-        .arg(fixture("etopo5_2deg_i16.tif"))
-        .arg(dir.path("pole.tif"))
-        .status()
-        .expect("gdalwarp runs");
-    assert!(status.success());
-    let input = dir.path("pole.tif").to_string_lossy().into_owned();
+    let input = crate::util::south_polar_fixture(&dir, "pole.tif", "1000000", "100");
     pyramid(&dir, &input, "p", &["-q", "--normals", "--max-zoom", "3"]);
     let mut at_pole = 0;
     for (&(z, x, y), t) in &decode_pyramid(&dir.path("p")) {

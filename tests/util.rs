@@ -112,6 +112,30 @@ pub fn gdaltransform(from: &str, to: &str, points: &[[f64; 3]]) -> Vec<[f64; 3]>
     transformed
 }
 
+/// The ETOPO fixture warped (bilinear) into `dir/name` in Antarctic polar stereographic
+/// (EPSG:3031) over x in -1000 .. 1000 km and y from -1000 km to `north` metres, 200
+/// columns by `rows`; returns its path. With `north` past 0 the pole is inside.
+pub fn south_polar_fixture(dir: &Dir, name: &str, north: &str, rows: &str) -> String {
+    let out = dir.path(name);
+    let status = Command::new("gdalwarp")
+        .args([
+            "-q",
+            "-t_srs",
+            "EPSG:3031",
+            "-te",
+            "-1000000",
+            "-1000000",
+            "1000000",
+        ])
+        .args([north, "-ts", "200", rows, "-r", "bilinear"])
+        .arg(fixture("etopo5_2deg_i16.tif"))
+        .arg(&out)
+        .status()
+        .expect("gdalwarp (Debian gdal-bin, installed by `make deps`) must be on PATH");
+    assert!(status.success());
+    out.to_string_lossy().into_owned()
+}
+
 /// A `tinsmith serve` process, killed when the test ends, however it ends (a failed
 /// assertion must not leave it waiting for requests, holding the test's output open).
 pub struct Server(pub std::process::Child);

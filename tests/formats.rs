@@ -651,21 +651,27 @@ fn wgs84_geojson_refuses_triangles_that_fold_around_a_pole() {
     // overlapping their neighbours, in a file `verify` passed (it maps back first).
     let d = Dir::new();
     crate::util::south_polar_fixture(&d, "south.tif", "-100000", "90");
-    for tiles in ["4096", "64"] {
-        let args = [
-            "mesh",
-            "south.tif",
-            "-o",
+    // One triangle, untiled, turns over with a sine of 0.13 (a fold, not a bent sliver).
+    let o = d.run(&[
+        "mesh",
+        "south.tif",
+        "-o",
+        "m.geojson",
+        "--max-error",
+        "50",
+        "--tile-size",
+        "4096",
+    ]);
+    assert_fails_naming(
+        &o,
+        &[
             "m.geojson",
-            "--max-error",
-            "50",
-            "--tile-size",
-            tiles,
-        ];
-        let o = d.run(&args);
-        assert_fails_naming(&o, &["m.geojson", "fold over", "--geojson-source-crs"]);
-        assert!(!d.path("m.geojson").exists());
-    }
+            "fold over",
+            "--geojson-source-crs",
+            "--max-edge-length",
+        ],
+    );
+    assert!(!d.path("m.geojson").exists());
     // The same mesh in the raster's CRS is written.
     let o = d.run(&[
         "mesh",
@@ -677,4 +683,42 @@ fn wgs84_geojson_refuses_triangles_that_fold_around_a_pole() {
         "--geojson-source-crs",
     ]);
     assert!(o.status.success(), "{}", crate::util::stderr(&o));
+}
+
+#[test]
+fn wgs84_geojson_keeps_long_slivers_that_the_projection_bends() {
+    // A strip of flat ground with one spike, 30 m pixels at 45 N in UTM 33N: decimation
+    // leaves triangles 90 km long and 30-60 m wide, which the projection's curvature turns
+    // over in longitude/latitude; the fold check refused the file, blaming a pole.
+    let d = Dir::new();
+    let (width, height) = (3001usize, 3usize);
+    let mut values = vec![0.0f64; width * height];
+    values[2 * width + 1500] = 100.0;
+    let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(d.path("strip.raw"), bytes).unwrap();
+    d.write(
+        "strip.vrt",
+        &format!(
+            "<VRTDataset rasterXSize=\"{width}\" rasterYSize=\"{height}\"><SRS>EPSG:32633</SRS>\
+             <GeoTransform>800000, 30, 0, 5000000, 0, -30</GeoTransform>\
+             <VRTRasterBand dataType=\"Float64\" band=\"1\" subClass=\"VRTRawRasterBand\">\
+             <SourceFilename relativeToVRT=\"1\">strip.raw</SourceFilename>\
+             <ImageOffset>0</ImageOffset><PixelOffset>8</PixelOffset>\
+             <LineOffset>{}</LineOffset><ByteOrder>LSB</ByteOrder></VRTRasterBand></VRTDataset>",
+            8 * width
+        ),
+    );
+    let o = d.run(&[
+        "mesh",
+        "strip.vrt",
+        "-o",
+        "m.geojson",
+        "--max-error",
+        "1",
+        "--tile-size",
+        "4096",
+    ]);
+    assert!(o.status.success(), "{}", crate::util::stderr(&o));
+    let v = d.run(&["verify", "strip.vrt", "m.geojson", "--max-error", "1"]);
+    assert!(v.status.success(), "{}", crate::util::stdout(&v));
 }

@@ -1311,6 +1311,8 @@ fn empty_output_says_why_and_a_mesh_of_another_band_suggests_band() {
             &["--interval", "5000"],
             "no level of the --interval lies within the TIN's heights",
         ),
+        // The highest sample only touches its level: within the range, yet no line.
+        (&["--levels", "2583"], "no level crosses the TIN"),
     ] {
         let o = d.run(&[&["contour", &dem, "-o", "c.geojson"], levels].concat());
         assert!(o.status.success(), "{}", stderr(&o));

@@ -221,14 +221,17 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         );
         if lines.is_empty() {
             if let Some((lo, hi)) = mesh.height_range() {
+                let why = if levels.is_empty() {
+                    "no level of the --interval lies within the TIN's heights"
+                } else if levels.iter().all(|&l| l < lo || l > hi) {
+                    "the levels miss the TIN's heights"
+                } else {
+                    "no level crosses the TIN (ground that only touches a level makes no \
+                     line, and lines too small to keep a point apart are dropped); its heights"
+                };
                 note!(
-                    "{}: no line: {} the TIN's heights, {} .. {}",
+                    "{}: no line: {why}, {} .. {}",
                     args.output.display(),
-                    if levels.is_empty() {
-                        "no level of the --interval lies within"
-                    } else {
-                        "the levels miss"
-                    },
                     readable(lo),
                     readable(hi)
                 );
@@ -259,8 +262,16 @@ fn without_repeated_points(points: &[[f64; 3]], ends: &[LineEnd]) -> (Vec<[f64; 
                 kept.push(p);
             }
         }
-        let count = kept.len() - first;
-        if count >= if closed { 4 } else { 2 } {
+        let line = &kept[first..];
+        let enough = match closed {
+            // Three distinct points: one that is neither the first nor the next other one.
+            true => line
+                .iter()
+                .find(|&&p| p != line[0])
+                .is_some_and(|&second| line.iter().any(|&p| p != line[0] && p != second)),
+            false => line.len() >= 2,
+        };
+        if enough {
             kept_ends.push((kept.len(), level, closed));
         } else {
             kept.truncate(first);

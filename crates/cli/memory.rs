@@ -105,7 +105,9 @@ fn rlimit_room(resource: libc::__rlimit_resource_t, usage: &str) -> Option<u64> 
 
 /// Room under the memory limits of this process's cgroup and its ancestors: the least of
 /// limit less usage (cgroup v2 `memory.max`/`memory.current`, v1
-/// `memory.limit_in_bytes`/`memory.usage_in_bytes`); `None` when no limit is set or
+/// `memory.limit_in_bytes`/`memory.usage_in_bytes`), usage not counting the inactive file
+/// cache the kernel reclaims first (`inactive_file`, v1 `total_inactive_file`, in
+/// `memory.stat`: reading a large raster fills it); `None` when no limit is set or
 /// readable.
 fn cgroup_room() -> Option<u64> {
     let membership = std::fs::read_to_string("/proc/self/cgroup").ok()?;
@@ -123,7 +125,11 @@ fn cgroup_room() -> Option<u64> {
         // v1 writes "no limit" as a huge number (about 2^63), v2 as "max" (no parse).
         if let (Some(limit), Some(usage)) = (read(files.0), read(files.1)) {
             if limit < 1 << 60 {
-                let here = limit.saturating_sub(usage);
+                let stat = std::fs::read_to_string(dir.join("memory.stat")).unwrap_or_default();
+                let reclaimable = stat_field(&stat, "total_inactive_file")
+                    .or_else(|| stat_field(&stat, "inactive_file"))
+                    .unwrap_or(0);
+                let here = limit.saturating_sub(usage.saturating_sub(reclaimable));
                 room = Some(room.map_or(here, |r| r.min(here)));
             }
         }
@@ -132,6 +138,14 @@ fn cgroup_room() -> Option<u64> {
         }
     }
     room
+}
+
+/// The value of a `name value` line of a cgroup's `memory.stat`.
+fn stat_field(stat: &str, name: &str) -> Option<u64> {
+    stat.lines().find_map(|line| {
+        let (key, value) = line.split_once(' ')?;
+        (key == name).then(|| value.trim().parse().ok())?
+    })
 }
 
 /// The cgroup mount, this process's path below it and the limit and usage file names, from
@@ -185,6 +199,14 @@ mod tests {
             ("/sys/fs/cgroup", "/user.slice/app", "memory.max")
         );
         assert!(cgroup_of("3:cpuset:/\n").is_none());
+    }
+
+    #[test]
+    fn memory_stat_fields() {
+        let v1 = "cache 10\ninactive_file 7\ntotal_cache 30\ntotal_inactive_file 21\n";
+        assert_eq!(stat_field(v1, "total_inactive_file"), Some(21));
+        assert_eq!(stat_field(v1, "inactive_file"), Some(7));
+        assert_eq!(stat_field("anon 5\n", "inactive_file"), None);
     }
 
     #[test]

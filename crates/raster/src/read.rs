@@ -375,7 +375,11 @@ fn open_dataset(path: &Path) -> Result<Dataset> {
             | GdalOpenFlags::GDAL_OF_VERBOSE_ERROR,
         ..Default::default()
     };
-    Dataset::open_ex(path, options).map_err(|source| {
+    let opened = Dataset::open_ex(path, options);
+    if let Ok(dataset) = &opened {
+        crate::quiet::note_driver(&dataset.driver().short_name());
+    }
+    opened.map_err(|source| {
         let reason = gdal_reason(&source, path);
         let reason = match std::fs::metadata(path) {
             Ok(m) if m.is_dir() => format!("a directory: {reason}"),

@@ -12,7 +12,9 @@ use crate::info::RasterInfo;
 use crate::read::{MaskSource, OpenBand};
 
 /// Where a raster lies in EPSG:4326 (degrees), and how fine it is. `west` is in
-/// `[-180, 180]` and `east` after it: beyond 180 when the raster crosses the antimeridian.
+/// `[-180, 180]`, or beyond 180 for a raster wholly east of it (the far part of a 0..360
+/// grid, kept in its own frame), and `east` after it: beyond 180 when the raster crosses
+/// the antimeridian.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GeoBounds {
     /// West longitude.

@@ -722,3 +722,44 @@ fn wgs84_geojson_keeps_long_slivers_that_the_projection_bends() {
     let v = d.run(&["verify", "strip.vrt", "m.geojson", "--max-error", "1"]);
     assert!(v.status.success(), "{}", crate::util::stdout(&v));
 }
+
+#[test]
+fn flatgeobuf_that_would_not_fit_in_memory_is_refused_before_writing() {
+    // The FlatGeobuf writer takes ~160 bytes a triangle on top of the mesh (its index and
+    // reordering); a 36 M-triangle mesh peaked at 6.4 GB and nothing checked it. Noise on a
+    // 2000 x 2000 grid at bound 0 keeps ~8 M triangles: ~1.3 GB to write, under a 1.3 GB
+    // address-space limit that the decimation itself (~0.3 GB more than its base) fits in.
+    let d = Dir::new();
+    let (width, height) = (2000usize, 2000usize);
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let bytes: Vec<u8> = (0..width * height)
+        .flat_map(|_| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 40) as f32 / 1000.0).to_le_bytes()
+        })
+        .collect();
+    std::fs::write(d.path("noise.raw"), bytes).unwrap();
+    d.write(
+        "noise.vrt",
+        &format!(
+            "<VRTDataset rasterXSize=\"{width}\" rasterYSize=\"{height}\">\
+             <VRTRasterBand dataType=\"Float32\" band=\"1\" subClass=\"VRTRawRasterBand\">\
+             <SourceFilename relativeToVRT=\"1\">noise.raw</SourceFilename>\
+             <ImageOffset>0</ImageOffset><PixelOffset>4</PixelOffset>\
+             <LineOffset>{}</LineOffset><ByteOrder>LSB</ByteOrder></VRTRasterBand></VRTDataset>",
+            4 * width
+        ),
+    );
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 1300000 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_tinsmith"))
+        .args(["mesh", "noise.vrt", "-o", "n.fgb", "--max-error", "0"])
+        .current_dir(d.path(""))
+        .output()
+        .expect("sh runs");
+    assert_fails_naming(&o, &["n.fgb", "as FlatGeobuf needs about", ".ply"]);
+    assert!(!d.path("n.fgb").exists());
+}

@@ -652,7 +652,7 @@ fn wgs84_geojson_refuses_triangles_that_fold_around_a_pole() {
     let d = Dir::new();
     crate::util::south_polar_fixture(&d, "south.tif", "-100000", "90");
     // One triangle, untiled, turns over with a sine of 0.13 (a fold, not a bent sliver).
-    let o = d.run(&[
+    let mesh = [
         "mesh",
         "south.tif",
         "-o",
@@ -661,27 +661,18 @@ fn wgs84_geojson_refuses_triangles_that_fold_around_a_pole() {
         "50",
         "--tile-size",
         "4096",
-    ]);
-    assert_fails_naming(
-        &o,
-        &[
-            "m.geojson",
-            "fold over",
-            "--geojson-source-crs",
-            "--max-edge-length",
-        ],
-    );
-    assert!(!d.path("m.geojson").exists());
-    // The same mesh in the raster's CRS is written.
-    let o = d.run(&[
-        "mesh",
-        "south.tif",
-        "-o",
+    ];
+    let o = d.run(&mesh);
+    let named = [
         "m.geojson",
-        "--max-error",
-        "50",
+        "fold over",
         "--geojson-source-crs",
-    ]);
+        "--max-edge-length",
+    ];
+    assert_fails_naming(&o, &named);
+    assert!(!d.path("m.geojson").exists());
+    // In the raster's CRS the same mesh is written.
+    let o = d.run(&[&mesh[..], &["--geojson-source-crs"]].concat());
     assert!(o.status.success(), "{}", crate::util::stderr(&o));
 }
 

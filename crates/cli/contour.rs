@@ -30,7 +30,7 @@ use tinsmith_tile::{mesh_tiles, MeshCollector, RasterSource, TileOptions};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
 use crate::args::ContourArgs;
-use crate::export::{file_crs, Pieces};
+use crate::export::{file_crs, LineEnd, Pieces};
 use crate::georef::Georef;
 use crate::number::readable;
 use crate::output::NamingFile;
@@ -65,7 +65,6 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     // A TIN decimated here is shaped for the levels (fewer segments, same bound), so they
     // come from the raster's height range first; a --mesh file's come from its own heights.
     let (mesh, info, source, levels) = if tiled {
-        tinsmith_raster::limit_block_cache(crate::tiled::TILED_BLOCK_CACHE_MB);
         let info = crate::progress::scan_raster(&args.input, args.band, args.quiet)?;
         let levels = levels_for(args, info.min.zip(info.max))?;
         let (mesh, tiles) = tiled_tin(args, e, &info, &levels)?;
@@ -109,21 +108,19 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     crate::output::note_gcps_unused(&info, args.pixel_coords, args.quiet);
 
     // The lines are held whole before writing: refuse levels that would not fit.
-    if let Some(available) = crate::memory::available_bytes() {
-        let segments = mesh.segment_count(&levels);
-        let needed = segments.saturating_mul(BYTES_PER_SEGMENT);
-        if needed > available {
-            bail!(
-                "{}: the {} levels cross the TIN about {segments} times; the lines would \
-                 need about {:.1} GB and {:.1} GB is available; give a larger --interval or \
-                 fewer --levels (or a larger --max-error)",
+    let segments = mesh.segment_count(&levels);
+    crate::memory::check_fits(
+        segments.saturating_mul(BYTES_PER_SEGMENT),
+        |needed, available| {
+            format!(
+                "{}: the {} levels cross the TIN about {segments} times; the lines would need \
+             about {needed:.1} GB and {available:.1} GB is available; give a larger \
+             --interval or fewer --levels (or a larger --max-error)",
                 args.input.display(),
-                levels.len(),
-                needed as f64 / 1e9,
-                available as f64 / 1e9
-            );
-        }
-    }
+                levels.len()
+            )
+        },
+    )?;
     let polylines = contour(&mesh, &levels)
         .with_context(|| format!("{}: contouring failed", args.input.display()))?;
 
@@ -158,13 +155,12 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         ends.push((points.len(), level, closed));
     }
     let wgs84 = format == LineFormat::GeoJson && !args.geojson_source_crs;
-    let line_ends: Vec<(usize, f64)> = ends.iter().map(|&(end, level, _)| (end, level)).collect();
     let crs = file_crs(
         &info,
         args.pixel_coords,
         wgs84,
         &mut points,
-        Pieces::Lines(&line_ends),
+        Pieces::Lines(&ends),
         &args.output,
         args.quiet,
     )?;
@@ -240,10 +236,6 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     }
     Ok(true)
 }
-
-/// A line's end (one past its last point) in a shared point buffer, its level, and whether
-/// it is a closed ring.
-type LineEnd = (usize, f64, bool);
 
 /// The lines (`ends`: each line's end in `points`, its level, whether it is a closed ring)
 /// in the file's coordinates without consecutive repeated points: crossings a hair's breadth

@@ -353,9 +353,13 @@ pub fn file_crs<'r>(
 pub enum Pieces<'a> {
     /// A mesh's vertices (shared by triangles).
     Mesh,
-    /// Lines, one after the other: the end index of each in the points (and its level).
-    Lines(&'a [(usize, f64)]),
+    /// Lines, one after the other (see [`LineEnd`]).
+    Lines(&'a [LineEnd]),
 }
+
+/// A line's end (one past its last point) in a shared point buffer, its level, and whether
+/// it is a closed ring.
+pub type LineEnd = (usize, f64, bool);
 
 /// Which pole ("north" or "south") lies within the hull of a projected raster's sample
 /// centres, if any: its longitudes then go all the way round.
@@ -380,9 +384,9 @@ fn pole_inside(info: &RasterInfo, wkt: &str) -> Option<&'static str> {
 /// Around a pole no frame of longitudes is continuous over the whole raster, but along a
 /// line each step is short: each point's longitude is moved by whole turns to within 180°
 /// of the point before it (the GeoJSON writer then cuts at the antimeridian).
-fn unwrap_along_lines(points: &mut [[f64; 3]], ends: &[(usize, f64)]) {
+fn unwrap_along_lines(points: &mut [[f64; 3]], ends: &[LineEnd]) {
     let mut start = 0;
-    for &(end, _) in ends {
+    for &(end, _, _) in ends {
         for i in start + 1..end {
             let previous = points[i - 1][0];
             let p = &mut points[i][0];
@@ -576,21 +580,15 @@ const FLATGEOBUF_BYTES_PER_TRIANGLE: u64 = 160;
 /// memory than is available (it was killed partway, or took the machine's swap, where a
 /// 100 M-triangle mesh needed about 16 GB); the streamed formats need none.
 fn check_flatgeobuf_fits(path: &Path, triangles: usize) -> Result<()> {
-    let Some(available) = crate::memory::available_bytes() else {
-        return Ok(());
-    };
     let needed = (triangles as u64).saturating_mul(FLATGEOBUF_BYTES_PER_TRIANGLE);
-    if needed > available {
-        bail!(
-            "{}: writing {triangles} triangles as FlatGeobuf needs about {:.1} GB for its \
-             spatial index, and {:.1} GB is available; write .ply or .obj (streamed to disk), \
-             or give a larger --max-error",
-            path.display(),
-            needed as f64 / 1e9,
-            available as f64 / 1e9
-        );
-    }
-    Ok(())
+    crate::memory::check_fits(needed, |needed, available| {
+        format!(
+            "{}: writing {triangles} triangles as FlatGeobuf needs about {needed:.1} GB for \
+             its spatial index, and {available:.1} GB is available; write .ply or .obj \
+             (streamed to disk), or give a larger --max-error",
+            path.display()
+        )
+    })
 }
 
 /// The last gate for float32 files: every stored position maps back to a sample centre

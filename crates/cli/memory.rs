@@ -34,24 +34,28 @@ pub fn check_whole_raster_fits(
     what: &str,
     instead: &str,
 ) -> Result<()> {
-    let Some(available) = available_bytes() else {
-        return Ok(());
-    };
     let samples = u64::from(width) * u64::from(height);
     let needed = samples
         .saturating_mul(need.bytes_per_sample)
         .saturating_add(need.extra_bytes);
-    if needed > available {
-        let gb = |bytes: u64| bytes as f64 / 1e9;
-        bail!(
+    check_fits(needed, |needed, available| {
+        format!(
             "{}: {what} needs the whole {width}x{height} raster in memory at once, about \
-             {:.1} GB, and {:.1} GB is available; {instead}",
-            input.display(),
-            gb(needed),
-            gb(available)
-        );
+             {needed:.1} GB, and {available:.1} GB is available; {instead}",
+            input.display()
+        )
+    })
+}
+
+/// Fails with `refusal(needed GB, available GB)` when `needed` bytes exceed the memory
+/// available ([`available_bytes`]); passes when that cannot be read.
+pub fn check_fits(needed: u64, refusal: impl FnOnce(f64, f64) -> String) -> Result<()> {
+    match available_bytes() {
+        Some(available) if needed > available => {
+            bail!("{}", refusal(needed as f64 / 1e9, available as f64 / 1e9))
+        }
+        _ => Ok(()),
     }
-    Ok(())
 }
 
 /// The memory this process can still take, in bytes: the least of the system's

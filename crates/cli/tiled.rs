@@ -21,8 +21,10 @@ use crate::output::NamingFile;
 use crate::output::{check_distinct, check_writable_target, write_atomically};
 use crate::report::{MeshSummary, Outcome, Seconds};
 
-/// GDAL block cache in tiled mode, in MB: several rows of tiles of a 16k-wide Float32
-/// raster, whether it is stored in strips or blocks.
+/// GDAL block cache, in MB, for the commands that read each block once (set in `main`):
+/// several rows of tiles of a 16k-wide Float32 raster, whether it is stored in strips or
+/// blocks. GDAL's default (5 % of the machine's memory) would keep most of a large raster
+/// resident.
 pub const TILED_BLOCK_CACHE_MB: u64 = 256;
 
 /// The output file when the untiled engine should run: no `--per-tile`, and the raster
@@ -143,9 +145,6 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         }
     }
 
-    // Tiles need only the blocks of the current row of tiles; GDAL's default (5 % of the
-    // machine's memory) would keep most of a large raster resident.
-    tinsmith_raster::limit_block_cache(TILED_BLOCK_CACHE_MB);
     let t = Instant::now();
     let info = crate::progress::scan_raster(&args.input, args.band, args.quiet)?;
     crate::output::note_gcps_unused(&info, args.pixel_coords, args.quiet);

@@ -313,9 +313,10 @@ impl LevelRows {
         let dx = tinsmith_export::WGS84_A * d * lat.to_radians().cos().max(1e-6);
         let dy = tinsmith_export::WGS84_A * d;
         let at_pole = lat.abs() >= 90.0 - 1e-9;
-        let ge = match at_pole {
-            true => 0.0,
-            false => slope(sample(ii - 1, jj), sample(ii + 1, jj), dx),
+        let ge = if at_pole {
+            0.0
+        } else {
+            slope(sample(ii - 1, jj), sample(ii + 1, jj), dx)
         };
         let gn = slope(sample(ii, jj - 1), sample(ii, jj + 1), dy);
         let (e, n, u) = (-ge, -gn, 1.0);

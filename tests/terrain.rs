@@ -894,6 +894,24 @@ fn layer_json_ends_at_the_deepest_level_with_tiles() {
 }
 
 #[test]
+fn very_tall_pixels_choose_a_level_from_their_area_not_their_width() {
+    // 0.1 by 20 degrees per pixel: the default level followed the finer axis (level 4,
+    // each pixel cut into about 400 lattice rows); a 100000 x 10 global raster ran for
+    // hours. The lattice now holds at most 64 times the samples: level 3 here.
+    let dir = Dir::new();
+    let row: String = (0..320).map(|c| format!("{} ", c % 7)).collect();
+    let rows = format!("{row}\n").repeat(4);
+    dir.write(
+        "tall.asc",
+        &format!("ncols 320\nnrows 4\nxllcorner -16\nyllcorner -40\ndx 0.1\ndy 20\n{rows}"),
+    );
+    dir.write("tall.prj", "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]");
+    pyramid(&dir, "tall.asc", "p", &["-q"]);
+    let (layer, _) = layer_json(&dir.path("p"));
+    assert_eq!(layer["maxzoom"].as_u64(), Some(3));
+}
+
+#[test]
 fn a_failed_pyramid_leaves_no_directory_it_made() {
     // The missing parents of -o are made (as mkdir -p); a run that then fails (here: no
     // valid sample at all) removes them again. They used to stay.

@@ -25,7 +25,9 @@ pub struct GeoBounds {
     pub east: f64,
     /// North latitude.
     pub north: f64,
-    /// The finer of the longitude and latitude spans per sample, in degrees.
+    /// The finer of the longitude and latitude spans per sample, in degrees, but no finer
+    /// than an eighth of their geometric mean: a lattice this fine holds at most 64 times
+    /// the raster's samples, however tall or wide its pixels.
     pub resolution: f64,
 }
 
@@ -76,7 +78,7 @@ pub fn geographic_bounds(path: &Path, band: usize) -> Result<GeoBounds> {
     } else {
         (b[0], b[2])
     };
-    let resolution = ((east - west) / w).min((b[3] - b[1]) / h);
+    let resolution = resolution((east - west) / w, (b[3] - b[1]) / h);
     // A global grid's extent can come out a rounding error short of the whole circle
     // (ETOPO5's 5' pixels from -0.041666666667: 3e-13 degrees short); a millionth of a
     // sample is far below any gap a raster could mean.
@@ -95,6 +97,19 @@ pub fn geographic_bounds(path: &Path, band: usize) -> Result<GeoBounds> {
         north: b[3].min(90.0),
         resolution,
     })
+}
+
+/// How many times finer than the geometric mean of a sample's longitude and latitude spans
+/// [`GeoBounds::resolution`] may be: a lattice that fine holds at most 64 times the raster's
+/// sample count. Pixels up to 64 times wider (in degrees) than tall, as projected rasters
+/// have up to about 89° of latitude (or a polar cap of 3600 x 3600 from 80° to the pole),
+/// resolve their finer axis; extremely tall or wide ones (a 100000 x 10 global raster is
+/// 0.0036° by 18°) would otherwise be resampled onto billions of lattice points.
+const MAX_ANISOTROPY: f64 = 8.0;
+
+/// The span per sample a lattice needs for a raster of `lon` by `lat` degrees per sample.
+fn resolution(lon: f64, lat: f64) -> f64 {
+    lon.min(lat).max((lon * lat).sqrt() / MAX_ANISOTROPY)
 }
 
 /// Whether the band's heights may lie beyond `f32`'s range, from its metadata alone: its

@@ -10,10 +10,14 @@ TOOLS := .tools
 PY_ORACLES := trimesh==4.12.2 numpy==2.2.6
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps oracles demo test bench-results bench-contour bench-compare bench-tiles
+.PHONY: deps gdal oracles demo test bench-results bench-contour bench-compare bench-tiles
 
-## Install Debian's GDAL (headers, tools) and pkg-config when missing.
-deps:
+## Everything the tests need: GDAL, then the independent oracles.
+deps: gdal
+	@$(MAKE) --no-print-directory oracles
+
+## Install Debian's GDAL (headers, tools) and pkg-config when missing; check for Rust.
+gdal:
 	@if ! pkg-config --exists gdal 2>/dev/null || ! command -v ogrinfo >/dev/null; then \
 	  echo "installing libgdal-dev gdal-bin pkg-config"; \
 	  $(SUDO) apt-get update -qq && \
@@ -21,7 +25,6 @@ deps:
 	    libgdal-dev gdal-bin pkg-config build-essential ca-certificates curl; \
 	fi
 	@command -v cargo >/dev/null || { echo "Rust is missing: install it from https://rustup.rs"; exit 1; }
-	@$(MAKE) --no-print-directory oracles
 
 ## The independent readers the format tests check our files with (tests/formats.rs):
 ## trimesh in .venv (PyPI) and the Khronos glTF validator in .tools (npm). Idempotent.
@@ -60,7 +63,7 @@ qm-oracles:
 	fi
 
 ## Mesh the sample DEM at $(DEMO_ERROR) m, then prove the bound with the verifier.
-demo: deps
+demo: gdal
 	cargo build --release --quiet
 	mkdir -p out
 	target/release/tinsmith info $(DEMO_DEM)

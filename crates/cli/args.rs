@@ -255,7 +255,7 @@ pub struct ContourArgs {
     /// in WGS84 longitude/latitude unless --geojson-source-crs.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Contour every multiple of this (plus --offset) within the TIN's height range.
+    /// Contour every multiple of this (plus --offset) within the raster's height range (the mesh file's with --mesh).
     #[arg(long, value_parser = parse_interval, allow_negative_numbers = true)]
     pub interval: Option<f64>,
     /// Shift of the --interval levels: levels are offset + k * interval.

@@ -1,7 +1,7 @@
 //! `tinsmith`: error-bounded DEM to TIN conversion on the command line.
 //!
-//! Exit codes: 0 success; 1 the verifier found the mesh outside the bound or invalid;
-//! 2 bad input or any other error (the message names the file and the problem).
+//! Exit codes: 0 success; 1 `verify` measured the mesh and found it outside the bound or
+//! invalid; 2 bad input or any other error (the message names the file and the problem).
 
 /// `eprintln!` for notes (summaries, warnings, the final error): a closed stderr (`2>&1 |
 /// head`) is not an error, and must not panic in the middle of writing output files.

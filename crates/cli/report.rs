@@ -76,7 +76,12 @@ impl<'a> MeshSummary<'a> {
             max_vertices: args.max_vertices,
             error_model: value_name(args.error_model),
             selection: value_name(args.selection),
-            order: value_name(args.order),
+            // A count target always removes in greedy order (see `with_max_triangles`).
+            order: if args.max_triangles.is_some() || args.max_vertices.is_some() {
+                value_name(crate::args::OrderArg::Greedy)
+            } else {
+                value_name(args.order)
+            },
             retriangulate: value_name(args.retriangulate),
             initial_mesh: value_name(args.initial_mesh),
             max_edge_length: args.max_edge_length,

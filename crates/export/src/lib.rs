@@ -1,4 +1,6 @@
-//! Writes and reads triangulated irregular networks as mesh files (binary PLY, OBJ).
+//! Writes and reads triangulated irregular networks as mesh files (PLY, OBJ, STL, glTF,
+//! GeoJSON, FlatGeobuf, LandXML; see [`MeshFormat`]); also contour lines
+//! ([`write_lines`]) and quantized-mesh terrain tiles.
 //!
 //! A mesh is given as plain slices ([`MeshRef`]): world `[x, y, z]` vertices, `[u32; 3]`
 //! triangles in the orientation to be written, and an optional CRS as WKT. This crate knows
@@ -8,19 +10,23 @@
 //! - **Atomic output.** [`write_mesh`] (and [`MeshStreamWriter`], which takes the mesh in
 //!   pieces) writes a temporary file next to the target and renames it into place. After an error there is no partial file and no temporary file;
 //!   an existing file at the target keeps its content.
-//! - **Exact round trip.** [`read_mesh`] of a file written by [`write_mesh`] returns the
-//!   same coordinates bit for bit (PLY stores `double`s, OBJ the shortest decimal that parses
-//!   back to the same `f64`), the same triangles in the same order and orientation, and the
-//!   CRS on one line.
+//! - **Exact round trip in the double-precision formats.** [`read_mesh`] of a PLY, OBJ,
+//!   FlatGeobuf or LandXML file written by [`write_mesh`] (and a GeoJSON one, which prints
+//!   the shortest decimals) returns the same coordinates bit for bit (PLY stores `double`s,
+//!   the text formats the shortest decimal that parses back to the same `f64`), the same
+//!   triangles in the same order and orientation, and the CRS on one line. STL and glTF
+//!   store float32 offsets from a [`LocalOrigin`]: they read back as the origin plus those
+//!   offsets.
 //! - **Validated input.** [`write_mesh`] refuses meshes with out-of-range indices or
 //!   non-finite coordinates before creating any file; [`read_mesh`] returns only meshes
 //!   with finite coordinates and in-range indices, and reports every malformed file as an
 //!   [`Error`] naming the file, never by panicking.
 //!
 //! # Formats
-//! See [`MeshFormat`]: [`MeshFormat::Ply`] is written as `binary_little_endian 1.0`
-//! (`double` x, y, z; `list uchar int vertex_indices`; `comment crs <wkt>`) and read as
-//! ASCII or binary; [`MeshFormat::Obj`] as `v`/`f` lines with a `# crs: <wkt>` comment.
+//! See [`MeshFormat`] for each: for example [`MeshFormat::Ply`] is written as
+//! `binary_little_endian 1.0` (`double` x, y, z; `list uchar int vertex_indices`; `comment
+//! crs <wkt>`) and read as ASCII or binary; [`MeshFormat::Obj`] as `v`/`f` lines with a
+//! `# crs: <wkt>` comment.
 //!
 //! # Example
 //! ```

@@ -11,11 +11,13 @@
 //! [`RasterInfo::max_abs_value`] of [`open_info`] gives the raster-wide largest |height|.
 //!
 //! # What callers can rely on
-//! - **Nodata.** A sample is nodata exactly when it is NaN or infinite, or equals the band's
+//! - **Nodata.** A sample is nodata exactly when it is NaN or infinite, is zero in the
+//!   band's mask (a GDAL mask band, or an alpha band of any type), or equals the band's
 //!   nodata value compared in the band's own type: Float32 bands compare in single precision
-//!   (a `-3.4e38` declared in text matches the `f32` stored in the pixels), integer bands
-//!   compare with the nodata value rounded to the type (and ignore one the type cannot
-//!   hold). Nodata samples are NaN in the grid; all other samples are finite.
+//!   (a `-3.4e38` declared in text matches the `f32` stored in the pixels) and floats within
+//!   GDAL's own tolerance, as `gdalinfo -stats` counts them; integer bands match a nodata
+//!   value only when it is an integer the type can hold (any other matches nothing).
+//!   Nodata samples are NaN in the grid; all other samples are finite.
 //! - **Heights.** Valid samples are mapped through the band's scale and offset when it has
 //!   them, so every height is in the band's real unit.
 //! - **Geotransform.** `None` when the dataset has none (GDAL reports an identity default

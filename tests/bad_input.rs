@@ -44,6 +44,21 @@ fn input_that_is_not_a_raster() {
 }
 
 #[test]
+fn a_vrt_whose_source_is_missing_says_so_once() {
+    // The message quoted GDAL's reason, then the gdal crate's wrapper of the same reason
+    // ("CPL error class: '3', error number: '4', error msg: ...").
+    let d = Dir::new();
+    let vrt = stretched_dem(50, 40).replace(&dem(), "gone.tif");
+    d.write("broken.vrt", &vrt);
+    let o = d.run(&["mesh", "broken.vrt", "-o", "out.ply", "--max-error", "1"]);
+    assert_fails_naming(&o, &["broken.vrt", "gone.tif: No such file"]);
+    let err = stderr(&o);
+    assert!(!err.contains("CPL error"), "{err}");
+    assert_eq!(err.matches("No such file").count(), 1, "{err}");
+    assert_eq!(d.files(), vec!["broken.vrt"]);
+}
+
+#[test]
 fn band_out_of_range() {
     let d = Dir::new();
     let o = d.run(&[

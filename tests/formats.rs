@@ -571,12 +571,36 @@ fn float32_formats_refuse_rasters_too_wide_for_float32_positions() {
          NODATA_value -9999\n{row}\n{row}\n"
     );
     let asc = d.write("wide.asc", &text).to_string_lossy().into_owned();
+    let vrt = d.write(
+        "unreadable.vrt",
+        &format!(
+            "<VRTDataset rasterXSize=\"{width}\" rasterYSize=\"2\">\
+             <GeoTransform>500000, 1, 0, 5000000, 0, -1</GeoTransform>\
+             <VRTRasterBand dataType=\"Float32\" band=\"1\"><SimpleSource>\
+             <SourceFilename relativeToVRT=\"1\">missing.tif</SourceFilename>\
+             <SourceBand>1</SourceBand></SimpleSource></VRTRasterBand></VRTDataset>"
+        ),
+    );
+    let vrt = vrt.to_string_lossy().into_owned();
     // One tile and many: the untiled and tiled engines make the same check, before
     // decimating, and write nothing.
     for (name, size) in [("w.stl", "40000"), ("w.glb", "40000"), ("w.stl", "1024")] {
         let o = d.run(&[
             "mesh",
             &asc,
+            "-o",
+            name,
+            "--max-error",
+            "1",
+            "--tile-size",
+            size,
+        ]);
+        crate::util::assert_fails_naming(&o, &[name, "too large for float32"]);
+        // Refused before reading any sample: the size alone decides (a VRT whose source
+        // is missing said only that reading failed, after trying).
+        let o = d.run(&[
+            "mesh",
+            &vrt,
             "-o",
             name,
             "--max-error",

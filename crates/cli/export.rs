@@ -177,6 +177,23 @@ fn height_rounding_bound(origin: LocalOrigin, min: f64, max: f64) -> f64 {
     2.0 * (offset * 2f64.powi(-24) + (offset + magnitude) * 2f64.powi(-52))
 }
 
+/// For STL and glTF, before reading any sample: fails when the raster is too wide for
+/// float32 positions (see [`Plan::new`]; the positions depend only on the size and the
+/// geotransform, so a huge raster is refused before its statistics scan).
+pub fn check_float32_positions(
+    format: MeshFormat,
+    info: &RasterInfo,
+    args: &MeshArgs,
+) -> Result<()> {
+    if !format.is_float32() {
+        return Ok(());
+    }
+    let georef = Georef::new(info.transform(), args.pixel_coords);
+    let (min, max) = extent(info, &georef);
+    let origin = LocalOrigin::around(min, max);
+    check_position_rounding(info, &georef, origin, min, max, out(args))
+}
+
 /// Min and max of the raster's file coordinates (sample centres) and valid heights.
 fn extent(info: &RasterInfo, georef: &Georef) -> ([f64; 3], [f64; 3]) {
     let (w, h) = (info.width.saturating_sub(1), info.height.saturating_sub(1));

@@ -111,12 +111,14 @@ fn end_quietly_on_closed_stdout() {
 }
 
 /// The error and its causes on one line, skipping a cause already quoted by the message
-/// above it, and the gdal crate's wrapper text (the raster errors quote GDAL's reason).
+/// above it, and the gdal crate's wrapper texts (the raster errors quote GDAL's reason).
 fn one_line(err: &anyhow::Error) -> String {
     let mut line = String::new();
     for cause in err.chain() {
         let text = cause.to_string();
-        if !line.contains(&text) && !text.starts_with("GDAL method") {
+        let gdal_wrapper = text.starts_with("GDAL method")
+            || (text.starts_with("CPL error class") && !line.is_empty());
+        if !line.contains(&text) && !gdal_wrapper {
             if !line.is_empty() {
                 line.push_str(": ");
             }

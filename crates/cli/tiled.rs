@@ -44,6 +44,7 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
         crate::output::check_sidecar_not_input(output, &args.input, format)?;
     }
     let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
+    crate::export::check_float32_positions(format, reader.info(), args)?;
     let fits = reader.width() <= args.tile_size && reader.height() <= args.tile_size;
     let count_target = args.max_triangles.is_some() || args.max_vertices.is_some();
     if count_target && !fits {

@@ -59,6 +59,63 @@ fn a_vrt_whose_source_is_missing_says_so_once() {
 }
 
 #[test]
+fn an_output_over_a_file_the_input_is_read_from_is_refused() {
+    // Only the input's own path was protected: a VRT's source (or a PNG's .aux.xml
+    // georeferencing) was overwritten and the run exited 0.
+    let d = Dir::new();
+    std::fs::copy(dem(), d.path("src.tif")).unwrap();
+    let vrt = stretched_dem(50, 40).replace(
+        &format!("relativeToVRT=\"0\">{}<", dem()),
+        "relativeToVRT=\"1\">src.tif<",
+    );
+    d.write("v.vrt", &vrt);
+    let before = std::fs::read(d.path("src.tif")).unwrap();
+    let mesh = [
+        "mesh",
+        "v.vrt",
+        "-o",
+        "src.tif",
+        "--format",
+        "ply",
+        "--max-error",
+        "1",
+    ];
+    let tiled = ["--tile-size", "16"];
+    for args in [&mesh[..], &[&mesh[..], &tiled[..]].concat()] {
+        let o = d.run(args);
+        assert_fails_naming(&o, &["src.tif", "v.vrt", "read from"]);
+    }
+    let o = d.run(&["contour", "v.vrt", "-o", "src.tif", "--levels", "0"]);
+    assert_eq!(o.status.code(), Some(2));
+    // The report too, and the OBJ's .prj sidecar.
+    let o = d.run(&[
+        "mesh",
+        "v.vrt",
+        "-o",
+        "m.ply",
+        "--max-error",
+        "1",
+        "--report",
+        "src.tif",
+    ]);
+    assert_fails_naming(&o, &["src.tif", "read from"]);
+    std::fs::copy(d.path("src.tif"), d.path("src.prj")).unwrap();
+    std::fs::write(
+        d.path("v.vrt"),
+        vrt.replace(
+            "<SourceFilename relativeToVRT=\"1\">src.tif",
+            "<SourceFilename relativeToVRT=\"1\">src.prj",
+        ),
+    )
+    .unwrap();
+    let o = d.run(&["mesh", "v.vrt", "-o", "src.obj", "--max-error", "1"]);
+    assert_fails_naming(&o, &["src.obj", "src.prj", "belongs to the input"]);
+    assert_eq!(std::fs::read(d.path("src.tif")).unwrap(), before);
+    assert_eq!(std::fs::read(d.path("src.prj")).unwrap(), before);
+    assert_eq!(d.files(), vec!["src.prj", "src.tif", "v.vrt"]);
+}
+
+#[test]
 fn band_out_of_range() {
     let d = Dir::new();
     let o = d.run(&[

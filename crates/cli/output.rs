@@ -32,16 +32,17 @@ pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
 }
 
 /// Fails when the `.prj` sidecar a georeferenced mesh in `format` writes beside `output`
-/// is the input's own `.prj` (an ESRI ASCII grid keeps its CRS there): writing it would
-/// replace the input's CRS file. (With `--pixel-coords` no sidecar is written.)
+/// is the input's own `.prj` (an ESRI ASCII grid keeps its CRS there) or another file the
+/// input is read from: writing it would change the input. (With `--pixel-coords` no
+/// sidecar is written.)
 pub fn check_sidecar_not_input(output: &Path, input: &Path, format: MeshFormat) -> Result<()> {
     if !format.uses_prj_sidecar() {
         return Ok(());
     }
     let ours = tinsmith_export::prj_path(output);
-    let theirs = tinsmith_export::prj_path(input);
-    if let (Ok(a), Ok(b)) = (std::fs::canonicalize(&ours), std::fs::canonicalize(&theirs)) {
-        if a == b {
+    if let Ok(a) = std::fs::canonicalize(&ours) {
+        let theirs = std::fs::canonicalize(tinsmith_export::prj_path(input)).ok();
+        if theirs.as_ref() == Some(&a) || tinsmith_raster::input_files(input).contains(&a) {
             bail!(
                 "{}: its CRS would go to {}, which belongs to the input {}; choose another \
                  output name",
@@ -87,18 +88,28 @@ pub fn note_gcps_unused(info: &tinsmith_raster::RasterInfo, pixel_coords: bool, 
     );
 }
 
-/// Fails when `output` is the file `input` (the same file by any path, links included):
-/// writing would destroy the input.
+/// Fails when `output` is the file `input` or one GDAL reads with it (a VRT's source, an
+/// ENVI header, a `.prj` or `.aux.xml` sidecar: see [`tinsmith_raster::input_files`]), by
+/// any path, links included: writing would destroy or change the input.
 pub fn check_not_input(output: &Path, input: &Path) -> Result<()> {
-    let target = tinsmith_export::resolve_output(output);
-    if let (Ok(a), Ok(b)) = (std::fs::canonicalize(target), std::fs::canonicalize(input)) {
-        if a == b {
-            bail!(
-                "{}: is the input raster {}; writing there would destroy it",
-                output.display(),
-                input.display()
-            );
-        }
+    let Ok(target) = std::fs::canonicalize(tinsmith_export::resolve_output(output)) else {
+        return Ok(());
+    };
+    let own = std::fs::canonicalize(input).ok();
+    if own.as_ref() == Some(&target) {
+        bail!(
+            "{}: is the input raster {}; writing there would destroy it",
+            output.display(),
+            input.display()
+        );
+    }
+    if tinsmith_raster::input_files(input).contains(&target) {
+        bail!(
+            "{}: is a file the input raster {} is read from (GDAL lists it among the \
+             input's files); writing there would change or destroy the input",
+            output.display(),
+            input.display()
+        );
     }
     Ok(())
 }

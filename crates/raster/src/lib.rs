@@ -58,6 +58,7 @@
 mod cache;
 mod decode;
 mod error;
+mod files;
 mod geographic;
 mod info;
 mod quiet;
@@ -67,6 +68,7 @@ mod window;
 
 pub use cache::limit_block_cache;
 pub use error::{Error, Result};
+pub use files::input_files;
 pub use geographic::{
     geographic_bounds, heights_may_exceed_f32, warp_to_geographic, GeoBounds, GeoLattice,
 };

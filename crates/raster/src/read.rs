@@ -362,7 +362,7 @@ impl OpenBand {
 }
 
 /// Opens `path` read-only with GDAL's raster drivers, asking GDAL to say why it cannot.
-fn open_dataset(path: &Path) -> Result<Dataset> {
+pub(crate) fn open_dataset(path: &Path) -> Result<Dataset> {
     if is_missing_file(path) {
         return Err(Error::NotFound {
             path: path.to_path_buf(),

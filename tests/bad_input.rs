@@ -430,6 +430,76 @@ fn two_files_of_one_run_that_are_the_same_file_are_refused() {
     assert_eq!(std::fs::read(d.path("m.geojson")).unwrap(), mesh_before);
 }
 
+#[test]
+fn a_report_over_another_file_of_the_run_is_refused() {
+    // The report replaced the OBJ's .prj, a pyramid's layer.json or a --per-tile mesh, and
+    // the run exited 0.
+    let d = Dir::new();
+    std::fs::create_dir(d.path("pyramid")).unwrap();
+    let cases: [(&[&str], [&str; 2]); 4] = [
+        (
+            &[
+                "mesh",
+                &dem(),
+                "-o",
+                "m.obj",
+                "--max-error",
+                "1",
+                "--report",
+                "m.prj",
+            ],
+            ["m.prj", "CRS sidecar"],
+        ),
+        (
+            &[
+                "mesh",
+                &dem(),
+                "-o",
+                "m.obj",
+                "--max-error",
+                "1",
+                "--report",
+                "m.prj",
+                "--tile-size",
+                "16",
+            ],
+            ["m.prj", "CRS sidecar"],
+        ),
+        (
+            &[
+                "mesh",
+                &dem(),
+                "--per-tile",
+                "per",
+                "--max-error",
+                "1",
+                "--tile-size",
+                "64",
+                "--report",
+                "per/tile_r0_c0.ply",
+            ],
+            ["per/tile_r0_c0.ply", "--per-tile directory"],
+        ),
+        (
+            &[
+                "tiles",
+                &dem(),
+                "-o",
+                "pyramid",
+                "--report",
+                "pyramid/layer.json",
+            ],
+            ["pyramid/layer.json", "pyramid directory"],
+        ),
+    ];
+    for (args, named) in cases {
+        let o = d.run(args);
+        assert_fails_naming(&o, &named);
+    }
+    assert_eq!(d.files(), vec!["pyramid"]);
+    assert_eq!(std::fs::read_dir(d.path("pyramid")).unwrap().count(), 0);
+}
+
 #[cfg(unix)]
 #[test]
 fn a_symlinked_output_stays_a_link() {

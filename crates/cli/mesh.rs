@@ -10,7 +10,7 @@ use tinsmith_verify::{GridRef, VerifyOptions};
 use crate::args::MeshArgs;
 use crate::georef::Georef;
 use crate::output::NamingFile;
-use crate::output::{check_distinct, check_writable_target, write_atomically};
+use crate::output::{check_distinct, check_writable_target, ReservedReport};
 use crate::report::{MeshSummary, Outcome, Seconds};
 
 /// The `--report` JSON.
@@ -69,7 +69,13 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     if let Some(report) = &args.report {
         check_writable_target(report, &args.input)?;
         check_distinct(output, report, "the output")?;
+        crate::output::check_distinct_from_sidecar(output, report, format, args.pixel_coords)?;
     }
+    let reserved = args
+        .report
+        .as_deref()
+        .map(ReservedReport::reserve)
+        .transpose()?;
 
     let t = Instant::now();
     let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
@@ -176,9 +182,8 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             );
         }
     }
-    if let Some(path) = &args.report {
-        let json = serde_json::to_vec_pretty(&report)?;
-        write_atomically(path, &json)?;
+    if let Some(reserved) = reserved {
+        reserved.write(&serde_json::to_vec_pretty(&report)?)?;
     }
     tinsmith_export::mark_finished();
     Ok(true)

@@ -1,7 +1,7 @@
 //! Checks and atomic writes for output files the CLI writes itself (reports).
 
-use std::io::Write;
-use std::path::Path;
+use std::io::{Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use tinsmith_export::MeshFormat;
@@ -141,27 +141,102 @@ fn file_identity(path: &Path) -> Option<std::path::PathBuf> {
     })
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same directory and an atomic
-/// rename: `path` is either untouched or complete. A symlink is followed (it stays a
-/// link); a device or pipe is written in place.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
-    let target = tinsmith_export::resolve_output(path);
-    if tinsmith_export::is_special_file(&target) {
-        return std::fs::write(&target, bytes)
-            .with_context(|| format!("{}: write failed", path.display()));
+/// Room for a `--report` file taken before the run's outputs are committed: its temporary
+/// file is made and [`REPORT_RESERVE_BYTES`] written when the run starts, so a report that
+/// cannot be written (a full disk, a directory that refuses files) fails the run before any
+/// output is in place, rather than after (an error exit with the outputs left behind).
+/// [`ReservedReport::write`] then overwrites the bytes already taken.
+pub struct ReservedReport {
+    path: PathBuf,
+    target: PathBuf,
+    file: Option<(tempfile::NamedTempFile, tinsmith_export::PendingGuard)>,
+}
+
+/// More than any report needs: a `mesh` report is about 1 KB, a `tiles` report about
+/// 0.6 KB plus 0.3 KB per level (10 KB at 32 levels).
+pub const REPORT_RESERVE_BYTES: usize = 16 * 1024;
+
+impl ReservedReport {
+    /// Creates the report's temporary file beside `path` and fills it with
+    /// [`REPORT_RESERVE_BYTES`] spaces (a device or pipe is written in place, later).
+    pub fn reserve(path: &Path) -> Result<ReservedReport> {
+        let target = tinsmith_export::resolve_output(path);
+        if tinsmith_export::is_special_file(&target) {
+            return Ok(ReservedReport {
+                path: path.to_path_buf(),
+                target,
+                file: None,
+            });
+        }
+        let dir = parent_dir(&target);
+        let mut tmp = tinsmith_export::output_temp_file(dir).with_context(|| {
+            format!(
+                "{}: cannot create a file in {}",
+                path.display(),
+                dir.display()
+            )
+        })?;
+        let guard = tinsmith_export::track_pending(tmp.path());
+        tmp.write_all(&[b' '; REPORT_RESERVE_BYTES])
+            .and_then(|()| tmp.flush())
+            .with_context(|| format!("{}: write failed", path.display()))?;
+        Ok(ReservedReport {
+            path: path.to_path_buf(),
+            target,
+            file: Some((tmp, guard)),
+        })
     }
-    let dir = parent_dir(&target);
-    let mut tmp = tinsmith_export::output_temp_file(dir).with_context(|| {
-        format!(
-            "{}: cannot create a file in {}",
-            path.display(),
-            dir.display()
-        )
-    })?;
-    tmp.write_all(bytes)
-        .with_context(|| format!("{}: write failed", path.display()))?;
-    tmp.persist(&target)
-        .with_context(|| format!("{}: cannot write", path.display()))?;
+
+    /// Writes `bytes` as the report, over the reserved room, and renames it into place.
+    pub fn write(self, bytes: &[u8]) -> Result<()> {
+        let failed = || format!("{}: write failed", self.path.display());
+        let Some((mut tmp, _guard)) = self.file else {
+            return std::fs::write(&self.target, bytes).with_context(failed);
+        };
+        tmp.seek(SeekFrom::Start(0))
+            .and_then(|_| tmp.write_all(bytes))
+            .and_then(|()| tmp.flush())
+            .and_then(|()| tmp.as_file().set_len(bytes.len() as u64))
+            .with_context(failed)?;
+        tmp.persist(&self.target)
+            .with_context(|| format!("{}: cannot write", self.path.display()))?;
+        Ok(())
+    }
+}
+
+/// Fails when `report` is the `.prj` sidecar a georeferenced mesh in `format` writes beside
+/// `output`: one would overwrite the other.
+pub fn check_distinct_from_sidecar(
+    output: &Path,
+    report: &Path,
+    format: MeshFormat,
+    pixel_coords: bool,
+) -> Result<()> {
+    if format.uses_prj_sidecar() && !pixel_coords {
+        check_distinct(
+            &tinsmith_export::prj_path(output),
+            report,
+            "the output's CRS sidecar",
+        )?;
+    }
+    Ok(())
+}
+
+/// Fails when `report` would be written inside `dir`, a directory the run fills with its
+/// own files (a `tiles` pyramid, `--per-tile` meshes): the report could replace one of them
+/// (`layer.json`) or be taken for one.
+pub fn check_not_inside(dir: &Path, report: &Path, what: &str) -> Result<()> {
+    let absolute = |p: &Path| std::fs::canonicalize(p).or_else(|_| std::path::absolute(p));
+    let parent = parent_dir(report);
+    if let (Ok(dir), Ok(parent)) = (absolute(dir), absolute(parent)) {
+        if parent.starts_with(&dir) {
+            bail!(
+                "{}: is inside {what} {}; write the report elsewhere",
+                report.display(),
+                dir.display()
+            );
+        }
+    }
     Ok(())
 }
 
@@ -190,5 +265,31 @@ impl<T, E: Into<anyhow::Error>> NamingFile<T> for std::result::Result<T, E> {
                 e.context(shown)
             }
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reserved_report_holds_exactly_what_is_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("r.json");
+        let reserved = ReservedReport::reserve(&path).unwrap();
+        // The room is taken (in a temporary file) before anything is written.
+        assert!(!path.exists());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        reserved.write(b"{}\n").unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"{}\n");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn a_report_that_cannot_be_reserved_fails_naming_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("missing").join("r.json");
+        let err = ReservedReport::reserve(&path).err().unwrap();
+        assert!(format!("{err:#}").contains("r.json"), "{err:#}");
     }
 }

@@ -19,8 +19,14 @@ pub fn run(args: &TilesArgs) -> Result<bool> {
         memory_limit: crate::memory::available_bytes(),
     };
     if let Some(report) = &args.report {
+        crate::output::check_not_inside(&args.output, report, "the pyramid directory")?;
         crate::output::check_writable_target(report, &args.input)?;
     }
+    let reserved = args
+        .report
+        .as_deref()
+        .map(crate::output::ReservedReport::reserve)
+        .transpose()?;
     let report = build_terrain(&args.input, &args.output, &options, &mut |level| {
         if args.quiet {
             return;
@@ -40,8 +46,8 @@ pub fn run(args: &TilesArgs) -> Result<bool> {
         );
     })
     .naming_file(&args.input)?;
-    if let Some(path) = &args.report {
-        crate::output::write_atomically(path, &serde_json::to_vec_pretty(&report)?)?;
+    if let Some(reserved) = reserved {
+        reserved.write(&serde_json::to_vec_pretty(&report)?)?;
     }
     tinsmith_export::mark_finished();
     if args.quiet {

@@ -18,7 +18,7 @@ use tinsmith_tile::{
 use crate::args::{MeshArgs, TileFormatArg};
 use crate::georef::Georef;
 use crate::output::NamingFile;
-use crate::output::{check_distinct, check_writable_target, write_atomically};
+use crate::output::{check_distinct, check_writable_target, ReservedReport};
 use crate::report::{MeshSummary, Outcome, Seconds};
 
 /// GDAL block cache, in MB, for the commands that read each block once (set in `main`):
@@ -140,11 +140,20 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         None => None,
     };
     if let Some(report) = &args.report {
+        if let Some(dir) = &args.per_tile {
+            crate::output::check_not_inside(dir, report, "the --per-tile directory")?;
+        }
         check_writable_target(report, &args.input)?;
-        if let Some(output) = &args.output {
+        if let (Some(output), Some(format)) = (&args.output, welded_format) {
             check_distinct(output, report, "the output")?;
+            crate::output::check_distinct_from_sidecar(output, report, format, args.pixel_coords)?;
         }
     }
+    let reserved = args
+        .report
+        .as_deref()
+        .map(ReservedReport::reserve)
+        .transpose()?;
 
     let t = Instant::now();
     let info = crate::progress::scan_raster(&args.input, args.band, args.quiet)?;
@@ -279,8 +288,8 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             json.tiles.count, json.tiles.size
         ));
     }
-    if let Some(path) = &args.report {
-        write_atomically(path, &serde_json::to_vec_pretty(&json)?)?;
+    if let Some(reserved) = reserved {
+        reserved.write(&serde_json::to_vec_pretty(&json)?)?;
     }
     tinsmith_export::mark_finished();
     Ok(true)

@@ -116,6 +116,58 @@ fn an_output_over_a_file_the_input_is_read_from_is_refused() {
 }
 
 #[test]
+fn a_singular_geotransform_is_refused_unless_pixel_coords() {
+    // A pixel size of 0 put every vertex at one point: mesh wrote it with exit 0, contour
+    // blamed the levels, tiles said the raster lay outside latitudes -90..90.
+    let d = Dir::new();
+    let vrt = stretched_dem(50, 40).replace(
+        "<VRTRasterBand",
+        "<SRS>EPSG:4326</SRS><GeoTransform>10, 0, 0, 50, 0, 0</GeoTransform><VRTRasterBand",
+    );
+    d.write("flat.vrt", &vrt);
+    let runs: [&[&str]; 5] = [
+        &["mesh", "flat.vrt", "-o", "m.ply", "--max-error", "1"],
+        &[
+            "mesh",
+            "flat.vrt",
+            "-o",
+            "m.ply",
+            "--max-error",
+            "1",
+            "--tile-size",
+            "16",
+        ],
+        &[
+            "mesh",
+            "flat.vrt",
+            "--per-tile",
+            "p",
+            "--max-error",
+            "1",
+            "--tile-size",
+            "16",
+        ],
+        &["contour", "flat.vrt", "-o", "c.geojson", "--interval", "10"],
+        &["tiles", "flat.vrt", "-o", "t"],
+    ];
+    for args in runs {
+        let o = d.run(args);
+        assert_fails_naming(&o, &["flat.vrt", "singular"]);
+    }
+    assert_eq!(d.files(), vec!["flat.vrt"]);
+    let o = d.run(&[
+        "mesh",
+        "flat.vrt",
+        "-o",
+        "m.ply",
+        "--max-error",
+        "1",
+        "--pixel-coords",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
 fn band_out_of_range() {
     let d = Dir::new();
     let o = d.run(&[

@@ -59,7 +59,10 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         check_distinct(mesh, &args.output, "the --mesh input")?;
     }
     let e = args.max_error.unwrap_or(0.0);
-    let size = crate::memory::raster_size(&args.input, args.band)?;
+    let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
+    crate::georef::check_transform(reader.info(), args.pixel_coords)?;
+    let size = (reader.width(), reader.height());
+    drop(reader);
     let tiled =
         args.mesh.is_none() && e > 0.0 && (size.0 > args.tile_size || size.1 > args.tile_size);
     // A TIN decimated here is shaped for the levels (fewer segments, same bound), so they

@@ -13,6 +13,22 @@ pub enum Georef {
     World(GeoTransform),
 }
 
+/// Fails (before any long work) when the raster's geotransform is singular and world
+/// coordinates are to be written: every sample would land on one point or line, and the
+/// mesh could not be read back. `--pixel-coords` needs no geotransform.
+pub fn check_transform(info: &tinsmith_raster::RasterInfo, pixel_coords: bool) -> Result<()> {
+    match info.transform() {
+        Some(t) if !pixel_coords && t.is_singular() => bail!(
+            "{}: its geotransform {:?} is singular (a pixel size of 0: samples have no \
+             distinct positions); assign a real one (e.g. `gdal_translate -of VRT -a_ullr \
+             ULX ULY LRX LRY IN OUT.vrt`) or write --pixel-coords",
+            info.path.display(),
+            t.0
+        ),
+        _ => Ok(()),
+    }
+}
+
 impl Georef {
     /// Pixel coordinates when asked for or when the raster has no geotransform.
     pub fn new(transform: Option<GeoTransform>, pixel_coords: bool) -> Georef {

@@ -44,6 +44,7 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
         crate::output::check_sidecar_not_input(output, &args.input, format)?;
     }
     let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
+    crate::georef::check_transform(reader.info(), args.pixel_coords)?;
     crate::export::check_float32_positions(format, reader.info(), args)?;
     let fits = reader.width() <= args.tile_size && reader.height() <= args.tile_size;
     let count_target = args.max_triangles.is_some() || args.max_vertices.is_some();
@@ -139,6 +140,9 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         }
         None => None,
     };
+    let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
+    crate::georef::check_transform(reader.info(), args.pixel_coords)?;
+    drop(reader);
     if let Some(report) = &args.report {
         if let Some(dir) = &args.per_tile {
             crate::output::check_not_inside(dir, report, "the --per-tile directory")?;

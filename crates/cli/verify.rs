@@ -24,6 +24,7 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
         "verification has no tiled mode; use a machine with more memory",
     )?;
     let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
+    crate::georef::check_transform(&raster.info, args.pixel_coords)?;
     let georef = Georef::new(raster.info.transform(), args.pixel_coords);
     let mesh = read_mesh_file(&args.mesh, &raster, georef)?;
     let positions = sample_positions(&args.mesh, &mesh, georef)?;

@@ -21,6 +21,15 @@ impl GeoTransform {
         ]
     }
 
+    /// Whether the transform maps the grid onto a line or a point (a pixel size of 0,
+    /// parallel axes) or has a non-finite coefficient: samples then have no distinct
+    /// positions, and no position maps back to one sample.
+    pub fn is_singular(&self) -> bool {
+        let c = &self.0;
+        let det = c[1] * c[5] - c[2] * c[4];
+        det == 0.0 || !det.is_finite() || c.iter().any(|v| !v.is_finite())
+    }
+
     /// The sample `(x, y)` whose centre maps to `world`, as fractional grid coordinates,
     /// or `None` when the transform is singular.
     pub fn world_to_sample(&self, world: [f64; 2]) -> Option<[f64; 2]> {

@@ -111,6 +111,8 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
             .map(crate::wgs84_code);
         mesh.crs_wkt = crs.wkt().map(str::to_owned).filter(|w| !w.is_empty());
     }
+    // 0 means "not known" (a writer that streamed without counting).
+    let declared = header.features_count();
     let kind = header.geometry_type();
     if !matches!(
         kind,
@@ -154,6 +156,11 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
         }
         feature_number += 1;
     }
+    if declared > 0 && feature_number as u64 != declared {
+        return Err(Problem::malformed(format_args!(
+            "truncated: the header declares {declared} features, {feature_number} were read"
+        )));
+    }
     mesh.vertices = welder.into_vertices();
     if ids.iter().all(Option::is_some) {
         let mut order: Vec<usize> = (0..mesh.triangles.len()).collect();
@@ -182,6 +189,25 @@ mod tests {
         let mut bytes = Vec::new();
         write(&mut bytes, mesh).expect("writing to a Vec");
         bytes
+    }
+
+    #[test]
+    fn a_file_cut_at_a_feature_boundary_is_refused_as_truncated() {
+        let vertices = [
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 2.0],
+            [0.0, 1.0, 3.0],
+            [1.0, 1.0, 4.0],
+        ];
+        let triangles = [[0, 1, 2], [1, 3, 2]];
+        let bytes = write_to_vec(MeshRef::new(&vertices, &triangles));
+        assert_eq!(read(&bytes[..]).unwrap().triangles.len(), 2);
+        // Drop the last feature: every cut that still parses must be refused.
+        let cut = (1..bytes.len()).filter(|&n| match read(&bytes[..n]) {
+            Ok(mesh) => panic!("{n} of {} bytes read as {mesh:?}", bytes.len()),
+            Err(problem) => format!("{problem:?}").contains("truncated"),
+        });
+        assert!(cut.count() > 0, "no cut reached the feature count check");
     }
 
     #[test]

@@ -169,6 +169,14 @@ fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
             hint,
         });
     };
+    if tinsmith_core::GeoTransform(gt).is_singular() {
+        return Err(Error::NotGeoreferenced {
+            path: path.to_path_buf(),
+            missing: "a singular geotransform (a pixel size of 0: every sample at one place)",
+            hint: "assign a real one, e.g. `gdal_translate -of VRT -a_ullr ULX ULY LRX LRY \
+                   IN OUT.vrt`",
+        });
+    }
     let (w, h) = (f64::from(info.width), f64::from(info.height));
     // All four corners: with a rotated geotransform two opposite ones do not bound it.
     let corners = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)];

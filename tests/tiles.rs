@@ -288,6 +288,54 @@ fn same_bytes_for_one_and_two_threads_and_run_to_run() {
 }
 
 #[test]
+fn no_more_workers_start_than_there_are_tiles_and_at_most_1024() {
+    // --threads 100000 started ~15,700 threads before one failed to start, then hung;
+    // --threads 1000 on four tiles took 5 s. Workers beyond the tile count are not started.
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let d = Dir::new();
+    let args = [
+        &dem,
+        "-o",
+        "m.ply",
+        "--max-error",
+        "5",
+        "--tile-size",
+        "300",
+    ];
+    let r = mesh(&d, &[&args[..], &["--threads", "64"]].concat());
+    assert_eq!(r["tiles"]["count"], 4);
+    assert_eq!(r["tiles"]["threads"], 4);
+    for command in [
+        vec![
+            "mesh",
+            &dem,
+            "-o",
+            "n.ply",
+            "--max-error",
+            "5",
+            "--threads",
+            "100000",
+        ],
+        vec![
+            "contour",
+            &dem,
+            "-o",
+            "n.fgb",
+            "--levels",
+            "500",
+            "--threads",
+            "1025",
+        ],
+        vec!["tiles", &dem, "-o", "n", "--threads", "100000"],
+    ] {
+        let o = d.run(&command);
+        assert_eq!(o.status.code(), Some(2), "{command:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains("1024"), "{}", stderr(&o));
+    }
+    assert_eq!(d.files(), vec!["m.ply", "r.json"]);
+}
+
+#[test]
 fn per_tile_directory_has_one_file_per_tile() {
     let dem = fixture("tintn_valid_raster_3857.tif");
     let d = Dir::new();

@@ -62,8 +62,8 @@ pub struct TilesArgs {
     /// Content-Encoding: gzip).
     #[arg(long)]
     pub no_gzip: bool,
-    /// Worker threads (default: all cores).
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads, at most 1024 (default: all cores).
+    #[arg(long, default_value_t = 0, value_parser = threads_or_all)]
     pub threads: usize,
     /// Write the per-level report (bounds, measured error, tiles, bytes) as JSON.
     #[arg(long)]
@@ -185,8 +185,9 @@ pub struct MeshArgs {
     #[arg(long, value_name = "N", default_value_t = tinsmith_tile::DEFAULT_TILE_SIZE,
           value_parser = clap::value_parser!(u32).range(2..))]
     pub tile_size: u32,
-    /// Worker threads for tiles [default: one per core].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    /// Worker threads for tiles, at most 1024 and no more than there are tiles [default: one
+    /// per core].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
     /// Write one mesh file per tile into DIR (which must not exist, or be empty) instead
     /// of one welded mesh; always uses tiles.
@@ -293,8 +294,9 @@ pub struct ContourArgs {
     #[arg(long, value_name = "N", default_value_t = tinsmith_tile::DEFAULT_TILE_SIZE,
           value_parser = clap::value_parser!(u32).range(2..))]
     pub tile_size: u32,
-    /// Worker threads for tiles [default: one per core].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    /// Worker threads for tiles, at most 1024 and no more than there are tiles [default: one
+    /// per core].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
     /// No summary on stderr.
     #[arg(short, long)]
@@ -469,4 +471,14 @@ fn parse_finite(s: &str) -> Result<f64, String> {
         return Err(format!("must be a finite number, got {s}"));
     }
     Ok(v)
+}
+
+/// `--threads` of `tiles`: 0 (one per core) to 1024.
+fn threads_or_all(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if n <= 1024 => Ok(n),
+        _ => Err(format!(
+            "{s} is not a thread count from 0 (one per core) to 1024"
+        )),
+    }
 }

@@ -35,7 +35,7 @@ pub struct TileOptions {
     pub decimation: DecimationOptions,
     /// Samples per tile side, shared row and column included (at least 2).
     pub tile_size: u32,
-    /// Worker threads; 0 means one per core.
+    /// Worker threads; 0 means one per core. No more than there are tiles are started.
     pub threads: usize,
 }
 
@@ -155,8 +155,14 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
         ));
     }
     let plan = TilePlan::new(source.width(), source.height(), options.tile_size)?;
+    // More workers than tiles would only start idle threads (thousands of them took
+    // seconds, and at tens of thousands a worker's start failed).
+    let workers = match options.threads {
+        0 => 0,
+        n => n.min(plan.len().max(1)),
+    };
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(options.threads)
+        .num_threads(workers)
         .thread_name(|i| format!("tinsmith-tile-{i}"))
         .build()
         .map_err(|source| Error::Threads {

@@ -253,6 +253,59 @@ fn every_model_order_and_retriangulation_from_the_cli() {
 }
 
 #[test]
+fn both_count_targets_are_met() {
+    // With both, decimation stopped at the first count reached (100 vertices, 170
+    // triangles) and the note blamed the domain's outline for the triangles.
+    let d = Dir::new();
+    let dem = fixture("tintn_valid_raster_3857.tif");
+    let o = d.run(&[
+        "mesh",
+        &dem,
+        "-o",
+        "m.ply",
+        "--max-triangles",
+        "60",
+        "--max-vertices",
+        "100",
+        "--report",
+        "r.json",
+    ]);
+    assert!(o.status.success(), "{}", crate::util::stderr(&o));
+    assert!(
+        !crate::util::stderr(&o).contains("note"),
+        "{}",
+        crate::util::stderr(&o)
+    );
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path("r.json")).unwrap()).unwrap();
+    assert!(r["triangles_after"].as_u64().unwrap() <= 60, "{r}");
+    assert!(r["vertices_after"].as_u64().unwrap() <= 100, "{r}");
+}
+
+#[test]
+fn heights_far_from_zero_say_how_much_of_the_bound_is_left() {
+    // At 1e12 the rounding margin (2^-40 of the largest |height|) took 0.9 of a bound of 1
+    // and nothing said so: far fewer triangles went than the bound allowed.
+    let d = Dir::new();
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    d.write(
+        "far.vrt",
+        &format!(
+            "<VRTDataset rasterXSize=\"430\" rasterYSize=\"516\"><VRTRasterBand \
+             dataType=\"Float64\" band=\"1\"><Offset>1e12</Offset><SimpleSource>\
+             <SourceFilename>{dem}</SourceFilename><SourceBand>1</SourceBand>\
+             </SimpleSource></VRTRasterBand></VRTDataset>"
+        ),
+    );
+    for input in ["far.vrt", dem.as_str()] {
+        let o = d.run(&["mesh", input, "-o", "m.ply", "--max-error", "1"]);
+        assert!(o.status.success(), "{}", crate::util::stderr(&o));
+        let noted = crate::util::stderr(&o).contains("margin for rounding");
+        assert_eq!(noted, input == "far.vrt", "{}", crate::util::stderr(&o));
+    }
+}
+
+#[test]
 fn max_triangles_reports_the_verified_error() {
     let d = Dir::new();
     let dem = fixture("tintn_valid_raster_3857.tif");

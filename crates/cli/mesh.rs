@@ -93,8 +93,10 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let max_error = args.max_error.unwrap_or(f64::INFINITY);
     let plan = crate::export::Plan::new(format, &raster.info, Some(grid), args)?;
     // Float32 formats leave the decimator the bound less their height rounding.
+    let heights = raster.info.min.zip(raster.info.max);
+    crate::output::note_rounding_margin(&args.input, plan.decimation_bound, heights, args.quiet);
     let options = args
-        .decimation_options(plan.decimation_bound, raster.info.min.zip(raster.info.max))
+        .decimation_options(plan.decimation_bound, heights)
         .naming_file(&args.input)?;
     let mut bar = crate::progress::Progress::new(args.quiet);
     let result = decimate_with_progress(grid, &options, &mut |p| {

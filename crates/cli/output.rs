@@ -88,6 +88,29 @@ pub fn note_gcps_unused(info: &tinsmith_raster::RasterInfo, pixel_coords: bool, 
     );
 }
 
+/// Notes on stderr (unless `quiet`) when heights as large as `heights` leave decimation
+/// noticeably less than `bound`: it keeps `2^-40` of the largest |height| as a margin for
+/// the rounding of its arithmetic (see `tinsmith_core::effective_limit`), 0.9 at 1e12.
+/// The bound is kept either way; the mesh just keeps more triangles than the bound needs.
+pub fn note_rounding_margin(input: &Path, bound: f64, heights: Option<(f64, f64)>, quiet: bool) {
+    let Some((lo, hi)) = heights else { return };
+    let max_abs = lo.abs().max(hi.abs());
+    let limit = tinsmith_core::effective_limit(bound, max_abs);
+    if quiet || !(bound.is_finite() && bound > 0.0) || bound - limit <= 0.01 * bound {
+        return;
+    }
+    note!(
+        "{}: heights up to {} leave decimation about {:.3e} of the bound {} (the rest is \
+         a margin for rounding, 2^-40 of the largest |height|): more triangles are kept \
+         than the bound needs; subtracting a constant offset from the heights would give \
+         it all",
+        input.display(),
+        crate::number::readable(max_abs),
+        limit,
+        crate::number::readable(bound)
+    );
+}
+
 /// Fails when `output` is the file `input` or one GDAL reads with it (a VRT's source, an
 /// ENVI header, a `.prj` or `.aux.xml` sidecar: see [`tinsmith_raster::input_files`]), by
 /// any path, links included: writing would destroy or change the input.

@@ -176,8 +176,10 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         None => None,
     };
     let bound = export_plan.map_or(max_error, |p| p.decimation_bound);
+    let heights = info.min.zip(info.max);
+    crate::output::note_rounding_margin(&args.input, bound, heights, args.quiet);
     let decimation = args
-        .decimation_options(bound, info.min.zip(info.max))
+        .decimation_options(bound, heights)
         .naming_file(&args.input)?;
     let options = TileOptions::new(decimation)
         .with_tile_size(args.tile_size)

@@ -510,12 +510,16 @@ struct Target {
 }
 
 impl Target {
-    /// Whether `mesh` is down to the count, `removed` of its `initial_vertices` gone.
+    /// Whether `mesh` is down to every count given (never without one), `removed` of its
+    /// `initial_vertices` gone.
     fn reached(&self, mesh: &Mesh<'_>, initial_vertices: usize, removed: usize) -> bool {
-        self.triangles.is_some_and(|t| mesh.triangle_count() <= t)
-            || self
+        if self.triangles.is_none() && self.vertices.is_none() {
+            return false;
+        }
+        self.triangles.is_none_or(|t| mesh.triangle_count() <= t)
+            && self
                 .vertices
-                .is_some_and(|t| initial_vertices - removed <= t)
+                .is_none_or(|t| initial_vertices - removed <= t)
     }
 }
 

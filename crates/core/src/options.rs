@@ -84,9 +84,11 @@ pub struct DecimationOptions {
     /// [`crate::effective_limit`]); `None` uses the grid's own. Tiles of one raster set the
     /// raster's value so that they all enforce the same limit.
     pub max_abs_value: Option<f64>,
-    /// Stop once the mesh has at most this many triangles (greedy order only).
+    /// Stop once the mesh has at most this many triangles (greedy order only; with
+    /// `max_vertices` too, once both are met).
     pub max_triangles: Option<usize>,
-    /// Stop once the mesh has at most this many vertices (greedy order only).
+    /// Stop once the mesh has at most this many vertices (greedy order only; with
+    /// `max_triangles` too, once both are met).
     pub max_vertices: Option<usize>,
     /// Longest edge allowed in the output, in sample spacings (at least 2): a removal that
     /// would need a longer edge is refused. For renderers that interpolate in another space

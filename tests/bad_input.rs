@@ -168,6 +168,60 @@ fn a_singular_geotransform_is_refused_unless_pixel_coords() {
 }
 
 #[test]
+fn small_cases_fail_early_and_clearly() {
+    let d = Dir::new();
+    // A trailing slash names a directory: refused before the work (it failed at the
+    // final rename).
+    let o = d.run(&["mesh", &dem(), "-o", "m.ply/", "--max-error", "1"]);
+    assert_fails_naming(&o, &["m.ply/", "ends with '/'"]);
+    // A negative count is an invalid value, not an unknown flag.
+    let o = d.run(&["mesh", &dem(), "-o", "m.ply", "--max-triangles", "-5"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("invalid value '-5'"), "{}", stderr(&o));
+    // A FIFO with no writer: GDAL blocked for ever.
+    let fifo = d.path("pipe.tif");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(made.success());
+    let o = d.run(&["info", "pipe.tif"]);
+    assert_fails_naming(&o, &["pipe.tif", "not a file"]);
+    std::fs::remove_file(&fifo).unwrap();
+    assert!(d.files().is_empty(), "{:?}", d.files());
+}
+
+#[cfg(unix)]
+#[test]
+fn a_replaced_output_keeps_its_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = Dir::new();
+    for name in ["m.ply", "r.json"] {
+        d.write(name, "old");
+        std::fs::set_permissions(d.path(name), std::fs::Permissions::from_mode(0o600)).unwrap();
+    }
+    let o = d.run(&[
+        "mesh",
+        &dem(),
+        "-o",
+        "m.ply",
+        "--max-error",
+        "1",
+        "--report",
+        "r.json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for name in ["m.ply", "r.json"] {
+        let mode = std::fs::metadata(d.path(name))
+            .unwrap()
+            .permissions()
+            .mode();
+        assert_eq!(mode & 0o777, 0o600, "{name}");
+        assert_ne!(std::fs::read(d.path(name)).unwrap(), b"old");
+    }
+}
+
+#[test]
 fn band_out_of_range() {
     let d = Dir::new();
     let o = d.run(&[

@@ -16,19 +16,27 @@ pub struct Cli {
     pub command: Command,
 }
 
+/// Every command reads negative numbers as values, so `--max-triangles -5` is refused as
+/// an invalid count rather than as an unknown flag.
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Print a raster's size, type, nodata, CRS, geotransform and value range.
+    #[command(allow_negative_numbers = true)]
     Info(InfoArgs),
     /// Decimate a raster into a TIN within --max-error of every valid sample.
+    #[command(allow_negative_numbers = true)]
     Mesh(MeshArgs),
     /// Measure a TIN's true error against its raster at every valid sample.
+    #[command(allow_negative_numbers = true)]
     Verify(VerifyArgs),
     /// Contour lines of the raster's TIN (decimated within --max-error, or given).
+    #[command(allow_negative_numbers = true)]
     Contour(ContourArgs),
     /// Build a Cesium quantized-mesh terrain pyramid (EPSG:4326 TMS) with layer.json.
+    #[command(allow_negative_numbers = true)]
     Tiles(TilesArgs),
     /// Serve a directory (a terrain pyramid) over HTTP on 127.0.0.1, for CesiumJS.
+    #[command(allow_negative_numbers = true)]
     Serve(ServeArgs),
 }
 

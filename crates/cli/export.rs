@@ -12,6 +12,7 @@ use tinsmith_raster::RasterInfo;
 
 use crate::args::MeshArgs;
 use crate::georef::Georef;
+use crate::number::readable;
 
 /// Largest rounding of a float32 position, in pixels, accepted before decimating: 90 % of
 /// the 1e-3 pixel within which the verifier maps file positions to samples. Half a float32
@@ -134,10 +135,12 @@ impl Plan {
         let decimation_bound = max_error - height_rounding;
         if decimation_bound < 0.0 {
             bail!(
-                "{}: --max-error {max_error} is smaller than the float32 rounding of the \
-                 heights ({height_rounding}) in {format}; use a larger bound or a \
-                 double-precision format (.ply, .obj, .fgb, .geojson, .xml)",
-                out(args).display()
+                "{}: --max-error {} is smaller than the float32 rounding of the heights ({}) \
+                 in {format}; use a larger bound or a double-precision format (.ply, .obj, \
+                 .fgb, .geojson, .xml)",
+                out(args).display(),
+                readable(max_error),
+                readable(height_rounding)
             );
         }
         Ok(Plan {

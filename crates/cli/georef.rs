@@ -3,6 +3,8 @@
 use anyhow::{bail, Result};
 use tinsmith_core::GeoTransform;
 
+use crate::number::readable;
+
 /// How grid positions map to file coordinates: pixel (column, row) or a geotransform to
 /// the world position of the sample's centre.
 #[derive(Debug, Clone, Copy)]
@@ -90,13 +92,20 @@ impl Georef {
         };
         let r = [s[0].round(), s[1].round()];
         if !((s[0] - r[0]).abs() <= 1e-3 && (s[1] - r[1]).abs() <= 1e-3) {
+            let grid = |v: f64| {
+                if v.abs() < 1e9 {
+                    format!("{v:.4}")
+                } else {
+                    format!("{v:.4e}")
+                }
+            };
             bail!(
-                "({}, {}) is not on a sample centre (grid position {:.4}, {:.4}): was the \
-                 mesh written from this raster, {}?",
-                p[0],
-                p[1],
-                s[0],
-                s[1],
+                "({}, {}) is not on a sample centre (grid position {}, {}): was the mesh \
+                 written from this raster, {}?",
+                readable(p[0]),
+                readable(p[1]),
+                grid(s[0]),
+                grid(s[1]),
                 match self {
                     Georef::Pixel => "in (column, row) coordinates as --pixel-coords reads it",
                     Georef::World(_) => "in its CRS (not with --pixel-coords)",

@@ -9,6 +9,12 @@ use tinsmith_export::MeshFormat;
 /// Fails early, before long work, when `path`'s directory is missing, `path` is a
 /// directory, or `path` is the `input` file.
 pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
+    if path.as_os_str().as_encoded_bytes().ends_with(b"/") {
+        bail!(
+            "{}: ends with '/', which names a directory, not an output file",
+            path.display()
+        );
+    }
     check_not_input(path, input)?;
     let (dir, file_in_the_way) = tinsmith_export::output_parent(path);
     if let Some(file) = file_in_the_way {
@@ -221,6 +227,7 @@ impl ReservedReport {
             .and_then(|()| tmp.flush())
             .and_then(|()| tmp.as_file().set_len(bytes.len() as u64))
             .with_context(failed)?;
+        tinsmith_export::keep_permissions(tmp.path(), &self.target);
         tmp.persist(&self.target)
             .with_context(|| format!("{}: cannot write", self.path.display()))?;
         Ok(())

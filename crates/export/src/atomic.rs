@@ -65,12 +65,25 @@ impl Staged {
         let Some(temp) = self.temp else {
             return Ok(());
         };
+        keep_permissions(temp.path(), &self.target);
         temp.persist(&self.target).map_err(|error| Error::Io {
             path: self.path,
             action: "move the finished temporary file into place",
             source: error.error,
         })?;
         Ok(())
+    }
+}
+
+/// Gives the temporary file at `temp` the permissions of the regular file at `target` it
+/// is about to replace, so that replacing a file keeps its mode (a private 0600 mesh stays
+/// private); nothing when `target` does not exist yet. Best effort: a failure leaves the
+/// new file's default mode.
+pub fn keep_permissions(temp: &Path, target: &Path) {
+    if let Ok(meta) = std::fs::metadata(target) {
+        if meta.is_file() {
+            let _ = std::fs::set_permissions(temp, meta.permissions());
+        }
     }
 }
 

@@ -8,8 +8,9 @@
 //!
 //! # Guarantees
 //! - **Atomic output.** [`write_mesh`] (and [`MeshStreamWriter`], which takes the mesh in
-//!   pieces) writes a temporary file next to the target and renames it into place. After an error there is no partial file and no temporary file;
-//!   an existing file at the target keeps its content.
+//!   pieces) writes a temporary file next to the target and renames it into place; a file
+//!   it replaces keeps its permissions. After an error there is no partial file and no
+//!   temporary file; an existing file at the target keeps its content.
 //! - **Exact round trip in the double-precision formats.** [`read_mesh`] of a PLY, OBJ,
 //!   FlatGeobuf or LandXML file written by [`write_mesh`] (and a GeoJSON one, which prints
 //!   the shortest decimals) returns the same coordinates bit for bit (PLY stores `double`s,
@@ -78,7 +79,8 @@ mod weld;
 
 pub use antimeridian::cut_at_antimeridian;
 pub use atomic::{
-    is_special_file, output_parent, output_temp_dir, output_temp_file, resolve_output,
+    is_special_file, keep_permissions, output_parent, output_temp_dir, output_temp_file,
+    resolve_output,
 };
 pub use error::{Error, Result};
 pub use file::{prj_path, read_mesh, read_mesh_as, write_mesh, write_mesh_with};

@@ -31,6 +31,17 @@ pub enum Error {
         #[source]
         source: Box<gdal::errors::GdalError>,
     },
+    /// The path is a pipe or socket: GDAL would block on a FIFO with no writer, and reads
+    /// rasters by seeking.
+    #[error(
+        "{}: is a pipe or socket, not a file: GDAL needs a file it can seek (save the \
+         stream to a file first)",
+        path.display()
+    )]
+    NotAFile {
+        /// The path.
+        path: PathBuf,
+    },
     /// The requested band does not exist (bands are numbered from 1).
     #[error("{}: band {band} out of range, the raster has {count} band(s)", path.display())]
     BandOutOfRange {

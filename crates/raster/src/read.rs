@@ -368,6 +368,18 @@ pub(crate) fn open_dataset(path: &Path) -> Result<Dataset> {
             path: path.to_path_buf(),
         });
     }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        // GDAL would block reading a FIFO with no writer, and seeks where there is none.
+        if let Ok(kind) = std::fs::metadata(path).map(|m| m.file_type()) {
+            if kind.is_fifo() || kind.is_socket() {
+                return Err(Error::NotAFile {
+                    path: path.to_path_buf(),
+                });
+            }
+        }
+    }
     crate::quiet::silence_hdf5_on_this_thread();
     let options = DatasetOptions {
         open_flags: GdalOpenFlags::GDAL_OF_RASTER

@@ -381,7 +381,7 @@ pub fn build_terrain(
 ) -> TerrainResult<TerrainReport> {
     if !(options.quality > 0.0 && options.quality <= MAX_QUALITY) {
         return Err(TerrainError::Options(format!(
-            "--quality must be a positive number up to {MAX_QUALITY:e}, got {:?}",
+            "--quality must be a positive number up to {MAX_QUALITY:e}, got {}",
             options.quality
         )));
     }
@@ -556,8 +556,9 @@ struct Staging {
 
 impl Staging {
     fn new(out_dir: &Path) -> TerrainResult<Staging> {
-        let refuse =
-            |reason: String| TerrainError::Options(format!("{}: {reason}", out_dir.display()));
+        let refuse = |reason: String| {
+            TerrainError::Options(format!("output {}: {reason}", out_dir.display()))
+        };
         if let Some(reason) = crate::per_tile::occupied_reason(out_dir) {
             return Err(refuse(format!(
                 "{reason}; give a new directory (the pyramid is written whole, never mixed \

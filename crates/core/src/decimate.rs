@@ -691,11 +691,13 @@ impl<'g> Remover<'g> {
             return Ok(());
         }
         let saved = self.rules;
+        let exact_zero = self.exact_zero();
         self.rules = Rules {
             model: crate::ErrorModel::Exact,
             selection: crate::EdgeSelection::MinError,
             method: crate::Retriangulation::Ears,
-            limit: f64::INFINITY,
+            // Exactly planar holes only, decided exactly, at a bound of 0 on integer heights.
+            limit: if exact_zero { 0.0 } else { f64::INFINITY },
             // The caller's 1-D rule already spaced the kept border samples.
             max_edge_squared: i64::MAX,
             ..saved
@@ -714,12 +716,25 @@ impl<'g> Remover<'g> {
         }
     }
 
+    /// Whether errors are decided exactly at 0: a bound of 0 under the exact model on a grid
+    /// of [`Grid::integral_heights`].
+    fn exact_zero(&self) -> bool {
+        self.rules.limit == 0.0
+            && self.rules.model == ErrorModel::Exact
+            && self.rules.grid.integral_heights()
+    }
+
     /// Plans the removal of border vertex `v` as a fan from its border neighbour that comes
     /// first along the border (already settled: kept, since border samples are removed in
     /// order). The next border vertex then keeps a small star, so a long run of removals
     /// stays linear. Returns false when `v` is not a boundary vertex or the fan is not a
     /// valid triangulation of the hole; bounds are the exact errors.
     fn plan_border_fan(&mut self, mesh: &Mesh<'_>, v: u32) -> bool {
+        let cap = if self.exact_zero() {
+            0.0
+        } else {
+            f64::INFINITY
+        };
         let star = &mut self.ring_star;
         mesh.star(v, star);
         if mesh.classify(v, star) != VertexClass::Boundary {
@@ -742,8 +757,14 @@ impl<'g> Remover<'g> {
             if crate::predicates::orient(&a, &b, &c) <= 0 {
                 return false;
             }
-            let bound = crate::exact::triangle_error(self.rules.grid, &a, &b, &c, f64::INFINITY)
-                .expect("no limit");
+            // At a bound of 0 on integer heights, planarity is decided exactly (as in
+            // `plan`); a fan off the plane gets an infinite bound and is refused.
+            let bound = crate::exact::triangle_error(self.rules.grid, &a, &b, &c, cap).unwrap_or(
+                ErrorBound {
+                    above: f64::INFINITY,
+                    below: f64::INFINITY,
+                },
+            );
             let corners = [apex, p, q].map(|i| star.ring[i]);
             self.new_triangles.push((slot, corners, bound));
         }

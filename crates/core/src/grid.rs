@@ -44,8 +44,7 @@ impl Grid {
             .fold((0.0f64, true), |(m, integers), v| {
                 (m.max(v.abs()), integers && v.fract() == 0.0)
             });
-        let integral_heights =
-            integers && expected as f64 * max_abs.max(1.0) < INTEGRAL_PRODUCT_LIMIT;
+        let integral_heights = integers && Grid::integral_product_fits(width, height, max_abs);
         Ok(Grid {
             width,
             height,
@@ -53,6 +52,13 @@ impl Grid {
             max_abs,
             integral_heights,
         })
+    }
+
+    /// Whether a grid of `width x height` integer samples up to `max_abs` in magnitude is
+    /// small enough for [`Grid::integral_heights`]: `width x height x max(max_abs, 1)` is
+    /// below 2^50. (Tiles of one raster use it to decide the same for all of them.)
+    pub fn integral_product_fits(width: u32, height: u32, max_abs: f64) -> bool {
+        f64::from(width) * f64::from(height) * max_abs.max(1.0) < INTEGRAL_PRODUCT_LIMIT
     }
 
     /// Whether every valid sample is an integer and `width x height x max|value|` is below

@@ -148,6 +148,8 @@ pub(crate) struct Stats {
     pub(crate) nodata: u64,
     pub(crate) min: Option<f64>,
     pub(crate) max: Option<f64>,
+    /// Some valid sample is not an integer.
+    pub(crate) fractional: bool,
 }
 
 impl Stats {
@@ -155,13 +157,16 @@ impl Stats {
     pub(crate) fn add(&mut self, decoded: &[f64]) {
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         let mut valid = 0u64;
+        let mut fractional = false;
         for &v in decoded {
             if v.is_finite() {
                 valid += 1;
                 lo = lo.min(v);
                 hi = hi.max(v);
+                fractional |= v.fract() != 0.0;
             }
         }
+        self.fractional |= fractional;
         self.valid += valid;
         self.nodata += decoded.len() as u64 - valid;
         if valid > 0 {

@@ -59,6 +59,11 @@ pub struct RasterInfo {
     pub min: Option<f64>,
     /// Largest valid height (after scale and offset); `None` when no sample is valid.
     pub max: Option<f64>,
+    /// Whether every valid height (after scale and offset) is an integer, as in most DEMs:
+    /// an error of 0 can then be decided exactly (see
+    /// `tinsmith_core::Grid::integral_heights`). `false` when the statistics were not
+    /// computed.
+    pub integral_heights: bool,
 }
 
 impl RasterInfo {

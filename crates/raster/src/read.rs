@@ -241,6 +241,7 @@ impl OpenBand {
             nodata_samples: 0,
             min: None,
             max: None,
+            integral_heights: false,
         };
         Ok(OpenBand {
             dataset,
@@ -356,6 +357,7 @@ impl OpenBand {
             nodata_samples: stats.nodata,
             min: stats.min,
             max: stats.max,
+            integral_heights: stats.valid > 0 && !stats.fractional,
             ..self.info
         }
     }

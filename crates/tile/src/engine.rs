@@ -3,7 +3,10 @@
 
 use std::time::Instant;
 
-use tinsmith_core::{decimate_with_border, DecimationOptions, DecimationReport, TinVertex};
+use tinsmith_core::{
+    decimate_with_border, effective_limit, DecimationOptions, DecimationReport, ErrorModel, Grid,
+    TinVertex,
+};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
 use crate::edge::{edge_limit, edge_span, EdgeProfile};
@@ -179,6 +182,17 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
         },
         edge_limit: edge_limit(d.max_error, max_abs_value),
         edge_span: edge_span(d.max_edge_length),
+        // At a bound of 0 every tile's core decides planarity exactly when the raster's
+        // heights are integers and a tile (halo included) is small enough for that; the
+        // edges then skip exactly collinear samples, which those cores accept.
+        exact_zero_edges: effective_limit(d.max_error, max_abs_value) == 0.0
+            && d.error_model == ErrorModel::Exact
+            && source.integral_heights()
+            && Grid::integral_product_fits(
+                options.tile_size.saturating_add(2),
+                options.tile_size.saturating_add(2),
+                max_abs_value,
+            ),
     };
 
     let mut report = TilesReport {
@@ -248,6 +262,8 @@ struct TileJob {
     edge_limit: f64,
     /// Longest skip along a shared edge (see [`edge_span`]).
     edge_span: usize,
+    /// At `edge_limit` 0: skip exactly collinear edge samples (integer heights).
+    exact_zero_edges: bool,
 }
 
 /// A tile decimated and verified on a worker thread, not yet numbered.
@@ -293,9 +309,11 @@ impl TileJob {
         let keep = |edge: &EdgeProfile| {
             if self.edge_limit > 0.0 {
                 edge.simplify(self.edge_limit, self.edge_span)
+            } else if self.exact_zero_edges {
+                edge.simplify_collinear(self.edge_span)
             } else {
-                // Below the rounding slack the core removes only exactly flat stars:
-                // keep every edge sample.
+                // Below the rounding slack on other heights the core removes only exactly
+                // flat stars, within f64 rounding: keep every edge sample.
                 vec![true; edge.values().len()]
             }
         };

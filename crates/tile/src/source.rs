@@ -31,6 +31,14 @@ pub trait TileSource: Sync {
     /// limit.
     fn max_abs_value(&self) -> f64;
 
+    /// Whether every valid sample of the whole raster is an integer: at a bound of 0 the
+    /// shared edges then skip exactly collinear samples, as the tiles' cores, measuring
+    /// errors of 0 exactly, accept (see `tinsmith_core::Grid::integral_heights`). `false`
+    /// (every edge sample kept at a bound of 0) when not known.
+    fn integral_heights(&self) -> bool {
+        false
+    }
+
     /// A reader for the calling thread.
     ///
     /// # Errors
@@ -65,6 +73,7 @@ pub struct RasterSource {
     width: u32,
     height: u32,
     max_abs_value: f64,
+    integral_heights: bool,
 }
 
 impl RasterSource {
@@ -84,6 +93,7 @@ impl RasterSource {
             width: info.width,
             height: info.height,
             max_abs_value,
+            integral_heights: info.integral_heights,
         })
     }
 
@@ -122,6 +132,10 @@ impl TileSource for RasterSource {
         self.max_abs_value
     }
 
+    fn integral_heights(&self) -> bool {
+        self.integral_heights
+    }
+
     fn reader(&self) -> std::result::Result<WindowReader, ReadError> {
         Ok(WindowReader::open(&self.path, self.band)?)
     }
@@ -145,6 +159,7 @@ impl WindowRead for WindowReader {
 pub struct GridSource<'a> {
     grid: &'a Grid,
     max_abs_value: f64,
+    integral_heights: bool,
 }
 
 impl<'a> GridSource<'a> {
@@ -155,9 +170,15 @@ impl<'a> GridSource<'a> {
             .iter()
             .filter(|v| v.is_finite())
             .fold(0.0, |m: f64, v| m.max(v.abs()));
+        let integral_heights = grid
+            .values()
+            .iter()
+            .filter(|v| v.is_finite())
+            .all(|v| v.fract() == 0.0);
         GridSource {
             grid,
             max_abs_value,
+            integral_heights,
         }
     }
 }
@@ -175,6 +196,10 @@ impl<'a> TileSource for GridSource<'a> {
 
     fn max_abs_value(&self) -> f64 {
         self.max_abs_value
+    }
+
+    fn integral_heights(&self) -> bool {
+        self.integral_heights
     }
 
     fn reader(&self) -> std::result::Result<GridSource<'a>, ReadError> {

@@ -287,6 +287,49 @@ fn a_bound_of_zero_keeps_every_edge_sample() {
 }
 
 #[test]
+fn a_bound_of_zero_on_integer_heights_skips_exactly_collinear_edge_samples() {
+    // Edges kept every sample at a bound of 0 (2130 triangles for a flat 180 x 180 raster
+    // in tiles of 64, against 2 untiled); on integer heights the cores decide an error of
+    // 0 exactly, and the edges now skip exactly collinear samples.
+    let plane = GridSpec {
+        width: 31,
+        height: 22,
+        values: (0..31 * 22)
+            .map(|i: i32| f64::from(3 * (i % 31) - 7 * (i / 31) + 100))
+            .collect(),
+    };
+    let (w, report) = run(&plane, 0.0, ErrorModel::Exact, 11, 2);
+    assert_bound_holds(&plane, 0.0, &w, &report);
+    assert_eq!((report.final_vertices, report.final_triangles), (16, 18));
+    // A roof with a ridge, a step and a hole: planar pieces, kinks on and off tile edges.
+    let roof = GridSpec {
+        width: 37,
+        height: 29,
+        values: (0..37 * 29i32)
+            .map(|i| {
+                let (x, y) = (i % 37, i / 37);
+                f64::from((x - 15).abs() + 2 * y + if x > 25 { 9 } else { 0 })
+            })
+            .collect(),
+    };
+    let roof = with_nodata_disc(roof, 20.0, 12.0, 3.0);
+    for size in 2..10 {
+        let (w, report) = run(&roof, 0.0, ErrorModel::Exact, size, 2);
+        assert_bound_holds(&roof, 0.0, &w, &report);
+        assert_crack_free(&roof, &w);
+        assert_shared_edges_identical(&roof, &w, &report);
+        if size >= 6 {
+            assert!(
+                report.final_triangles * 3 < report.initial_triangles,
+                "tiles of {size}: {} of {} triangles kept",
+                report.final_triangles,
+                report.initial_triangles
+            );
+        }
+    }
+}
+
+#[test]
 fn same_mesh_for_one_and_two_threads_and_run_to_run() {
     let spec = with_nodata_disc(terrain(60, 45, 4.0, 11), 30.0, 22.0, 4.0);
     let (one, _) = run(&spec, 1.5, ErrorModel::Bounds, 9, 1);

@@ -189,6 +189,15 @@ fn small_cases_fail_early_and_clearly() {
     assert_fails_naming(&o, &["pipe.tif", "not a file"]);
     std::fs::remove_file(&fifo).unwrap();
     assert!(d.files().is_empty(), "{:?}", d.files());
+    // A symlink loop: one of the links was replaced by the mesh.
+    std::os::unix::fs::symlink("b.ply", d.path("a.ply")).unwrap();
+    std::os::unix::fs::symlink("a.ply", d.path("b.ply")).unwrap();
+    let o = d.run(&["mesh", &dem(), "-o", "a.ply", "--max-error", "1"]);
+    assert_fails_naming(&o, &["a.ply", "loops"]);
+    for link in ["a.ply", "b.ply"] {
+        let meta = std::fs::symlink_metadata(d.path(link)).unwrap();
+        assert!(meta.file_type().is_symlink(), "{link}");
+    }
 }
 
 #[cfg(unix)]

@@ -15,6 +15,13 @@ pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
             path.display()
         );
     }
+    if std::fs::metadata(path).is_err_and(|e| e.raw_os_error() == Some(libc::ELOOP)) {
+        bail!(
+            "{}: is a symbolic link that loops (or a chain of too many); point it at a file \
+             or remove it",
+            path.display()
+        );
+    }
     check_not_input(path, input)?;
     let (dir, file_in_the_way) = tinsmith_export::output_parent(path);
     if let Some(file) = file_in_the_way {

@@ -381,7 +381,7 @@ pub fn build_terrain(
 ) -> TerrainResult<TerrainReport> {
     if !(options.quality > 0.0 && options.quality <= MAX_QUALITY) {
         return Err(TerrainError::Options(format!(
-            "--quality must be a positive number up to {MAX_QUALITY:e}, got {}",
+            "--quality must be a positive number up to {MAX_QUALITY:e}, got {:?}",
             options.quality
         )));
     }

@@ -113,6 +113,26 @@ fn an_output_over_a_file_the_input_is_read_from_is_refused() {
     assert_eq!(std::fs::read(d.path("src.tif")).unwrap(), before);
     assert_eq!(std::fs::read(d.path("src.prj")).unwrap(), before);
     assert_eq!(d.files(), vec!["src.prj", "src.tif", "v.vrt"]);
+    // A raster read from inside an archive: the archive was overwritten.
+    let o = std::process::Command::new("gdal_translate")
+        .args(["-q", "-of", "AAIGrid", &dem(), "/vsizip/a.zip/dem.asc"])
+        .current_dir(d.path(""))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let zip = std::fs::read(d.path("a.zip")).unwrap();
+    let o = d.run(&[
+        "mesh",
+        "/vsizip/a.zip/dem.asc",
+        "-o",
+        "a.zip",
+        "--format",
+        "ply",
+        "--max-error",
+        "1",
+    ]);
+    assert_fails_naming(&o, &["a.zip", "read from"]);
+    assert_eq!(std::fs::read(d.path("a.zip")).unwrap(), zip);
 }
 
 #[test]
@@ -551,7 +571,27 @@ fn a_report_over_another_file_of_the_run_is_refused() {
     // the run exited 0.
     let d = Dir::new();
     std::fs::create_dir(d.path("pyramid")).unwrap();
-    let cases: [(&[&str], [&str; 2]); 4] = [
+    let cases: [(&[&str], [&str; 2]); 6] = [
+        // The directory itself: the report's rename failed after the output was in place.
+        (
+            &[
+                "mesh",
+                &dem(),
+                "--per-tile",
+                "per",
+                "--max-error",
+                "1",
+                "--tile-size",
+                "64",
+                "--report",
+                "per",
+            ],
+            ["per", "--per-tile directory"],
+        ),
+        (
+            &["tiles", &dem(), "-o", "new", "--report", "new"],
+            ["new", "pyramid directory"],
+        ),
         (
             &[
                 "mesh",

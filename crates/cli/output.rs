@@ -6,8 +6,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use tinsmith_export::MeshFormat;
 
-/// Fails early, before long work, when `path`'s directory is missing, `path` is a
-/// directory, or `path` is the `input` file.
+/// Fails early, before long work, when `path` ends with '/', is a looping symbolic link,
+/// is the `input` file or one the input is read from (see [`check_not_input`]), is a
+/// directory, or its directory is missing.
 pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
     if path.as_os_str().as_encoded_bytes().ends_with(b"/") {
         bail!(
@@ -264,11 +265,16 @@ pub fn check_distinct_from_sidecar(
 /// (`layer.json`) or be taken for one.
 pub fn check_not_inside(dir: &Path, report: &Path, what: &str) -> Result<()> {
     let absolute = |p: &Path| std::fs::canonicalize(p).or_else(|_| std::path::absolute(p));
-    let parent = parent_dir(report);
-    if let (Ok(dir), Ok(parent)) = (absolute(dir), absolute(parent)) {
-        if parent.starts_with(&dir) {
+    // The report's directory as it resolves, and its own name: the report may not exist.
+    let report_path = match (absolute(parent_dir(report)), report.file_name()) {
+        (Ok(parent), Some(name)) => Ok(parent.join(name)),
+        (parent, _) => parent,
+    };
+    if let (Ok(resolved), Ok(report_path)) = (absolute(dir), report_path) {
+        // Inside it, or the directory itself (the report's rename would fail at the end).
+        if report_path.starts_with(&resolved) {
             bail!(
-                "{}: is inside {what} {}; write the report elsewhere",
+                "{}: is {what} {} or inside it; write the report elsewhere",
                 report.display(),
                 dir.display()
             );

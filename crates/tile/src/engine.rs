@@ -160,10 +160,7 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
     let plan = TilePlan::new(source.width(), source.height(), options.tile_size)?;
     // More workers than tiles would only start idle threads (thousands of them took
     // seconds, and at tens of thousands a worker's start failed).
-    let workers = match options.threads {
-        0 => 0,
-        n => n.min(plan.len().max(1)),
-    };
+    let workers = worker_count(options.threads, plan.len());
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(workers)
         .thread_name(|i| format!("tinsmith-tile-{i}"))
@@ -253,6 +250,17 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
     report.final_vertices = welder.vertex_count() as u64;
     report.seconds_total = started.elapsed().as_secs_f64();
     Ok(report)
+}
+
+/// Worker threads for `jobs` independent jobs: `asked`, or one per core for 0, but never
+/// more than there are jobs (thousands of idle workers took seconds to start, and at tens
+/// of thousands one failed to start).
+pub(crate) fn worker_count(asked: usize, jobs: usize) -> usize {
+    let asked = match asked {
+        0 => std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get),
+        n => n,
+    };
+    asked.min(jobs.max(1))
 }
 
 /// What every tile of a run shares.

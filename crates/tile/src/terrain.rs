@@ -655,11 +655,15 @@ fn build_pyramid(
     options: &TerrainOptions,
     progress: &mut dyn FnMut(&LevelReport),
 ) -> TerrainResult<(Vec<LevelReport>, Available)> {
+    // The finest level has the most tiles: more workers than that would idle.
+    let finest = LevelRows::new(bounds, max_zoom);
+    let tiles = finest.tiles_x as usize * finest.tiles_y as usize;
+    let workers = crate::engine::worker_count(options.threads, tiles);
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(options.threads)
+        .num_threads(workers)
         .build()
         .map_err(|source| TerrainError::Threads {
-            threads: options.threads,
+            threads: workers,
             source,
         })?;
     let zooms = (options.min_zoom, max_zoom);

@@ -158,7 +158,8 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
     }
     if declared > 0 && feature_number as u64 != declared {
         return Err(Problem::malformed(format_args!(
-            "truncated: the header declares {declared} features, {feature_number} were read"
+            "the header declares {declared} features and {feature_number} were read (a \
+             truncated or damaged file)"
         )));
     }
     mesh.vertices = welder.into_vertices();
@@ -192,7 +193,7 @@ mod tests {
     }
 
     #[test]
-    fn a_file_cut_at_a_feature_boundary_is_refused_as_truncated() {
+    fn a_file_cut_at_a_feature_boundary_is_refused() {
         let vertices = [
             [0.0, 0.0, 1.0],
             [1.0, 0.0, 2.0],
@@ -205,7 +206,7 @@ mod tests {
         // Drop the last feature: every cut that still parses must be refused.
         let cut = (1..bytes.len()).filter(|&n| match read(&bytes[..n]) {
             Ok(mesh) => panic!("{n} of {} bytes read as {mesh:?}", bytes.len()),
-            Err(problem) => format!("{problem:?}").contains("truncated"),
+            Err(problem) => format!("{problem:?}").contains("features and"),
         });
         assert!(cut.count() > 0, "no cut reached the feature count check");
     }

@@ -56,7 +56,9 @@ pub(crate) fn write_collection_start<W: Write>(
             }
         }
     }
-    if let Some(wkt) = crs_wkt {
+    // RFC 7946 fixes its CRS: a WGS84 WKT would only add an axis order (EPSG:4326's
+    // latitude, longitude) that the coordinates do not follow.
+    if let (Some(wkt), false) = (crs_wkt, epsg == Some(4326)) {
         writeln!(w, "\"crs_wkt\":{},", quote(wkt)?)?;
     }
     w.write_all(b"\"features\":[\n")
@@ -341,6 +343,22 @@ mod tests {
         assert_eq!(mesh.triangles, TRIANGLES);
         assert_eq!((mesh.epsg, mesh.crs_wkt), (Some(4326), None));
         Ok(())
+    }
+
+    #[test]
+    fn wgs84_gets_no_crs_wkt_whose_axes_it_does_not_follow() {
+        // EPSG:4326's WKT declares latitude, longitude; RFC 7946 positions are longitude,
+        // latitude. It was written beside them (a 4326 raster with --geojson-source-crs).
+        let wkt = "GEOGCS[\"WGS 84\",AXIS[\"Latitude\",NORTH],AXIS[\"Longitude\",EAST],\
+                   AUTHORITY[\"EPSG\",\"4326\"]]";
+        let text = write_to_string(
+            MeshRef::new(&VERTICES, &TRIANGLES)
+                .with_crs_wkt(wkt)
+                .with_epsg(4326),
+        );
+        let value: Value = serde_json::from_str(&text).expect("valid JSON");
+        assert!(value.get("crs_wkt").is_none(), "{text}");
+        assert!(value.get("crs").is_none());
     }
 
     #[test]

@@ -251,6 +251,61 @@ fn a_replaced_output_keeps_its_permissions() {
 }
 
 #[test]
+fn a_container_of_subdatasets_names_one_to_give() {
+    // A GeoPackage (as a netCDF) with two rasters has no band of its own: the message said
+    // "band 1 out of range, the raster has 0 band(s)".
+    let d = Dir::new();
+    let etopo = fixture("etopo5_2deg_i16.tif");
+    for (table, extra) in [("a", None), ("b", Some("APPEND_SUBDATASET=YES"))] {
+        let mut args = vec!["-q", "-of", "GPKG", &etopo, "two.gpkg"];
+        let name = format!("RASTER_TABLE={table}");
+        args.extend(["-co", &name]);
+        if let Some(extra) = extra {
+            args.extend(["-co", extra]);
+        }
+        let o = std::process::Command::new("gdal_translate")
+            .args(&args)
+            .current_dir(d.path(""))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let o = d.run(&["mesh", "two.gpkg", "-o", "m.ply", "--max-error", "10"]);
+    assert_fails_naming(&o, &["two.gpkg", "2 subdataset(s)", "GPKG:two.gpkg:a"]);
+    let o = d.run(&[
+        "mesh",
+        "GPKG:two.gpkg:b",
+        "-o",
+        "m.ply",
+        "--max-error",
+        "10",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn a_raster_placed_by_geolocation_arrays_says_they_are_not_used() {
+    // A netCDF swath placed by geolocation arrays was meshed in pixel coordinates without a
+    // word, and tiles said only "no CRS and no geotransform".
+    let d = Dir::new();
+    let vrt = stretched_dem(50, 40).replace(
+        "<VRTRasterBand",
+        "<Metadata domain=\"GEOLOCATION\"><MDI key=\"X_DATASET\">lon.tif</MDI>\
+         <MDI key=\"X_BAND\">1</MDI><MDI key=\"Y_DATASET\">lat.tif</MDI>\
+         <MDI key=\"Y_BAND\">1</MDI></Metadata><VRTRasterBand",
+    );
+    d.write("swath.vrt", &vrt);
+    let o = d.run(&["mesh", "swath.vrt", "-o", "m.ply", "--max-error", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("geolocation arrays"), "{}", stderr(&o));
+    let o = d.run(&["info", "swath.vrt"]);
+    assert!(crate::util::stdout(&o).contains("geolocation arrays"));
+    let o = d.run(&["tiles", "swath.vrt", "-o", "t"]);
+    assert_fails_naming(&o, &["swath.vrt", "geolocation arrays", "gdalwarp -geoloc"]);
+}
+
+#[test]
 fn band_out_of_range() {
     let d = Dir::new();
     let o = d.run(&[

@@ -53,6 +53,10 @@ pub fn run(args: &InfoArgs) -> Result<bool> {
              first, e.g. `gdalwarp IN OUT.tif`",
             info.gcp_count
         ),
+        None if info.geolocation => println!(
+            "geotransform:  none (pixel coordinates); geolocation arrays, not used: warp \
+             onto a grid first (gdalwarp -geoloc)"
+        ),
         None => println!("geotransform:  none (pixel coordinates)"),
     }
     Ok(true)

@@ -87,17 +87,22 @@ pub fn note_prj_left_beside(output: &Path, format: MeshFormat, crs_written: bool
 }
 
 /// Notes on stderr (unless `quiet` or `pixel_coords`) that a raster placed only by ground
-/// control points is written in pixel coordinates: tinsmith does not georeference by GCPs.
+/// control points or geolocation arrays is written in pixel coordinates: tinsmith
+/// georeferences by a geotransform only.
 pub fn note_gcps_unused(info: &tinsmith_raster::RasterInfo, pixel_coords: bool, quiet: bool) {
-    if quiet || pixel_coords || info.geo_transform.is_some() || info.gcp_count == 0 {
+    if quiet || pixel_coords || info.geo_transform.is_some() {
         return;
     }
+    let (by, warp) = match (info.gcp_count, info.geolocation) {
+        (0, false) => return,
+        (0, true) => ("geolocation arrays".to_owned(), "gdalwarp -geoloc"),
+        (n, _) => (format!("{n} ground control points (GCPs)"), "gdalwarp"),
+    };
     note!(
-        "{}: georeferenced only by {} ground control points (GCPs), which tinsmith does not \
-         use: the output is in pixel (column, row) coordinates; for world coordinates warp \
-         it onto a grid first, e.g. `gdalwarp {} warped.tif`",
+        "{}: georeferenced only by {by}, which tinsmith does not use: the output is in pixel \
+         (column, row) coordinates; for world coordinates warp it onto a grid first, e.g. \
+         `{warp} {} warped.tif`",
         info.path.display(),
-        info.gcp_count,
         info.path.display()
     );
 }

@@ -42,6 +42,20 @@ pub enum Error {
         /// The path.
         path: PathBuf,
     },
+    /// The file has no band of its own, only subdatasets (a netCDF or HDF5 container).
+    #[error(
+        "{}: has no raster band of its own but {count} subdataset(s), such as {first}; give \
+         one of them as the input (`gdalinfo` lists them)",
+        path.display()
+    )]
+    Subdatasets {
+        /// The file.
+        path: PathBuf,
+        /// How many subdatasets it lists.
+        count: usize,
+        /// The first one's name, as GDAL opens it.
+        first: String,
+    },
     /// The requested band does not exist (bands are numbered from 1).
     #[error("{}: band {band} out of range, the raster has {count} band(s)", path.display())]
     BandOutOfRange {

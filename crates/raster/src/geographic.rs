@@ -148,6 +148,10 @@ fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
                 "only ground control points (GCPs), no geotransform",
                 "warp it onto a grid in the GCPs' CRS first, e.g. `gdalwarp IN OUT.tif`",
             ),
+            (None, _) if info.geolocation => (
+                "only geolocation arrays, no geotransform",
+                "warp it onto a grid first, e.g. `gdalwarp -geoloc IN OUT.tif`",
+            ),
             (Some(_), _) => (
                 "no CRS",
                 "assign the CRS its coordinates are in, e.g. `gdal_translate -of VRT -a_srs \

@@ -46,6 +46,9 @@ pub struct RasterInfo {
     /// How many ground control points (GCPs) the dataset has. tinsmith does not georeference
     /// by them: a raster placed only by GCPs is in pixel coordinates until it is warped.
     pub gcp_count: usize,
+    /// Whether the dataset is placed by geolocation arrays (GDAL's `GEOLOCATION` metadata,
+    /// as netCDF swaths have), which tinsmith does not use either.
+    pub geolocation: bool,
     /// The kind of GDAL mask the band has besides its nodata value (`"alpha band"`,
     /// `"per-dataset mask"` or `"mask band"`), whose zero samples count as nodata; `None`
     /// when it has none.

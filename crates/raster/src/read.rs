@@ -143,6 +143,26 @@ impl OpenBand {
     pub(crate) fn open(path: &Path, band: usize) -> Result<OpenBand> {
         let dataset = open_dataset(path)?;
         let count = dataset.raster_count();
+        if count == 0 {
+            // A container (netCDF, HDF5, GeoPackage...) whose rasters are its subdatasets
+            // (some drivers list them whole but do not answer for one item).
+            let names: Vec<String> = dataset
+                .metadata_domain("SUBDATASETS")
+                .unwrap_or_default()
+                .into_iter()
+                .filter_map(|item| {
+                    let (key, value) = item.split_once('=')?;
+                    key.ends_with("_NAME").then(|| value.to_owned())
+                })
+                .collect();
+            if let Some(first) = names.first() {
+                return Err(Error::Subdatasets {
+                    path: path.to_path_buf(),
+                    count: names.len(),
+                    first: first.clone(),
+                });
+            }
+        }
         if band == 0 || band > count {
             return Err(Error::BandOutOfRange {
                 path: path.to_path_buf(),
@@ -220,6 +240,7 @@ impl OpenBand {
         // GDAL fails (and fills in an identity) when the dataset has no geotransform.
         let geo_transform = dataset.geo_transform().ok();
         let gcp_count = dataset.gcps().len();
+        let geolocation = dataset.metadata_domain("GEOLOCATION").is_some();
 
         let info = RasterInfo {
             path: path.to_path_buf(),
@@ -236,6 +257,7 @@ impl OpenBand {
             epsg,
             geo_transform,
             gcp_count,
+            geolocation,
             mask,
             valid_samples: 0,
             nodata_samples: 0,

@@ -306,6 +306,47 @@ fn a_raster_placed_by_geolocation_arrays_says_they_are_not_used() {
 }
 
 #[test]
+fn verify_against_the_wrong_band_says_which_band_it_read() {
+    let d = Dir::new();
+    let one = stretched_dem(50, 40);
+    let start = one.find("<VRTRasterBand").unwrap();
+    let end = one.find("</VRTRasterBand>").unwrap() + "</VRTRasterBand>".len();
+    let second = one[start..end]
+        .replace("band=\"1\"", "band=\"2\"")
+        .replace("<SimpleSource", "<Offset>100</Offset><SimpleSource");
+    d.write(
+        "two.vrt",
+        &one.replace("</VRTDataset>", &format!("{second}</VRTDataset>")),
+    );
+    let o = d.run(&[
+        "mesh",
+        "two.vrt",
+        "-o",
+        "m.ply",
+        "--max-error",
+        "1",
+        "--band",
+        "2",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = d.run(&["verify", "two.vrt", "m.ply", "--max-error", "1"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("band 1 of 2"), "{}", stderr(&o));
+    let o = d.run(&[
+        "verify",
+        "two.vrt",
+        "m.ply",
+        "--max-error",
+        "1",
+        "--band",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("band"), "{}", stderr(&o));
+}
+
+#[test]
 fn band_out_of_range() {
     let d = Dir::new();
     let o = d.run(&[

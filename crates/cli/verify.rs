@@ -48,6 +48,15 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
     } else {
         print_report(&report, args);
     }
+    if !report.passed() && raster.info.band_count > 1 {
+        note!(
+            "{}: note: verified against band {} of {}; a mesh of another band fails here \
+             (--band picks another)",
+            args.mesh.display(),
+            args.band,
+            raster.info.band_count
+        );
+    }
     Ok(report.passed())
 }
 

@@ -1,10 +1,12 @@
 //! `tinsmith mesh`: decimate a raster into a TIN, check it, write it.
 
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Result};
 use serde::Serialize;
 use tinsmith_core::decimate_with_progress;
+use tinsmith_export::MeshFormat;
 use tinsmith_verify::{GridRef, VerifyOptions};
 
 use crate::args::MeshArgs;
@@ -66,16 +68,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     if !args.pixel_coords {
         crate::output::check_sidecar_not_input(output, &args.input, format)?;
     }
-    if let Some(report) = &args.report {
-        check_writable_target(report, &args.input)?;
-        check_distinct(output, report, "the output")?;
-        crate::output::check_distinct_from_sidecar(output, report, format, args.pixel_coords)?;
-    }
-    let reserved = args
-        .report
-        .as_deref()
-        .map(ReservedReport::reserve)
-        .transpose()?;
+    let reserved = reserve_report(args, Some((output, format)))?;
 
     let t = Instant::now();
     let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
@@ -189,4 +182,25 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     }
     tinsmith_export::mark_finished();
     Ok(true)
+}
+
+/// Checks `--report` before the work (writable; not the input, the output, its `.prj`
+/// sidecar, or inside the `--per-tile` directory) and takes its room (see
+/// [`ReservedReport`]); `None` without `--report`.
+pub fn reserve_report(
+    args: &MeshArgs,
+    output: Option<(&Path, MeshFormat)>,
+) -> Result<Option<ReservedReport>> {
+    let Some(report) = &args.report else {
+        return Ok(None);
+    };
+    if let Some(dir) = &args.per_tile {
+        crate::output::check_not_inside(dir, report, "the --per-tile directory")?;
+    }
+    check_writable_target(report, &args.input)?;
+    if let Some((output, format)) = output {
+        check_distinct(output, report, "the output")?;
+        crate::output::check_distinct_from_sidecar(output, report, format, args.pixel_coords)?;
+    }
+    ReservedReport::reserve(report).map(Some)
 }

@@ -17,8 +17,8 @@ use tinsmith_tile::{
 
 use crate::args::{MeshArgs, TileFormatArg};
 use crate::georef::Georef;
+use crate::output::check_writable_target;
 use crate::output::NamingFile;
-use crate::output::{check_distinct, check_writable_target, ReservedReport};
 use crate::report::{MeshSummary, Outcome, Seconds};
 
 /// GDAL block cache, in MB, for the commands that read each block once (set in `main`):
@@ -143,21 +143,8 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
     crate::georef::check_transform(reader.info(), args.pixel_coords)?;
     drop(reader);
-    if let Some(report) = &args.report {
-        if let Some(dir) = &args.per_tile {
-            crate::output::check_not_inside(dir, report, "the --per-tile directory")?;
-        }
-        check_writable_target(report, &args.input)?;
-        if let (Some(output), Some(format)) = (&args.output, welded_format) {
-            check_distinct(output, report, "the output")?;
-            crate::output::check_distinct_from_sidecar(output, report, format, args.pixel_coords)?;
-        }
-    }
-    let reserved = args
-        .report
-        .as_deref()
-        .map(ReservedReport::reserve)
-        .transpose()?;
+    let welded_output = args.output.as_deref().zip(welded_format);
+    let reserved = crate::mesh::reserve_report(args, welded_output)?;
 
     let t = Instant::now();
     let info = crate::progress::scan_raster(&args.input, args.band, args.quiet)?;

@@ -347,6 +347,23 @@ fn verify_against_the_wrong_band_says_which_band_it_read() {
 }
 
 #[test]
+fn info_says_nan_samples_are_nodata_when_none_is_declared() {
+    // "nodata: none" beside "(2 nodata)" read as a contradiction.
+    let d = Dir::new();
+    d.write(
+        "nan.asc",
+        "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1.5 nan 3.5\n4.5 5.5 nan\n",
+    );
+    let o = d.run(&["info", "nan.asc"]);
+    let out = crate::util::stdout(&o);
+    assert!(
+        out.contains("none declared (NaN or infinite samples are nodata)"),
+        "{out}"
+    );
+    assert!(out.contains("(2 nodata)"), "{out}");
+}
+
+#[test]
 fn band_out_of_range() {
     let d = Dir::new();
     let o = d.run(&[

@@ -28,6 +28,9 @@ pub fn run(args: &InfoArgs) -> Result<bool> {
     }
     match info.nodata {
         Some(n) => println!("nodata:        {}", readable(n)),
+        None if info.nodata_samples > 0 => {
+            println!("nodata:        none declared (NaN or infinite samples are nodata)")
+        }
         None => println!("nodata:        none"),
     }
     if let Some(mask) = &info.mask {

@@ -59,10 +59,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         check_distinct(mesh, &args.output, "the --mesh input")?;
     }
     let e = args.max_error.unwrap_or(0.0);
-    let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
-    crate::georef::check_transform(reader.info(), args.pixel_coords)?;
-    let size = (reader.width(), reader.height());
-    drop(reader);
+    let size = crate::georef::check_input_transform(&args.input, args.band, args.pixel_coords)?;
     let tiled =
         args.mesh.is_none() && e > 0.0 && (size.0 > args.tile_size || size.1 > args.tile_size);
     // A TIN decimated here is shaped for the levels (fewer segments, same bound), so they

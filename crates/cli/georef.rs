@@ -1,5 +1,7 @@
 //! Between grid positions and the coordinates written in mesh files.
 
+use std::path::Path;
+
 use anyhow::{bail, Result};
 use tinsmith_core::GeoTransform;
 
@@ -29,6 +31,14 @@ pub fn check_transform(info: &tinsmith_raster::RasterInfo, pixel_coords: bool) -
         ),
         _ => Ok(()),
     }
+}
+
+/// [`check_transform`] on the band's metadata alone (no sample is read); returns the
+/// raster's width and height.
+pub fn check_input_transform(input: &Path, band: usize, pixel_coords: bool) -> Result<(u32, u32)> {
+    let reader = tinsmith_raster::WindowReader::open(input, band)?;
+    check_transform(reader.info(), pixel_coords)?;
+    Ok((reader.width(), reader.height()))
 }
 
 impl Georef {

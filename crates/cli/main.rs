@@ -70,7 +70,7 @@ fn main() -> ExitCode {
         // These read each block of the raster once (a scan, a whole-raster read, or tiles
         // in order): GDAL's default cache, 5 % of the machine's memory, would only hold
         // blocks never read again (`info` on a 40k x 40k raster peaked at 1.16 GB).
-        tinsmith_raster::limit_block_cache(tiled::TILED_BLOCK_CACHE_MB);
+        tinsmith_raster::limit_block_cache(BLOCK_CACHE_MB);
     }
     let result = match cli.command {
         Command::Info(a) => info::run(&a),
@@ -99,6 +99,10 @@ fn main() -> ExitCode {
         }
     }
 }
+
+/// GDAL block cache, in MB, for the commands that read each block once: several rows of
+/// tiles of a 16k-wide Float32 raster, whether it is stored in strips or blocks.
+const BLOCK_CACHE_MB: u64 = 256;
 
 /// `info` and `verify` print their results on stdout and write no file: like other Unix
 /// tools they end quietly when the reader of a pipe goes away (`| head`), where Rust's

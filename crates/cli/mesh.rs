@@ -63,11 +63,8 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         return crate::tiled::run(args);
     };
     let total = Instant::now();
+    // `untiled_output` has checked the output path and its sidecar.
     let format = crate::export::format(args)?;
-    check_writable_target(output, &args.input)?;
-    if !args.pixel_coords {
-        crate::output::check_sidecar_not_input(output, &args.input, format)?;
-    }
     let reserved = reserve_report(args, Some((output, format)))?;
 
     let t = Instant::now();
@@ -87,7 +84,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let plan = crate::export::Plan::new(format, &raster.info, Some(grid), args)?;
     // Float32 formats leave the decimator the bound less their height rounding.
     let heights = raster.info.min.zip(raster.info.max);
-    crate::output::note_rounding_margin(&args.input, plan.decimation_bound, heights, args.quiet);
+    crate::report::note_rounding_margin(&args.input, plan.decimation_bound, heights, args.quiet);
     let options = args
         .decimation_options(plan.decimation_bound, heights)
         .naming_file(&args.input)?;

@@ -56,7 +56,7 @@ pub fn check_sidecar_not_input(output: &Path, input: &Path, format: MeshFormat) 
     let ours = tinsmith_export::prj_path(output);
     if let Ok(a) = std::fs::canonicalize(&ours) {
         let theirs = std::fs::canonicalize(tinsmith_export::prj_path(input)).ok();
-        if theirs.as_ref() == Some(&a) || tinsmith_raster::input_files(input).contains(&a) {
+        if theirs.as_ref() == Some(&a) || input_files(input).contains(&a) {
             bail!(
                 "{}: its CRS would go to {}, which belongs to the input {}; choose another \
                  output name",
@@ -86,6 +86,19 @@ pub fn note_prj_left_beside(output: &Path, format: MeshFormat, crs_written: bool
     );
 }
 
+/// [`tinsmith_raster::input_files`] of `input`, opened once per run: every output path of
+/// a run (the mesh, its sidecar, the report) is checked against the same input.
+fn input_files(input: &Path) -> std::borrow::Cow<'static, [PathBuf]> {
+    static FILES: std::sync::OnceLock<(PathBuf, Vec<PathBuf>)> = std::sync::OnceLock::new();
+    let (path, files) =
+        FILES.get_or_init(|| (input.to_path_buf(), tinsmith_raster::input_files(input)));
+    if path == input {
+        files.as_slice().into()
+    } else {
+        tinsmith_raster::input_files(input).into()
+    }
+}
+
 /// Notes on stderr (unless `quiet` or `pixel_coords`) that a raster placed only by ground
 /// control points or geolocation arrays is written in pixel coordinates: tinsmith
 /// georeferences by a geotransform only.
@@ -107,29 +120,6 @@ pub fn note_gcps_unused(info: &tinsmith_raster::RasterInfo, pixel_coords: bool, 
     );
 }
 
-/// Notes on stderr (unless `quiet`) when heights as large as `heights` leave decimation
-/// noticeably less than `bound`: it keeps `2^-40` of the largest |height| as a margin for
-/// the rounding of its arithmetic (see `tinsmith_core::effective_limit`), 0.9 at 1e12.
-/// The bound is kept either way; the mesh just keeps more triangles than the bound needs.
-pub fn note_rounding_margin(input: &Path, bound: f64, heights: Option<(f64, f64)>, quiet: bool) {
-    let Some((lo, hi)) = heights else { return };
-    let max_abs = lo.abs().max(hi.abs());
-    let limit = tinsmith_core::effective_limit(bound, max_abs);
-    if quiet || !(bound.is_finite() && bound > 0.0) || bound - limit <= 0.01 * bound {
-        return;
-    }
-    note!(
-        "{}: heights up to {} leave decimation about {:.3e} of the bound {} (the rest is \
-         a margin for rounding, 2^-40 of the largest |height|): more triangles are kept \
-         than the bound needs; subtracting a constant offset from the heights would give \
-         it all",
-        input.display(),
-        crate::number::readable(max_abs),
-        limit,
-        crate::number::readable(bound)
-    );
-}
-
 /// Fails when `output` is the file `input` or one GDAL reads with it (a VRT's source, an
 /// ENVI header, a `.prj` or `.aux.xml` sidecar: see [`tinsmith_raster::input_files`]), by
 /// any path, links included: writing would destroy or change the input.
@@ -145,7 +135,7 @@ pub fn check_not_input(output: &Path, input: &Path) -> Result<()> {
             input.display()
         );
     }
-    if tinsmith_raster::input_files(input).contains(&target) {
+    if input_files(input).contains(&target) {
         bail!(
             "{}: is a file the input raster {} is read from (GDAL lists it among the \
              input's files); writing there would change or destroy the input",

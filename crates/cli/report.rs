@@ -170,6 +170,29 @@ pub struct Seconds {
     pub total: f64,
 }
 
+/// Notes on stderr (unless `quiet`) when heights as large as `heights` leave decimation
+/// noticeably less than `bound`: it keeps `2^-40` of the largest |height| as a margin for
+/// the rounding of its arithmetic (see `tinsmith_core::effective_limit`), 0.9 at 1e12.
+/// The bound is kept either way; the mesh just keeps more triangles than the bound needs.
+pub fn note_rounding_margin(input: &Path, bound: f64, heights: Option<(f64, f64)>, quiet: bool) {
+    let Some((lo, hi)) = heights else { return };
+    let max_abs = lo.abs().max(hi.abs());
+    let limit = tinsmith_core::effective_limit(bound, max_abs);
+    if quiet || !(bound.is_finite() && bound > 0.0) || bound - limit <= 0.01 * bound {
+        return;
+    }
+    note!(
+        "{}: heights up to {} leave decimation about {:.3e} of the bound {} (the rest is \
+         a margin for rounding, 2^-40 of the largest |height|): more triangles are kept \
+         than the bound needs; subtracting a constant offset from the heights would give \
+         it all",
+        input.display(),
+        readable(max_abs),
+        limit,
+        readable(bound)
+    );
+}
+
 /// The flag value clap shows for `v`.
 fn value_name(v: impl clap::ValueEnum) -> String {
     v.to_possible_value()

@@ -17,15 +17,8 @@ use tinsmith_tile::{
 
 use crate::args::{MeshArgs, TileFormatArg};
 use crate::georef::Georef;
-use crate::output::check_writable_target;
 use crate::output::NamingFile;
 use crate::report::{MeshSummary, Outcome, Seconds};
-
-/// GDAL block cache, in MB, for the commands that read each block once (set in `main`):
-/// several rows of tiles of a 16k-wide Float32 raster, whether it is stored in strips or
-/// blocks. GDAL's default (5 % of the machine's memory) would keep most of a large raster
-/// resident.
-pub const TILED_BLOCK_CACHE_MB: u64 = 256;
 
 /// The output file when the untiled engine should run: no `--per-tile`, and the raster
 /// fits in one tile or a triangle or vertex count is the target (which needs the whole
@@ -39,7 +32,7 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
     }
     // Checks the untiled path makes first, so that errors come in the same order.
     let format = crate::export::format(args)?;
-    check_writable_target(output, &args.input)?;
+    crate::output::check_writable_target(output, &args.input)?;
     if !args.pixel_coords {
         crate::output::check_sidecar_not_input(output, &args.input, format)?;
     }
@@ -129,20 +122,15 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let Some(max_error) = args.max_error else {
         bail!("{input}: tiles need --max-error");
     };
+    // With -o, `untiled_output` has checked the output path, its sidecar and the
+    // geotransform; --per-tile has not been through it.
     let welded_format = match &args.output {
-        Some(output) => {
-            let format = crate::export::format(args)?;
-            check_writable_target(output, &args.input)?;
-            if !args.pixel_coords {
-                crate::output::check_sidecar_not_input(output, &args.input, format)?;
-            }
-            Some(format)
+        Some(_) => Some(crate::export::format(args)?),
+        None => {
+            crate::georef::check_input_transform(&args.input, args.band, args.pixel_coords)?;
+            None
         }
-        None => None,
     };
-    let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
-    crate::georef::check_transform(reader.info(), args.pixel_coords)?;
-    drop(reader);
     let welded_output = args.output.as_deref().zip(welded_format);
     let reserved = crate::mesh::reserve_report(args, welded_output)?;
 
@@ -164,7 +152,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     };
     let bound = export_plan.map_or(max_error, |p| p.decimation_bound);
     let heights = info.min.zip(info.max);
-    crate::output::note_rounding_margin(&args.input, bound, heights, args.quiet);
+    crate::report::note_rounding_margin(&args.input, bound, heights, args.quiet);
     let decimation = args
         .decimation_options(bound, heights)
         .naming_file(&args.input)?;

@@ -53,13 +53,9 @@ fn on_disk(name: &str) -> PathBuf {
         }
     }
     let inner = on_disk(inner);
-    inner
-        .ancestors()
-        .collect::<Vec<_>>()
-        .into_iter()
-        .rev()
-        .find(|p| !p.as_os_str().is_empty() && p.is_file())
-        .map_or(inner.clone(), Path::to_path_buf)
+    // Ancestors run from the whole path to its root: the last file among them.
+    let archive = inner.ancestors().filter(|p| p.is_file()).last();
+    archive.map_or_else(|| inner.clone(), Path::to_path_buf)
 }
 
 #[cfg(test)]

@@ -498,6 +498,33 @@ fn a_memory_ulimit_counts_as_what_is_available() {
 }
 
 #[test]
+fn tiled_lines_that_outgrow_memory_stop_the_run() {
+    // Tiles are contoured as they are finished and only the lines are held, so the check
+    // runs as they grow: the sample DEM at ε = 0.5 in tiles of 128, contoured every 0.1 m,
+    // makes lines beyond a 1.5 GB ulimit partway through and is stopped there.
+    let d = Dir::new();
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 1500000 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_tinsmith"))
+        .args(["contour", &dem, "-o", "c.fgb", "--interval", "0.1"])
+        .args(["--max-error", "0.5", "--tile-size", "128"])
+        .current_dir(d.path(""))
+        .output()
+        .expect("sh runs");
+    assert_fails_naming(
+        &o,
+        &[
+            "becmodel",
+            "levels cross the TIN at least",
+            "GB is available",
+        ],
+    );
+    assert!(!d.path("c.fgb").exists());
+}
+
+#[test]
 fn contour_bad_input_fails_cleanly() {
     let dem = fixture("tintn_valid_raster_3857.tif");
     let d = Dir::new();

@@ -9,7 +9,10 @@
 //! directly ([`tinsmith_contour::ContourMesh::from_grid`]): the same surface decimation at
 //! 0 would give, without its cost. A raster wider or taller than `--tile-size` is decimated
 //! by the tiled engine instead (a window at a time, in parallel, every tile verified; the
-//! same TIN `tinsmith mesh --tile-size` writes), so memory is the TIN, not the raster.
+//! same TIN `tinsmith mesh --tile-size` writes), each tile contoured as it is finished and
+//! its lines stitched to its neighbours' ([`tinsmith_contour::ContourStitcher`]: the lines
+//! of the welded TIN, which is never held), so memory is the lines, not the TIN or the
+//! raster.
 //! Lines are computed in grid coordinates and mapped to the
 //! world position of sample centres through the geotransform, as `tinsmith mesh` writes
 //! vertices, so a line through a vertex passes through the mesh file's vertex exactly.
@@ -22,11 +25,14 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use tinsmith_contour::{contour, interval_levels, simplify_indices, sorted_levels, ContourMesh};
+use tinsmith_contour::{
+    contour, interval_levels, simplify_indices, sorted_levels, ContourMesh, ContourStitcher,
+    Polyline,
+};
 use tinsmith_core::{decimate, DecimationOptions, Grid};
 use tinsmith_export::LineFormat;
 use tinsmith_raster::{Raster, RasterInfo};
-use tinsmith_tile::{mesh_tiles, MeshCollector, RasterSource, TileOptions};
+use tinsmith_tile::{mesh_tiles, FinishedTile, RasterSource, SinkError, TileOptions, TileSink};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
 use crate::args::ContourArgs;
@@ -64,12 +70,12 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         args.mesh.is_none() && e > 0.0 && (size.0 > args.tile_size || size.1 > args.tile_size);
     // A TIN decimated here is shaped for the levels (fewer segments, same bound), so they
     // come from the raster's height range first; a --mesh file's come from its own heights.
-    let (mesh, info, source, levels) = if tiled {
+    let (contoured, info, source, levels) = if tiled {
         let info = crate::progress::scan_raster(&args.input, args.band, args.quiet)?;
         let levels = levels_for(args, info.min.zip(info.max))?;
-        let (mesh, tiles) = tiled_tin(args, e, &info, &levels)?;
+        let (contoured, tiles) = tiled_lines(args, e, &info, &levels)?;
         let source = format!("TIN within {} ({tiles} tiles)", readable(e));
-        (mesh, info, source, levels)
+        (contoured, info, source, levels)
     } else {
         let (need, what, instead) = match &args.mesh {
             Some(mesh) => (
@@ -102,27 +108,32 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         crate::memory::check_whole_raster_fits(&args.input, size, need, what, instead)?;
         let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
         let (mesh, source, levels) = untiled_tin(args, e, &raster)?;
-        (mesh, raster.info, source, levels)
+        // The lines are held whole before writing: refuse levels that would not fit.
+        let segments = mesh.segment_count(&levels);
+        crate::memory::check_fits(
+            segments.saturating_mul(BYTES_PER_SEGMENT),
+            |needed, available| {
+                lines_refusal(
+                    args,
+                    levels.len(),
+                    &format!("about {segments} times"),
+                    needed,
+                    available,
+                )
+            },
+        )?;
+        let lines = contour(&mesh, &levels)
+            .with_context(|| format!("{}: contouring failed", args.input.display()))?;
+        let contoured = Contoured {
+            lines,
+            triangles: mesh.triangles().len(),
+            height_range: mesh.height_range(),
+        };
+        (contoured, raster.info, source, levels)
     };
     let georef = Georef::new(info.transform(), args.pixel_coords);
     crate::output::note_gcps_unused(&info, args.pixel_coords, args.quiet);
-
-    // The lines are held whole before writing: refuse levels that would not fit.
-    let segments = mesh.segment_count(&levels);
-    crate::memory::check_fits(
-        segments.saturating_mul(BYTES_PER_SEGMENT),
-        |needed, available| {
-            format!(
-                "{}: the {} levels cross the TIN about {segments} times; the lines would need \
-             about {needed:.1} GB and {available:.1} GB is available; give a larger \
-             --interval or fewer --levels (or a larger --max-error)",
-                args.input.display(),
-                levels.len()
-            )
-        },
-    )?;
-    let polylines = contour(&mesh, &levels)
-        .with_context(|| format!("{}: contouring failed", args.input.display()))?;
+    let polylines = contoured.lines;
 
     // Grid coordinates -> file coordinates, with the level as z for the reprojection, then
     // --simplify. A north-up raster flips orientation; reverse so the high ground stays on
@@ -212,11 +223,11 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
                 .unwrap_or_default(),
             levels.len(),
             source,
-            mesh.triangles().len(),
+            contoured.triangles,
             started.elapsed().as_secs_f64()
         );
         if lines.is_empty() {
-            if let Some((lo, hi)) = mesh.height_range() {
+            if let Some((lo, hi)) = contoured.height_range {
                 let why = if levels.is_empty() {
                     "no level of the --interval lies within the TIN's heights"
                 } else if levels.iter().all(|&l| l < lo || l > hi) {
@@ -323,38 +334,121 @@ fn untiled_tin(
     Ok((mesh, format!("TIN within {}", readable(e)), levels))
 }
 
-/// The TIN to contour from a raster larger than `--tile-size`: decimated within `e` and
-/// shaped for `levels` by the tiled engine (windowed reads, in parallel, each tile
-/// verified), welded in memory. Returns it with the number of tiles.
-fn tiled_tin(
+/// Contour lines and what they were drawn on: the TIN's triangle count and height range.
+struct Contoured {
+    lines: Vec<Polyline>,
+    triangles: usize,
+    height_range: Option<(f64, f64)>,
+}
+
+/// The refusal for lines that would not fit in memory: `crossing` says how often the
+/// levels cross the TIN.
+fn lines_refusal(
+    args: &ContourArgs,
+    levels: usize,
+    crossing: &str,
+    needed: f64,
+    available: f64,
+) -> String {
+    format!(
+        "{}: the {levels} levels cross the TIN {crossing}; the lines would need about \
+         {needed:.1} GB and {available:.1} GB is available; give a larger --interval or fewer \
+         --levels (or a larger --max-error)",
+        args.input.display(),
+    )
+}
+
+/// The lines of a raster larger than `--tile-size`: decimated within `e` and shaped for
+/// `levels` by the tiled engine (windowed reads, in parallel, each tile verified), each
+/// tile contoured as it is finished and its lines stitched to its neighbours' through
+/// their shared edges (the lines `contour` gives on the welded TIN, which is never held).
+/// Returns them with the number of tiles.
+fn tiled_lines(
     args: &ContourArgs,
     e: f64,
     info: &RasterInfo,
     levels: &[f64],
-) -> Result<(ContourMesh, usize)> {
-    let input = args.input.display();
+) -> Result<(Contoured, usize)> {
     let source = RasterSource::new(info)?;
     let options = TileOptions::new(DecimationOptions::new(e).with_contour_levels(levels))
         .with_tile_size(args.tile_size)
         .with_threads(args.threads.map_or(0, |n| n as usize));
-    let mut collector = MeshCollector::new();
+    let mut sink = StitchingSink {
+        stitcher: ContourStitcher::new(levels).naming_file(&args.input)?,
+        levels,
+        triangles: 0,
+        height_range: None,
+        room: crate::memory::available_bytes(),
+        refusal: None,
+        args,
+    };
     let bar = crate::tiled::progress_bar(args.quiet);
     bar.set_message("tiles");
     let mut progress = |p: tinsmith_tile::TileProgress| {
         bar.set_length(p.total as u64);
         bar.set_position(p.done as u64);
     };
-    let report =
-        mesh_tiles(&source, &options, &mut collector, &mut progress).naming_file(&args.input);
+    let report = mesh_tiles(&source, &options, &mut sink, &mut progress);
     bar.finish_and_clear();
-    let report = report?;
+    if let Some(refusal) = sink.refusal.take() {
+        bail!("{refusal}");
+    }
+    let report = report.naming_file(&args.input)?;
     if report.final_triangles == 0 {
         return Err(nothing_to_contour(args));
     }
-    let (vertices, triangles) = collector.into_parts();
-    let mesh =
-        ContourMesh::new(vertices, triangles).with_context(|| format!("{input}: decimated TIN"))?;
-    Ok((mesh, report.plan.len()))
+    let contoured = Contoured {
+        lines: sink.stitcher.finish(),
+        triangles: sink.triangles,
+        height_range: sink.height_range,
+    };
+    Ok((contoured, report.plan.len()))
+}
+
+/// Contours each finished tile and stitches its lines to the earlier tiles', holding the
+/// lines but not the TIN; refuses (and stops the run) once the lines would outgrow the
+/// memory that was available at the start.
+struct StitchingSink<'a> {
+    stitcher: ContourStitcher,
+    levels: &'a [f64],
+    triangles: usize,
+    height_range: Option<(f64, f64)>,
+    /// Bytes available when the run started, if known.
+    room: Option<u64>,
+    /// Why the run was stopped, for the caller to report as is.
+    refusal: Option<String>,
+    args: &'a ContourArgs,
+}
+
+impl TileSink for StitchingSink<'_> {
+    fn tile(&mut self, tile: &FinishedTile) -> Result<(), SinkError> {
+        let vertices = tile
+            .vertices()
+            .iter()
+            .map(|v| [f64::from(v.x), f64::from(v.y), v.z])
+            .collect();
+        let mesh = ContourMesh::new(vertices, tile.triangles().to_vec())?;
+        let segments = self.stitcher.crossings_held() + mesh.segment_count(self.levels);
+        let needed = segments.saturating_mul(BYTES_PER_SEGMENT);
+        if let Some(room) = self.room.filter(|&room| needed > room) {
+            let refusal = lines_refusal(
+                self.args,
+                self.levels.len(),
+                &format!("at least {segments} times"),
+                needed as f64 / 1e9,
+                room as f64 / 1e9,
+            );
+            self.refusal = Some(refusal.clone());
+            return Err(refusal.into());
+        }
+        self.stitcher.add(&mesh, tile.ids())?;
+        self.triangles += mesh.triangles().len();
+        if let Some((lo, hi)) = mesh.height_range() {
+            let (l, h) = self.height_range.unwrap_or((lo, hi));
+            self.height_range = Some((l.min(lo), h.max(hi)));
+        }
+        Ok(())
+    }
 }
 
 /// The error for a band without a valid 2x2 block of samples.

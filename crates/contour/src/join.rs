@@ -33,6 +33,52 @@ use crate::{levels::sorted_levels, ContourMesh, Error, Polyline, Result};
 /// `O(triangles × log(levels) + segments)` after the mesh is built.
 pub fn contour(mesh: &ContourMesh, levels: &[f64]) -> Result<Vec<Polyline>> {
     let levels = sorted_levels(levels)?;
+    let mut lines = Vec::new();
+    walk_levels(mesh, &levels, None, |_, level, walk| {
+        lines.extend(finish_line(level, walk.closed, walk.crossings));
+        Ok(())
+    })?;
+    sort_lines(&mut lines);
+    Ok(lines)
+}
+
+/// Sorts lines by level, then by the edge under their first point: the output order of
+/// [`contour`] (levels are distinct, and no two lines of a level start on the same edge).
+pub(crate) fn sort_lines(lines: &mut [Polyline]) {
+    lines.sort_by(|a, b| {
+        a.level
+            .total_cmp(&b.level)
+            .then(a.edges[0].cmp(&b.edges[0]))
+    });
+}
+
+/// One crossing of a line with a mesh edge: the edge (as `[smaller id, larger id]`) and the
+/// crossing point on it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Crossing {
+    pub(crate) edge: [u32; 2],
+    pub(crate) point: [f64; 2],
+}
+
+/// A walk of one line through a mesh, entry to exit (high ground on the left): the edges it
+/// crosses in order, first and last included.
+pub(crate) struct Walk {
+    pub(crate) crossings: Vec<Crossing>,
+    /// A ring (its last crossing repeats its first), not a walk from a boundary edge to a
+    /// boundary edge.
+    pub(crate) closed: bool,
+}
+
+/// Walks every line of `mesh` at each of `levels` (sorted, distinct) and hands each to
+/// `found` with its level's index and value: for each level, the walks from boundary edges
+/// first (in the order of their triangles), then the rings. Edges are named through `ids`
+/// (vertex index -> id) when given, else by vertex index.
+pub(crate) fn walk_levels(
+    mesh: &ContourMesh,
+    levels: &[f64],
+    ids: Option<&[u32]>,
+    mut found: impl FnMut(usize, f64, Walk) -> Result<()>,
+) -> Result<()> {
     let vertices = mesh.vertices();
     let triangles = mesh.triangles();
     // Which triangles each level cuts: those with min z < level <= max z.
@@ -48,22 +94,22 @@ pub fn contour(mesh: &ContourMesh, levels: &[f64]) -> Result<Vec<Polyline>> {
     }
     let mut joiner = Joiner {
         mesh,
+        ids,
         slot: vec![NONE; triangles.len()],
         used: Vec::new(),
         walk: Vec::new(),
     };
-    let mut lines = Vec::new();
-    for (level, bucket) in levels.iter().zip(&cut) {
-        let start = lines.len();
-        joiner.join(*level, bucket, &mut lines)?;
-        lines[start..].sort_by_key(|l: &Polyline| l.edges[0]);
+    for (index, (&level, bucket)) in levels.iter().zip(&cut).enumerate() {
+        joiner.join(level, bucket, &mut |level, walk| found(index, level, walk))?;
     }
-    Ok(lines)
+    Ok(())
 }
 
 /// Joins one level's segments; holds the buffers reused across levels.
 struct Joiner<'a> {
     mesh: &'a ContourMesh,
+    /// Vertex index -> the id edges are named by, when not the index itself.
+    ids: Option<&'a [u32]>,
     /// Triangle -> its index in the current level's bucket, or `NONE`.
     slot: Vec<u32>,
     /// Per bucket entry: its segment already belongs to a line.
@@ -73,13 +119,18 @@ struct Joiner<'a> {
 }
 
 impl Joiner<'_> {
-    fn join(&mut self, level: f64, bucket: &[u32], lines: &mut Vec<Polyline>) -> Result<()> {
+    fn join(
+        &mut self,
+        level: f64,
+        bucket: &[u32],
+        found: &mut dyn FnMut(f64, Walk) -> Result<()>,
+    ) -> Result<()> {
         for (i, &t) in bucket.iter().enumerate() {
             self.slot[t as usize] = i as u32;
         }
         self.used.clear();
         self.used.resize(bucket.len(), false);
-        let result = self.join_slotted(level, bucket, lines);
+        let result = self.join_slotted(level, bucket, found);
         for &t in bucket {
             self.slot[t as usize] = NONE;
         }
@@ -90,7 +141,7 @@ impl Joiner<'_> {
         &mut self,
         level: f64,
         bucket: &[u32],
-        lines: &mut Vec<Polyline>,
+        found: &mut dyn FnMut(f64, Walk) -> Result<()>,
     ) -> Result<()> {
         // Open lines first, from each not yet used segment on a boundary edge...
         for (i, &t) in bucket.iter().enumerate() {
@@ -112,7 +163,8 @@ impl Joiner<'_> {
                     what: "a line from a boundary edge came back to its start",
                 });
             }
-            self.emit(level, false, lines);
+            let walk = self.crossings(level, false);
+            found(level, walk)?;
         }
         // ...then the rings that remain.
         for (i, &t) in bucket.iter().enumerate() {
@@ -126,7 +178,8 @@ impl Joiner<'_> {
                     what: "a line from an interior edge reached the boundary",
                 });
             }
-            self.emit(level, true, lines);
+            let walk = self.crossings(level, true);
+            found(level, walk)?;
         }
         Ok(())
     }
@@ -175,66 +228,81 @@ impl Joiner<'_> {
         })
     }
 
-    /// Turns `self.walk` into a [`Polyline`]: high ground on the left, a ring started at
-    /// its smallest edge, coincident points merged; dropped if it collapses to a point.
-    fn emit(&mut self, level: f64, closed: bool, lines: &mut Vec<Polyline>) {
+    /// The crossings of `self.walk`, turned to run entry -> exit (high ground on the left).
+    fn crossings(&mut self, level: f64, closed: bool) -> Walk {
         let tris = self.mesh.triangles();
         let verts = self.mesh.vertices();
-        let edge = |h: u32| {
-            let tri = tris[(h / 3) as usize];
-            let (p, q) = (tri[(h % 3) as usize], tri[((h + 1) % 3) as usize]);
-            [p.min(q), p.max(q)]
-        };
         // Direction: the first segment must run entry -> exit.
         let (first_t, first_in) = (self.walk[0] / 3, self.walk[0] % 3);
         let (entry, _) = self.segment(first_t, level);
         if entry != first_in {
             self.walk.reverse();
         }
-        if closed {
-            // Drop the repeated start, rotate to the smallest edge, close again.
-            self.walk.pop();
-            let m = (0..self.walk.len())
-                .min_by_key(|&i| edge(self.walk[i]))
-                .unwrap_or(0);
-            self.walk.rotate_left(m);
-            self.walk.push(self.walk[0]);
-        }
-        let n = self.walk.len();
-        let mut points: Vec<[f64; 2]> = Vec::with_capacity(n);
-        let mut edges: Vec<[u32; 2]> = Vec::with_capacity(n);
-        for (i, &h) in self.walk.iter().enumerate() {
-            let [p, q] = edge(h);
-            let point = crossing_point(verts[p as usize], verts[q as usize], level);
-            if points.last() == Some(&point) {
-                // Coincident crossings (at a vertex on the level) become one point; the
-                // line's last point keeps its own edge, so an open line still ends on its
-                // boundary edge and a ring on its first edge.
-                if i == n - 1 {
-                    *edges.last_mut().expect("not empty") = [p, q];
+        let id = |v: u32| self.ids.map_or(v, |ids| ids[v as usize]);
+        let crossings = self
+            .walk
+            .iter()
+            .map(|&h| {
+                let tri = tris[(h / 3) as usize];
+                let (p, q) = (tri[(h % 3) as usize], tri[((h + 1) % 3) as usize]);
+                let (ip, iq) = (id(p), id(q));
+                Crossing {
+                    edge: [ip.min(iq), ip.max(iq)],
+                    point: crossing_point(verts[p as usize], verts[q as usize], level),
                 }
-                continue;
-            }
-            points.push(point);
-            edges.push([p, q]);
-        }
-        remove_spikes(&mut points, &mut edges);
-        let degenerate = if closed {
-            // A ring needs three distinct points (its first is repeated at the end): `A,
-            // B, A` encloses nothing.
-            points.len() < 4
-        } else {
-            points.len() < 2
-        };
-        if !degenerate {
-            lines.push(Polyline {
-                level,
-                points,
-                edges,
-                closed,
-            });
-        }
+            })
+            .collect();
+        Walk { crossings, closed }
     }
+}
+
+/// Turns a walk's crossings into a [`Polyline`]: a ring started at its smallest edge,
+/// coincident points merged, excursions removed; `None` if it collapses to a point (or a
+/// ring to fewer than three distinct points). A ring's last crossing repeats its first.
+pub(crate) fn finish_line(
+    level: f64,
+    closed: bool,
+    mut crossings: Vec<Crossing>,
+) -> Option<Polyline> {
+    if closed {
+        // Drop the repeated start, rotate to the smallest edge, close again.
+        crossings.pop();
+        let m = (0..crossings.len())
+            .min_by_key(|&i| crossings[i].edge)
+            .unwrap_or(0);
+        crossings.rotate_left(m);
+        crossings.push(crossings[0]);
+    }
+    let n = crossings.len();
+    let mut points: Vec<[f64; 2]> = Vec::with_capacity(n);
+    let mut edges: Vec<[u32; 2]> = Vec::with_capacity(n);
+    for (i, c) in crossings.iter().enumerate() {
+        if points.last() == Some(&c.point) {
+            // Coincident crossings (at a vertex on the level) become one point; the
+            // line's last point keeps its own edge, so an open line still ends on its
+            // boundary edge and a ring on its first edge.
+            if i == n - 1 {
+                *edges.last_mut().expect("not empty") = c.edge;
+            }
+            continue;
+        }
+        points.push(c.point);
+        edges.push(c.edge);
+    }
+    remove_spikes(&mut points, &mut edges);
+    let degenerate = if closed {
+        // A ring needs three distinct points (its first is repeated at the end): `A,
+        // B, A` encloses nothing.
+        points.len() < 4
+    } else {
+        points.len() < 2
+    };
+    (!degenerate).then_some(Polyline {
+        level,
+        points,
+        edges,
+        closed,
+    })
 }
 
 /// Removes the back-and-forth excursions `A, B, A` inside a line (keeping the first `A`),

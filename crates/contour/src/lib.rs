@@ -7,8 +7,10 @@
 //! triangle list, or [`ContourMesh::from_grid`] for the full-resolution grid); [`contour`]
 //! cuts it at each level by marching triangles and joins the segments into [`Polyline`]s.
 //! No I/O, no GDAL: coordinates are whatever the caller gives (the `tinsmith` CLI uses grid
-//! positions and maps the result to world coordinates). [`simplify_indices`] is an opt-in
-//! Douglas–Peucker step for callers that trade exactness on the TIN for fewer points.
+//! positions and maps the result to world coordinates). [`ContourStitcher`] gives the same
+//! lines for a mesh that arrives in pieces (tiles), holding only the lines.
+//! [`simplify_indices`] is an opt-in Douglas–Peucker step for callers that trade exactness
+//! on the TIN for fewer points.
 //!
 //! # Guarantees
 //! - **On the TIN.** Every output point lies on a mesh edge where the edge's linear
@@ -54,6 +56,7 @@ mod levels;
 mod mesh;
 mod polyline;
 mod simplify;
+mod stitch;
 
 pub use error::{Error, Result};
 pub use join::contour;
@@ -61,3 +64,4 @@ pub use levels::{interval_levels, sorted_levels, MAX_LEVELS};
 pub use mesh::ContourMesh;
 pub use polyline::Polyline;
 pub use simplify::simplify_indices;
+pub use stitch::ContourStitcher;

@@ -30,15 +30,13 @@ pub(crate) fn triangle_error(
     let g = plane_gradient(a, b, c);
     let width = grid.width() as usize;
     let values = grid.values();
-    let y0 = a.y.min(b.y).min(c.y);
-    let y1 = a.y.max(b.y).max(c.y);
-    let x_lo = a.x.min(b.x).min(c.x);
-    let x_hi = a.x.max(b.x).max(c.x);
     let (mut above, mut below) = (0.0f64, 0.0f64);
-    for y in y0..=y1 {
-        let Some((lo, hi)) = row_span(a, b, c, y, x_lo, x_hi) else {
+    let mut spans = RowSpans::new(a, b, c);
+    for y in spans.rows() {
+        let (lo, hi) = spans.next_span();
+        if lo > hi {
             continue;
-        };
+        }
         let row = &values[y as usize * width..][..width];
         let base = a.z + g[1] * (y - a.y) as f64;
         for x in lo..=hi {
@@ -78,26 +76,112 @@ pub(crate) fn error_at<'p>(
     (above <= limit && below <= limit).then_some(ErrorBound { above, below })
 }
 
-/// The columns `lo..=hi` of row `y` inside the closed counter-clockwise triangle `abc`
-/// (within `x_lo..=x_hi`, its bounding box), decided exactly; `None` when there are none.
-#[inline]
-fn row_span(a: &Point, b: &Point, c: &Point, y: i64, x_lo: i64, x_hi: i64) -> Option<(i64, i64)> {
-    // Each edge function E(x) = e0 + s * x must be >= 0.
-    let (mut lo, mut hi) = (x_lo, x_hi);
-    for (p, q) in [(a, b), (b, c), (c, a)] {
-        let s = p.y - q.y;
-        let e0 = (q.x - p.x) * (y - p.y) + (q.y - p.y) * p.x;
-        match s.cmp(&0) {
-            std::cmp::Ordering::Greater => lo = lo.max(div_ceil(-e0, s)),
-            std::cmp::Ordering::Less => hi = hi.min(div_floor(e0, -s)),
-            std::cmp::Ordering::Equal => {
-                if e0 < 0 {
-                    return None;
-                }
-            }
+/// The columns inside a closed counter-clockwise triangle, row by row from its lowest row
+/// to its highest, decided exactly and without a division per row: each edge's bound
+/// `x >= ceil(..)` or `x <= floor(..)` is a floor quotient whose numerator grows by a
+/// constant per row, so it is kept as quotient and remainder and stepped.
+struct RowSpans {
+    /// Per edge: the floor quotient of its bound on the current row.
+    bounds: [FloorQuotient; 3],
+    /// Per edge: whether it bounds the row from below (`lo = -quotient`) rather than from
+    /// above (`hi = quotient`), or not at all (a horizontal edge).
+    kind: [EdgeKind; 3],
+    x_lo: i64,
+    x_hi: i64,
+    y0: i64,
+    y1: i64,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum EdgeKind {
+    Lower,
+    Upper,
+    Horizontal,
+}
+
+/// `floor(n / d)` for a numerator `n` that grows by `step` per row, with `d > 0`.
+#[derive(Clone, Copy, Default)]
+struct FloorQuotient {
+    quotient: i64,
+    remainder: i64,
+    divisor: i64,
+    step_quotient: i64,
+    step_remainder: i64,
+}
+
+impl FloorQuotient {
+    fn new(n: i64, divisor: i64, step: i64) -> FloorQuotient {
+        FloorQuotient {
+            quotient: n.div_euclid(divisor),
+            remainder: n.rem_euclid(divisor),
+            divisor,
+            step_quotient: step.div_euclid(divisor),
+            step_remainder: step.rem_euclid(divisor),
         }
     }
-    (lo <= hi).then_some((lo, hi))
+
+    #[inline]
+    fn step(&mut self) {
+        self.quotient += self.step_quotient;
+        self.remainder += self.step_remainder;
+        if self.remainder >= self.divisor {
+            self.remainder -= self.divisor;
+            self.quotient += 1;
+        }
+    }
+}
+
+impl RowSpans {
+    fn new(a: &Point, b: &Point, c: &Point) -> RowSpans {
+        let y0 = a.y.min(b.y).min(c.y);
+        let mut bounds = [FloorQuotient::default(); 3];
+        let mut kind = [EdgeKind::Horizontal; 3];
+        for (k, (p, q)) in [(a, b), (b, c), (c, a)].into_iter().enumerate() {
+            // The edge function E(x) = e0 + s * x must be >= 0, with e0 growing by q.x - p.x
+            // per row. A horizontal edge (s = 0) holds on every row of the triangle: its
+            // e0 has the sign it has at the third corner, which is positive.
+            let s = p.y - q.y;
+            let e0 = (q.x - p.x) * (y0 - p.y) + (q.y - p.y) * p.x;
+            if s > 0 {
+                // x >= ceil(-e0 / s) = -floor(e0 / s)
+                bounds[k] = FloorQuotient::new(e0, s, q.x - p.x);
+                kind[k] = EdgeKind::Lower;
+            } else if s < 0 {
+                // x <= floor(e0 / -s)
+                bounds[k] = FloorQuotient::new(e0, -s, q.x - p.x);
+                kind[k] = EdgeKind::Upper;
+            }
+        }
+        RowSpans {
+            bounds,
+            kind,
+            x_lo: a.x.min(b.x).min(c.x),
+            x_hi: a.x.max(b.x).max(c.x),
+            y0,
+            y1: a.y.max(b.y).max(c.y),
+        }
+    }
+
+    /// The triangle's rows, lowest first; call [`RowSpans::next_span`] once for each.
+    fn rows(&self) -> std::ops::RangeInclusive<i64> {
+        self.y0..=self.y1
+    }
+
+    /// The columns `lo..=hi` of the next row inside the triangle (`lo > hi` when none).
+    #[inline]
+    fn next_span(&mut self) -> (i64, i64) {
+        let (mut lo, mut hi) = (self.x_lo, self.x_hi);
+        for k in 0..3 {
+            let q = self.bounds[k].quotient;
+            match self.kind[k] {
+                EdgeKind::Lower => lo = lo.max(-q),
+                EdgeKind::Upper => hi = hi.min(q),
+                EdgeKind::Horizontal => {}
+            }
+            self.bounds[k].step();
+        }
+        (lo, hi)
+    }
 }
 
 /// Whether every sample of the closed counter-clockwise triangle `abc` lies exactly on the
@@ -111,11 +195,12 @@ fn all_on_plane(grid: &Grid, a: &Point, b: &Point, c: &Point) -> bool {
     let normal = [uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx];
     let width = grid.width() as usize;
     let values = grid.values();
-    let (x_lo, x_hi) = (a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
-    for y in a.y.min(b.y).min(c.y)..=a.y.max(b.y).max(c.y) {
-        let Some((lo, hi)) = row_span(a, b, c, y, x_lo, x_hi) else {
+    let mut spans = RowSpans::new(a, b, c);
+    for y in spans.rows() {
+        let (lo, hi) = spans.next_span();
+        if lo > hi {
             continue;
-        };
+        }
         let row = &values[y as usize * width..][..width];
         let dy = normal[1] * (y - a.y) as i128;
         for x in lo..=hi {
@@ -126,14 +211,6 @@ fn all_on_plane(grid: &Grid, a: &Point, b: &Point, c: &Point) -> bool {
         }
     }
     true
-}
-
-fn div_floor(n: i64, d: i64) -> i64 {
-    n.div_euclid(d)
-}
-
-fn div_ceil(n: i64, d: i64) -> i64 {
-    -((-n).div_euclid(d))
 }
 
 #[cfg(test)]
@@ -185,6 +262,43 @@ mod tests {
             }
             assert_eq!((got.above, got.below), (up, down));
         }
+    }
+
+    #[test]
+    fn row_spans_are_the_samples_inside() {
+        // Every triangle on a small lattice, against the three orientation tests per sample.
+        let corners: Vec<(i64, i64)> = (-3..4).flat_map(|x| (-2..3).map(move |y| (x, y))).collect();
+        let p = |(x, y): (i64, i64)| Point { x, y, z: 0.0 };
+        let mut checked = 0;
+        for (i, &a) in corners.iter().enumerate() {
+            for (j, &b) in corners.iter().enumerate().skip(i + 1) {
+                for &c in &corners[j + 1..] {
+                    let (a, b, c) = (p(a), p(b), p(c));
+                    let (b, c) = match orient(&a, &b, &c) {
+                        o if o > 0 => (b, c),
+                        o if o < 0 => (c, b),
+                        _ => continue,
+                    };
+                    let mut spans = RowSpans::new(&a, &b, &c);
+                    for y in spans.rows() {
+                        let (lo, hi) = spans.next_span();
+                        for x in -5..6 {
+                            let q = Point { x, y, z: 0.0 };
+                            let inside = orient(&a, &b, &q) >= 0
+                                && orient(&b, &c, &q) >= 0
+                                && orient(&c, &a, &q) >= 0;
+                            assert_eq!(
+                                inside,
+                                (lo..=hi).contains(&x),
+                                "{a:?} {b:?} {c:?} at {x},{y}"
+                            );
+                        }
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 5000, "{checked}");
     }
 
     #[test]

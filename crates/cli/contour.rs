@@ -175,7 +175,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         &args.output,
         args.quiet,
     )?;
-    let (points, ends) = without_repeated_points(&points, &ends);
+    let (points, ends) = without_repeated_points(points, &ends);
     let closed = ends.iter().filter(|&&(_, _, closed)| closed).count();
     let mut start = 0;
     let lines: Vec<(&[[f64; 2]], f64)> = ends
@@ -252,8 +252,12 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
 /// in the file's coordinates without consecutive repeated points: crossings a hair's breadth
 /// apart in the grid (a sample within rounding of a level) can land on the same map
 /// coordinate. A line left with fewer than two points, or a ring with fewer than three
-/// distinct ones, is dropped (gdal_contour writes none there either).
-fn without_repeated_points(points: &[[f64; 3]], ends: &[LineEnd]) -> (Vec<[f64; 2]>, Vec<LineEnd>) {
+/// distinct ones, is dropped (gdal_contour writes none there either). Takes `points` so that
+/// they are freed before the lines are written.
+fn without_repeated_points(
+    points: Vec<[f64; 3]>,
+    ends: &[LineEnd],
+) -> (Vec<[f64; 2]>, Vec<LineEnd>) {
     let mut kept: Vec<[f64; 2]> = Vec::with_capacity(points.len());
     let mut kept_ends = Vec::with_capacity(ends.len());
     let mut start = 0;

@@ -11,8 +11,9 @@ use anyhow::{bail, Result};
 /// 9.3 M samples, session 4; rounded up).
 #[derive(Debug, Clone, Copy)]
 pub struct Need {
-    /// Bytes per sample: 48 for a count target (raster as `f64`, the RTIN's and the
-    /// mesh's per-sample arrays, the verifier's; 47 measured), 120 to contour the full
+    /// Bytes per sample: 50 for a count target (raster as `f64`, the RTIN's and the
+    /// mesh's per-sample arrays, the verifier's; 47 measured, plus 2 for the runs of
+    /// equal samples a flat-heavy grid keeps), 120 to contour the full
     /// grid (its TIN has two triangles per cell; 115 measured), 24 for `verify` and
     /// `contour --mesh` (18 and 21 measured).
     pub bytes_per_sample: u64,

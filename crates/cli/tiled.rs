@@ -53,7 +53,7 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
             &args.input,
             (reader.width(), reader.height()),
             crate::memory::Need {
-                bytes_per_sample: 48,
+                bytes_per_sample: 50,
                 extra_bytes: start_triangles
                     .saturating_mul(crate::memory::BYTES_PER_START_TRIANGLE),
             },

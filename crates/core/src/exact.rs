@@ -1,6 +1,7 @@
 //! The exact error model: a triangle's error is measured over the original samples it
 //! covers, with no accumulation (beyond the paper; issue 3).
 
+use crate::grid::MIN_EQUAL_RUN;
 use crate::predicates::{orient, plane_gradient, Point};
 use crate::{ErrorBound, Grid};
 
@@ -27,6 +28,12 @@ pub(crate) fn triangle_error(
         // Doubled area 1: by Pick's theorem the corners are the only samples.
         return error_at(a, b, c, [a, b, c], limit);
     }
+    if let Some(v) = flat_value(grid, a, b, c) {
+        // Every sample, the corners included, is `v`: the plane is `v` and so is every
+        // sample, exactly as the scan below would find.
+        debug_assert!(a.z == v && b.z == v && c.z == v);
+        return Some(ErrorBound::default());
+    }
     let g = plane_gradient(a, b, c);
     let width = grid.width() as usize;
     let values = grid.values();
@@ -39,13 +46,37 @@ pub(crate) fn triangle_error(
         }
         let row = &values[y as usize * width..][..width];
         let base = a.z + g[1] * (y - a.y) as f64;
-        for x in lo..=hi {
+        let mut measure = |x: i64| {
             let plane = base + g[0] * (x - a.x) as f64;
             let d = row[x as usize] - plane;
             // Comparisons rather than `f64::max`: one instruction each, the same result
             // (a NaN would be skipped either way).
             above = if d > above { d } else { above };
             below = if -d > below { -d } else { below };
+        };
+        match grid.equal_runs() {
+            None => (lo..=hi).for_each(&mut measure),
+            Some(runs) => {
+                // Along a run of equal samples the computed plane is monotone in x (each
+                // rounding step is), and so is the difference: its ends bound the rest,
+                // bit for bit.
+                let runs = &runs[y as usize * width..][..width];
+                let mut x = lo;
+                while x <= hi {
+                    let run = runs[x as usize];
+                    let end = if run >= MIN_EQUAL_RUN {
+                        let end = (x + i64::from(run) - 1).min(hi);
+                        measure(x);
+                        measure(end);
+                        end
+                    } else {
+                        let end = (x + i64::from(MIN_EQUAL_RUN) - 1).min(hi);
+                        (x..=end).for_each(&mut measure);
+                        end
+                    };
+                    x = end + 1;
+                }
+            }
         }
         if above > limit || below > limit {
             return None;
@@ -74,6 +105,18 @@ pub(crate) fn error_at<'p>(
         below = below.max(-d);
     }
     (above <= limit && below <= limit).then_some(ErrorBound { above, below })
+}
+
+/// The value every sample in the bounding box of `abc` is known to have
+/// ([`Grid::flat_value`]).
+fn flat_value(grid: &Grid, a: &Point, b: &Point, c: &Point) -> Option<f64> {
+    grid.equal_runs()?;
+    grid.flat_value(
+        a.x.min(b.x).min(c.x),
+        a.x.max(b.x).max(c.x),
+        a.y.min(b.y).min(c.y),
+        a.y.max(b.y).max(c.y),
+    )
 }
 
 /// The columns inside a closed counter-clockwise triangle, row by row from its lowest row
@@ -189,9 +232,14 @@ impl RowSpans {
 /// `(b - a) x (c - a)` and each sample's offset from `a` are integers, and their dot
 /// product is computed exactly in `i128`.
 fn all_on_plane(grid: &Grid, a: &Point, b: &Point, c: &Point) -> bool {
-    let z = |p: &Point| p.z as i128;
-    let (ux, uy, uz) = ((b.x - a.x) as i128, (b.y - a.y) as i128, z(b) - z(a));
-    let (vx, vy, vz) = ((c.x - a.x) as i128, (c.y - a.y) as i128, z(c) - z(a));
+    if flat_value(grid, a, b, c).is_some() {
+        return true;
+    }
+    // Integral heights are below 2^50 in magnitude: exact through `i64`, whose conversion
+    // is one instruction (to `i128` it is a library call).
+    let z = |v: f64| i128::from(v as i64);
+    let (ux, uy, uz) = ((b.x - a.x) as i128, (b.y - a.y) as i128, z(b.z) - z(a.z));
+    let (vx, vy, vz) = ((c.x - a.x) as i128, (c.y - a.y) as i128, z(c.z) - z(a.z));
     let normal = [uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx];
     let width = grid.width() as usize;
     let values = grid.values();
@@ -203,10 +251,27 @@ fn all_on_plane(grid: &Grid, a: &Point, b: &Point, c: &Point) -> bool {
         }
         let row = &values[y as usize * width..][..width];
         let dy = normal[1] * (y - a.y) as i128;
-        for x in lo..=hi {
-            let dz = row[x as usize] as i128 - z(a);
-            if normal[0] * (x - a.x) as i128 + dy + normal[2] * dz != 0 {
-                return false;
+        let on_plane = |x: i64| {
+            normal[0] * (x - a.x) as i128 + dy + normal[2] * (z(row[x as usize]) - z(a.z)) == 0
+        };
+        match grid.equal_runs() {
+            None => {
+                if !(lo..=hi).all(on_plane) {
+                    return false;
+                }
+            }
+            Some(runs) => {
+                // Along a run of equal samples the offset from the plane is linear in x:
+                // zero at both ends means zero throughout.
+                let runs = &runs[y as usize * width..][..width];
+                let mut x = lo;
+                while x <= hi {
+                    let end = (x + i64::from(runs[x as usize]) - 1).min(hi);
+                    if !on_plane(x) || !on_plane(end) {
+                        return false;
+                    }
+                    x = end + 1;
+                }
             }
         }
     }
@@ -262,6 +327,80 @@ mod tests {
             }
             assert_eq!((got.above, got.below), (up, down));
         }
+    }
+
+    #[test]
+    fn flat_ground_shortcuts_match_a_per_sample_scan() {
+        // Mostly flat (so the grid keeps its runs and flat blocks), with a bump, a ramp
+        // and a step: every triangle of a lattice of corners, measured by the shortcuts
+        // (runs, flat blocks, and the exact planarity test at 0) and by a plain scan.
+        let g = grid(70, 50, |x, y| {
+            if (30..36).contains(&x) && (20..24).contains(&y) {
+                ((x * 3 + y) % 5) as f64
+            } else if x >= 50 {
+                (y / 7) as f64
+            } else if y >= 40 {
+                2.0
+            } else {
+                0.0
+            }
+        });
+        assert!(g.equal_runs().is_some());
+        let corners: Vec<(i64, i64)> = (0..70)
+            .step_by(9)
+            .flat_map(|x| (0..50).step_by(7).map(move |y| (x, y)))
+            .collect();
+        let mut checked = 0;
+        for (i, &a) in corners.iter().enumerate() {
+            for (j, &b) in corners.iter().enumerate().skip(i + 1) {
+                for &c in &corners[j + 1..] {
+                    let (a, b, c) = (pt(&g, a.0, a.1), pt(&g, b.0, b.1), pt(&g, c.0, c.1));
+                    let (b, c) = match orient(&a, &b, &c) {
+                        o if o > 0 => (b, c),
+                        o if o < 0 => (c, b),
+                        _ => continue,
+                    };
+                    let gr = plane_gradient(&a, &b, &c);
+                    let (mut up, mut down) = (0.0f64, 0.0f64);
+                    for y in 0..50 {
+                        for x in 0..70 {
+                            let p = Point { x, y, z: 0.0 };
+                            if orient(&a, &b, &p) >= 0
+                                && orient(&b, &c, &p) >= 0
+                                && orient(&c, &a, &p) >= 0
+                            {
+                                let base = a.z + gr[1] * (y - a.y) as f64;
+                                let d = g.get(x as u32, y as u32).unwrap()
+                                    - (base + gr[0] * (x - a.x) as f64);
+                                up = if d > up { d } else { up };
+                                down = if -d > down { -d } else { down };
+                            }
+                        }
+                    }
+                    let got = triangle_error(&g, &a, &b, &c, f64::INFINITY).unwrap();
+                    assert_eq!(
+                        (got.above.to_bits(), got.below.to_bits()),
+                        (up.to_bits(), down.to_bits()),
+                        "{a:?} {b:?} {c:?}"
+                    );
+                    let flat = triangle_error(&g, &a, &b, &c, 0.0).is_some();
+                    assert_eq!(flat, up == 0.0 && down == 0.0, "{a:?} {b:?} {c:?}");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 10_000, "{checked}");
+        // A run of equal samples that only starts on a tilted plane: z = x through
+        // (0, 0, 0), (12, 0, 12), (0, 4, 0), over zeros.
+        let g = grid(20, 6, |x, y| if (x, y) == (12, 0) { 12.0 } else { 0.0 });
+        assert!(g.equal_runs().is_some());
+        let (a, b, c) = (pt(&g, 0, 0), pt(&g, 0, 4), pt(&g, 12, 0));
+        let (b, c) = if orient(&a, &b, &c) > 0 {
+            (b, c)
+        } else {
+            (c, b)
+        };
+        assert!(triangle_error(&g, &a, &b, &c, 0.0).is_none());
     }
 
     #[test]

@@ -16,7 +16,31 @@ pub struct Grid {
     max_abs: f64,
     /// See [`Grid::integral_heights`].
     integral_heights: bool,
+    /// See [`Grid::equal_runs`].
+    equal_runs: Option<Vec<u16>>,
+    /// See [`Grid::flat_value`]; built with `equal_runs`.
+    flat_blocks: Vec<FlatLevel>,
 }
+
+/// Square blocks of one size, each with its samples' common value when they are all bit
+/// for bit equal and finite ([`NOT_FLAT`] otherwise).
+#[derive(Debug, Clone, PartialEq)]
+struct FlatLevel {
+    /// Blocks are `1 << shift` samples a side.
+    shift: u32,
+    columns: usize,
+    bits: Vec<u64>,
+}
+
+/// A block whose samples differ (or hold nodata): the bits of a NaN, which no flat block
+/// holds.
+const NOT_FLAT: u64 = u64::MAX;
+
+/// The smallest flat blocks are this many samples a side (as a shift).
+const FLAT_BLOCK_SHIFT: u32 = 4;
+
+/// Runs of equal samples this long or longer are measured at their two ends only.
+pub(crate) const MIN_EQUAL_RUN: u16 = 8;
 
 /// `width x height x max|value|` below this keeps an integer grid's plane arithmetic exact
 /// in `f64` (see [`Grid::integral_heights`]).
@@ -45,13 +69,49 @@ impl Grid {
                 (m.max(v.abs()), integers && v.fract() == 0.0)
             });
         let integral_heights = integers && Grid::integral_product_fits(width, height, max_abs);
+        let equal_runs = equal_runs(width as usize, &values);
+        let flat_blocks = match &equal_runs {
+            Some(runs) => flat_levels(width as usize, height as usize, &values, runs),
+            None => Vec::new(),
+        };
         Ok(Grid {
             width,
             height,
             values,
             max_abs,
             integral_heights,
+            equal_runs,
+            flat_blocks,
         })
+    }
+
+    /// For each sample, how many samples from it rightwards in its row are bit for bit
+    /// equal to it (at least 1, capped at `u16::MAX`); `None` when long runs (at least
+    /// [`MIN_EQUAL_RUN`]) cover under an eighth of the grid, as on most terrain. Flat
+    /// ground (water, filled voids, the air around a CT slice) is where they pay: along
+    /// a run the error against a plane is monotone, so only its two ends need measuring.
+    pub(crate) fn equal_runs(&self) -> Option<&[u16]> {
+        self.equal_runs.as_deref()
+    }
+
+    /// `Some(v)` when every sample of columns `x0..=x1`, rows `y0..=y1` (inside the grid)
+    /// is known to equal `v` bit for bit, from at most four aligned blocks covering them;
+    /// `None` when they differ or that is not known (a grid without [`Grid::equal_runs`],
+    /// or a rectangle straddling blocks that are not all flat).
+    pub(crate) fn flat_value(&self, x0: i64, x1: i64, y0: i64, y1: i64) -> Option<f64> {
+        let level = self.flat_blocks.iter().find(|l| {
+            (x1 >> l.shift) - (x0 >> l.shift) <= 1 && (y1 >> l.shift) - (y0 >> l.shift) <= 1
+        })?;
+        let at = |bx: i64, by: i64| level.bits[by as usize * level.columns + bx as usize];
+        let bits = at(x0 >> level.shift, y0 >> level.shift);
+        let same = [
+            (x1 >> level.shift, y0 >> level.shift),
+            (x0 >> level.shift, y1 >> level.shift),
+            (x1 >> level.shift, y1 >> level.shift),
+        ]
+        .iter()
+        .all(|&(bx, by)| at(bx, by) == bits);
+        (bits != NOT_FLAT && same).then(|| f64::from_bits(bits))
     }
 
     /// Whether a grid of `width x height` integer samples up to `max_abs` in magnitude is
@@ -144,4 +204,74 @@ impl Grid {
     pub(crate) fn max_abs_value(&self) -> f64 {
         self.max_abs
     }
+}
+
+/// [`Grid::flat_value`]'s blocks, from 16 samples a side up to one block covering the grid.
+fn flat_levels(width: usize, height: usize, values: &[f64], runs: &[u16]) -> Vec<FlatLevel> {
+    let side = 1usize << FLAT_BLOCK_SHIFT;
+    let (columns, rows) = (width.div_ceil(side), height.div_ceil(side));
+    let mut bits = vec![NOT_FLAT; columns * rows];
+    for by in 0..rows {
+        for bx in 0..columns {
+            let (x0, y0) = (bx * side, by * side);
+            let w = side.min(width - x0);
+            let first = values[y0 * width + x0];
+            let flat = first.is_finite()
+                && (y0..(y0 + side).min(height)).all(|y| {
+                    let i = y * width + x0;
+                    values[i].to_bits() == first.to_bits() && usize::from(runs[i]) >= w
+                });
+            if flat {
+                bits[by * columns + bx] = first.to_bits();
+            }
+        }
+    }
+    let mut levels = vec![FlatLevel {
+        shift: FLAT_BLOCK_SHIFT,
+        columns,
+        bits,
+    }];
+    loop {
+        let below = levels.last().expect("one level");
+        let rows = below.bits.len() / below.columns;
+        if below.columns == 1 && rows == 1 {
+            return levels;
+        }
+        let (columns, up_rows) = (below.columns.div_ceil(2), rows.div_ceil(2));
+        let mut bits = vec![NOT_FLAT; columns * up_rows];
+        for by in 0..up_rows {
+            for bx in 0..columns {
+                let first = below.bits[2 * by * below.columns + 2 * bx];
+                let children = (2 * by..(2 * by + 2).min(rows))
+                    .flat_map(|y| (2 * bx..(2 * bx + 2).min(below.columns)).map(move |x| (x, y)));
+                if children
+                    .into_iter()
+                    .all(|(x, y)| below.bits[y * below.columns + x] == first)
+                {
+                    bits[by * columns + bx] = first;
+                }
+            }
+        }
+        let shift = below.shift + 1;
+        levels.push(FlatLevel {
+            shift,
+            columns,
+            bits,
+        });
+    }
+}
+
+/// [`Grid::equal_runs`] of row-major `values` with `width` columns.
+fn equal_runs(width: usize, values: &[f64]) -> Option<Vec<u16>> {
+    let mut runs = vec![1u16; values.len()];
+    let mut long = 0usize;
+    for (row, runs) in values.chunks_exact(width).zip(runs.chunks_exact_mut(width)) {
+        for x in (0..width - 1).rev() {
+            if row[x].to_bits() == row[x + 1].to_bits() {
+                runs[x] = runs[x + 1].saturating_add(1);
+                long += usize::from(runs[x] >= MIN_EQUAL_RUN);
+            }
+        }
+    }
+    (long >= values.len() / 8).then_some(runs)
 }

@@ -298,7 +298,8 @@ pub struct ContourArgs {
     pub geojson_source_crs: bool,
     /// Samples per tile side: with --max-error > 0, a raster wider or taller than this is
     /// decimated tile by tile (in parallel, reading a window at a time), as `tinsmith mesh`
-    /// does; the lines are then drawn on the welded TIN.
+    /// does; each tile is contoured as it is finished and its lines are joined to its
+    /// neighbours' (the lines of the welded TIN, which is never held).
     #[arg(long, value_name = "N", default_value_t = tinsmith_tile::DEFAULT_TILE_SIZE,
           value_parser = clap::value_parser!(u32).range(2..))]
     pub tile_size: u32,

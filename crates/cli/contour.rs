@@ -382,8 +382,7 @@ fn tiled_lines(
         levels,
         triangles: 0,
         height_range: None,
-        room: crate::memory::available_bytes(),
-        refusal: None,
+        stopped: None,
         args,
     };
     let bar = crate::tiled::progress_bar(args.quiet);
@@ -394,8 +393,8 @@ fn tiled_lines(
     };
     let report = mesh_tiles(&source, &options, &mut sink, &mut progress);
     bar.finish_and_clear();
-    if let Some(refusal) = sink.refusal.take() {
-        bail!("{refusal}");
+    if let Some(stopped) = sink.stopped.take() {
+        return Err(stopped);
     }
     let report = report.naming_file(&args.input)?;
     if report.final_triangles == 0 {
@@ -410,48 +409,71 @@ fn tiled_lines(
 }
 
 /// Contours each finished tile and stitches its lines to the earlier tiles', holding the
-/// lines but not the TIN; refuses (and stops the run) once the lines would outgrow the
-/// memory that was available at the start.
+/// lines but not the TIN; stops the run once the lines would outgrow the memory available.
 struct StitchingSink<'a> {
     stitcher: ContourStitcher,
     levels: &'a [f64],
     triangles: usize,
     height_range: Option<(f64, f64)>,
-    /// Bytes available when the run started, if known.
-    room: Option<u64>,
-    /// Why the run was stopped, for the caller to report as is.
-    refusal: Option<String>,
+    /// Why the run was stopped (lines that would not fit, or a contouring failure), for the
+    /// caller to report as is.
+    stopped: Option<anyhow::Error>,
     args: &'a ContourArgs,
 }
 
-impl TileSink for StitchingSink<'_> {
-    fn tile(&mut self, tile: &FinishedTile) -> Result<(), SinkError> {
+/// Bytes a held crossing takes while tiles are still coming (its edge and point).
+const BYTES_PER_HELD_CROSSING: u64 = 24;
+
+impl StitchingSink<'_> {
+    fn contour_tile(&mut self, tile: &FinishedTile) -> Result<()> {
+        let input = self.args.input.display();
         let vertices = tile
             .vertices()
             .iter()
             .map(|v| [f64::from(v.x), f64::from(v.y), v.z])
             .collect();
-        let mesh = ContourMesh::new(vertices, tile.triangles().to_vec())?;
-        let segments = self.stitcher.crossings_held() + mesh.segment_count(self.levels);
+        let mesh = ContourMesh::new(vertices, tile.triangles().to_vec())
+            .with_context(|| format!("{input}: contouring failed"))?;
+        // The lines will need BYTES_PER_SEGMENT a segment by the time they are written, of
+        // which the held crossings already take their share. The memory available is read
+        // again for every tile: the engine's threads and tiles in flight take some too.
+        let held = self.stitcher.crossings_held();
+        let segments = held + mesh.segment_count(self.levels);
         let needed = segments.saturating_mul(BYTES_PER_SEGMENT);
-        if let Some(room) = self.room.filter(|&room| needed > room) {
-            let refusal = lines_refusal(
-                self.args,
-                self.levels.len(),
-                &format!("at least {segments} times"),
-                needed as f64 / 1e9,
-                room as f64 / 1e9,
-            );
-            self.refusal = Some(refusal.clone());
-            return Err(refusal.into());
+        let in_use = held * BYTES_PER_HELD_CROSSING;
+        if let Some(available) = crate::memory::available_bytes() {
+            if needed > available.saturating_add(in_use) {
+                bail!(
+                    "{}",
+                    lines_refusal(
+                        self.args,
+                        self.levels.len(),
+                        &format!("about {segments} times or more"),
+                        needed as f64 / 1e9,
+                        (available + in_use) as f64 / 1e9,
+                    )
+                );
+            }
         }
-        self.stitcher.add(&mesh, tile.ids())?;
+        self.stitcher
+            .add(&mesh, tile.ids())
+            .with_context(|| format!("{input}: contouring failed"))?;
         self.triangles += mesh.triangles().len();
         if let Some((lo, hi)) = mesh.height_range() {
             let (l, h) = self.height_range.unwrap_or((lo, hi));
             self.height_range = Some((l.min(lo), h.max(hi)));
         }
         Ok(())
+    }
+}
+
+impl TileSink for StitchingSink<'_> {
+    fn tile(&mut self, tile: &FinishedTile) -> Result<(), SinkError> {
+        self.contour_tile(tile).map_err(|e| {
+            let message = format!("{e:#}");
+            self.stopped = Some(e);
+            message.into()
+        })
     }
 }
 

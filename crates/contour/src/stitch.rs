@@ -1,7 +1,7 @@
 //! Contouring a mesh that arrives in pieces (the tiles of a tiled decimation), holding the
 //! lines but never the whole mesh.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 
 use crate::join::{finish_line, sort_lines, walk_levels, Crossing};
 use crate::{levels::sorted_levels, ContourMesh, Error, Polyline, Result};
@@ -42,10 +42,30 @@ pub struct ContourStitcher {
     held: u64,
 }
 
+/// A line's parts joined so far, entry to exit: the pieces' walks in order, each after the
+/// first without the crossing it shares with the one before. Kept as a list so that
+/// joining two parts moves the shorter list into the longer one instead of copying
+/// crossings (a line crossing many tiles against their order would otherwise be copied
+/// once per tile).
 #[derive(Debug)]
 struct Part {
     level: u32,
-    crossings: Vec<Crossing>,
+    walks: VecDeque<Vec<Crossing>>,
+}
+
+impl Part {
+    fn exit(&self) -> [u32; 2] {
+        let last = self.walks.back().expect("a part has a walk");
+        last[last.len() - 1].edge
+    }
+
+    fn into_crossings(self) -> Vec<Crossing> {
+        let mut all = Vec::with_capacity(self.walks.iter().map(Vec::len).sum());
+        for walk in self.walks {
+            all.extend(walk);
+        }
+        all
+    }
 }
 
 impl ContourStitcher {
@@ -70,7 +90,8 @@ impl ContourStitcher {
     ///
     /// # Errors
     /// [`Error::Internal`] when two parts would enter (or leave) through the same edge at
-    /// one level: the pieces overlap.
+    /// one level, as when a piece is added twice. Other overlaps (a ring added twice, a
+    /// piece inside another) are not detected: see the requirements above.
     ///
     /// # Panics
     /// When `ids` does not have one id per vertex of `piece`.
@@ -101,14 +122,15 @@ impl ContourStitcher {
     pub fn finish(mut self) -> Vec<Polyline> {
         for part in self.parts.into_iter().flatten() {
             let level = self.levels[part.level as usize];
-            self.lines.extend(finish_line(level, false, part.crossings));
+            self.lines
+                .extend(finish_line(level, false, part.into_crossings()));
         }
         sort_lines(&mut self.lines);
         self.lines
     }
 
     /// Joins an open part (entry to exit) with the waiting parts it meets.
-    fn join(&mut self, level_index: u32, level: f64, crossings: Vec<Crossing>) -> Result<()> {
+    fn join(&mut self, level_index: u32, level: f64, mut crossings: Vec<Crossing>) -> Result<()> {
         let overlap = Error::Internal {
             level,
             what: "two pieces cross the same edge in the same direction",
@@ -118,8 +140,10 @@ impl ContourStitcher {
         // The part the new one continues, or a new slot.
         let slot = match self.by_exit.remove(&entry) {
             Some(before) => {
+                // The shared crossing is the last of the part before.
+                crossings.remove(0);
                 let part = self.parts[before].as_mut().expect("waiting part");
-                part.crossings.extend_from_slice(&crossings[1..]);
+                part.walks.push_back(crossings);
                 before
             }
             None => {
@@ -128,7 +152,7 @@ impl ContourStitcher {
                 }
                 let part = Part {
                     level: level_index,
-                    crossings,
+                    walks: VecDeque::from([crossings]),
                 };
                 let slot = match self.free.pop() {
                     Some(slot) => {
@@ -151,15 +175,25 @@ impl ContourStitcher {
                 self.by_entry.remove(&exit);
                 let part = self.parts[slot].take().expect("waiting part");
                 self.free.push(slot);
-                self.lines.extend(finish_line(level, true, part.crossings));
+                self.lines
+                    .extend(finish_line(level, true, part.into_crossings()));
             }
             Some(after) => {
                 self.by_entry.remove(&exit);
-                let next = self.parts[after].take().expect("waiting part");
+                let mut next = self.parts[after].take().expect("waiting part");
                 self.free.push(after);
-                let next_exit = (level_index, next.crossings[next.crossings.len() - 1].edge);
+                let next_exit = (level_index, next.exit());
+                // The shared crossing is the last of this part.
+                next.walks.front_mut().expect("a part has a walk").remove(0);
                 let part = self.parts[slot].as_mut().expect("waiting part");
-                part.crossings.extend_from_slice(&next.crossings[1..]);
+                if part.walks.len() >= next.walks.len() {
+                    part.walks.extend(next.walks);
+                } else {
+                    while let Some(walk) = part.walks.pop_back() {
+                        next.walks.push_front(walk);
+                    }
+                    part.walks = next.walks;
+                }
                 self.by_exit.insert(next_exit, slot);
             }
             None => {

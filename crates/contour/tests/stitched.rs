@@ -155,7 +155,7 @@ fn stitched_terrain_with_holes_and_quantized_heights() {
 }
 
 #[test]
-fn overlapping_pieces_are_refused() {
+fn a_piece_added_twice_is_refused() {
     let values: Vec<f64> = (0..25).map(|i| (i % 5) as f64).collect();
     let mesh = ContourMesh::from_grid(5, 5, &values).unwrap();
     let (all, ids) = piece(&mesh, |_, _| true);

@@ -1,5 +1,5 @@
-//! The sink that keeps the welded mesh in memory, for callers that use the TIN itself
-//! (contouring) rather than a file.
+//! The sink that keeps the welded mesh in memory, for callers that need it whole (the
+//! mesh formats that cannot be streamed).
 
 use crate::sink::{FinishedTile, SinkError, TileSink};
 

@@ -290,6 +290,9 @@ pub(crate) fn finish_line(
         edges.push(c.edge);
     }
     remove_spikes(&mut points, &mut edges);
+    if closed {
+        remove_spikes_across_the_start(&mut points, &mut edges);
+    }
     let degenerate = if closed {
         // A ring needs three distinct points (its first is repeated at the end): `A,
         // B, A` encloses nothing.
@@ -303,6 +306,49 @@ pub(crate) fn finish_line(
         edges,
         closed,
     })
+}
+
+/// Removes a ring's excursions across its start, which [`remove_spikes`] keeps (it keeps
+/// the first and last points): read cyclically, a ring `B, A, .., A, B` has its tip `B` at
+/// the start, and `A, .., A, B, A` at the end. Where one goes, the ring starts again at its
+/// smallest edge, so what is removed does not depend on where the walk began (on how the
+/// mesh numbers its vertices).
+fn remove_spikes_across_the_start(points: &mut Vec<[f64; 2]>, edges: &mut Vec<[u32; 2]>) {
+    if points.len() < 4 {
+        return;
+    }
+    // The ring without its closing point.
+    points.pop();
+    edges.pop();
+    let mut changed = false;
+    while points.len() >= 3 {
+        let m = points.len();
+        if points[1] == points[m - 1] {
+            // The tip is the first point: it goes with the last (the same point as the
+            // second).
+            points.remove(0);
+            edges.remove(0);
+            points.pop();
+            edges.pop();
+        } else if points[m - 2] == points[0] {
+            // The tip is the last point: it goes with the one before (the same point as
+            // the first).
+            points.truncate(m - 2);
+            edges.truncate(m - 2);
+        } else {
+            break;
+        }
+        changed = true;
+    }
+    if changed && !points.is_empty() {
+        let m = (0..points.len()).min_by_key(|&i| edges[i]).unwrap_or(0);
+        points.rotate_left(m);
+        edges.rotate_left(m);
+    }
+    if let (Some(&p), Some(&e)) = (points.first(), edges.first()) {
+        points.push(p);
+        edges.push(e);
+    }
 }
 
 /// Removes the back-and-forth excursions `A, B, A` inside a line (keeping the first `A`),

@@ -9,42 +9,10 @@ use std::collections::HashMap;
 
 use proptest::prelude::*;
 use tinsmith_contour::{contour, ContourMesh, Polyline};
-use tinsmith_core::{decimate, DecimationOptions, Grid};
 use tinsmith_testkit::{max_error, small_grid, GridSpec, SplitMix};
 
-/// Levels: some between samples, some exactly at sample values (the degenerate case).
-fn levels_for(spec: &GridSpec, seed: u64) -> Vec<f64> {
-    let valid: Vec<f64> = spec
-        .values
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    if valid.is_empty() {
-        return vec![0.0];
-    }
-    let lo = valid.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = valid.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let mut rng = SplitMix::new(seed);
-    let mut levels: Vec<f64> = (0..4).map(|_| lo + (hi - lo) * rng.unit()).collect();
-    for _ in 0..4 {
-        levels.push(valid[(rng.next_u64() % valid.len() as u64) as usize]);
-    }
-    levels
-}
-
-fn meshes(spec: &GridSpec, e: f64) -> Vec<ContourMesh> {
-    let mut out = vec![ContourMesh::from_grid(spec.width, spec.height, &spec.values).unwrap()];
-    let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
-    let tin = decimate(&grid, &DecimationOptions::new(e)).unwrap().tin;
-    let v = tin
-        .vertices()
-        .iter()
-        .map(|v| [v.x as f64, v.y as f64, v.z])
-        .collect();
-    out.push(ContourMesh::new(v, tin.triangles().to_vec()).unwrap());
-    out
-}
+mod common;
+use common::{levels_for, meshes};
 
 fn key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
@@ -215,4 +183,73 @@ fn terrain_with_holes_at_many_levels() {
     }
     let lines: Vec<Polyline> = contour(&meshes(&q, 0.0)[0], &levels).unwrap();
     assert!(lines.iter().any(Polyline::is_closed) && lines.iter().any(|l| !l.is_closed()));
+}
+
+/// The lines as a set that ignores vertex numbering: each ring turned into its smallest
+/// rotation (a ring through a saddle vertex at the level visits that point twice, so its
+/// smallest point alone does not fix where it starts), all sorted.
+fn canonical(lines: &[Polyline]) -> Vec<(u64, bool, Vec<[u64; 2]>)> {
+    let mut out: Vec<(u64, bool, Vec<[u64; 2]>)> = lines
+        .iter()
+        .map(|l| {
+            let mut points: Vec<[u64; 2]> = l
+                .points()
+                .iter()
+                .map(|p| [p[0].to_bits(), p[1].to_bits()])
+                .collect();
+            if l.is_closed() {
+                points.pop();
+                points = (0..points.len())
+                    .map(|m| {
+                        let mut rotation = points.clone();
+                        rotation.rotate_left(m);
+                        rotation
+                    })
+                    .min()
+                    .unwrap_or_default();
+            }
+            (l.level().to_bits(), l.is_closed(), points)
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+proptest! {
+    #[test]
+    fn lines_do_not_depend_on_vertex_numbering(
+        spec in small_grid(),
+        e in max_error(),
+        seed in any::<u64>(),
+    ) {
+        // Integer heights and levels at sample values: rings touching the level at a
+        // vertex or along an edge, whose excursions must go wherever the ring starts.
+        let spec = GridSpec {
+            values: spec.values.iter().map(|v| (v * 4.0).round()).collect(),
+            ..spec
+        };
+        let levels = levels_for(&spec, seed);
+        for mesh in meshes(&spec, e) {
+            let n = mesh.vertices().len();
+            let mut order: Vec<u32> = (0..n as u32).collect();
+            let mut rng = SplitMix::new(seed);
+            for i in (1..n).rev() {
+                order.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
+            }
+            let mut vertices = vec![[0.0; 3]; n];
+            for (old, &new) in order.iter().enumerate() {
+                vertices[new as usize] = mesh.vertices()[old];
+            }
+            let triangles = mesh
+                .triangles()
+                .iter()
+                .map(|t| t.map(|v| order[v as usize]))
+                .collect();
+            let relabelled = ContourMesh::new(vertices, triangles).unwrap();
+            prop_assert_eq!(
+                canonical(&contour(&mesh, &levels).unwrap()),
+                canonical(&contour(&relabelled, &levels).unwrap())
+            );
+        }
+    }
 }

@@ -5,43 +5,10 @@
 
 use proptest::prelude::*;
 use tinsmith_contour::{contour, ContourMesh, ContourStitcher, Polyline};
-use tinsmith_core::{decimate, DecimationOptions, Grid};
 use tinsmith_testkit::{max_error, small_grid, GridSpec, SplitMix};
 
-/// Levels between samples and exactly at sample values (lines through vertices, flats).
-fn levels_for(spec: &GridSpec, seed: u64) -> Vec<f64> {
-    let valid: Vec<f64> = spec
-        .values
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    if valid.is_empty() {
-        return vec![0.0];
-    }
-    let lo = valid.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = valid.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let mut rng = SplitMix::new(seed);
-    let mut levels: Vec<f64> = (0..4).map(|_| lo + (hi - lo) * rng.unit()).collect();
-    for _ in 0..4 {
-        levels.push(valid[(rng.next_u64() % valid.len() as u64) as usize]);
-    }
-    levels
-}
-
-/// The full grid's mesh and a decimated TIN of it.
-fn meshes(spec: &GridSpec, e: f64) -> Vec<ContourMesh> {
-    let mut out = vec![ContourMesh::from_grid(spec.width, spec.height, &spec.values).unwrap()];
-    let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
-    let tin = decimate(&grid, &DecimationOptions::new(e)).unwrap().tin;
-    let v = tin
-        .vertices()
-        .iter()
-        .map(|v| [v.x as f64, v.y as f64, v.z])
-        .collect();
-    out.push(ContourMesh::new(v, tin.triangles().to_vec()).unwrap());
-    out
-}
+mod common;
+use common::{levels_for, meshes};
 
 /// The piece of `mesh` holding the triangles `pick` selects: its own vertex numbering, and
 /// each vertex's index in `mesh` as its id.

@@ -5,7 +5,7 @@
 
 use std::process::Command;
 
-use crate::util::{assert_fails_naming, fixture, gdaltransform, stderr, Dir};
+use crate::util::{assert_fails_naming, fixture, gdaltransform, run_under_ulimit, stderr, Dir};
 
 /// `ogrinfo -so -al FILE` (summary of every layer). gdal-bin is installed by `make deps`.
 fn ogrinfo(path: &std::path::Path) -> String {
@@ -485,14 +485,11 @@ fn a_memory_ulimit_counts_as_what_is_available() {
     // "memory allocation failed" instead of being refused.
     let d = Dir::new();
     let dem = fixture("becmodel_dem_bc_albers_50m.tif");
-    let o = Command::new("sh")
-        .arg("-c")
-        .arg("ulimit -v 1500000 && exec \"$0\" \"$@\"")
-        .arg(env!("CARGO_BIN_EXE_tinsmith"))
-        .args(["contour", &dem, "-o", "c.fgb", "--interval", "0.1"])
-        .current_dir(d.path(""))
-        .output()
-        .expect("sh runs");
+    let o = run_under_ulimit(
+        &d,
+        1_500_000,
+        &["contour", &dem, "-o", "c.fgb", "--interval", "0.1"],
+    );
     assert_fails_naming(&o, &["becmodel", "levels cross the TIN", "GB is available"]);
     assert!(!d.path("c.fgb").exists());
 }
@@ -506,22 +503,24 @@ fn tiled_lines_that_outgrow_memory_stop_the_run() {
     // start, the run aborted on a failed allocation instead.
     let d = Dir::new();
     let dem = fixture("becmodel_dem_bc_albers_50m.tif");
-    let o = Command::new("sh")
-        .arg("-c")
-        .arg("ulimit -v 1500000 && exec \"$0\" \"$@\"")
-        .arg(env!("CARGO_BIN_EXE_tinsmith"))
-        .args(["contour", &dem, "-o", "c.fgb", "--interval", "0.1"])
-        .args([
+    let o = run_under_ulimit(
+        &d,
+        1_500_000,
+        &[
+            "contour",
+            &dem,
+            "-o",
+            "c.fgb",
+            "--interval",
+            "0.1",
             "--max-error",
             "0.5",
             "--tile-size",
             "128",
             "--threads",
             "20",
-        ])
-        .current_dir(d.path(""))
-        .output()
-        .expect("sh runs");
+        ],
+    );
     assert_fails_naming(
         &o,
         &[

@@ -11,7 +11,9 @@ use std::process::Command;
 
 use serde_json::Value;
 
-use crate::util::{assert_fails_naming, fixture, gdaltransform, stderr, stdout, Dir};
+use crate::util::{
+    assert_fails_naming, fixture, gdaltransform, run_under_ulimit, stderr, stdout, Dir,
+};
 
 /// The small DEM most tests use: 100 x 80 Float32, EPSG:3857, nodata.
 const DEM: &str = "tintn_valid_raster_3857.tif";
@@ -758,14 +760,11 @@ fn flatgeobuf_that_would_not_fit_in_memory_is_refused_before_writing() {
             4 * width
         ),
     );
-    let o = Command::new("sh")
-        .arg("-c")
-        .arg("ulimit -v 1300000 && exec \"$0\" \"$@\"")
-        .arg(env!("CARGO_BIN_EXE_tinsmith"))
-        .args(["mesh", "noise.vrt", "-o", "n.fgb", "--max-error", "0"])
-        .current_dir(d.path(""))
-        .output()
-        .expect("sh runs");
+    let o = run_under_ulimit(
+        &d,
+        1_300_000,
+        &["mesh", "noise.vrt", "-o", "n.fgb", "--max-error", "0"],
+    );
     assert_fails_naming(&o, &["n.fgb", "as FlatGeobuf needs about", ".ply"]);
     assert!(!d.path("n.fgb").exists());
 }

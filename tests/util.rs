@@ -57,6 +57,19 @@ pub fn fixture(name: &str) -> String {
     panic!("fixture {name} is missing");
 }
 
+/// Runs tinsmith with `args` in `dir` under `ulimit -v kib` (the address space limit a
+/// container or a user may set).
+pub fn run_under_ulimit(dir: &Dir, kib: u32, args: &[&str]) -> Output {
+    Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {kib} && exec \"$0\" \"$@\""))
+        .arg(env!("CARGO_BIN_EXE_tinsmith"))
+        .args(args)
+        .current_dir(dir.path(""))
+        .output()
+        .expect("sh runs")
+}
+
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }

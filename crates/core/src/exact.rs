@@ -110,7 +110,6 @@ pub(crate) fn error_at<'p>(
 /// The value every sample in the bounding box of `abc` is known to have
 /// ([`Grid::flat_value`]).
 fn flat_value(grid: &Grid, a: &Point, b: &Point, c: &Point) -> Option<f64> {
-    grid.equal_runs()?;
     grid.flat_value(
         a.x.min(b.x).min(c.x),
         a.x.max(b.x).max(c.x),

@@ -403,6 +403,10 @@ pub enum InitialMeshArg {
     Full,
     /// The coarsest right-triangulated network within the bound (measured exactly).
     Rtin,
+    /// Rows or columns simplified as 1-D lines within the bound, zipped into triangles.
+    Strips,
+    /// Strips, or the RTIN where it is cheap to build and has fewer triangles.
+    Auto,
 }
 
 impl From<InitialMeshArg> for InitialMesh {
@@ -410,6 +414,8 @@ impl From<InitialMeshArg> for InitialMesh {
         match m {
             InitialMeshArg::Full => InitialMesh::Full,
             InitialMeshArg::Rtin => InitialMesh::Rtin,
+            InitialMeshArg::Strips => InitialMesh::Strips,
+            InitialMeshArg::Auto => InitialMesh::Auto,
         }
     }
 }

@@ -5,9 +5,10 @@ use std::time::Instant;
 
 use crate::hole::{Retriangulator, Rules};
 use crate::levels::triangle_levels;
-use crate::mesh::{Mesh, Star, VertexClass};
+use crate::mesh::{CompactBound, Mesh, Star, VertexClass};
 use crate::predicates::Point;
-use crate::rtin::{rtin_for_count, rtin_triangles};
+use crate::rtin::{cheap_rtin_with_fewer_triangles, rtin_for_count, rtin_triangles};
+use crate::strips::StripPlan;
 use crate::{
     DecimationOptions, Error, ErrorBound, ErrorModel, Grid, InitialMesh, Order, Result, Tin,
     TinVertex,
@@ -179,7 +180,11 @@ fn run(
     let rtin_ok = limit > 0.0 || exact_zero;
     let mut count_start_bound = None;
     let mut mesh = match options.initial_mesh {
-        InitialMesh::Rtin if count_target && limit > 0.0 => {
+        // A count target starts from an RTIN refined to a multiple of the count, whatever
+        // coarse start was chosen (the strips have no such knob).
+        InitialMesh::Rtin | InitialMesh::Strips | InitialMesh::Auto
+            if count_target && limit > 0.0 =>
+        {
             let (corners, bounds, start_bound) = rtin_for_count(
                 grid,
                 COUNT_START_FACTOR
@@ -198,9 +203,10 @@ fn run(
                 Mesh::from_triangles(grid, corners, bounds)
             }
         }
-        InitialMesh::Rtin if rtin_ok => {
-            let (corners, bounds) = rtin_triangles(
+        InitialMesh::Rtin | InitialMesh::Strips | InitialMesh::Auto if rtin_ok => {
+            let (corners, bounds) = coarse_start(
                 grid,
+                options.initial_mesh,
                 limit,
                 max_edge_squared(options),
                 keep_border.is_some(),
@@ -307,6 +313,40 @@ fn run(
         seconds_decimation,
     };
     Ok(Decimation { tin, report })
+}
+
+/// The triangles and exact errors of a coarse start within `limit`: the RTIN, the strips,
+/// or (for [`InitialMesh::Auto`]) the strips unless the RTIN is cheap and has fewer
+/// triangles. The strips need edges of any length, so a maximum edge length, or strips
+/// refused by their exact measurement (rounding in their 1-D pass), give the RTIN.
+fn coarse_start(
+    grid: &Grid,
+    initial_mesh: InitialMesh,
+    limit: f64,
+    max_edge_squared: i64,
+    full_border: bool,
+) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
+    let rtin = || rtin_triangles(grid, limit, max_edge_squared, full_border);
+    if initial_mesh == InitialMesh::Rtin || max_edge_squared != i64::MAX {
+        return rtin();
+    }
+    let Some(strips) = StripPlan::new(grid, limit, full_border) else {
+        return rtin();
+    };
+    let cheap_rtin = if initial_mesh == InitialMesh::Auto {
+        cheap_rtin_with_fewer_triangles(
+            grid,
+            limit,
+            max_edge_squared,
+            full_border,
+            strips.triangle_count(),
+        )
+    } else {
+        None
+    };
+    cheap_rtin
+        .or_else(|| strips.triangles())
+        .unwrap_or_else(rtin)
 }
 
 /// A count target's RTIN start has at least this many times the triangles asked for, so

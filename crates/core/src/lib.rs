@@ -40,6 +40,7 @@ mod mesh;
 mod options;
 mod predicates;
 mod rtin;
+mod strips;
 mod tin;
 
 pub use decimate::{

@@ -61,6 +61,24 @@ pub(crate) fn rtin_triangles(
     rtin.triangles(&need)
 }
 
+/// The RTIN of [`rtin_triangles`], if its probe finds it cheap to build (it refines
+/// top-down: few of the finest squares split, so it stops at large triangles) and it has
+/// fewer than `fewer_than` triangles; `None` otherwise, without emitting any.
+pub(crate) fn cheap_rtin_with_fewer_triangles(
+    grid: &Grid,
+    limit: f64,
+    max_edge_squared: i64,
+    full_border: bool,
+    fewer_than: usize,
+) -> Option<(Vec<[u32; 3]>, Vec<CompactBound>)> {
+    let rtin = Rtin::new(grid, limit, max_edge_squared, full_border);
+    if rtin.finest_split_fraction() > TOP_DOWN_BELOW {
+        return None;
+    }
+    let need = rtin.refine();
+    (rtin.count(&need) < fewer_than).then(|| rtin.triangles(&need))
+}
+
 /// The start for a count target: of the RTINs at bounds `range / 2^k`, k = 1, 2, ...
 /// (`range` the spread of the grid's values) that are within `limit`, the first with at
 /// least `triangles` triangles more than the RTIN at no bound has, or the last tried if

@@ -175,7 +175,12 @@ fn check_two_tiles(spec: &GridSpec, bound: f64, model: ErrorModel, initial: Init
 #[test]
 fn two_tiles_weld_within_the_bound() {
     for model in [ErrorModel::Bounds, ErrorModel::Exact] {
-        for initial in [InitialMesh::Full, InitialMesh::Rtin] {
+        for initial in [
+            InitialMesh::Full,
+            InitialMesh::Rtin,
+            InitialMesh::Strips,
+            InitialMesh::Auto,
+        ] {
             for bound in [0.5, 3.0, 20.0] {
                 check_two_tiles(&terrain(41, 30, 3.0, 5), bound, model, initial);
                 // Odd and even sizes put the RTIN's corner cells both ways.
@@ -189,7 +194,12 @@ fn two_tiles_weld_within_the_bound() {
 fn nodata_across_the_shared_border() {
     let spec = with_nodata_disc(terrain(40, 36, 2.0, 9), 20.0, 18.0, 5.0);
     for model in [ErrorModel::Bounds, ErrorModel::Exact] {
-        for initial in [InitialMesh::Full, InitialMesh::Rtin] {
+        for initial in [
+            InitialMesh::Full,
+            InitialMesh::Rtin,
+            InitialMesh::Strips,
+            InitialMesh::Auto,
+        ] {
             check_two_tiles(&spec, 2.0, model, initial);
         }
     }
@@ -198,7 +208,12 @@ fn nodata_across_the_shared_border() {
 #[test]
 fn narrow_tiles() {
     for w in [3, 4, 5] {
-        for initial in [InitialMesh::Full, InitialMesh::Rtin] {
+        for initial in [
+            InitialMesh::Full,
+            InitialMesh::Rtin,
+            InitialMesh::Strips,
+            InitialMesh::Auto,
+        ] {
             check_two_tiles(
                 &terrain(w, 12, 5.0, w as u64),
                 1.0,

@@ -22,7 +22,12 @@ fn all_options(bound: f64) -> Vec<DecimationOptions> {
     let mut all = Vec::new();
     for model in [ErrorModel::Bounds, ErrorModel::Exact] {
         for order in [Order::Sweep, Order::Greedy] {
-            for start in [InitialMesh::Full, InitialMesh::Rtin] {
+            for start in [
+                InitialMesh::Full,
+                InitialMesh::Rtin,
+                InitialMesh::Strips,
+                InitialMesh::Auto,
+            ] {
                 let base = DecimationOptions::paper(bound)
                     .with_error_model(model)
                     .with_order(order)
@@ -157,7 +162,7 @@ proptest! {
         length in 2u32..7,
     ) {
         for model in [ErrorModel::Bounds, ErrorModel::Exact] {
-            for start in [InitialMesh::Full, InitialMesh::Rtin] {
+            for start in [InitialMesh::Full, InitialMesh::Rtin, InitialMesh::Strips, InitialMesh::Auto] {
                 let options = DecimationOptions::new(bound)
                     .with_error_model(model)
                     .with_initial_mesh(start)
@@ -264,7 +269,12 @@ fn integer_heights_decimate_exactly_at_zero_error() {
             .map(|i| f64::from(3 * (i % w)) - f64::from(2 * (i / w)) + 7.0)
             .collect(),
     };
-    for initial in [InitialMesh::Full, InitialMesh::Rtin] {
+    for initial in [
+        InitialMesh::Full,
+        InitialMesh::Rtin,
+        InitialMesh::Strips,
+        InitialMesh::Auto,
+    ] {
         let options = DecimationOptions::new(0.0).with_initial_mesh(initial);
         let tin = check_with(&ramp, &options).unwrap();
         assert_eq!(tin.triangles().len(), 2, "{initial:?}");
@@ -274,7 +284,12 @@ fn integer_heights_decimate_exactly_at_zero_error() {
     for v in &mut rough.values {
         *v = (*v * 3.0).round();
     }
-    for initial in [InitialMesh::Full, InitialMesh::Rtin] {
+    for initial in [
+        InitialMesh::Full,
+        InitialMesh::Rtin,
+        InitialMesh::Strips,
+        InitialMesh::Auto,
+    ] {
         let options = DecimationOptions::new(0.0).with_initial_mesh(initial);
         let tin = check_with(&rough, &options).unwrap();
         assert!(tin.triangles().len() < 2 * 59 * 44, "{initial:?}");

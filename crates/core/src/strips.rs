@@ -1,0 +1,356 @@
+//! A cheap initial mesh: every row (or every column) simplified as a 1-D polyline within
+//! the limit, and each pair of adjacent simplified lines zipped into triangles (beyond the
+//! paper; issue 3).
+//!
+//! A triangle between two adjacent lines holds samples only on those two lines, and on a
+//! line only along its own edge there (a diagonal between adjacent lines passes through
+//! no other sample). So its error is the 1-D error of one line segment, and each line can
+//! be simplified on its own. The 1-D simplification is one pass per line, with no
+//! triangle measured more than once, so this start costs a fraction of the RTIN's
+//! ([`crate::rtin`]); it also keeps fewer samples wherever the bound is small relative to
+//! the ground's roughness, where the RTIN must keep most of its finest level.
+//!
+//! # Guarantees
+//! Every emitted triangle lies in the domain (all cells in its bounding box are valid)
+//! and its exact error, measured with [`triangle_error`], is within the limit; every valid
+//! cell is covered; every sample where the domain's outline turns or pinches is a vertex.
+//! With `full_border`, every triangle that reaches the grid's outer rows or columns is a
+//! half cell, as [`crate::decimate_with_border`] needs.
+
+use crate::exact::triangle_error;
+use crate::mesh::CompactBound;
+use crate::predicates::{orient, Point};
+use crate::Grid;
+
+/// The strip start planned: its lines simplified, its triangles not yet made.
+pub(crate) struct StripPlan<'g> {
+    grid: &'g Grid,
+    limit: f64,
+    lines: Lines,
+    kept: Kept,
+}
+
+impl<'g> StripPlan<'g> {
+    /// Simplifies the rows and the columns within `limit` and keeps whichever keep fewer
+    /// samples (rows on a tie); `None` if the grid is less than two samples wide or high.
+    pub(crate) fn new(grid: &'g Grid, limit: f64, full_border: bool) -> Option<StripPlan<'g>> {
+        if grid.width() < 2 || grid.height() < 2 {
+            return None;
+        }
+        let rows = Lines::new(grid, true);
+        let columns = Lines::new(grid, false);
+        let along_rows = kept_samples(grid, rows, limit, full_border);
+        let along_columns = kept_samples(grid, columns, limit, full_border);
+        let (lines, kept) = if along_columns.positions.len() < along_rows.positions.len() {
+            (columns, along_columns)
+        } else {
+            (rows, along_rows)
+        };
+        Some(StripPlan {
+            grid,
+            limit,
+            lines,
+            kept,
+        })
+    }
+
+    /// How many triangles [`StripPlan::triangles`] makes.
+    pub(crate) fn triangle_count(&self) -> usize {
+        let mut count = 0;
+        self.zip(|_, _, _| {
+            count += 1;
+            Some(())
+        });
+        count
+    }
+
+    /// The triangles (counter-clockwise sample indices, in row-major order of their
+    /// first corner's row) with their exact errors; `None` if one measured above the
+    /// limit after all (the 1-D pass works in floating point, the measurement decides).
+    pub(crate) fn triangles(&self) -> Option<(Vec<[u32; 3]>, Vec<CompactBound>)> {
+        let grid = self.grid;
+        let values = grid.values();
+        let width = self.lines.width;
+        let point = |i: usize| Point {
+            x: (i % width) as i64,
+            y: (i / width) as i64,
+            z: values[i],
+        };
+        let count = self.triangle_count();
+        let mut corners = Vec::with_capacity(count);
+        let mut bounds = Vec::with_capacity(count);
+        self.zip(|a, b, c| {
+            let (pa, pb, pc) = (point(a), point(b), point(c));
+            let (b, c, pb, pc) = if orient(&pa, &pb, &pc) > 0 {
+                (b, c, pb, pc)
+            } else {
+                (c, b, pc, pb)
+            };
+            let bound = triangle_error(grid, &pa, &pb, &pc, self.limit)?;
+            corners.push([a as u32, b as u32, c as u32]);
+            bounds.push(CompactBound::from(bound));
+            Some(())
+        })?;
+        if self.lines.along_rows {
+            Some((corners, bounds))
+        } else {
+            Some(in_row_order(grid, corners, bounds))
+        }
+    }
+
+    /// Zips each strip's runs of valid cells into triangles (the shorter diagonal first),
+    /// calling `emit` with each one's sample indices (in either orientation); stops at
+    /// the first `None` it returns.
+    fn zip(&self, mut emit: impl FnMut(usize, usize, usize) -> Option<()>) -> Option<()> {
+        let (grid, lines, kept) = (self.grid, self.lines, &self.kept);
+        for strip in 0..lines.count() - 1 {
+            let (near, far) = (kept.line(strip), kept.line(strip + 1));
+            let (mut i, mut j) = (0, 0);
+            let mut pos = 0;
+            while pos + 1 < lines.len() {
+                if !lines.cell_valid(grid, strip, pos) {
+                    pos += 1;
+                    continue;
+                }
+                let mut end = pos + 1;
+                while lines.cell_valid(grid, strip, end) {
+                    end += 1;
+                }
+                // Both lines keep `pos` and `end` (a run's ends are always kept).
+                while near[i] as usize != pos {
+                    i += 1;
+                }
+                while far[j] as usize != pos {
+                    j += 1;
+                }
+                while near[i] as usize != end || far[j] as usize != end {
+                    let advance_near = far[j] as usize == end
+                        || (near[i] as usize != end
+                            && near[i + 1].abs_diff(far[j]) <= far[j + 1].abs_diff(near[i]));
+                    if advance_near {
+                        emit(
+                            lines.sample(strip, near[i] as usize),
+                            lines.sample(strip, near[i + 1] as usize),
+                            lines.sample(strip + 1, far[j] as usize),
+                        )?;
+                        i += 1;
+                    } else {
+                        emit(
+                            lines.sample(strip, near[i] as usize),
+                            lines.sample(strip + 1, far[j + 1] as usize),
+                            lines.sample(strip + 1, far[j] as usize),
+                        )?;
+                        j += 1;
+                    }
+                }
+                pos = end;
+            }
+        }
+        Some(())
+    }
+}
+
+/// The grid seen as lines: its rows, or its columns.
+#[derive(Debug, Clone, Copy)]
+struct Lines {
+    along_rows: bool,
+    width: usize,
+    height: usize,
+}
+
+impl Lines {
+    fn new(grid: &Grid, along_rows: bool) -> Lines {
+        Lines {
+            along_rows,
+            width: grid.width() as usize,
+            height: grid.height() as usize,
+        }
+    }
+
+    /// How many lines there are.
+    fn count(&self) -> usize {
+        if self.along_rows {
+            self.height
+        } else {
+            self.width
+        }
+    }
+
+    /// Samples per line.
+    fn len(&self) -> usize {
+        if self.along_rows {
+            self.width
+        } else {
+            self.height
+        }
+    }
+
+    /// The sample index of position `pos` on line `line`.
+    fn sample(&self, line: usize, pos: usize) -> usize {
+        if self.along_rows {
+            line * self.width + pos
+        } else {
+            pos * self.width + line
+        }
+    }
+
+    /// Whether the cell between lines `strip` and `strip + 1` and positions `pos` and
+    /// `pos + 1` is valid; cells outside the grid are not.
+    fn cell_valid(&self, grid: &Grid, strip: usize, pos: usize) -> bool {
+        if strip + 1 >= self.count() || pos + 1 >= self.len() {
+            return false;
+        }
+        if self.along_rows {
+            grid.cell_is_valid(pos, strip)
+        } else {
+            grid.cell_is_valid(strip, pos)
+        }
+    }
+}
+
+/// The kept positions of every line, line after line, in increasing position.
+struct Kept {
+    positions: Vec<u32>,
+    /// `positions[starts[l]..starts[l + 1]]` are line `l`'s.
+    starts: Vec<usize>,
+}
+
+impl Kept {
+    fn line(&self, line: usize) -> &[u32] {
+        &self.positions[self.starts[line]..self.starts[line + 1]]
+    }
+}
+
+/// Simplifies every line: the positions where a strip's run of valid cells begins or ends
+/// (and, with `full_border`, every position of the two outer lines on each side and the
+/// two outer positions at each end of every line) are kept, and each stretch between two
+/// of them that borders a valid cell is simplified within `limit`.
+fn kept_samples(grid: &Grid, lines: Lines, limit: f64, full_border: bool) -> Kept {
+    let (count, len) = (lines.count(), lines.len());
+    let values = grid.values();
+    let mut kept = Kept {
+        positions: Vec::new(),
+        starts: Vec::with_capacity(count + 1),
+    };
+    let mut z = vec![0.0; len];
+    let reciprocals: Vec<f64> = (0..len).map(|k| 1.0 / k as f64).collect();
+    let mut must = Vec::new();
+    // Cell validity of the strips before and after the current line, one entry per
+    // position (the last always invalid: no cell starts there).
+    let all_valid = grid.valid_cell_count() == (lines.width - 1) * (lines.height - 1);
+    let strip_cells = |strip: Option<usize>, cells: &mut Vec<bool>| {
+        cells.clear();
+        cells.extend((0..len).map(|pos| {
+            strip.is_some_and(|s| {
+                if all_valid {
+                    s + 1 < count && pos + 1 < len
+                } else {
+                    lines.cell_valid(grid, s, pos)
+                }
+            })
+        }));
+    };
+    let (mut before, mut after) = (Vec::with_capacity(len), Vec::with_capacity(len));
+    strip_cells(None, &mut before);
+    for line in 0..count {
+        kept.starts.push(kept.positions.len());
+        if line > 0 {
+            std::mem::swap(&mut before, &mut after);
+        }
+        strip_cells(Some(line), &mut after);
+        let outer_line = full_border && (line <= 1 || line + 2 >= count);
+        must.clear();
+        let mut left = (false, false);
+        for pos in 0..len {
+            let right = (before[pos], after[pos]);
+            if left != right
+                || ((right.0 || right.1)
+                    && (outer_line || (full_border && (pos <= 1 || pos + 2 >= len))))
+            {
+                must.push(pos);
+            }
+            left = right;
+        }
+        for (k, &pos) in must.iter().enumerate() {
+            kept.positions.push(pos as u32);
+            let Some(&next) = must.get(k + 1) else {
+                break;
+            };
+            if next == pos + 1 || !(before[pos] || after[pos]) {
+                continue;
+            }
+            for (p, zp) in (pos..=next).zip(z.iter_mut()) {
+                *zp = values[lines.sample(line, p)];
+            }
+            simplify(&z[..=next - pos], limit, &reciprocals, |p| {
+                kept.positions.push((pos + p) as u32)
+            });
+        }
+    }
+    kept.starts.push(kept.positions.len());
+    kept
+}
+
+/// Calls `keep` with the interior positions, in order, of a polyline through samples of
+/// `z` (both ends always in it) such that every sample lies within `limit` of it
+/// vertically: from each kept sample, the furthest next one that a straight segment
+/// reaches with every sample between within the bound (tracked as the cone of slopes
+/// that keeps them all).
+fn simplify(z: &[f64], limit: f64, reciprocals: &[f64], mut keep: impl FnMut(usize)) {
+    let n = z.len();
+    // A hair tighter than the limit, so that rounding here rarely admits a segment the
+    // exact measurement then refuses.
+    let bound = limit * (1.0 - 1e-9);
+    let mut start = 0;
+    while start + 2 < n {
+        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+        let mut reach = start + 1;
+        let zs = z[start];
+        for (end, &ze) in z.iter().enumerate().skip(start + 1) {
+            let per_run = reciprocals[end - start];
+            let rise = ze - zs;
+            let slope = rise * per_run;
+            if lo <= slope && slope <= hi {
+                reach = end;
+            }
+            lo = lo.max((rise - bound) * per_run);
+            hi = hi.min((rise + bound) * per_run);
+            if lo > hi {
+                break;
+            }
+        }
+        if reach + 1 >= n {
+            return;
+        }
+        keep(reach);
+        start = reach;
+    }
+}
+
+/// Triangles reordered by the row of their first sample index (stable within a row): the
+/// mesh's slots then follow the grid's row-major order, as its removal sweeps do, instead
+/// of striding across rows along columns.
+fn in_row_order(
+    grid: &Grid,
+    corners: Vec<[u32; 3]>,
+    bounds: Vec<CompactBound>,
+) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
+    let width = grid.width();
+    let row = |c: &[u32; 3]| (c.iter().min().expect("three corners") / width) as usize;
+    let mut starts = vec![0usize; grid.height() as usize + 1];
+    for c in &corners {
+        starts[row(c) + 1] += 1;
+    }
+    for r in 1..starts.len() {
+        starts[r] += starts[r - 1];
+    }
+    let mut order = vec![0u32; corners.len()];
+    for (t, c) in corners.iter().enumerate() {
+        let r = row(c);
+        order[starts[r]] = t as u32;
+        starts[r] += 1;
+    }
+    let sorted_corners = order.iter().map(|&t| corners[t as usize]).collect();
+    let sorted_bounds = order.iter().map(|&t| bounds[t as usize]).collect();
+    (sorted_corners, sorted_bounds)
+}

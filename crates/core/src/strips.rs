@@ -20,6 +20,8 @@
 use crate::exact::triangle_error;
 use crate::mesh::CompactBound;
 use crate::predicates::{orient, Point};
+#[cfg(test)]
+use crate::ErrorBound;
 use crate::Grid;
 
 /// The strip start planned: its lines simplified, its triangles not yet made.
@@ -353,4 +355,107 @@ fn in_row_order(
     let sorted_corners = order.iter().map(|&t| corners[t as usize]).collect();
     let sorted_bounds = order.iter().map(|&t| bounds[t as usize]).collect();
     (sorted_corners, sorted_bounds)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn kept_interior(z: &[f64], limit: f64) -> Vec<usize> {
+        let reciprocals: Vec<f64> = (0..z.len()).map(|k| 1.0 / k as f64).collect();
+        let mut kept = Vec::new();
+        simplify(z, limit, &reciprocals, |p| kept.push(p));
+        kept
+    }
+
+    #[test]
+    fn simplify_keeps_only_what_the_bound_needs() {
+        let tent = [0.0, 1.0, 2.0, 3.0, 2.0, 1.0, 0.0];
+        assert_eq!(kept_interior(&tent, 0.1), vec![3]);
+        assert_eq!(kept_interior(&tent, 1.6), vec![4]);
+        assert!(kept_interior(&tent, 3.5).is_empty());
+        let line: Vec<f64> = (0..50).map(|x| 0.5 * x as f64).collect();
+        assert!(kept_interior(&line, 1e-9).is_empty());
+        let zigzag = [0.0, 1.0, 0.0, 1.0, 0.0];
+        assert_eq!(kept_interior(&zigzag, 0.4), vec![1, 2, 3]);
+    }
+
+    /// Sum of doubled areas, and that every triangle's bounding box has only valid cells.
+    fn doubled_area_in_domain(grid: &Grid, corners: &[[u32; 3]]) -> i64 {
+        let w = grid.width();
+        let p = |i: u32| Point {
+            x: i64::from(i % w),
+            y: i64::from(i / w),
+            z: 0.0,
+        };
+        let mut area = 0;
+        for c in corners {
+            let [a, b, d] = c.map(p);
+            let o = orient(&a, &b, &d);
+            assert!(o > 0, "{c:?} not counter-clockwise");
+            area += o;
+            let (x0, x1) = (a.x.min(b.x).min(d.x), a.x.max(b.x).max(d.x));
+            let (y0, y1) = (a.y.min(b.y).min(d.y), a.y.max(b.y).max(d.y));
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    assert!(grid.cell_is_valid(x as usize, y as usize), "{c:?}");
+                }
+            }
+        }
+        area
+    }
+
+    #[test]
+    fn a_plane_zips_into_two_triangles_per_strip() {
+        let values = (0..20)
+            .map(|i| (i % 5) as f64 + 2.0 * (i / 5) as f64)
+            .collect();
+        let grid = Grid::new(5, 4, values).unwrap();
+        let plan = StripPlan::new(&grid, 0.25, false).unwrap();
+        assert_eq!(plan.triangle_count(), 6);
+        let (corners, bounds) = plan.triangles().unwrap();
+        assert_eq!(corners.len(), 6);
+        assert!(bounds.iter().all(|b| ErrorBound::from(*b).max() == 0.0));
+        assert_eq!(doubled_area_in_domain(&grid, &corners), 2 * 4 * 3);
+    }
+
+    #[test]
+    fn strips_cover_exactly_the_valid_cells_within_the_bound() {
+        let (w, h) = (23u32, 17u32);
+        let mut values: Vec<f64> = (0..w * h)
+            .map(|i| {
+                let (x, y) = (f64::from(i % w), f64::from(i / w));
+                (x * 0.7).sin() * 5.0 + (y * 0.3).cos() * 3.0 + x * y * 0.01
+            })
+            .collect();
+        for i in [40, 41, 100, 250, 251, 252, 300] {
+            values[i] = f64::NAN;
+        }
+        let grid = Grid::new(w, h, values).unwrap();
+        for full_border in [false, true] {
+            for limit in [0.3, 2.0, 50.0] {
+                let plan = StripPlan::new(&grid, limit, full_border).unwrap();
+                let (corners, bounds) = plan.triangles().unwrap();
+                assert_eq!(corners.len(), plan.triangle_count());
+                assert!(bounds.iter().all(|b| ErrorBound::from(*b).max() <= limit));
+                let area = doubled_area_in_domain(&grid, &corners);
+                assert_eq!(area, 2 * grid.valid_cell_count() as i64, "at {limit}");
+                if full_border {
+                    // Triangles touching the grid's outer rows or columns are half cells.
+                    for c in &corners {
+                        let on_border = c.iter().any(|&i| {
+                            let (x, y) = (i % w, i / w);
+                            x == 0 || y == 0 || x == w - 1 || y == h - 1
+                        });
+                        let [a, b, d] = c.map(|i| Point {
+                            x: i64::from(i % w),
+                            y: i64::from(i / w),
+                            z: 0.0,
+                        });
+                        assert!(!on_border || orient(&a, &b, &d) == 1, "{c:?}");
+                    }
+                }
+            }
+        }
+    }
 }

@@ -30,6 +30,8 @@ pub(crate) struct StripPlan<'g> {
     limit: f64,
     lines: Lines,
     kept: Kept,
+    /// How many triangles [`StripPlan::triangles`] makes (counted once, by a zip pass).
+    triangle_count: usize,
 }
 
 impl<'g> StripPlan<'g> {
@@ -48,22 +50,25 @@ impl<'g> StripPlan<'g> {
         } else {
             (rows, along_rows)
         };
-        Some(StripPlan {
+        let mut plan = StripPlan {
             grid,
             limit,
             lines,
             kept,
-        })
+            triangle_count: 0,
+        };
+        let mut count = 0;
+        plan.zip(|_, _, _| {
+            count += 1;
+            Some(())
+        });
+        plan.triangle_count = count;
+        Some(plan)
     }
 
     /// How many triangles [`StripPlan::triangles`] makes.
     pub(crate) fn triangle_count(&self) -> usize {
-        let mut count = 0;
-        self.zip(|_, _, _| {
-            count += 1;
-            Some(())
-        });
-        count
+        self.triangle_count
     }
 
     /// The triangles (counter-clockwise sample indices, in row-major order of their
@@ -78,9 +83,8 @@ impl<'g> StripPlan<'g> {
             y: (i / width) as i64,
             z: values[i],
         };
-        let count = self.triangle_count();
-        let mut corners = Vec::with_capacity(count);
-        let mut bounds = Vec::with_capacity(count);
+        let mut corners = Vec::with_capacity(self.triangle_count);
+        let mut bounds = Vec::with_capacity(self.triangle_count);
         self.zip(|a, b, c| {
             let (pa, pb, pc) = (point(a), point(b), point(c));
             let (b, c, pb, pc) = if orient(&pa, &pb, &pc) > 0 {

@@ -5,7 +5,7 @@ Builds Float32 DEMs from real data (ETOPO5, resampled with GDAL's gdalwarp, cubi
 work directory outside the repository (never committed), runs `tinsmith mesh` on them
 under /usr/bin/time, and prints a Markdown report (also written to --out):
 
-  main      16384^2 at eps = 1 m with the defaults (exact error, RTIN start, default tile
+  main      16384^2 at eps = 1 m with the defaults (exact error, default start, default tile
             size), --threads 1 and 2: wall time, samples/s, peak RSS, CPU seconds; speedup
             of 2 threads over 1 (target >= 1.8x), end to end <= 60 s on 2 cores, peak RSS
             <= 1.5 GB.

@@ -150,7 +150,7 @@ pub struct MeshArgs {
     #[arg(long, value_name = "N", default_value_t = 8, value_parser = clap::value_parser!(u16).range(3..=64))]
     pub dp_max_ring: u16,
     /// The mesh decimation starts from.
-    #[arg(long, value_enum, default_value_t = InitialMeshArg::Rtin)]
+    #[arg(long, value_enum, default_value_t = InitialMeshArg::Auto)]
     pub initial_mesh: InitialMeshArg,
     /// Longest triangle edge allowed, in sample spacings (at least 2): no long slivers,
     /// at the cost of more triangles. The error bound holds either way.

@@ -35,7 +35,6 @@ pub enum InitialMesh {
     /// The coarsest right-triangulated irregular network (longest-edge bisection of a
     /// power-of-two square) whose triangles are all within the bound, measured exactly;
     /// much faster than the full grid when the bound removes most samples.
-    #[default]
     Rtin,
     /// Every row (or every column, whichever keeps fewer samples) simplified as a 1-D
     /// polyline within the bound, adjacent lines zipped into triangles: one pass over the
@@ -43,7 +42,10 @@ pub enum InitialMesh {
     /// ground's roughness.
     Strips,
     /// [`InitialMesh::Strips`], or the RTIN where its probe finds it cheap (few of the
-    /// finest squares split) and it has fewer triangles.
+    /// finest squares split) and it has fewer triangles; the RTIN when contour levels
+    /// are given ([`DecimationOptions::with_contour_levels`]), which keep fewer segments
+    /// from it.
+    #[default]
     Auto,
 }
 

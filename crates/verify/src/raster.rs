@@ -73,9 +73,9 @@ pub(crate) fn rasterize(
         for (&slope, &offset) in slopes.iter().zip(&offsets) {
             match slope.signum() {
                 // slope * x + offset >= 0  <=>  x >= ceil(-offset / slope)
-                1 => lo = lo.max(-offset.div_euclid(slope)),
+                1 => lo = lo.max(-floor_div(offset, slope)),
                 // <=>  x <= floor(offset / -slope)
-                -1 => hi = hi.min(offset.div_euclid(-slope)),
+                -1 => hi = hi.min(floor_div(offset, -slope)),
                 _ if offset < 0 => hi = lo - 1,
                 _ => {}
             }
@@ -95,6 +95,15 @@ pub(crate) fn rasterize(
                 *w += step;
             }
         }
+    }
+}
+
+/// `floor(n / d)` for `d > 0`, in 64 bits when both fit (a grid's triangles always do;
+/// 128-bit division is a library call several times slower), else in 128.
+fn floor_div(n: i128, d: i128) -> i128 {
+    match (i64::try_from(n), i64::try_from(d)) {
+        (Ok(n), Ok(d)) => i128::from(n.div_euclid(d)),
+        _ => n.div_euclid(d),
     }
 }
 
@@ -129,6 +138,16 @@ mod tests {
         let mut out = Vec::new();
         rasterize(tri, width, height, |x, y, w| out.push((x, y, w)));
         out
+    }
+
+    #[test]
+    fn floor_div_matches_128_bit_division() {
+        let big = i128::from(i64::MAX) * 4 + 3;
+        for n in [-big, -7, -6, -1, 0, 1, 6, 7, big, i128::from(i64::MIN)] {
+            for d in [1, 2, 3, 7, big] {
+                assert_eq!(floor_div(n, d), n.div_euclid(d), "{n} / {d}");
+            }
+        }
     }
 
     #[test]

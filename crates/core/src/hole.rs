@@ -382,7 +382,17 @@ impl Retriangulator {
                 match self.exact_errors.iter().find(|e| e.0 == key) {
                     Some(&(_, cached)) => cached?,
                     None => {
-                        let e = triangle_error(rules.grid, pa, pb, pc, cap);
+                        // The removed vertex is a sample: where it lies in the triangle and
+                        // alone passes the cap, the scan is not needed to say so (the same
+                        // plane arithmetic as the scan's, so the same verdict).
+                        let centre = self.centre.expect("hole loaded");
+                        let e = if in_closed_triangle(pa, pb, pc, &centre)
+                            && error_at(pa, pb, pc, [&centre], cap).is_none()
+                        {
+                            None
+                        } else {
+                            triangle_error(rules.grid, pa, pb, pc, cap)
+                        };
                         // "Over the cap" is only worth keeping when the cap is the limit.
                         if e.is_some() || cap >= rules.limit {
                             self.exact_errors.push((key, e));

@@ -28,16 +28,7 @@ pub(crate) fn check_edges(
     report: &mut Report,
     log: &mut ProblemLog,
 ) {
-    let mut ids: FxHashMap<([i64; 2], u64), u32> = FxHashMap::default();
-    ids.reserve(mesh.positions.len());
-    let welded: Vec<u32> = mesh
-        .positions
-        .iter()
-        .zip(mesh.heights)
-        .enumerate()
-        // +0.0 and -0.0 are the same height.
-        .map(|(v, (&p, z))| *ids.entry((p, (z + 0.0).to_bits())).or_insert(v as u32))
-        .collect();
+    let welded = welded_ids(mesh);
     let mut sides: Vec<Side> = Vec::with_capacity(3 * mesh.triangles.len());
     for (corners, _) in mesh.triangles.iter().zip(measured).filter(|(_, &m)| m) {
         for k in 0..3 {
@@ -90,6 +81,30 @@ pub(crate) fn check_edges(
             }
         }
     }
+}
+
+/// Each vertex's id after welding: the first vertex with its position and height. When
+/// the positions strictly increase in row-major order (as a TIN's vertices from the core
+/// do), no two share a position and every vertex is its own id, without a hash map.
+fn welded_ids(mesh: MeshRef<'_>) -> Vec<u32> {
+    let n = mesh.positions.len() as u32;
+    let row_major = |p: &[i64; 2]| (p[1], p[0]);
+    if mesh
+        .positions
+        .windows(2)
+        .all(|w| row_major(&w[0]) < row_major(&w[1]))
+    {
+        return (0..n).collect();
+    }
+    let mut ids: FxHashMap<([i64; 2], u64), u32> = FxHashMap::default();
+    ids.reserve(mesh.positions.len());
+    mesh.positions
+        .iter()
+        .zip(mesh.heights)
+        .enumerate()
+        // +0.0 and -0.0 are the same height.
+        .map(|(v, (&p, z))| *ids.entry((p, (z + 0.0).to_bits())).or_insert(v as u32))
+        .collect()
 }
 
 /// `sides` ordered by `(low, high, left)`: a counting sort by `low` (vertex ids are below
@@ -156,6 +171,27 @@ fn cell_is_valid(grid: GridRef<'_>, (x, y): (i64, i64)) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn welding_joins_equal_positions_and_heights_only() {
+        let ids = |positions: &[[i64; 2]], heights: &[f64]| {
+            welded_ids(MeshRef::new(positions, heights, &[]))
+        };
+        // Row-major and distinct: every vertex is its own id.
+        assert_eq!(ids(&[[0, 0], [5, 0], [0, 1]], &[1.0, 2.0, 3.0]), [0, 1, 2]);
+        // Out of row-major order, still distinct.
+        assert_eq!(ids(&[[0, 1], [5, 0], [0, 0]], &[1.0, 2.0, 3.0]), [0, 1, 2]);
+        // Repeated positions, even in row-major order, go through the welding.
+        assert_eq!(ids(&[[0, 0], [0, 0], [1, 0]], &[1.0, 1.0, 2.0]), [0, 0, 2]);
+        // Repeated positions: welded to the first with the same height (-0 = +0).
+        assert_eq!(
+            ids(
+                &[[0, 0], [1, 0], [0, 0], [0, 0], [1, 0]],
+                &[0.0, 2.0, -0.0, 7.0, 2.0]
+            ),
+            [0, 1, 0, 3, 1]
+        );
+    }
 
     #[test]
     fn counting_sort_orders_sides_as_a_full_sort() {

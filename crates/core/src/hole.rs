@@ -384,9 +384,12 @@ impl Retriangulator {
                     None => {
                         // The removed vertex is a sample: where it lies in the triangle and
                         // alone passes the cap, the scan is not needed to say so (the same
-                        // plane arithmetic as the scan's, so the same verdict).
+                        // plane arithmetic as the scan's, so the same verdict; not at a cap
+                        // of 0 on integer heights, which the scan decides exactly).
                         let centre = self.centre.expect("hole loaded");
-                        let e = if in_closed_triangle(pa, pb, pc, &centre)
+                        let exact_zero = cap == 0.0 && rules.grid.integral_heights();
+                        let e = if !exact_zero
+                            && in_closed_triangle(pa, pb, pc, &centre)
                             && error_at(pa, pb, pc, [&centre], cap).is_none()
                         {
                             None

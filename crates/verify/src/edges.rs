@@ -29,21 +29,31 @@ pub(crate) fn check_edges(
     log: &mut ProblemLog,
 ) {
     let welded = welded_ids(mesh);
-    let mut sides: Vec<Side> = Vec::with_capacity(3 * mesh.triangles.len());
-    for (corners, _) in mesh.triangles.iter().zip(measured).filter(|(_, &m)| m) {
-        for k in 0..3 {
-            let (p, q, r) = (corners[k], corners[(k + 1) % 3], corners[(k + 2) % 3]);
-            let (a, b) = (welded[p as usize], welded[q as usize]);
-            let (low, high) = (a.min(b), a.max(b));
-            let [pl, ph, pr] = [low, high, r].map(|v| mesh.positions[v as usize]);
-            sides.push(Side {
-                low,
-                high,
-                left: orient(pl, ph, pr) > 0,
-            });
-        }
-    }
-    let sides = sorted_by_edge(sides, mesh.positions.len());
+    let triangles = || {
+        mesh.triangles
+            .iter()
+            .zip(measured)
+            .filter(|(_, &m)| m)
+            .map(|(corners, _)| corners.map(|v| welded[v as usize]))
+    };
+    let sides = sorted_by_edge(
+        triangles().flat_map(|c| (0..3).map(move |k| c[k].min(c[(k + 1) % 3]))),
+        || {
+            triangles().flat_map(|c| {
+                (0..3).map(move |k| {
+                    let (a, b, r) = (c[k], c[(k + 1) % 3], c[(k + 2) % 3]);
+                    let (low, high) = (a.min(b), a.max(b));
+                    let [pl, ph, pr] = [low, high, r].map(|v| mesh.positions[v as usize]);
+                    Side {
+                        low,
+                        high,
+                        left: orient(pl, ph, pr) > 0,
+                    }
+                })
+            })
+        },
+        mesh.positions.len(),
+    );
     for group in sides.chunk_by(|a, b| (a.low, a.high) == (b.low, b.high)) {
         let [p, q] = [group[0].low, group[0].high].map(|v| mesh.positions[v as usize]);
         match group {
@@ -107,20 +117,31 @@ fn welded_ids(mesh: MeshRef<'_>) -> Vec<u32> {
         .collect()
 }
 
-/// `sides` ordered by `(low, high, left)`: a counting sort by `low` (vertex ids are below
-/// `vertices`), then each vertex's few sides sorted on their own, in linear time where a
-/// comparison sort of all sides took a quarter of the verification.
-fn sorted_by_edge(sides: Vec<Side>, vertices: usize) -> Vec<Side> {
+/// The sides `sides()` yields, ordered by `(low, high, left)`, given `lows` (their `low`
+/// ids, in any order, all below `vertices`): counted by `low` in a first pass, placed in a
+/// second, then each vertex's few sides sorted on their own. Linear time, where a
+/// comparison sort of all sides took a quarter of the verification, and one array of
+/// sides, not an unsorted copy besides.
+fn sorted_by_edge<I: Iterator<Item = Side>>(
+    lows: impl Iterator<Item = u32>,
+    sides: impl FnOnce() -> I,
+    vertices: usize,
+) -> Vec<Side> {
     let mut start = vec![0usize; vertices + 1];
-    for s in &sides {
-        start[s.low as usize + 1] += 1;
+    for low in lows {
+        start[low as usize + 1] += 1;
     }
     for v in 0..vertices {
         start[v + 1] += start[v];
     }
-    let mut next = start.clone();
-    let mut sorted = sides.clone();
-    for s in sides {
+    let mut next = start[..vertices].to_vec();
+    let unset = Side {
+        low: 0,
+        high: 0,
+        left: false,
+    };
+    let mut sorted = vec![unset; start[vertices]];
+    for s in sides() {
         sorted[next[s.low as usize]] = s;
         next[s.low as usize] += 1;
     }
@@ -217,7 +238,11 @@ mod tests {
         let key = |s: &Side| (s.low, s.high, s.left);
         let mut expected = sides.clone();
         expected.sort_unstable_by_key(key);
-        let got = sorted_by_edge(sides, vertices as usize);
+        let got = sorted_by_edge(
+            sides.iter().map(|s| s.low),
+            || sides.iter().copied(),
+            vertices as usize,
+        );
         assert_eq!(
             got.iter().map(key).collect::<Vec<_>>(),
             expected.iter().map(key).collect::<Vec<_>>()

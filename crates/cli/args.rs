@@ -405,7 +405,8 @@ pub enum InitialMeshArg {
     Rtin,
     /// Rows or columns simplified as 1-D lines within the bound, zipped into triangles.
     Strips,
-    /// Strips, or the RTIN where it is cheap to build and has fewer triangles.
+    /// Strips, or the RTIN where it is cheap to build and has fewer triangles; the RTIN
+    /// with contour levels.
     Auto,
 }
 

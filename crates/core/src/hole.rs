@@ -350,13 +350,12 @@ impl Retriangulator {
         {
             return None;
         }
+        // At a cap of 0 on integer heights only the scan decides, exactly (see
+        // `Grid::integral_heights`): no shortcut through f64 plane values.
+        let scan_only = cap == 0.0 && rules.grid.integral_heights();
         let bound = match rules.model {
             ErrorModel::Bounds => self.triangle_bound(a, b, c, edges),
-            // (At a cap of 0 on integer heights the measurement is exact; see
-            // `Grid::integral_heights`.)
-            ErrorModel::Exact
-                if self.unit_hole && in_hole && !(cap == 0.0 && rules.grid.integral_heights()) =>
-            {
+            ErrorModel::Exact if self.unit_hole && in_hole && !scan_only => {
                 let centre = self.centre.expect("hole loaded");
                 let inside = in_closed_triangle(pa, pb, pc, &centre);
                 let samples = [pa, pb, pc, &centre];
@@ -384,11 +383,9 @@ impl Retriangulator {
                     None => {
                         // The removed vertex is a sample: where it lies in the triangle and
                         // alone passes the cap, the scan is not needed to say so (the same
-                        // plane arithmetic as the scan's, so the same verdict; not at a cap
-                        // of 0 on integer heights, which the scan decides exactly).
+                        // plane arithmetic as the scan's, so the same verdict).
                         let centre = self.centre.expect("hole loaded");
-                        let exact_zero = cap == 0.0 && rules.grid.integral_heights();
-                        let e = if !exact_zero
+                        let e = if !scan_only
                             && in_closed_triangle(pa, pb, pc, &centre)
                             && error_at(pa, pb, pc, [&centre], cap).is_none()
                         {

@@ -119,8 +119,9 @@ pub struct DecimationOptions {
 
 impl DecimationOptions {
     /// Options with the given error bound and the defaults chosen by measurement
-    /// (docs/results.md): exact error, RTIN start, row-major sweeps, DP holes.
-    /// [`DecimationOptions::paper`] gives the paper's configuration.
+    /// (docs/results.md): exact error, the `auto` start (strips, or the RTIN where it is
+    /// cheap), row-major sweeps, DP holes. [`DecimationOptions::paper`] gives the paper's
+    /// configuration.
     pub fn new(max_error: f64) -> DecimationOptions {
         DecimationOptions {
             max_error,

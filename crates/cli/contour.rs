@@ -81,7 +81,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             Some(mesh) => (
                 crate::memory::Need {
                     bytes_per_sample: 24,
-                    extra_bytes: 2 * crate::memory::file_bytes(mesh),
+                    extra_bytes: crate::memory::mesh_file_memory(mesh),
                 },
                 "contouring a --mesh",
                 "contour it with --max-error instead (decimated tile by tile, in bounded memory)",

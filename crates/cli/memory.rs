@@ -17,7 +17,7 @@ pub struct Need {
     /// grid (its TIN has two triangles per cell; 115 measured), 24 for `verify` and
     /// `contour --mesh` (18 and 21 measured).
     pub bytes_per_sample: u64,
-    /// Bytes besides, such as a start mesh or a mesh file read in.
+    /// Bytes besides, such as a start mesh or a mesh file read in ([`mesh_file_memory`]).
     pub extra_bytes: u64,
 }
 
@@ -180,6 +180,29 @@ pub fn file_bytes(path: &Path) -> u64 {
     std::fs::metadata(path).map_or(0, |m| m.len())
 }
 
+/// The bytes the mesh file at `path` takes once read, with the verifier's per-triangle
+/// arrays: its size times a factor per format. Measured with `verify` on one ETOPO5 mesh
+/// (5.9 M triangles, session 15) written in every format: the mesh took 385 MB read from
+/// PLY, OBJ, STL, glTF or LandXML alike (417 MB from FlatGeobuf), 2.3 GB from GeoJSON
+/// (parsed whole), while the files weigh 18 (glTF) to 282 (GeoJSON) bytes a triangle.
+/// Each factor is the measured ratio rounded up, with room for files written more
+/// compactly than tinsmith writes them (OBJ).
+pub fn mesh_file_memory(path: &Path) -> u64 {
+    use tinsmith_export::MeshFormat;
+    // Measured ratios: PLY 2.6, OBJ 1.36, STL 1.3, glTF 3.6, GeoJSON 1.37,
+    // FlatGeobuf 0.32, LandXML 0.85.
+    let (times, per) = match MeshFormat::from_path(path) {
+        Ok(MeshFormat::Ply) => (3, 1),
+        Ok(MeshFormat::Obj) => (2, 1),
+        Ok(MeshFormat::Stl | MeshFormat::GeoJson) => (3, 2),
+        Ok(MeshFormat::Glb) => (4, 1),
+        Ok(MeshFormat::FlatGeobuf) => (2, 5),
+        Ok(MeshFormat::LandXml) => (1, 1),
+        _ => (2, 1),
+    };
+    file_bytes(path).saturating_mul(times) / per
+}
+
 /// The raster's `(width, height)`, without reading its samples.
 pub fn raster_size(input: &Path, band: usize) -> Result<(u32, u32)> {
     let reader = tinsmith_raster::WindowReader::open(input, band)?;
@@ -212,6 +235,46 @@ mod tests {
         assert_eq!(stat_field(v1, "total_inactive_file"), Some(21));
         assert_eq!(stat_field(v1, "inactive_file"), Some(7));
         assert_eq!(stat_field("anon 5\n", "inactive_file"), None);
+    }
+
+    /// The verifier held 65 bytes a triangle for a mesh read from any format but GeoJSON
+    /// (measured, see [`mesh_file_memory`]): the estimate covers that for files as tinsmith
+    /// writes them, in every format.
+    #[test]
+    fn mesh_file_estimates_cover_the_measured_memory_per_triangle() {
+        use tinsmith_export::{MeshFormat, MeshRef};
+        // Over 65,536 vertices: glTF then stores 32-bit indices, as large meshes do.
+        let n = 260u32;
+        let vertices: Vec<[f64; 3]> = (0..n * n)
+            .map(|i| {
+                let (x, y) = (f64::from(i % n), f64::from(i / n));
+                [
+                    500_000.0 + 30.0 * x,
+                    4_100_000.0 - 30.0 * y,
+                    1234.5 + (x * y).sqrt(),
+                ]
+            })
+            .collect();
+        let mut triangles = Vec::new();
+        for y in 0..n - 1 {
+            for x in 0..n - 1 {
+                let i = y * n + x;
+                triangles.push([i, i + n, i + 1]);
+                triangles.push([i + 1, i + n, i + n + 1]);
+            }
+        }
+        let dir = tempfile::tempdir().unwrap();
+        for format in MeshFormat::ALL {
+            let path = dir.path().join(format!("mesh.{}", format.extension()));
+            let mesh = MeshRef::new(&vertices, &triangles);
+            tinsmith_export::write_mesh(&path, format, mesh).unwrap();
+            let estimate = mesh_file_memory(&path);
+            assert!(
+                estimate >= 65 * triangles.len() as u64,
+                "{format:?}: {estimate} bytes for {} triangles",
+                triangles.len()
+            );
+        }
     }
 
     #[test]

@@ -18,7 +18,7 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
         crate::memory::raster_size(&args.input, args.band)?,
         crate::memory::Need {
             bytes_per_sample: 24,
-            extra_bytes: 2 * crate::memory::file_bytes(&args.mesh),
+            extra_bytes: crate::memory::mesh_file_memory(&args.mesh),
         },
         "verify",
         "verification has no tiled mode; use a machine with more memory",

@@ -874,26 +874,6 @@ fn zoom_and_quality_out_of_range_are_refused_saying_why() {
 }
 
 #[test]
-fn layer_json_ends_at_the_deepest_level_with_tiles() {
-    // A 3 x 1 raster has no cell at its own level: the coarser levels' filter spreads it
-    // into cells. layer.json's maxzoom named the empty level (available: []).
-    let dir = Dir::new();
-    dir.write(
-        "row.asc",
-        "ncols 3\nnrows 1\nxllcorner 10\nyllcorner 40\ncellsize 0.01\n1 2 3\n",
-    );
-    dir.write("row.prj", "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]");
-    pyramid(&dir, "row.asc", "p", &["-q"]);
-    let layer: Value =
-        serde_json::from_slice(&std::fs::read(dir.path("p/layer.json")).unwrap()).unwrap();
-    let available = layer["available"].as_array().unwrap();
-    let deepest = available.len() - 1;
-    assert_eq!(layer["maxzoom"].as_u64(), Some(deepest as u64));
-    assert!(!available[deepest].as_array().unwrap().is_empty());
-    assert!(dir.path(&format!("p/{deepest}")).is_dir());
-}
-
-#[test]
 fn very_tall_pixels_choose_a_level_from_their_area_not_their_width() {
     // 0.1 by 20 degrees per pixel: the default level followed the finer axis (level 4,
     // each pixel cut into about 400 lattice rows); a 100000 x 10 global raster ran for
@@ -925,6 +905,42 @@ fn a_failed_pyramid_leaves_no_directory_it_made() {
     }
     assert!(!dir.path("made").exists());
     assert!(dir.path("kept").is_dir() && !dir.path("kept/made").exists());
+}
+
+#[test]
+fn a_pyramid_needs_a_2x2_block_of_valid_samples_at_its_finest_level() {
+    // One valid sample, and a 3 x 1 raster: `mesh` finds no 2x2 block of valid samples to
+    // triangulate, and neither does `tiles` at the finest level (the raster's own). The
+    // coarser levels, made from it by a filter that reaches a sample further out, used to
+    // smear them into terrain anyway (a flat square some degrees wide at level 0).
+    let dir = Dir::new();
+    let prj = "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]";
+    let one: String = (0..36)
+        .map(|i| if i == 14 { "250 " } else { "-9999 " })
+        .collect();
+    let rasters = [
+        (
+            "one",
+            format!(
+                "ncols 6\nnrows 6\nxllcorner 10\nyllcorner 40\ncellsize 0.01\n\
+                 NODATA_value -9999\n{one}\n"
+            ),
+        ),
+        (
+            "row",
+            "ncols 3\nnrows 1\nxllcorner 10\nyllcorner 40\ncellsize 0.01\n1 2 3\n".to_string(),
+        ),
+    ];
+    for (name, text) in rasters {
+        dir.write(&format!("{name}.asc"), &text);
+        dir.write(&format!("{name}.prj"), prj);
+        let input = format!("{name}.asc");
+        let o = dir.run(&["mesh", &input, "-o", "m.ply", "--max-error", "1"]);
+        crate::util::assert_fails_naming(&o, &[&input, "2x2"]);
+        let o = dir.run(&["tiles", &input, "-o", "p", "-q"]);
+        crate::util::assert_fails_naming(&o, &[&input, "2x2", "finest", "no terrain"]);
+        assert!(!dir.path("p").exists());
+    }
 }
 
 #[test]

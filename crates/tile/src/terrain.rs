@@ -510,7 +510,12 @@ pub fn build_terrain(
         options,
         progress,
     )?;
-    if levels.iter().all(|l| l.tiles == l.flat_tiles) {
+    // The coarser levels are made from the finest, each reaching a sample further out
+    // (see `LevelRows::coarser_rows`): without a triangle at the finest level they would
+    // only smear samples that hold none (a single valid sample, a single row) into
+    // terrain, where `mesh` and `contour` find nothing to triangulate.
+    let finest = levels.last().expect("min_zoom <= max_zoom");
+    if finest.tiles == finest.flat_tiles {
         let hint = if options.max_zoom.is_some() {
             " (at this --max-zoom the tile samples may be too far apart for the raster's \
              extent: try a larger one)"
@@ -518,11 +523,10 @@ pub fn build_terrain(
             ""
         };
         return Err(TerrainError::Options(format!(
-            "{}: band {} has no tile with a 2x2 block of valid samples at levels {}..={max_zoom}, \
-             so there is no terrain to write{hint}",
+            "{}: band {} has no tile with a 2x2 block of valid samples at level {max_zoom}, the \
+             finest (the coarser levels are made from it), so there is no terrain to write{hint}",
             input.display(),
             options.band,
-            options.min_zoom
         )));
     }
     write_layer_json(

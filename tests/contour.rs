@@ -307,7 +307,7 @@ fn tiled_decimation_contours_the_same_tin_mesh_writes() {
             "-q",
         ],
     );
-    for threads in ["1", "2"] {
+    for threads in ["1", "2", "0"] {
         let mut b = vec![
             "contour",
             &input,

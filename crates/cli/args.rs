@@ -113,7 +113,7 @@ pub struct MeshArgs {
     /// Any single-band raster GDAL can read (GeoTIFF, ESRI ASCII, HGT, VRT, PNG...).
     pub input: PathBuf,
     /// Output mesh; the format follows the extension (.ply, .obj, .stl, .glb, .geojson,
-    /// .fgb, .xml for LandXML) unless --format names it. Optional with --per-tile.
+    /// .fgb, .xml or .landxml for LandXML) unless --format names it. Optional with --per-tile.
     #[arg(short, long, required_unless_present = "per_tile")]
     pub output: Option<PathBuf>,
     #[command(flatten)]
@@ -193,9 +193,9 @@ pub struct MeshArgs {
     #[arg(long, value_name = "N", default_value_t = tinsmith_tile::DEFAULT_TILE_SIZE,
           value_parser = clap::value_parser!(u32).range(2..))]
     pub tile_size: u32,
-    /// Worker threads for tiles, at most 1024 and no more than there are tiles [default: one
-    /// per core].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    /// Worker threads for tiles, at most 1024 and no more than there are tiles; 0 (the
+    /// default) for one per core, as in `tiles`.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(0..=1024))]
     pub threads: Option<u32>,
     /// Write one mesh file per tile into DIR (which must not exist, or be empty) instead
     /// of one welded mesh; always uses tiles.
@@ -303,9 +303,9 @@ pub struct ContourArgs {
     #[arg(long, value_name = "N", default_value_t = tinsmith_tile::DEFAULT_TILE_SIZE,
           value_parser = clap::value_parser!(u32).range(2..))]
     pub tile_size: u32,
-    /// Worker threads for tiles, at most 1024 and no more than there are tiles [default: one
-    /// per core].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    /// Worker threads for tiles, at most 1024 and no more than there are tiles; 0 (the
+    /// default) for one per core, as in `tiles`.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(0..=1024))]
     pub threads: Option<u32>,
     /// No summary on stderr.
     #[arg(short, long)]

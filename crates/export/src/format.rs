@@ -50,18 +50,21 @@ impl MeshFormat {
         MeshFormat::LandXml,
     ];
 
-    /// Picks the format from the path's extension, ignoring ASCII case (`tile.PLY` is PLY).
+    /// Picks the format from the path's extension, ignoring ASCII case (`tile.PLY` is PLY);
+    /// the format's [`MeshFormat::name`] works too (`tin.landxml` is LandXML).
     ///
     /// # Errors
     /// [`Error::UnknownExtension`], naming the path and the supported extensions, if the
-    /// extension is missing, not UTF-8 or not one of [`MeshFormat::extension`].
+    /// extension is missing, not UTF-8 or not one of [`MeshFormat::extension`] or
+    /// [`MeshFormat::name`].
     pub fn from_path(path: &Path) -> Result<MeshFormat> {
         path.extension()
             .and_then(|extension| extension.to_str())
             .and_then(|extension| {
-                Self::ALL
-                    .into_iter()
-                    .find(|format| format.extension().eq_ignore_ascii_case(extension))
+                Self::ALL.into_iter().find(|format| {
+                    format.extension().eq_ignore_ascii_case(extension)
+                        || format.name().eq_ignore_ascii_case(extension)
+                })
             })
             .ok_or_else(|| Error::UnknownExtension {
                 path: path.to_path_buf(),
@@ -229,5 +232,10 @@ mod tests {
             assert_eq!(MeshFormat::from_path(Path::new(&path)).ok(), Some(format));
         }
         assert_eq!(MeshFormat::Ply.to_string(), "PLY");
+        // The format's name works as an extension too.
+        assert_eq!(
+            MeshFormat::from_path(Path::new("tin.LandXML")).ok(),
+            Some(MeshFormat::LandXml)
+        );
     }
 }

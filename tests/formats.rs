@@ -508,6 +508,42 @@ fn float32_formats_keep_the_bound_when_heights_do_not_fit_float32() {
 }
 
 #[test]
+fn stl_and_gltf_from_a_geographic_raster_say_their_positions_are_degrees() {
+    // Heights in metres over positions in degrees: true to the raster, but a 3D viewer
+    // draws it stretched about 100,000 times, so STL and glTF output says so. GIS formats
+    // (and a projected raster, and -q) say nothing.
+    let d = Dir::new();
+    let geographic = fixture("etopo5_2deg_i16.tif");
+    let projected = fixture(DEM);
+    for (dem, name, noted) in [
+        (&geographic, "g.glb", true),
+        (&geographic, "g.stl", true),
+        (&geographic, "g.ply", false),
+        (&geographic, "g.fgb", false),
+        (&projected, "p.glb", false),
+    ] {
+        let o = d.run(&["mesh", dem, "-o", name, "--max-error", "50"]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let said = stderr(&o).contains("degrees");
+        assert_eq!(said, noted, "{name}: {}", stderr(&o));
+    }
+    let o = d.run(&[
+        "mesh",
+        &geographic,
+        "-o",
+        "q.glb",
+        "--max-error",
+        "50",
+        "-q",
+    ]);
+    assert!(
+        o.status.success() && stderr(&o).is_empty(),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
 fn flags_for_another_format_are_refused_and_format_overrides_the_extension() {
     let d = Dir::new();
     let dem = fixture(DEM);

@@ -108,6 +108,7 @@ impl Plan {
             }
         }
         let georef = Georef::new(info.transform(), args.pixel_coords);
+        note_degrees_in_a_3d_format(info, &georef, args)?;
         let (min, max) = extent(info, &georef);
         let origin = LocalOrigin::around(min, max);
         if let Some(base) = args.export.base {
@@ -366,6 +367,28 @@ pub fn file_crs<'r>(
             Ok(crs)
         }
     }
+}
+
+/// Notes (unless quiet) that STL and glTF, formats for 3D viewers and printers, get
+/// positions in degrees beside heights in metres from a geographic raster: true to the
+/// raster, but drawn stretched by about 100,000 vertically.
+fn note_degrees_in_a_3d_format(info: &RasterInfo, georef: &Georef, args: &MeshArgs) -> Result<()> {
+    let Georef::World(_) = georef else {
+        return Ok(());
+    };
+    let geographic = match info.crs_wkt.as_deref() {
+        Some(wkt) => info.epsg == Some(4326) || tinsmith_raster::is_geographic(wkt)?,
+        None => false,
+    };
+    if geographic && !args.quiet {
+        note!(
+            "{}: the raster's CRS is geographic, so x and y are written in degrees and z in \
+             its height unit: a 3D viewer draws the TIN stretched (for true proportions, \
+             reproject the raster to a projected CRS first, e.g. with gdalwarp -t_srs)",
+            out(args).display()
+        );
+    }
+    Ok(())
 }
 
 /// What the points given to [`file_crs`] are.

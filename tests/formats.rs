@@ -595,6 +595,19 @@ fn flags_for_another_format_are_refused_and_format_overrides_the_extension() {
         &["-so", "-al", &d.path("tin.dat").to_string_lossy()],
     );
     assert_eq!(ogr_field(&summary, "Geometry:"), "3D Triangle");
+    // Reading it back: the extension says nothing, so `verify` and `contour --mesh` say
+    // so and take the format as `mesh` did, from an option.
+    let o = d.run(&["verify", &dem, "tin.dat"]);
+    assert_fails_naming(&o, &["tin.dat", "extension"]);
+    verify(&d, &dem, "tin.dat", E, &["--format", "fgb"]);
+    let contour = ["contour", &dem, "-o", "c.geojson", "--interval", "50"];
+    let o = d.run(&[&contour[..], &["--mesh", "tin.dat"]].concat());
+    assert_fails_naming(&o, &["tin.dat", "extension"]);
+    let o = d.run(&[&contour[..], &["--mesh", "tin.dat", "--mesh-format", "fgb"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    // A format that is not the file's is an error naming the file.
+    let o = d.run(&["verify", &dem, "tin.dat", "--format", "ply"]);
+    assert_fails_naming(&o, &["tin.dat", "PLY"]);
 }
 
 #[test]

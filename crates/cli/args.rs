@@ -241,6 +241,10 @@ pub struct VerifyArgs {
     /// The mesh to check (.ply, .obj, .stl, .glb, .geojson, .fgb, .xml); GeoJSON in WGS84
     /// is transformed back to the raster's CRS.
     pub mesh: PathBuf,
+    /// The mesh's format, whatever its extension: ply, obj, stl, glb, geojson, fgb,
+    /// landxml (for a file written with `mesh --format`).
+    #[arg(long, value_name = "NAME", value_parser = crate::export::parse_format)]
+    pub format: Option<MeshFormat>,
     /// Fail (exit 1) when the measured error exceeds this.
     #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true)]
     pub max_error: Option<f64>,
@@ -281,6 +285,10 @@ pub struct ContourArgs {
     /// Contour this TIN (any format `tinsmith mesh` writes, written from INPUT) instead.
     #[arg(long, value_name = "MESH")]
     pub mesh: Option<PathBuf>,
+    /// The --mesh file's format, whatever its extension: ply, obj, stl, glb, geojson, fgb,
+    /// landxml.
+    #[arg(long, value_name = "NAME", requires = "mesh", value_parser = crate::export::parse_format)]
+    pub mesh_format: Option<MeshFormat>,
     /// Simplify each line (Douglas-Peucker) within this distance, in the output's map
     /// units (pixels with --pixel-coords): lines move up to D sideways and are no longer
     /// exact contours of the TIN.

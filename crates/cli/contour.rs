@@ -81,7 +81,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             Some(mesh) => (
                 crate::memory::Need {
                     bytes_per_sample: 24,
-                    extra_bytes: crate::memory::mesh_file_memory(mesh),
+                    extra_bytes: crate::memory::mesh_file_memory(mesh, args.mesh_format),
                 },
                 "contouring a --mesh",
                 "contour it with --max-error instead (decimated tile by tile, in bounded memory)",
@@ -313,7 +313,8 @@ fn untiled_tin(
     let grid = &raster.grid;
     if let Some(path) = &args.mesh {
         let georef = Georef::new(raster.info.transform(), args.pixel_coords);
-        let mesh = mesh_from_file(path, raster, georef, args.band)?;
+        let format = crate::verify::mesh_format(path, args.mesh_format)?;
+        let mesh = mesh_from_file(path, format, raster, georef, args.band)?;
         let levels = levels_for(args, mesh.height_range())?;
         return Ok((mesh, "mesh file".to_owned(), levels));
     }
@@ -499,12 +500,13 @@ fn nothing_to_contour(args: &ContourArgs) -> anyhow::Error {
 /// raster's.
 fn mesh_from_file(
     path: &Path,
+    format: tinsmith_export::MeshFormat,
     raster: &Raster,
     georef: Georef,
     band: usize,
 ) -> Result<ContourMesh> {
     let grid: &Grid = &raster.grid;
-    let file = read_mesh_file(path, raster, georef)?;
+    let file = read_mesh_file(path, format, raster, georef)?;
     let (lo, hi) = file
         .vertices
         .iter()
@@ -516,7 +518,7 @@ fn mesh_from_file(
     // other tools may round to about six decimals or significant digits: a millionth of
     // the sample's magnitude or of the range is allowed for that, far below any DEM's
     // precision. A vertex within it takes its sample's height.
-    let float32 = tinsmith_export::MeshFormat::from_path(path).is_ok_and(|f| f.is_float32());
+    let float32 = format.is_float32();
     let range = if hi >= lo { hi - lo } else { 0.0 };
     let slack = if float32 {
         range / f64::from(1u32 << 23)
@@ -589,7 +591,7 @@ fn mesh_from_file(
         .map(|t| t.map(|v| index[v as usize]))
         .collect();
     let orientation = expected_orientation(&georef);
-    crate::verify::orient_polygon_triangles(path, &positions, &mut triangles, orientation);
+    crate::verify::orient_polygon_triangles(format, &positions, &mut triangles, orientation);
     let options = VerifyOptions::new().with_orientation(orientation);
     let report = tinsmith_verify::verify(
         GridRef::new(grid.width(), grid.height(), grid.values()),

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use tinsmith_export::Mesh;
+use tinsmith_export::{Mesh, MeshFormat};
 use tinsmith_raster::Raster;
 use tinsmith_verify::{GridRef, MeshRef, Orientation, Report, VerifyOptions};
 
@@ -18,7 +18,7 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
         crate::memory::raster_size(&args.input, args.band)?,
         crate::memory::Need {
             bytes_per_sample: 24,
-            extra_bytes: crate::memory::mesh_file_memory(&args.mesh),
+            extra_bytes: crate::memory::mesh_file_memory(&args.mesh, args.format),
         },
         "verify",
         "verification has no tiled mode; use a machine with more memory",
@@ -26,12 +26,13 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
     let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
     crate::georef::check_transform(&raster.info, args.pixel_coords)?;
     let georef = Georef::new(raster.info.transform(), args.pixel_coords);
-    let mesh = read_mesh_file(&args.mesh, &raster, georef)?;
+    let format = mesh_format(&args.mesh, args.format)?;
+    let mesh = read_mesh_file(&args.mesh, format, &raster, georef)?;
     let positions = sample_positions(&args.mesh, &mesh, georef)?;
     let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();
     let orientation = expected_orientation(&georef);
     let mut triangles = mesh.triangles;
-    orient_polygon_triangles(&args.mesh, &positions, &mut triangles, orientation);
+    orient_polygon_triangles(format, &positions, &mut triangles, orientation);
     let grid = &raster.grid;
     let mut options = VerifyOptions::new().with_orientation(orientation);
     if let Some(e) = args.max_error {
@@ -65,9 +66,14 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
 ///
 /// Longitudes in WGS84 files are in [-180, 180] (RFC 7946); for a geographic raster they
 /// are moved by whole turns into the raster's own range (0..360 for many global grids).
-pub fn read_mesh_file(path: &Path, raster: &Raster, georef: Georef) -> Result<Mesh> {
-    let mut mesh = tinsmith_export::read_mesh(path)?;
-    let polygons = is_polygon_format(path);
+pub fn read_mesh_file(
+    path: &Path,
+    format: MeshFormat,
+    raster: &Raster,
+    georef: Georef,
+) -> Result<Mesh> {
+    let mut mesh = tinsmith_export::read_mesh_as(path, format)?;
+    let polygons = is_polygon_format(format);
     // A GIS rewrite may keep WGS84 as WKT alone (a shapefile's GCS_WGS_1984).
     if polygons
         && mesh.epsg.is_none()
@@ -191,13 +197,19 @@ fn into_raster_frame(mesh: &mut Mesh, raster: &Raster, transform: tinsmith_core:
     mesh.vertices = vertices;
 }
 
-/// Whether `path` is GeoJSON or FlatGeobuf: triangles stored as polygons, whose winding
+/// The format of the mesh file at `path`: `given` (a `--format` option), or the one its
+/// extension names.
+pub fn mesh_format(path: &Path, given: Option<MeshFormat>) -> Result<MeshFormat> {
+    match given {
+        Some(format) => Ok(format),
+        None => Ok(MeshFormat::from_path(path)?),
+    }
+}
+
+/// Whether `format` is GeoJSON or FlatGeobuf: triangles stored as polygons, whose winding
 /// says nothing (see [`orient_polygon_triangles`]).
-fn is_polygon_format(path: &Path) -> bool {
-    matches!(
-        tinsmith_export::MeshFormat::from_path(path),
-        Ok(tinsmith_export::MeshFormat::GeoJson | tinsmith_export::MeshFormat::FlatGeobuf)
-    )
+fn is_polygon_format(format: MeshFormat) -> bool {
+    matches!(format, MeshFormat::GeoJson | MeshFormat::FlatGeobuf)
 }
 
 /// Reverses every triangle when most are clockwise in longitude, latitude as written (a
@@ -228,12 +240,12 @@ fn counter_clockwise_in_lon_lat(mesh: &mut Mesh) {
 /// them clockwise), so a triangle wound the other way is the same triangle. Other formats
 /// are left as they are: their winding says which way a face points.
 pub fn orient_polygon_triangles(
-    path: &Path,
+    format: MeshFormat,
     positions: &[[i64; 2]],
     triangles: &mut [[u32; 3]],
     orientation: Orientation,
 ) {
-    if !is_polygon_format(path) {
+    if !is_polygon_format(format) {
         return;
     }
     for t in triangles {

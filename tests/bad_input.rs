@@ -1034,3 +1034,36 @@ fn commands_that_write_files_finish_when_stderr_is_closed() {
         assert!(d.path(output).exists(), "{args:?}: no {output}");
     }
 }
+
+#[test]
+fn a_read_only_output_is_not_replaced() {
+    // Writing renames a new file over the output, which the directory allows whatever the
+    // file's mode: a mesh, lines or report made read-only used to be replaced silently.
+    use std::os::unix::fs::PermissionsExt;
+    let d = Dir::new();
+    for name in ["kept.ply", "kept.geojson", "kept.json"] {
+        let p = d.write(name, "precious");
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o444)).unwrap();
+    }
+    let dem = dem();
+    let runs: [&[&str]; 3] = [
+        &["mesh", &dem, "-o", "kept.ply", "--max-error", "5"],
+        &["contour", &dem, "-o", "kept.geojson", "--interval", "50"],
+        &[
+            "mesh",
+            &dem,
+            "-o",
+            "new.ply",
+            "--max-error",
+            "5",
+            "--report",
+            "kept.json",
+        ],
+    ];
+    for (args, name) in runs.iter().zip(["kept.ply", "kept.geojson", "kept.json"]) {
+        let o = d.run(args);
+        assert_fails_naming(&o, &[name, "read-only"]);
+        assert_eq!(std::fs::read_to_string(d.path(name)).unwrap(), "precious");
+    }
+    assert_eq!(d.files(), vec!["kept.geojson", "kept.json", "kept.ply"]);
+}

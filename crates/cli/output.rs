@@ -8,7 +8,7 @@ use tinsmith_export::MeshFormat;
 
 /// Fails early, before long work, when `path` ends with '/', is a looping symbolic link,
 /// is the `input` file or one the input is read from (see [`check_not_input`]), is a
-/// directory, or its directory is missing.
+/// directory, is a read-only file, or its directory is missing.
 pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
     if path.as_os_str().as_encoded_bytes().ends_with(b"/") {
         bail!(
@@ -41,6 +41,16 @@ pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
     }
     if path.is_dir() {
         bail!("{}: is a directory, not an output file", path.display());
+    }
+    // The write renames a new file over it, which the directory allows whatever the file's
+    // mode: a file made read-only is not replaced behind its owner's back.
+    let target = tinsmith_export::resolve_output(path);
+    if std::fs::metadata(&target).is_ok_and(|m| m.is_file() && m.permissions().readonly()) {
+        bail!(
+            "{}: exists and is read-only; make it writable (chmod u+w) or remove it to \
+             replace it",
+            path.display()
+        );
     }
     Ok(())
 }

@@ -19,6 +19,8 @@ struct Tile {
     v: Vec<i64>,
     /// Decoded heights.
     h: Vec<f64>,
+    /// The header's minimum and maximum heights.
+    header: (f64, f64),
     triangles: Vec<[usize; 3]>,
     edges: [Vec<usize>; 4],
     normals: Option<Vec<u64>>,
@@ -85,6 +87,7 @@ fn decode_pyramid(dir: &Path) -> BTreeMap<(u32, u32, u32), Tile> {
             u: numbers(&t["u"]),
             v: numbers(&t["v"]),
             h,
+            header: (min, max),
             triangles: idx
                 .chunks(3)
                 .map(|c| [c[0] as usize, c[1] as usize, c[2] as usize])
@@ -352,11 +355,21 @@ fn all_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
 fn check_pyramid(input: &str, quality: f64, flat_roots: usize) {
     let dir = Dir::new();
     let q = quality.to_string();
+    let report = dir.path("one.json").to_string_lossy().into_owned();
     pyramid(
         &dir,
         input,
         "one",
-        &["--quality", &q, "--normals", "--metadata", "--threads", "1"],
+        &[
+            "--quality",
+            &q,
+            "--normals",
+            "--metadata",
+            "--threads",
+            "1",
+            "--report",
+            &report,
+        ],
     );
     pyramid(
         &dir,
@@ -443,6 +456,44 @@ fn check_pyramid(input: &str, quality: f64, flat_roots: usize) {
         }
     }
     assert!(check_shared_edges(&tiles) > 0, "no shared edges tested");
+
+    // The header's height range bounds the tile's heights (the spec), and CesiumJS builds
+    // the tile's bounding box from it: within twice the tile's own relief plus a height
+    // step, unless float32 could not hold a finer division of the 16-bit range exactly.
+    // It used to be 32767 steps whatever the relief, steps the level's widest tile sets.
+    let report: Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    let step_of = |z: u32| {
+        report["levels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|l| l["level"] == z)
+            .and_then(|l| l["height_step"].as_f64())
+            .expect("level in the report")
+    };
+    let mut tight = 0;
+    for (&key, t) in &tiles {
+        let (min, max) = t.header;
+        let s = step_of(key.0);
+        let relief = t.h.iter().fold(f64::NEG_INFINITY, |m, &h| m.max(h)) - min;
+        assert!(max - min >= relief - 1e-9, "{key:?}: header below a vertex");
+        let quanta = 32767.0 * s / (max - min);
+        assert!(
+            (quanta - quanta.round()).abs() < 1e-6 && (quanta.round() as u32).is_power_of_two(),
+            "{key:?}: {quanta} quanta a step"
+        );
+        let finer_is_inexact = 2.0 * quanta * (min / s).abs() + 32767.0 >= 16_777_216.0;
+        if max - min <= 2.0 * relief + 2.0 * s {
+            tight += 1;
+        } else {
+            assert!(
+                quanta.round() == 16384.0 || finer_is_inexact,
+                "{key:?}: header range {} for relief {relief} (step {s})",
+                max - min
+            );
+        }
+    }
+    assert!(tight > 0);
 
     // The finest level against GDAL's own warp of each tile's lattice.
     let mut checked = 0;

@@ -337,6 +337,25 @@ struct LevelBudget {
     max_abs: f64,
 }
 
+/// How many 16-bit height quanta a tile gives each height step: the largest power of two
+/// up to 2^14 that keeps `top` steps (its highest vertex above its minimum, `k_min`
+/// steps above 0) within 32767 quanta, and its maximum height exact in float32
+/// (`k_min * quanta + 32767` below 2^24 in magnitude). The header's maximum, the top of
+/// the 16-bit range, is then within twice the tile's own height range (plus a step) instead
+/// of 32767 steps up, which the level's widest tile sets; CesiumJS builds each tile's
+/// bounding box from it. Heights stay multiples of the step, exactly, as neighbours
+/// decode them.
+fn quanta_per_step(k_min: f64, top: f64) -> u32 {
+    let mut quanta = 1u32;
+    while quanta < 1 << 14
+        && top * f64::from(2 * quanta) <= f64::from(QUANTIZED_MAX)
+        && k_min.abs() * f64::from(2 * quanta) + f64::from(QUANTIZED_MAX) < f64::from(1u32 << 24)
+    {
+        quanta *= 2;
+    }
+    quanta
+}
+
 /// One tile done on a worker.
 struct TileOut {
     x: u32,
@@ -1001,12 +1020,18 @@ fn build_tile(
         .fold(f64::INFINITY, f64::min);
     let k_min = (lo / s).floor();
     let min_height = k_min * s;
-    let max_height = (k_min + f64::from(QUANTIZED_MAX)) * s;
+    let hi = tin
+        .vertices()
+        .iter()
+        .map(|v| v.z)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let per_step = quanta_per_step(k_min, (hi / s).round() - k_min);
+    let max_height = min_height + f64::from(QUANTIZED_MAX) * s / f64::from(per_step);
     let quantized: Vec<[u16; 3]> = tin
         .vertices()
         .iter()
         .map(|v| {
-            let h = (v.z / s).round() - k_min;
+            let h = ((v.z / s).round() - k_min) * f64::from(per_step);
             [
                 (v.x * U_PER_CELL) as u16,
                 (v.y * U_PER_CELL) as u16,
@@ -1023,7 +1048,7 @@ fn build_tile(
         .collect();
     let decoded: Vec<f64> = quantized
         .iter()
-        .map(|q| min_height + f64::from(q[2]) * s)
+        .map(|q| min_height + f64::from(q[2] / per_step as u16) * s)
         .collect();
     let check = tinsmith_verify::verify(
         GridRef::new(grid.width(), grid.height(), grid.values()),

@@ -238,8 +238,8 @@ pub struct ExportArgs {
 pub struct VerifyArgs {
     /// The raster the mesh was made from.
     pub input: PathBuf,
-    /// The mesh to check (.ply, .obj, .stl, .glb, .geojson, .fgb, .xml); GeoJSON in WGS84
-    /// is transformed back to the raster's CRS.
+    /// The mesh to check (.ply, .obj, .stl, .glb, .geojson, .fgb, .xml, or any with
+    /// --format); GeoJSON in WGS84 is transformed back to the raster's CRS.
     pub mesh: PathBuf,
     /// The mesh's format, whatever its extension: ply, obj, stl, glb, geojson, fgb,
     /// landxml (for a file written with `mesh --format`).

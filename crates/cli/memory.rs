@@ -181,10 +181,11 @@ pub fn file_bytes(path: &Path) -> u64 {
 }
 
 /// The bytes the mesh file at `path` takes once read, with the verifier's per-triangle
-/// arrays: its size times a factor per format (`format`, or the extension's). Measured with `verify` on one ETOPO5 mesh
-/// (5.9 M triangles, session 15) written in every format: the mesh took 385 MB read from
-/// PLY, OBJ, STL, glTF or LandXML alike (417 MB from FlatGeobuf), 2.3 GB from GeoJSON
-/// (parsed whole), while the files weigh 18 (glTF) to 282 (GeoJSON) bytes a triangle.
+/// arrays: its size times a factor per format (`format`, or the extension's). Measured
+/// with `verify` on one ETOPO5 mesh (5.9 M triangles, session 15) written in every
+/// format: the mesh took 385 MB read from PLY, OBJ, STL, glTF or LandXML alike (417 MB
+/// from FlatGeobuf), 2.3 GB from GeoJSON (parsed whole), while the files weigh 18 (glTF)
+/// to 282 (GeoJSON) bytes a triangle.
 /// Each factor is the measured ratio rounded up, with room for files written more
 /// compactly than tinsmith writes them (OBJ).
 pub fn mesh_file_memory(path: &Path, format: Option<tinsmith_export::MeshFormat>) -> u64 {

@@ -959,17 +959,30 @@ fn a_failed_pyramid_leaves_no_directory_it_made() {
 }
 
 #[test]
-fn a_pyramid_needs_a_2x2_block_of_valid_samples_at_its_finest_level() {
+fn a_pyramid_needs_a_2x2_block_of_valid_samples() {
     // One valid sample, and a 3 x 1 raster: `mesh` finds no 2x2 block of valid samples to
-    // triangulate, and neither does `tiles` at the finest level (the raster's own). The
-    // coarser levels, made from it by a filter that reaches a sample further out, used to
-    // smear them into terrain anyway (a flat square some degrees wide at level 0).
+    // triangulate, and neither does `tiles`. The coarser levels, made from the finest by a
+    // filter that reaches a sample further out, used to smear them into terrain anyway (a
+    // flat square some degrees wide at level 0).
     let dir = Dir::new();
     let prj = "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]";
     let one: String = (0..36)
         .map(|i| if i == 14 { "250 " } else { "-9999 " })
         .collect();
+    // At 10 m in UTM the default finest level is finer than the raster: the warp alone
+    // would fill a 2x2 block of the lattice from the one sample.
+    let utm = "PROJCS[\"WGS 84 / UTM zone 11N\",GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],PARAMETER[\"latitude_of_origin\",0],PARAMETER[\"central_meridian\",-117],PARAMETER[\"scale_factor\",0.9996],PARAMETER[\"false_easting\",500000],PARAMETER[\"false_northing\",0],UNIT[\"metre\",1]]";
     let rasters = [
+        (
+            "fine",
+            format!(
+                "ncols 5\nnrows 5\nxllcorner 400000\nyllcorner 3800000\ncellsize 10\n\
+                 NODATA_value -9999\n{}\n",
+                (0..25)
+                    .map(|i| if i == 12 { "250 " } else { "-9999 " })
+                    .collect::<String>()
+            ),
+        ),
         (
             "one",
             format!(
@@ -984,12 +997,15 @@ fn a_pyramid_needs_a_2x2_block_of_valid_samples_at_its_finest_level() {
     ];
     for (name, text) in rasters {
         dir.write(&format!("{name}.asc"), &text);
-        dir.write(&format!("{name}.prj"), prj);
+        dir.write(
+            &format!("{name}.prj"),
+            if name == "fine" { utm } else { prj },
+        );
         let input = format!("{name}.asc");
         let o = dir.run(&["mesh", &input, "-o", "m.ply", "--max-error", "1"]);
         crate::util::assert_fails_naming(&o, &[&input, "2x2"]);
         let o = dir.run(&["tiles", &input, "-o", "p", "-q"]);
-        crate::util::assert_fails_naming(&o, &[&input, "2x2", "finest", "no terrain"]);
+        crate::util::assert_fails_naming(&o, &[&input, "2x2", "no terrain"]);
         assert!(!dir.path("p").exists());
     }
 }

@@ -120,6 +120,32 @@ impl WindowReader {
             source,
         })
     }
+
+    /// Whether the band has a 2x2 block of valid samples (a cell a TIN can cover): read in
+    /// bands of whole rows (about 2^20 samples, sharing a row), stopping at the first such
+    /// block, so a raster with data answers after its first band.
+    ///
+    /// # Errors
+    /// As [`WindowReader::read_window`].
+    pub fn has_valid_cell(&self) -> Result<bool> {
+        let (width, height) = (self.width(), self.height());
+        if width < 2 || height < 2 {
+            return Ok(false);
+        }
+        let rows = ((1u32 << 20) / width).clamp(2, height);
+        let mut y0 = 0;
+        loop {
+            let band = rows.min(height - y0);
+            if self.read_window(0, y0, width, band)?.valid_cell_count() > 0 {
+                return Ok(true);
+            }
+            if y0 + band >= height {
+                return Ok(false);
+            }
+            // The next band starts on this one's last row: no cell is skipped.
+            y0 += band - 1;
+        }
+    }
 }
 
 /// Reads one window of band `band` (1-based) of the raster at `path`: opens the raster,

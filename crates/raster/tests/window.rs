@@ -149,3 +149,68 @@ fn a_reader_moves_to_another_thread() {
         .expect("thread");
     assert_eq!(grid.width(), 4);
 }
+
+/// A Float32 GeoTIFF of `width` x `height` with nodata -9999 everywhere but `valid`.
+fn sparse_raster(
+    dir: &Path,
+    name: &str,
+    (width, height): (usize, usize),
+    valid: &[(usize, usize)],
+) -> PathBuf {
+    let path = dir.join(name);
+    let driver = DriverManager::get_driver_by_name("GTiff").expect("GTiff");
+    let ds = driver
+        .create_with_band_type_with_options::<f32, _>(
+            &path,
+            width,
+            height,
+            1,
+            &RasterCreationOptions::default(),
+        )
+        .expect("create");
+    let mut band = ds.rasterband(1).expect("band");
+    band.set_no_data_value(Some(-9999.0)).expect("nodata");
+    let mut values = vec![-9999.0f32; width * height];
+    for &(x, y) in valid {
+        values[y * width + x] = 1.0;
+    }
+    let mut buffer = Buffer::new((width, height), values);
+    band.write((0, 0), (width, height), &mut buffer)
+        .expect("write");
+    path
+}
+
+#[test]
+fn a_valid_cell_is_found_wherever_it_is_and_only_if_there_is_one() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // 2^19 columns: bands of two rows, so the block on rows 1 and 2 straddles the first
+    // two bands and is only found through the row they share.
+    let wide = (1usize << 19, 4);
+    let block = [(7, 1), (8, 1), (7, 2), (8, 2)];
+    let cases: [(&str, (usize, usize), Vec<(usize, usize)>, bool); 5] = [
+        ("straddling.tif", wide, block.to_vec(), true),
+        ("empty.tif", wide, vec![], false),
+        // Valid samples, but no four of them in a 2x2 block.
+        (
+            "checker.tif",
+            (9, 7),
+            (0..63)
+                .filter(|i| (i % 9 + i / 9) % 2 == 0)
+                .map(|i| (i % 9, i / 9))
+                .collect(),
+            false,
+        ),
+        (
+            "last.tif",
+            (9, 7),
+            vec![(7, 5), (8, 5), (7, 6), (8, 6)],
+            true,
+        ),
+        ("row.tif", (9, 1), (0..9).map(|x| (x, 0)).collect(), false),
+    ];
+    for (name, size, valid, expected) in cases {
+        let path = sparse_raster(dir.path(), name, size, &valid);
+        let reader = WindowReader::open(&path, 1).expect("open");
+        assert_eq!(reader.has_valid_cell().expect("read"), expected, "{name}");
+    }
+}

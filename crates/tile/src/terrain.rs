@@ -412,6 +412,15 @@ pub fn build_terrain(
                 .into(),
         ));
     }
+    // Refused as `mesh` and `contour` refuse it: a warp to a lattice finer than the raster
+    // would fill a block from a single sample, and every coarser level is made from it.
+    if !tinsmith_raster::WindowReader::open(input, options.band)?.has_valid_cell()? {
+        return Err(TerrainError::Options(format!(
+            "{}: band {} has no 2x2 block of valid samples, so there is no terrain to write",
+            input.display(),
+            options.band,
+        )));
+    }
     // The first level whose lattice is at least as fine as the raster.
     let own_level = (0..MAX_LEVEL)
         .find(|&l| step(l) <= bounds.resolution * (1.0 + 1e-9))

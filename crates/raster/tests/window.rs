@@ -187,7 +187,8 @@ fn a_valid_cell_is_found_wherever_it_is_and_only_if_there_is_one() {
     // two bands and is only found through the row they share.
     let wide = (1usize << 19, 4);
     let block = [(7, 1), (8, 1), (7, 2), (8, 2)];
-    let cases: [(&str, (usize, usize), Vec<(usize, usize)>, bool); 5] = [
+    type Samples = Vec<(usize, usize)>;
+    let cases: [(&str, (usize, usize), Samples, bool); 5] = [
         ("straddling.tif", wide, block.to_vec(), true),
         ("empty.tif", wide, vec![], false),
         // Valid samples, but no four of them in a 2x2 block.

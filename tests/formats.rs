@@ -508,6 +508,31 @@ fn float32_formats_keep_the_bound_when_heights_do_not_fit_float32() {
 }
 
 #[test]
+fn float32_formats_print_their_origin_tiled_or_not() {
+    // README: the origin is printed (and in the report); tiled runs used to print nothing.
+    let d = Dir::new();
+    let dem = fixture(DEM);
+    for tile_size in ["4096", "33"] {
+        let o = d.run(&[
+            "mesh",
+            &dem,
+            "-o",
+            "m.glb",
+            "--max-error",
+            E,
+            "--tile-size",
+            tile_size,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains("m.glb: float32 positions relative to the local origin ("),
+            "tiles of {tile_size}: {}",
+            stderr(&o)
+        );
+    }
+}
+
+#[test]
 fn stl_and_gltf_from_a_geographic_raster_say_their_positions_are_degrees() {
     // Heights in metres over positions in degrees: true to the raster, but a 3D viewer
     // draws it stretched about 100,000 times, so STL and glTF output says so. GIS formats

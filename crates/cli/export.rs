@@ -75,6 +75,20 @@ pub struct PlanReport {
 }
 
 impl Plan {
+    /// Notes on stderr the float32 formats' origin and height rounding for `output`
+    /// (nothing for the double-precision formats).
+    pub fn note_origin(&self, output: &Path) {
+        if let Some(origin) = self.origin {
+            let [x, y, z] = origin.offset();
+            note!(
+                "{}: float32 positions relative to the local origin ({x}, {y}, {z}); \
+                 heights round by at most {}",
+                output.display(),
+                self.height_rounding
+            );
+        }
+    }
+
     /// For STL and glTF: the origin in the middle of the raster's file coordinates and
     /// heights, the largest float32 rounding of a height, and the bound left for the
     /// decimator; fails when float32 cannot hold the positions to a sample or the heights

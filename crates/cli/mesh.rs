@@ -164,15 +164,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     };
     if !args.quiet {
         report.summary.print("");
-        if let Some(origin) = plan.origin {
-            let [x, y, z] = origin.offset();
-            note!(
-                "{}: float32 positions relative to the local origin ({x}, {y}, {z}); \
-                 heights round by at most {}",
-                output.display(),
-                plan.height_rounding
-            );
-        }
+        plan.note_origin(output);
     }
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&report)?)?;

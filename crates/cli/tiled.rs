@@ -268,6 +268,9 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             " in {} tiles of {}",
             json.tiles.count, json.tiles.size
         ));
+        if let (Some(plan), Some(output)) = (export_plan, &args.output) {
+            plan.note_origin(output);
+        }
     }
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&json)?)?;

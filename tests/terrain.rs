@@ -915,6 +915,11 @@ fn zoom_and_quality_out_of_range_are_refused_saying_why() {
             &["--min-zoom", "3"][..],
             &["--min-zoom 3", "default --max-zoom 0"][..],
         ),
+        // Given both the wrong way round: said so (it said "not within 0..=24").
+        (
+            &["--min-zoom", "3", "--max-zoom", "2"][..],
+            &["--min-zoom 3 is above --max-zoom 2"][..],
+        ),
     ] {
         let mut args = vec!["tiles", &input, "-o", "p", "-q"];
         args.extend_from_slice(extra);

@@ -123,10 +123,17 @@ impl MeshFormat {
 
     /// `".ply, .obj, ..."`, for messages.
     pub(crate) fn supported_extensions() -> String {
-        let list: Vec<String> = Self::ALL
+        let mut list: Vec<String> = Self::ALL
             .iter()
             .map(|format| format!(".{}", format.extension()))
             .collect();
+        // Names that differ from their extension work as extensions too (`from_path`).
+        list.extend(
+            Self::ALL
+                .iter()
+                .filter(|format| format.name() != format.extension())
+                .map(|format| format!(".{}", format.name())),
+        );
         list.join(", ")
     }
 
@@ -202,7 +209,7 @@ mod tests {
             .unwrap_or_default();
         assert!(message.contains("out/tin.xyz"), "{message}");
         assert!(
-            message.contains(".ply, .obj, .stl, .glb, .geojson, .fgb, .xml"),
+            message.contains(".ply, .obj, .stl, .glb, .geojson, .fgb, .xml, .landxml"),
             "{message}"
         );
     }

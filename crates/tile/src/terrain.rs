@@ -440,7 +440,13 @@ pub fn build_terrain(
             options.min_zoom
         )));
     }
-    if max_zoom > MAX_LEVEL || options.min_zoom > max_zoom {
+    if options.min_zoom > max_zoom {
+        return Err(TerrainError::Options(format!(
+            "--min-zoom {} is above --max-zoom {max_zoom}",
+            options.min_zoom
+        )));
+    }
+    if max_zoom > MAX_LEVEL {
         return Err(TerrainError::Options(format!(
             "zoom range {}..={max_zoom} is not within 0..={MAX_LEVEL}",
             options.min_zoom

@@ -253,6 +253,45 @@ fn every_model_order_and_retriangulation_from_the_cli() {
 }
 
 #[test]
+fn the_report_records_every_decimation_option() {
+    // --flip-rounds, --extend-rounds, --dp-max-ring, the contour levels and --pixel-coords
+    // were left out of the report.
+    let d = Dir::new();
+    let dem = fixture("tintn_valid_raster_3857.tif");
+    let o = d.run(&[
+        "mesh",
+        &dem,
+        "-o",
+        "m.ply",
+        "--max-error",
+        "2",
+        "--flip-rounds",
+        "1",
+        "--extend-rounds",
+        "2",
+        "--dp-max-ring",
+        "6",
+        "--contour-interval",
+        "50",
+        "--contour-offset",
+        "5",
+        "--pixel-coords",
+        "--report",
+        "r.json",
+    ]);
+    assert!(o.status.success(), "{}", crate::util::stderr(&o));
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path("r.json")).unwrap()).unwrap();
+    assert_eq!(r["flip_rounds"], 1);
+    assert_eq!(r["extend_rounds"], 2);
+    assert_eq!(r["dp_max_ring"], 6);
+    assert_eq!(r["contour_interval"], 50.0);
+    assert_eq!(r["contour_offset"], 5.0);
+    assert_eq!(r["contour_levels"], serde_json::json!([]));
+    assert_eq!(r["pixel_coords"], true);
+}
+
+#[test]
 fn both_count_targets_are_met() {
     // With both, decimation stopped at the first count reached (100 vertices, 170
     // triangles) and the note blamed the domain's outline for the triangles.

@@ -1067,3 +1067,17 @@ fn a_read_only_output_is_not_replaced() {
     }
     assert_eq!(d.files(), vec!["kept.geojson", "kept.json", "kept.ply"]);
 }
+
+#[test]
+fn heights_beyond_1e37_are_refused_with_one_message() {
+    // The refusal came after a note that the heights left decimation 0 of the bound.
+    let d = Dir::new();
+    d.write(
+        "huge.asc",
+        "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n4 2e37 6\n7 8 9\n",
+    );
+    let o = d.run(&["mesh", "huge.asc", "-o", "m.ply", "--max-error", "1"]);
+    assert_fails_naming(&o, &["huge.asc", "1e37"]);
+    assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
+    assert_eq!(d.files(), vec!["huge.asc"]);
+}

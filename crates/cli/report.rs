@@ -193,7 +193,12 @@ pub fn note_rounding_margin(input: &Path, bound: f64, heights: Option<(f64, f64)
     let Some((lo, hi)) = heights else { return };
     let max_abs = lo.abs().max(hi.abs());
     let limit = tinsmith_core::effective_limit(bound, max_abs);
-    if quiet || !(bound.is_finite() && bound > 0.0) || bound - limit <= 0.01 * bound {
+    // Beyond MAX_ABS_HEIGHT the run is refused, which says enough.
+    if quiet
+        || !(bound.is_finite() && bound > 0.0)
+        || bound - limit <= 0.01 * bound
+        || max_abs > tinsmith_core::MAX_ABS_HEIGHT
+    {
         return;
     }
     note!(

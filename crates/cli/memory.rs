@@ -183,19 +183,20 @@ pub fn file_bytes(path: &Path) -> u64 {
 /// The bytes the mesh file at `path` takes once read, with the verifier's per-triangle
 /// arrays: its size times a factor per format (`format`, or the extension's). Measured
 /// with `verify` on one ETOPO5 mesh (5.9 M triangles, session 15) written in every
-/// format: the mesh took 385 MB read from PLY, OBJ, STL, glTF or LandXML alike (417 MB
-/// from FlatGeobuf), 2.3 GB from GeoJSON (parsed whole), while the files weigh 18 (glTF)
-/// to 282 (GeoJSON) bytes a triangle.
+/// format: the mesh took 385 MB read from PLY, OBJ, STL, glTF, GeoJSON or LandXML alike
+/// (417 MB from FlatGeobuf), while the files weigh 18 (glTF) to 282 (GeoJSON) bytes a
+/// triangle.
 /// Each factor is the measured ratio rounded up, with room for files written more
 /// compactly than tinsmith writes them (OBJ).
 pub fn mesh_file_memory(path: &Path, format: Option<tinsmith_export::MeshFormat>) -> u64 {
     use tinsmith_export::MeshFormat;
-    // Measured ratios: PLY 2.6, OBJ 1.36, STL 1.3, glTF 3.6, GeoJSON 1.37,
+    // Measured ratios: PLY 2.6, OBJ 1.36, STL 1.3, glTF 3.6, GeoJSON 0.23,
     // FlatGeobuf 0.32, LandXML 0.85.
     let (times, per) = match format.map_or_else(|| MeshFormat::from_path(path), Ok) {
         Ok(MeshFormat::Ply) => (3, 1),
         Ok(MeshFormat::Obj) => (2, 1),
-        Ok(MeshFormat::Stl | MeshFormat::GeoJson) => (3, 2),
+        Ok(MeshFormat::Stl) => (3, 2),
+        Ok(MeshFormat::GeoJson) => (3, 10),
         Ok(MeshFormat::Glb) => (4, 1),
         Ok(MeshFormat::FlatGeobuf) => (2, 5),
         Ok(MeshFormat::LandXml) => (1, 1),
@@ -238,9 +239,9 @@ mod tests {
         assert_eq!(stat_field("anon 5\n", "inactive_file"), None);
     }
 
-    /// The verifier held 65 bytes a triangle for a mesh read from any format but GeoJSON
-    /// (measured, see [`mesh_file_memory`]): the estimate covers that for files as tinsmith
-    /// writes them, in every format.
+    /// The verifier held 65 bytes a triangle for a mesh read from any format (measured,
+    /// see [`mesh_file_memory`]): the estimate covers that for files as tinsmith writes
+    /// them, in every format.
     #[test]
     fn mesh_file_estimates_cover_the_measured_memory_per_triangle() {
         use tinsmith_export::{MeshFormat, MeshRef};

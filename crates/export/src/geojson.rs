@@ -1,5 +1,6 @@
 //! GeoJSON: a `FeatureCollection` with one `Polygon` Z feature (a closed ring of four
-//! positions) per triangle, written as a stream of text and read back with serde.
+//! positions) per triangle, written as a stream of text and read back with serde, a
+//! feature at a time.
 //!
 //! RFC 7946 coordinates are WGS84 longitude, latitude. A mesh whose EPSG code is 4326 is
 //! written that way, with no `crs` member, longitudes wrapped into [-180, 180], and a
@@ -11,6 +12,7 @@
 
 use std::io::{self, Read, Write};
 
+use serde::de::{DeserializeSeed, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use serde_json::Value;
 
@@ -128,23 +130,6 @@ fn write_ring<W: Write>(w: &mut W, ring: &[[f64; 3]]) -> io::Result<()> {
     w.write_all(b"]]")
 }
 
-/// Deserializes a member that may be absent (`None`) or `null` (`Some(Value::Null)`).
-fn present<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Value>, D::Error> {
-    Value::deserialize(d).map(Some)
-}
-
-#[derive(Deserialize)]
-struct Collection {
-    #[serde(rename = "type")]
-    kind: String,
-    #[serde(default, deserialize_with = "present")]
-    crs: Option<Value>,
-    #[serde(default)]
-    crs_wkt: Option<String>,
-    #[serde(default)]
-    features: Vec<Feature>,
-}
-
 #[derive(Deserialize)]
 struct Feature {
     geometry: Option<Geometry>,
@@ -215,46 +200,107 @@ fn epsg_of_name(name: &str) -> Option<u32> {
 
 /// Reads a GeoJSON `FeatureCollection` of triangle `Polygon` Z features (closed rings of
 /// four positions), welding equal positions into shared vertices in order of appearance.
+///
+/// The features are streamed: each is welded into the mesh as it is parsed, so memory is
+/// the mesh's, not the text's (a whole parse took about 1.4 times the file).
 pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
-    let collection: Collection = serde_json::from_reader(r).map_err(|e| {
+    let mut collection = Streamed::default();
+    let mut deserializer = serde_json::Deserializer::from_reader(r);
+    let parsed = CollectionSeed(&mut collection)
+        .deserialize(&mut deserializer)
+        .and_then(|()| deserializer.end());
+    if let Some(problem) = collection.problem.take() {
+        return Err(problem);
+    }
+    parsed.map_err(|e| {
         if e.is_eof() && e.line() == 1 && e.column() == 0 {
             Problem::malformed("the file is empty")
         } else {
             Problem::malformed(e)
         }
     })?;
-    if collection.kind != "FeatureCollection" {
-        return Err(Problem::unsupported(format_args!(
-            "a {} at the top level; only a FeatureCollection is read",
-            collection.kind
-        )));
+    match collection.kind.as_deref() {
+        Some("FeatureCollection") => {}
+        Some(kind) => {
+            return Err(Problem::unsupported(format_args!(
+                "a {kind} at the top level; only a FeatureCollection is read"
+            )))
+        }
+        None => return Err(Problem::malformed("missing field `type`")),
     }
     let mut mesh = Mesh::default();
     match &collection.crs {
         // RFC 7946: WGS84 longitude, latitude.
         None => mesh.epsg = Some(4326),
-        Some(Value::Null) => {}
-        Some(crs) => {
-            let name = crs["properties"]["name"]
-                .as_str()
-                .ok_or_else(|| Problem::unsupported("a crs member that is not of type `name`"))?;
-            mesh.epsg = epsg_of_name(name);
-            if mesh.epsg.is_none() {
-                mesh.crs_wkt = Some(name.to_owned());
-            }
-        }
+        Some(crs) => (mesh.epsg, mesh.crs_wkt) = crs_of(crs)?,
     }
     if collection.crs_wkt.is_some() {
         mesh.crs_wkt = collection.crs_wkt;
     }
-    let mut welder = Welder::default();
-    for (f, feature) in collection.features.iter().enumerate() {
+    // Triangles cut at the antimeridian were read as WGS84 has them; they are only that in
+    // WGS84, which a file without a crs member turns out to be once it has all been read.
+    if let Some(f) = collection.first_cut {
+        if mesh.epsg != Some(4326) {
+            return Err(not_a_triangle(f, "MultiPolygon"));
+        }
+    }
+    if let Some(problem) = collection.cut_problem {
+        return Err(problem);
+    }
+    mesh.vertices = collection.welder.into_vertices();
+    mesh.triangles = collection.triangles;
+    Ok(mesh)
+}
+
+/// The EPSG code, or the name as WKT when it has none, of a `crs` member (`null`: none).
+fn crs_of(crs: &Value) -> Result<(Option<u32>, Option<String>), Problem> {
+    if crs.is_null() {
+        return Ok((None, None));
+    }
+    let name = crs["properties"]["name"]
+        .as_str()
+        .ok_or_else(|| Problem::unsupported("a crs member that is not of type `name`"))?;
+    Ok(match epsg_of_name(name) {
+        Some(code) => (Some(code), None),
+        None => (None, Some(name.to_owned())),
+    })
+}
+
+/// The error for feature `f`, a `kind` geometry that is not read as a triangle.
+fn not_a_triangle(f: usize, kind: &str) -> Problem {
+    Problem::unsupported(format_args!(
+        "feature {f} is a {kind}; only Polygon triangles, MultiPolygons of one triangle and, \
+         in WGS84, triangles cut in two at the antimeridian are read"
+    ))
+}
+
+/// A `FeatureCollection` as it is parsed: its members, and its features welded so far.
+#[derive(Default)]
+struct Streamed {
+    kind: Option<String>,
+    /// The `crs` member, when there is one (`null` included).
+    crs: Option<Value>,
+    /// Whether a `crs` member read so far names another CRS than WGS84 (or none).
+    other_crs: bool,
+    crs_wkt: Option<String>,
+    welder: Welder,
+    triangles: Vec<[u32; 3]>,
+    /// The first feature that is a triangle cut at the antimeridian (two parts).
+    first_cut: Option<usize>,
+    /// What the first such feature that spans no triangle fails with.
+    cut_problem: Option<Problem>,
+    /// The first problem with a feature: parsing stops there.
+    problem: Option<Problem>,
+}
+
+impl Streamed {
+    /// Welds feature `f` into the mesh.
+    fn add(&mut self, f: usize, feature: &Feature) -> Result<(), Problem> {
         let Some(geometry) = &feature.geometry else {
             return Err(Problem::malformed(format_args!(
                 "feature {f} has no geometry"
             )));
         };
-        let rfc7946 = mesh.epsg == Some(4326);
         let corners: [[f64; 3]; 3] = match (geometry.kind.as_str(), &geometry.coordinates) {
             ("Polygon", Coordinates::Polygon(rings)) => {
                 let ring = match rings.as_slice() {
@@ -276,40 +322,117 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
                 let positions = ring_positions(f, &polygons[0][0], false)?;
                 [positions[0], positions[1], positions[2]]
             }
-            ("MultiPolygon", Coordinates::MultiPolygon(polygons)) if rfc7946 => {
-                let parts = match polygons.as_slice() {
-                    [west, east] if west.len() == 1 && east.len() == 1 => [
-                        ring_positions(f, &west[0], true)?,
-                        ring_positions(f, &east[0], true)?,
-                    ],
-                    _ => {
-                        return Err(Problem::unsupported(format_args!(
-                            "feature {f} is a MultiPolygon other than a triangle cut in two \
-                             at the antimeridian"
-                        )))
+            ("MultiPolygon", Coordinates::MultiPolygon(polygons)) if !self.other_crs => {
+                self.first_cut.get_or_insert(f);
+                match cut_triangle(f, polygons) {
+                    Ok(corners) => corners,
+                    Err(problem) => {
+                        self.cut_problem.get_or_insert(problem);
+                        return Ok(());
                     }
-                };
-                triangle_from_parts(&[&parts[0], &parts[1]]).ok_or_else(|| {
-                    Problem::malformed(format_args!("feature {f}: its two parts span no triangle"))
-                })?
+                }
             }
-            (kind, _) => {
-                return Err(Problem::unsupported(format_args!(
-                    "feature {f} is a {kind}; only Polygon triangles, MultiPolygons of one \
-                     triangle and, in WGS84, triangles cut in two at the antimeridian are read"
-                )))
-            }
+            (kind, _) => return Err(not_a_triangle(f, kind)),
         };
         let mut triangle = [0u32; 3];
         for (index, p) in triangle.iter_mut().zip(corners) {
-            *index = welder
+            *index = self
+                .welder
                 .vertex(p)
                 .ok_or_else(|| Problem::unsupported("more than 2^32 vertices"))?;
         }
-        mesh.triangles.push(triangle);
+        self.triangles.push(triangle);
+        Ok(())
     }
-    mesh.vertices = welder.into_vertices();
-    Ok(mesh)
+}
+
+/// The triangle whose two parts, cut at the antimeridian, are feature `f`'s polygons.
+fn cut_triangle(f: usize, polygons: &[Vec<Vec<Vec<f64>>>]) -> Result<[[f64; 3]; 3], Problem> {
+    let parts = match polygons {
+        [west, east] if west.len() == 1 && east.len() == 1 => [
+            ring_positions(f, &west[0], true)?,
+            ring_positions(f, &east[0], true)?,
+        ],
+        _ => {
+            return Err(Problem::unsupported(format_args!(
+                "feature {f} is a MultiPolygon other than a triangle cut in two at the \
+                 antimeridian"
+            )))
+        }
+    };
+    triangle_from_parts(&[&parts[0], &parts[1]]).ok_or_else(|| {
+        Problem::malformed(format_args!("feature {f}: its two parts span no triangle"))
+    })
+}
+
+/// Parses a `FeatureCollection` object into a [`Streamed`].
+struct CollectionSeed<'s>(&'s mut Streamed);
+
+impl<'de> DeserializeSeed<'de> for CollectionSeed<'_> {
+    type Value = ();
+
+    fn deserialize<D: Deserializer<'de>>(self, deserializer: D) -> Result<(), D::Error> {
+        deserializer.deserialize_map(self)
+    }
+}
+
+impl<'de> Visitor<'de> for CollectionSeed<'_> {
+    type Value = ();
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a GeoJSON object")
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<(), A::Error> {
+        while let Some(key) = map.next_key::<String>()? {
+            match key.as_str() {
+                "type" => self.0.kind = Some(map.next_value()?),
+                "crs" => {
+                    let crs: Value = map.next_value()?;
+                    // A crs member that names no CRS fails once the file is read.
+                    self.0.other_crs = crs_of(&crs).is_ok_and(|(epsg, _)| epsg != Some(4326));
+                    self.0.crs = Some(crs);
+                }
+                "crs_wkt" => self.0.crs_wkt = map.next_value()?,
+                "features" => map.next_value_seed(FeaturesSeed(&mut *self.0))?,
+                _ => {
+                    map.next_value::<IgnoredAny>()?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Parses the `features` array, welding each feature as it comes.
+struct FeaturesSeed<'s>(&'s mut Streamed);
+
+impl<'de> DeserializeSeed<'de> for FeaturesSeed<'_> {
+    type Value = ();
+
+    fn deserialize<D: Deserializer<'de>>(self, deserializer: D) -> Result<(), D::Error> {
+        deserializer.deserialize_seq(self)
+    }
+}
+
+impl<'de> Visitor<'de> for FeaturesSeed<'_> {
+    type Value = ();
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("an array of features")
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
+        let mut f = 0;
+        while let Some(feature) = seq.next_element::<Feature>()? {
+            if let Err(problem) = self.0.add(f, &feature) {
+                self.0.problem = Some(problem);
+                return Err(serde::de::Error::custom("stopped at a feature"));
+            }
+            f += 1;
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -415,6 +538,42 @@ mod tests {
         // Only in WGS84: elsewhere coordinates are written as they are.
         let text = write_to_string(MeshRef::new(&cut, &triangles).with_epsg(32660));
         assert!(!text.contains("MultiPolygon") && text.contains("181"));
+        Ok(())
+    }
+
+    #[test]
+    fn members_are_read_in_any_order_and_cut_triangles_only_in_wgs84() -> Result<(), Problem> {
+        // The features are welded as they are parsed: a crs member after them still
+        // decides whether a triangle cut at the antimeridian is one.
+        let vertices = [[179.0, 0.0, 1.0], [181.0, 0.0, 2.0], [179.0, 1.0, 3.0]];
+        let text = write_to_string(MeshRef::new(&vertices, &[[0, 1, 2]]).with_epsg(4326));
+        let mut value: Value = serde_json::from_str(&text).expect("valid JSON");
+        let features = value["features"].take();
+        assert_eq!(features[0]["geometry"]["type"], "MultiPolygon");
+        let before = read(text.as_bytes())?;
+        for crs in [
+            "",
+            ",\"crs\":null",
+            ",\"crs\":{\"type\":\"name\",\"properties\":{\"name\":\"EPSG:32660\"}}",
+        ] {
+            for features_first in [true, false] {
+                let text = if features_first {
+                    format!("{{\"features\":{features}{crs},\"type\":\"FeatureCollection\"}}")
+                } else {
+                    format!("{{\"type\":\"FeatureCollection\"{crs},\"features\":{features}}}")
+                };
+                match read(text.as_bytes()) {
+                    Ok(mesh) if crs.is_empty() => {
+                        assert_eq!(mesh.vertices, before.vertices);
+                        assert_eq!(mesh.triangles, before.triangles);
+                    }
+                    Err(Problem::Unsupported(reason)) if !crs.is_empty() => {
+                        assert!(reason.contains("feature 0 is a MultiPolygon"), "{reason}");
+                    }
+                    other => panic!("{text}: {other:?}"),
+                }
+            }
+        }
         Ok(())
     }
 

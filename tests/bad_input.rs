@@ -407,11 +407,15 @@ fn no_valid_cell() {
 #[test]
 fn bad_max_error_values() {
     let d = Dir::new();
-    for bad in ["-1", "NaN", "inf", "abc"] {
+    // "-inf" was taken for a flag ("unexpected argument '-i'").
+    for bad in ["-1", "NaN", "inf", "-inf", "abc"] {
         let o = d.run(&["mesh", &dem(), "-o", "out.ply", "--max-error", bad]);
         assert!(!o.status.success(), "--max-error {bad} accepted");
         let err = crate::util::stderr(&o);
         assert!(err.contains("--max-error"), "{err}");
+        if bad != "abc" {
+            assert!(err.contains("finite number"), "{err}");
+        }
         assert!(d.files().is_empty());
     }
     let o = d.run(&["mesh", &dem(), "-o", "out.ply"]);

@@ -120,7 +120,7 @@ pub struct MeshArgs {
     pub export: ExportArgs,
     /// Largest allowed |sample - TIN| at any valid sample, in data units. Required unless
     /// --max-triangles or --max-vertices is given.
-    #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true,
+    #[arg(long, value_parser = parse_max_error, allow_hyphen_values = true,
           required_unless_present_any = ["max_triangles", "max_vertices"])]
     pub max_error: Option<f64>,
     /// Decimate until at most N triangles remain (greedy order), then report the verified
@@ -170,10 +170,10 @@ pub struct MeshArgs {
     /// Shape the TIN for contour lines every I (plus --contour-offset) over the raster's
     /// heights, as `tinsmith contour --max-error` does: `contour --mesh` then draws lines
     /// with fewer segments. The error bound holds either way.
-    #[arg(long, value_name = "I", value_parser = parse_interval, allow_negative_numbers = true, conflicts_with = "contour_levels")]
+    #[arg(long, value_name = "I", value_parser = parse_interval, allow_hyphen_values = true, conflicts_with = "contour_levels")]
     pub contour_interval: Option<f64>,
     /// Shift of the --contour-interval levels: offset + k * interval.
-    #[arg(long, value_name = "O", requires = "contour_interval", value_parser = parse_finite, allow_negative_numbers = true)]
+    #[arg(long, value_name = "O", requires = "contour_interval", value_parser = parse_finite, allow_hyphen_values = true)]
     pub contour_offset: Option<f64>,
     /// Shape the TIN for contour lines at these levels, comma-separated (see
     /// --contour-interval).
@@ -223,7 +223,7 @@ pub struct ExportArgs {
     pub format: Option<MeshFormat>,
     /// STL only: close the surface into a watertight solid, with walls along every
     /// boundary down to z = Z and a bottom at Z (Z below every height).
-    #[arg(long, value_name = "Z", allow_negative_numbers = true)]
+    #[arg(long, value_name = "Z", allow_hyphen_values = true)]
     pub base: Option<f64>,
     /// glTF only: write per-vertex normals.
     #[arg(long)]
@@ -246,7 +246,7 @@ pub struct VerifyArgs {
     #[arg(long, value_name = "NAME", value_parser = crate::export::parse_format)]
     pub format: Option<MeshFormat>,
     /// Fail (exit 1) when the measured error exceeds this.
-    #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_max_error, allow_hyphen_values = true)]
     pub max_error: Option<f64>,
     /// Band the mesh was made from (1-based).
     #[arg(long, default_value_t = 1)]
@@ -269,18 +269,18 @@ pub struct ContourArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Contour every multiple of this (plus --offset) within the raster's height range (the mesh file's with --mesh).
-    #[arg(long, value_parser = parse_interval, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_interval, allow_hyphen_values = true)]
     pub interval: Option<f64>,
     /// Shift of the --interval levels: levels are offset + k * interval.
     /// (Default 0.)
-    #[arg(long, requires = "interval", value_parser = parse_finite, allow_negative_numbers = true)]
+    #[arg(long, requires = "interval", value_parser = parse_finite, allow_hyphen_values = true)]
     pub offset: Option<f64>,
     /// Explicit levels, comma-separated (negative ones too: --levels -100,0,100).
     #[arg(long, value_delimiter = ',', value_parser = parse_finite, allow_hyphen_values = true, conflicts_with = "interval")]
     pub levels: Vec<f64>,
     /// Contour the TIN decimated within this error of every sample; 0 (default) contours
     /// the full grid.
-    #[arg(long, value_parser = parse_max_error, allow_negative_numbers = true, conflicts_with = "mesh")]
+    #[arg(long, value_parser = parse_max_error, allow_hyphen_values = true, conflicts_with = "mesh")]
     pub max_error: Option<f64>,
     /// Contour this TIN (any format `tinsmith mesh` writes, written from INPUT) instead.
     #[arg(long, value_name = "MESH")]
@@ -292,7 +292,7 @@ pub struct ContourArgs {
     /// Simplify each line (Douglas-Peucker) within this distance, in the output's map
     /// units (pixels with --pixel-coords): lines move up to D sideways and are no longer
     /// exact contours of the TIN.
-    #[arg(long, value_name = "D", value_parser = parse_interval, allow_negative_numbers = true)]
+    #[arg(long, value_name = "D", value_parser = parse_interval, allow_hyphen_values = true)]
     pub simplify: Option<f64>,
     /// Band to read (1-based).
     #[arg(long, default_value_t = 1)]

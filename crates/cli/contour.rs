@@ -81,7 +81,10 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             Some(mesh) => (
                 crate::memory::Need {
                     bytes_per_sample: 24,
-                    extra_bytes: crate::memory::mesh_file_memory(mesh, args.mesh_format),
+                    extra_bytes: crate::memory::mesh_file_memory(
+                        mesh,
+                        crate::verify::mesh_format(mesh, args.mesh_format)?,
+                    ),
                 },
                 "contouring a --mesh",
                 "contour it with --max-error instead (decimated tile by tile, in bounded memory)",

@@ -391,7 +391,7 @@ fn note_degrees_in_a_3d_format(info: &RasterInfo, georef: &Georef, args: &MeshAr
         return Ok(());
     };
     let geographic = match info.crs_wkt.as_deref() {
-        Some(wkt) => info.epsg == Some(4326) || tinsmith_raster::is_geographic(wkt)?,
+        Some(wkt) => is_geographic(info, wkt)?,
         None => false,
     };
     if geographic && !args.quiet {
@@ -521,8 +521,12 @@ fn projected_crs(info: &RasterInfo) -> Result<Option<(&str, tinsmith_core::GeoTr
     let (Some(wkt), Some(transform)) = (info.crs_wkt.as_deref(), info.transform()) else {
         return Ok(None);
     };
-    let geographic = info.epsg == Some(4326) || tinsmith_raster::is_geographic(wkt)?;
-    Ok((!geographic).then_some((wkt, transform)))
+    Ok((!is_geographic(info, wkt)?).then_some((wkt, transform)))
+}
+
+/// Whether the raster's CRS, `wkt`, is EPSG:4326 or another geographic one.
+fn is_geographic(info: &RasterInfo, wkt: &str) -> Result<bool> {
+    Ok(info.epsg == Some(4326) || tinsmith_raster::is_geographic(wkt)?)
 }
 
 fn pole_message(pole: &str) -> String {

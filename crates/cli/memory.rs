@@ -181,25 +181,25 @@ pub fn file_bytes(path: &Path) -> u64 {
 }
 
 /// The bytes the mesh file at `path` takes once read, with the verifier's per-triangle
-/// arrays: its size times a factor per format (`format`, or the extension's). Measured
+/// arrays: its size times a factor per format. Measured
 /// with `verify` on one ETOPO5 mesh (5.9 M triangles, session 15) written in every
 /// format: the mesh took 385 MB read from PLY, OBJ, STL, glTF, GeoJSON or LandXML alike
 /// (417 MB from FlatGeobuf), while the files weigh 18 (glTF) to 282 (GeoJSON) bytes a
 /// triangle.
 /// Each factor is the measured ratio rounded up, with room for files written more
 /// compactly than tinsmith writes them (OBJ).
-pub fn mesh_file_memory(path: &Path, format: Option<tinsmith_export::MeshFormat>) -> u64 {
+pub fn mesh_file_memory(path: &Path, format: tinsmith_export::MeshFormat) -> u64 {
     use tinsmith_export::MeshFormat;
     // Measured ratios: PLY 2.6, OBJ 1.36, STL 1.3, glTF 3.6, GeoJSON 0.23,
     // FlatGeobuf 0.32, LandXML 0.85.
-    let (times, per) = match format.map_or_else(|| MeshFormat::from_path(path), Ok) {
-        Ok(MeshFormat::Ply) => (3, 1),
-        Ok(MeshFormat::Obj) => (2, 1),
-        Ok(MeshFormat::Stl) => (3, 2),
-        Ok(MeshFormat::GeoJson) => (3, 10),
-        Ok(MeshFormat::Glb) => (4, 1),
-        Ok(MeshFormat::FlatGeobuf) => (2, 5),
-        Ok(MeshFormat::LandXml) => (1, 1),
+    let (times, per) = match format {
+        MeshFormat::Ply => (3, 1),
+        MeshFormat::Obj => (2, 1),
+        MeshFormat::Stl => (3, 2),
+        MeshFormat::GeoJson => (3, 10),
+        MeshFormat::Glb => (4, 1),
+        MeshFormat::FlatGeobuf => (2, 5),
+        MeshFormat::LandXml => (1, 1),
         _ => (2, 1),
     };
     file_bytes(path).saturating_mul(times) / per
@@ -270,7 +270,7 @@ mod tests {
             let path = dir.path().join(format!("mesh.{}", format.extension()));
             let mesh = MeshRef::new(&vertices, &triangles);
             tinsmith_export::write_mesh(&path, format, mesh).unwrap();
-            let estimate = mesh_file_memory(&path, None);
+            let estimate = mesh_file_memory(&path, format);
             assert!(
                 estimate >= 65 * triangles.len() as u64,
                 "{format:?}: {estimate} bytes for {} triangles",

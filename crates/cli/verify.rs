@@ -13,12 +13,13 @@ use crate::number::readable;
 
 /// Runs the verifier; `Ok(false)` when the mesh is invalid or exceeds `--max-error`.
 pub fn run(args: &VerifyArgs) -> Result<bool> {
+    let format = mesh_format(&args.mesh, args.format)?;
     crate::memory::check_whole_raster_fits(
         &args.input,
         crate::memory::raster_size(&args.input, args.band)?,
         crate::memory::Need {
             bytes_per_sample: 24,
-            extra_bytes: crate::memory::mesh_file_memory(&args.mesh, args.format),
+            extra_bytes: crate::memory::mesh_file_memory(&args.mesh, format),
         },
         "verify",
         "verification has no tiled mode; use a machine with more memory",
@@ -26,7 +27,6 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
     let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
     crate::georef::check_transform(&raster.info, args.pixel_coords)?;
     let georef = Georef::new(raster.info.transform(), args.pixel_coords);
-    let format = mesh_format(&args.mesh, args.format)?;
     let mesh = read_mesh_file(&args.mesh, format, &raster, georef)?;
     let positions = sample_positions(&args.mesh, &mesh, georef)?;
     let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();

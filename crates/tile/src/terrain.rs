@@ -1028,18 +1028,14 @@ fn build_tile(
 
     // Heights on the level's lattice: tile minimum rounded down to a multiple of the step.
     let s = budget.step;
-    let lo = tin
+    let (lo, hi) = tin
         .vertices()
         .iter()
-        .map(|v| v.z)
-        .fold(f64::INFINITY, f64::min);
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v.z), hi.max(v.z))
+        });
     let k_min = (lo / s).floor();
     let min_height = k_min * s;
-    let hi = tin
-        .vertices()
-        .iter()
-        .map(|v| v.z)
-        .fold(f64::NEG_INFINITY, f64::max);
     let per_step = quanta_per_step(k_min, (hi / s).round() - k_min);
     let max_height = min_height + f64::from(QUANTIZED_MAX) * s / f64::from(per_step);
     let quantized: Vec<[u16; 3]> = tin

@@ -61,7 +61,18 @@ fn contour_of_an_unwelded_rounded_copy_is_the_same_lines() {
     let input = fixture(BEC);
     passes(
         &d,
-        &["mesh", &input, "-o", "m.obj", "--max-error", "10", "-q"],
+        // Vertices at their samples: the rounded copy's heights snap back to them.
+        &[
+            "mesh",
+            &input,
+            "-o",
+            "m.obj",
+            "--max-error",
+            "10",
+            "--vertex-heights",
+            "samples",
+            "-q",
+        ],
     );
     let obj = std::fs::read_to_string(d.path("m.obj")).unwrap();
     let copy = unwelded_six_decimals(&obj);
@@ -217,7 +228,17 @@ fn contour_takes_heights_rounded_to_six_decimals_as_the_samples() {
     d.write("f.asc", &asc);
     passes(
         &d,
-        &["mesh", "f.asc", "-o", "m.obj", "--max-error", "0.5", "-q"],
+        &[
+            "mesh",
+            "f.asc",
+            "-o",
+            "m.obj",
+            "--max-error",
+            "0.5",
+            "--vertex-heights",
+            "samples",
+            "-q",
+        ],
     );
     let obj = std::fs::read_to_string(d.path("m.obj")).unwrap();
     let copy = unwelded_six_decimals(&obj);

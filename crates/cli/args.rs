@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
 use tinsmith_core::{
     DecimationOptions, EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation,
+    VertexHeights,
 };
 use tinsmith_export::MeshFormat;
 
@@ -167,6 +168,9 @@ pub struct MeshArgs {
     /// Not with --max-triangles/--max-vertices.
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub extend_rounds: usize,
+    /// Where vertices sit in height. The error bound holds at every sample either way.
+    #[arg(long, value_enum, default_value_t = VertexHeightsArg::Fitted)]
+    pub vertex_heights: VertexHeightsArg,
     /// Shape the TIN for contour lines every I (plus --contour-offset) over the raster's
     /// heights, as `tinsmith contour --max-error` does: `contour --mesh` then draws lines
     /// with fewer segments. The error bound holds either way.
@@ -347,6 +351,7 @@ impl MeshArgs {
         options.max_edge_length = self.max_edge_length;
         options.flip_rounds = self.flip_rounds;
         options.extend_rounds = self.extend_rounds;
+        options.vertex_heights = self.vertex_heights.into();
         let count_target = self.max_triangles.is_some() || self.max_vertices.is_some();
         if count_target && (self.flip_rounds > 0 || self.extend_rounds > 0) {
             anyhow::bail!(
@@ -384,6 +389,25 @@ impl From<ErrorModelArg> for ErrorModel {
         match m {
             ErrorModelArg::Bounds => ErrorModel::Bounds,
             ErrorModelArg::Exact => ErrorModel::Exact,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum VertexHeightsArg {
+    /// Every vertex at its sample's value.
+    Samples,
+    /// Each vertex moved towards its 3x3 neighbourhood's mean by at most a sixteenth of
+    /// --max-error (exact model, no count target, no contour levels): fewer triangles on
+    /// integer heights at small bounds. Vertices on the raster's edges (and tiles') stay.
+    Fitted,
+}
+
+impl From<VertexHeightsArg> for VertexHeights {
+    fn from(h: VertexHeightsArg) -> VertexHeights {
+        match h {
+            VertexHeightsArg::Samples => VertexHeights::Samples,
+            VertexHeightsArg::Fitted => VertexHeights::Fitted,
         }
     }
 }

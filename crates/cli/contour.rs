@@ -530,6 +530,8 @@ fn mesh_from_file(
     };
     // Each file vertex's sample, as its row-major index.
     let mut samples: Vec<u64> = Vec::with_capacity(file.vertices.len());
+    // Each file vertex's height: its sample's, or the file's where it is fitted.
+    let mut file_heights: Vec<f64> = Vec::with_capacity(file.vertices.len());
     let at = sample_positions(path, &file, georef)?;
     for (i, (v, &[x, y])) in file.vertices.iter().zip(&at).enumerate() {
         if !(0..grid.width() as i64).contains(&x) || !(0..grid.height() as i64).contains(&y) {
@@ -544,7 +546,14 @@ fn mesh_from_file(
         let tolerance = slack + 1e-6 * sample.abs().max(range);
         // False for a NaN sample (nodata under a vertex) too.
         let matches = (v[2] - sample).abs() <= tolerance;
-        if !matches {
+        // A fitted height lies between its sample and its neighbourhood's mean.
+        let fitted = !matches
+            && grid
+                .neighbourhood_mean(x as u32, y as u32)
+                .is_some_and(|mean| {
+                    (sample.min(mean) - tolerance..=sample.max(mean) + tolerance).contains(&v[2])
+                });
+        if !matches && !fitted {
             bail!(
                 "{}: vertex {i} at column {x}, row {y} has height {}, but band {band} of {} \
                  has {} there (more than {:.2e} apart): `contour --mesh` needs a TIN of this \
@@ -567,6 +576,7 @@ fn mesh_from_file(
             );
         }
         samples.push(y as u64 * u64::from(grid.width()) + x as u64);
+        file_heights.push(if fitted { v[2] } else { sample });
     }
     if file.triangles.is_empty() {
         bail!("{}: the mesh has no triangles", path.display());
@@ -583,11 +593,15 @@ fn mesh_from_file(
         .iter()
         .map(|&s| [(s % width) as i64, (s / width) as i64])
         .collect();
-    let heights: Vec<f64> = used.iter().map(|&s| grid.values()[s as usize]).collect();
     let index: Vec<u32> = samples
         .iter()
         .map(|s| used.binary_search(s).expect("every sample is listed") as u32)
         .collect();
+    // Copies of one vertex (repeated per triangle) carry the same height: the last wins.
+    let mut heights = vec![0.0; used.len()];
+    for (&i, &z) in index.iter().zip(&file_heights) {
+        heights[i as usize] = z;
+    }
     let mut triangles: Vec<[u32; 3]> = file
         .triangles
         .iter()

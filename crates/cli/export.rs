@@ -10,7 +10,7 @@ use tinsmith_core::Grid;
 use tinsmith_export::{CrsRef, LocalOrigin, MeshFormat, MeshRef, WriteOptions};
 use tinsmith_raster::RasterInfo;
 
-use crate::args::MeshArgs;
+use crate::args::{MeshArgs, VertexHeightsArg};
 use crate::georef::Georef;
 use crate::number::readable;
 
@@ -92,8 +92,9 @@ impl Plan {
     /// For STL and glTF: the origin in the middle of the raster's file coordinates and
     /// heights, the largest float32 rounding of a height, and the bound left for the
     /// decimator; fails when float32 cannot hold the positions to a sample or the heights
-    /// within `max_error`. With the `grid` in memory the rounding is measured at every
-    /// valid sample; without it (the tiled engine) it is bounded from the height range.
+    /// within `max_error`. With the `grid` in memory and vertices at their samples the
+    /// rounding is measured at every valid sample; otherwise (the tiled engine, fitted
+    /// vertex heights) it is bounded from the height range.
     pub fn new(
         format: MeshFormat,
         info: &RasterInfo,
@@ -136,7 +137,10 @@ impl Plan {
         }
         check_position_rounding(info, &georef, origin, min, max, out(args))?;
 
-        let height_rounding = match grid {
+        // Fitted vertex heights are not samples, but lie within the samples' range: the
+        // bound from the range covers them.
+        let samples_only = matches!(args.vertex_heights, VertexHeightsArg::Samples);
+        let height_rounding = match grid.filter(|_| samples_only) {
             Some(grid) => {
                 let mut rounding = 0.0f64;
                 for &z in grid.values().iter().filter(|z| z.is_finite()) {

@@ -11,7 +11,7 @@ use crate::rtin::{cheap_rtin_with_fewer_triangles, rtin_for_count, rtin_triangle
 use crate::strips::StripPlan;
 use crate::{
     DecimationOptions, Error, ErrorBound, ErrorModel, Grid, InitialMesh, Order, Result, Tin,
-    TinVertex,
+    TinVertex, VertexHeights,
 };
 
 /// Relative slack kept below the requested bound so that `f64` rounding in the bound
@@ -141,6 +141,22 @@ pub fn effective_limit(max_error: f64, max_abs_value: f64) -> f64 {
     }
 }
 
+/// [`VertexHeights::Fitted`] moves a vertex by at most the bound over this.
+const FITTED_HEIGHT_SHARE: f64 = 16.0;
+
+/// Whether vertex heights are fitted: asked for, under the exact model (the paper's
+/// bounds start from vertices at their samples), with a bound to take the room from
+/// (count targets have none), and without contour levels (`contour --mesh` reads a
+/// level-shaped TIN back with its vertices at their samples).
+fn fits_heights(options: &DecimationOptions, limit: f64) -> bool {
+    options.vertex_heights == VertexHeights::Fitted
+        && options.contour_levels.is_none()
+        && options.error_model == ErrorModel::Exact
+        && options.max_triangles.is_none()
+        && options.max_vertices.is_none()
+        && limit > 0.0
+}
+
 /// The largest |height| decimation accepts: error bounds are stored as `f32`, and between
 /// heights up to this they stay well within its range (and planes far from `f64` overflow).
 pub const MAX_ABS_HEIGHT: f64 = 1e37;
@@ -169,6 +185,13 @@ fn run(
         return Err(Error::HeightsTooLarge(max_abs));
     }
     let limit = effective_limit(max_error, max_abs);
+    let fitted;
+    let grid = if fits_heights(options, limit) {
+        fitted = grid.with_fitted_heights(limit / FITTED_HEIGHT_SHARE);
+        &fitted
+    } else {
+        grid
+    };
 
     let started = Instant::now();
     // Below the slack only exactly flat stars may go (see `Remover::plan`); the RTIN's
@@ -843,7 +866,7 @@ impl<'g> Remover<'g> {
         }
         self.points.clear();
         self.points.extend(star.ring.iter().map(|&u| mesh.point(u)));
-        let centre = mesh.point(v);
+        let centre = mesh.sample_point(v);
         if self.rules.limit == 0.0
             && !(self.rules.model == ErrorModel::Exact && self.rules.grid.integral_heights())
             && self.points.iter().any(|p| p.z != centre.z)
@@ -916,7 +939,7 @@ fn extract(mesh: Mesh<'_>, grid: &Grid) -> (Tin, f64) {
         .map(|&v| TinVertex {
             x: v % width,
             y: v / width,
-            z: grid.values()[v as usize],
+            z: grid.vertex_height(v as usize),
         })
         .collect();
     (

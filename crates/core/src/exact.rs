@@ -26,13 +26,18 @@ pub(crate) fn triangle_error(
     }
     if orient(a, b, c) == 1 {
         // Doubled area 1: by Pick's theorem the corners are the only samples.
-        return error_at(a, b, c, [a, b, c], limit);
+        if !grid.has_fitted_heights() {
+            return error_at(a, b, c, [a, b, c], limit);
+        }
+        return error_at(a, b, c, &corner_samples(grid, [a, b, c]), limit);
     }
     if let Some(v) = flat_value(grid, a, b, c) {
-        // Every sample, the corners included, is `v`: the plane is `v` and so is every
-        // sample, exactly as the scan below would find.
-        debug_assert!(a.z == v && b.z == v && c.z == v);
-        return Some(ErrorBound::default());
+        // Every sample, the corners included, is `v`: where the corners' heights are `v`
+        // too, so is the plane, exactly as the scan below would find.
+        debug_assert!(grid.has_fitted_heights() || (a.z == v && b.z == v && c.z == v));
+        if a.z == v && b.z == v && c.z == v {
+            return Some(ErrorBound::default());
+        }
     }
     let g = plane_gradient(a, b, c);
     let width = grid.width() as usize;
@@ -83,6 +88,16 @@ pub(crate) fn triangle_error(
         }
     }
     Some(ErrorBound { above, below })
+}
+
+/// The samples at the given vertices' positions, as points (their heights may differ, see
+/// [`Grid::vertex_height`]).
+pub(crate) fn corner_samples<const N: usize>(grid: &Grid, corners: [&Point; N]) -> [Point; N] {
+    let width = grid.width() as i64;
+    corners.map(|p| Point {
+        z: grid.values()[(p.y * width + p.x) as usize],
+        ..*p
+    })
 }
 
 /// The above/below error of the plane through counter-clockwise triangle `abc` over the

@@ -22,7 +22,7 @@
 //! bound a true bound; the paper's boundary rule (§3.3.2) is the special case of (a) and
 //! (b) on the new boundary edge, which passes through `c`.
 
-use crate::exact::{error_at, triangle_error};
+use crate::exact::{corner_samples, error_at, triangle_error};
 use crate::levels::{dirichlet_energy, triangle_levels};
 use crate::predicates::{in_closed_triangle, orient, plane_gradient, Point};
 use crate::{EdgeSelection, ErrorBound, ErrorModel, Grid, Retriangulation};
@@ -358,7 +358,14 @@ impl Retriangulator {
             ErrorModel::Exact if self.unit_hole && in_hole && !scan_only => {
                 let centre = self.centre.expect("hole loaded");
                 let inside = in_closed_triangle(pa, pb, pc, &centre);
-                let samples = [pa, pb, pc, &centre];
+                // The corners' samples: the vertices themselves unless heights are fitted.
+                let fitted;
+                let samples = if rules.grid.has_fitted_heights() {
+                    fitted = corner_samples(rules.grid, [pa, pb, pc]);
+                    [&fitted[0], &fitted[1], &fitted[2], &centre]
+                } else {
+                    [pa, pb, pc, &centre]
+                };
                 let e = error_at(
                     pa,
                     pb,

@@ -54,5 +54,6 @@ pub use grid::Grid;
 pub use mesh::VertexClass;
 pub use options::{
     DecimationOptions, EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation,
+    VertexHeights,
 };
 pub use tin::{Tin, TinVertex};

@@ -355,8 +355,20 @@ impl<'g> Mesh<'g> {
         self.vertex_triangle.len()
     }
 
-    /// Position and value of vertex `v`.
+    /// Position and height of vertex `v` (see [`Grid::vertex_height`]).
     pub(crate) fn point(&self, v: u32) -> Point {
+        let w = self.grid.width() as usize;
+        let i = v as usize;
+        Point {
+            x: (i % w) as i64,
+            y: (i / w) as i64,
+            z: self.grid.vertex_height(i),
+        }
+    }
+
+    /// Position and sample value at vertex `v`: what the TIN must come within the bound of
+    /// there once `v` is gone.
+    pub(crate) fn sample_point(&self, v: u32) -> Point {
         let w = self.grid.width() as usize;
         let i = v as usize;
         Point {

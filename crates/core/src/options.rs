@@ -74,6 +74,20 @@ pub enum EdgeSelection {
     Hybrid,
 }
 
+/// Where the TIN's vertices sit in height.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum VertexHeights {
+    /// Every vertex at its sample's value, as the paper and hmm have them.
+    Samples,
+    /// Each vertex off the grid's outer rows and columns moved towards the mean of its
+    /// 3 x 3 neighbourhood by at most a sixteenth of the bound (exact model with a bound
+    /// and no contour levels only; otherwise as `Samples`). The bound still holds at every sample, the vertices'
+    /// own included. Integer heights decimate to fewer triangles at small bounds: exact
+    /// ties between integer planes and integer samples no longer decide every removal.
+    #[default]
+    Fitted,
+}
+
 /// Options of [`crate::decimate`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct DecimationOptions {
@@ -115,6 +129,8 @@ pub struct DecimationOptions {
     /// Rounds of removal through extended holes, each followed by another sweep (see
     /// [`DecimationOptions::with_extend_rounds`]); 0 (the default) for none.
     pub extend_rounds: usize,
+    /// Where the vertices sit in height.
+    pub vertex_heights: VertexHeights,
 }
 
 impl DecimationOptions {
@@ -138,6 +154,7 @@ impl DecimationOptions {
             contour_levels: None,
             flip_rounds: 0,
             extend_rounds: 0,
+            vertex_heights: VertexHeights::default(),
         }
     }
 
@@ -236,6 +253,12 @@ impl DecimationOptions {
     /// Sets the edge selection rule.
     pub fn with_selection(mut self, selection: EdgeSelection) -> DecimationOptions {
         self.selection = selection;
+        self
+    }
+
+    /// Sets where the vertices sit in height.
+    pub fn with_vertex_heights(mut self, vertex_heights: VertexHeights) -> DecimationOptions {
+        self.vertex_heights = vertex_heights;
         self
     }
 

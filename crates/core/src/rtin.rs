@@ -239,7 +239,7 @@ impl<'g> Rtin<'g> {
         t.map(|p| Point {
             x: p.0,
             y: p.1,
-            z: self.grid.values()[self.index(p)],
+            z: self.grid.vertex_height(self.index(p)),
         })
     }
 

@@ -76,12 +76,11 @@ impl<'g> StripPlan<'g> {
     /// limit after all (the 1-D pass works in floating point, the measurement decides).
     pub(crate) fn triangles(&self) -> Option<(Vec<[u32; 3]>, Vec<CompactBound>)> {
         let grid = self.grid;
-        let values = grid.values();
         let width = self.lines.width;
         let point = |i: usize| Point {
             x: (i % width) as i64,
             y: (i / width) as i64,
-            z: values[i],
+            z: grid.vertex_height(i),
         };
         let mut corners = Vec::with_capacity(self.triangle_count);
         let mut bounds = Vec::with_capacity(self.triangle_count);
@@ -239,6 +238,7 @@ fn kept_samples(grid: &Grid, lines: Lines, limit: f64, full_border: bool) -> Kep
         starts: Vec::with_capacity(count + 1),
     };
     let mut z = vec![0.0; len];
+    let mut heights = vec![0.0; len];
     let reciprocals: Vec<f64> = (0..len).map(|k| 1.0 / k as f64).collect();
     let mut must = Vec::new();
     // Cell validity of the strips before and after the current line, one entry per
@@ -285,10 +285,13 @@ fn kept_samples(grid: &Grid, lines: Lines, limit: f64, full_border: bool) -> Kep
             if next == pos + 1 || !(before[pos] || after[pos]) {
                 continue;
             }
-            for (p, zp) in (pos..=next).zip(z.iter_mut()) {
-                *zp = values[lines.sample(line, p)];
+            for (p, (zp, hp)) in (pos..=next).zip(z.iter_mut().zip(heights.iter_mut())) {
+                let i = lines.sample(line, p);
+                *zp = values[i];
+                *hp = grid.vertex_height(i);
             }
-            simplify(&z[..=next - pos], limit, &reciprocals, |p| {
+            let n = next - pos + 1;
+            simplify(&z[..n], &heights[..n], limit, &reciprocals, |p| {
                 kept.positions.push((pos + p) as u32)
             });
         }
@@ -297,12 +300,18 @@ fn kept_samples(grid: &Grid, lines: Lines, limit: f64, full_border: bool) -> Kep
     kept
 }
 
-/// Calls `keep` with the interior positions, in order, of a polyline through samples of
-/// `z` (both ends always in it) such that every sample lies within `limit` of it
-/// vertically: from each kept sample, the furthest next one that a straight segment
+/// Calls `keep` with the interior positions, in order, of a polyline through vertices at
+/// `heights` (both ends always in it) such that every sample of `z` lies within `limit`
+/// of it vertically: from each kept vertex, the furthest next one that a straight segment
 /// reaches with every sample between within the bound (tracked as the cone of slopes
-/// that keeps them all).
-fn simplify(z: &[f64], limit: f64, reciprocals: &[f64], mut keep: impl FnMut(usize)) {
+/// that keeps them all). Each height must be within `limit` of its sample.
+fn simplify(
+    z: &[f64],
+    heights: &[f64],
+    limit: f64,
+    reciprocals: &[f64],
+    mut keep: impl FnMut(usize),
+) {
     let n = z.len();
     // A hair tighter than the limit, so that rounding here rarely admits a segment the
     // exact measurement then refuses.
@@ -311,11 +320,11 @@ fn simplify(z: &[f64], limit: f64, reciprocals: &[f64], mut keep: impl FnMut(usi
     while start + 2 < n {
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
         let mut reach = start + 1;
-        let zs = z[start];
+        let zs = heights[start];
         for (end, &ze) in z.iter().enumerate().skip(start + 1) {
             let per_run = reciprocals[end - start];
+            let slope = (heights[end] - zs) * per_run;
             let rise = ze - zs;
-            let slope = rise * per_run;
             if lo <= slope && slope <= hi {
                 reach = end;
             }
@@ -368,7 +377,7 @@ mod tests {
     fn kept_interior(z: &[f64], limit: f64) -> Vec<usize> {
         let reciprocals: Vec<f64> = (0..z.len()).map(|k| 1.0 / k as f64).collect();
         let mut kept = Vec::new();
-        simplify(z, limit, &reciprocals, |p| kept.push(p));
+        simplify(z, z, limit, &reciprocals, |p| kept.push(p));
         kept
     }
 

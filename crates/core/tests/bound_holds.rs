@@ -5,7 +5,7 @@
 use proptest::prelude::*;
 use tinsmith_core::{
     decimate, DecimationOptions, EdgeSelection, ErrorModel, Grid, InitialMesh, Order,
-    Retriangulation, Tin,
+    Retriangulation, Tin, VertexHeights,
 };
 use tinsmith_testkit::{max_error, small_grid, GridSpec};
 use tinsmith_verify::{verify, GridRef, MeshRef, Orientation, VerifyOptions};
@@ -17,7 +17,8 @@ const SELECTIONS: [EdgeSelection; 3] = [
 ];
 
 /// Every combination of error model, order, retriangulation and selection (selection
-/// matters only for ears).
+/// matters only for ears), with fitted vertex heights (the default) and some with heights
+/// at the samples.
 fn all_options(bound: f64) -> Vec<DecimationOptions> {
     let mut all = Vec::new();
     for model in [ErrorModel::Bounds, ErrorModel::Exact] {
@@ -35,6 +36,7 @@ fn all_options(bound: f64) -> Vec<DecimationOptions> {
                 for selection in SELECTIONS {
                     all.push(base.clone().with_selection(selection));
                 }
+                all.push(base.clone().with_vertex_heights(VertexHeights::Samples));
                 all.push(base.clone().with_extend_rounds(1));
                 let dp = base.with_retriangulation(Retriangulation::Dp);
                 // Levels spread over the small grids' values (see `small_grid`).
@@ -42,6 +44,7 @@ fn all_options(bound: f64) -> Vec<DecimationOptions> {
                 all.push(dp.clone().with_contour_levels(&levels));
                 all.push(dp.clone().with_flip_rounds(2));
                 all.push(dp.clone().with_extend_rounds(2));
+                all.push(dp.clone().with_vertex_heights(VertexHeights::Samples));
                 all.push(
                     dp.clone()
                         .with_extend_rounds(1)
@@ -306,6 +309,13 @@ fn a_single_spike_is_kept_and_the_rest_goes() {
         values,
     };
     let tin = check(&spec, 1.0, EdgeSelection::Hybrid).unwrap();
+    // Fitted towards its neighbourhood's mean (50 / 9) by at most a sixteenth of the bound.
+    assert!(tin
+        .vertices()
+        .iter()
+        .any(|v| v.x == 5 && v.y == 5 && v.z < 50.0 && v.z >= 50.0 - 1.0 / 16.0));
+    let samples = DecimationOptions::new(1.0).with_vertex_heights(VertexHeights::Samples);
+    let tin = check_with(&spec, &samples).unwrap();
     assert!(tin
         .vertices()
         .iter()

@@ -2,7 +2,7 @@
 //! spec, and the meshes to contour (the full grid and a decimated TIN).
 
 use tinsmith_contour::ContourMesh;
-use tinsmith_core::{decimate, DecimationOptions, Grid};
+use tinsmith_core::{decimate, DecimationOptions, Grid, VertexHeights};
 use tinsmith_testkit::{GridSpec, SplitMix};
 
 /// Levels: some between samples, some exactly at sample values (the degenerate case).
@@ -26,16 +26,20 @@ pub fn levels_for(spec: &GridSpec, seed: u64) -> Vec<f64> {
     levels
 }
 
-/// The full grid's mesh and a TIN of it decimated within `e`.
+/// The full grid's mesh and TINs of it decimated within `e`: with vertices at their
+/// samples (levels at sample values land on vertices), then with fitted heights.
 pub fn meshes(spec: &GridSpec, e: f64) -> Vec<ContourMesh> {
     let mut out = vec![ContourMesh::from_grid(spec.width, spec.height, &spec.values).unwrap()];
     let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
-    let tin = decimate(&grid, &DecimationOptions::new(e)).unwrap().tin;
-    let v = tin
-        .vertices()
-        .iter()
-        .map(|v| [v.x as f64, v.y as f64, v.z])
-        .collect();
-    out.push(ContourMesh::new(v, tin.triangles().to_vec()).unwrap());
+    for heights in [VertexHeights::Samples, VertexHeights::Fitted] {
+        let options = DecimationOptions::new(e).with_vertex_heights(heights);
+        let tin = decimate(&grid, &options).unwrap().tin;
+        let v = tin
+            .vertices()
+            .iter()
+            .map(|v| [v.x as f64, v.y as f64, v.z])
+            .collect();
+        out.push(ContourMesh::new(v, tin.triangles().to_vec()).unwrap());
+    }
     out
 }

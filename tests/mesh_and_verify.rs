@@ -455,22 +455,23 @@ fn a_scaling_vrt_is_read_as_its_band_type_holds_it() {
 }
 
 #[test]
-fn fitted_vertex_heights_keep_fewer_triangles_on_integer_heights() {
-    // The sample DEM is Int16: at a bound of half a unit, vertices at their samples tie
-    // exactly with many integer planes; fitted heights (the default) break those ties.
+fn raised_vertex_heights_keep_fewer_triangles_on_integer_heights() {
+    // The sample DEM is Int16: at a bound of half a unit, many candidate triangles have a
+    // sample exactly the bound from their plane; raised heights (the default) let the
+    // half with the sample above pass.
     let dem = fixture("becmodel_dem_bc_albers_50m.tif");
     let untiled = ["--tile-size", "1024"];
-    let fitted = mesh_then_verify(&dem, 0.5, &untiled, "ply");
+    let raised = mesh_then_verify(&dem, 0.5, &untiled, "ply");
     let mut samples_args = untiled.to_vec();
     samples_args.extend(["--vertex-heights", "samples"]);
     let samples = mesh_then_verify(&dem, 0.5, &samples_args, "ply");
-    assert_eq!(fitted["vertex_heights"], "fitted");
+    assert_eq!(raised["vertex_heights"], "raised");
     assert_eq!(samples["vertex_heights"], "samples");
     let count = |r: &serde_json::Value| r["triangles_after"].as_f64().unwrap();
     assert!(
-        count(&fitted) < 0.97 * count(&samples),
-        "fitted {} vs samples {}",
-        count(&fitted),
+        count(&raised) < 0.95 * count(&samples),
+        "raised {} vs samples {}",
+        count(&raised),
         count(&samples)
     );
     // Tiled, too: tiles agree on their shared edges (the engine checks the weld).
@@ -479,7 +480,7 @@ fn fitted_vertex_heights_keep_fewer_triangles_on_integer_heights() {
 }
 
 #[test]
-fn contour_reads_a_mesh_with_fitted_heights_and_still_refuses_a_foreign_one() {
+fn contour_reads_a_mesh_with_raised_heights_and_still_refuses_a_foreign_one() {
     let dem = fixture("becmodel_dem_bc_albers_50m.tif");
     let d = Dir::new();
     let o = d.run(&["mesh", &dem, "-o", "m.obj", "--max-error", "1", "-q"]);
@@ -506,34 +507,44 @@ fn contour_reads_a_mesh_with_fitted_heights_and_still_refuses_a_foreign_one() {
         "-q",
     ]);
     assert!(o.status.success(), "{}", crate::util::stderr(&o));
-    // Moving one vertex by a unit (beyond any fitted height) is still refused.
-    let mut moved = String::new();
-    let mut done = false;
-    for line in obj.lines() {
-        match line.strip_prefix("v ") {
-            Some(rest) if !done => {
-                let f: Vec<f64> = rest.split(' ').map(|s| s.parse().unwrap()).collect();
-                moved.push_str(&format!("v {} {} {}\n", f[0], f[1], f[2] + 1.0));
-                done = true;
-            }
-            _ => {
-                moved.push_str(line);
-                moved.push('\n');
+    // Moving one vertex by a unit is still refused: a border vertex (the first, not
+    // raised) or an inner one (then raised by another amount than the rest).
+    for (pick, name) in [(0, "border.obj"), (1, "inner.obj")] {
+        let mut moved = String::new();
+        let mut done = false;
+        for line in obj.lines() {
+            match line.strip_prefix("v ") {
+                Some(rest)
+                    if !done && (pick == 0 || rest.split(' ').nth(2).unwrap().contains('.')) =>
+                {
+                    let f: Vec<f64> = rest.split(' ').map(|s| s.parse().unwrap()).collect();
+                    moved.push_str(&format!("v {} {} {}\n", f[0], f[1], f[2] + 1.0));
+                    done = true;
+                }
+                _ => {
+                    moved.push_str(line);
+                    moved.push('\n');
+                }
             }
         }
+        assert!(done);
+        d.write(name, &moved);
+        let o = d.run(&[
+            "contour",
+            &dem,
+            "--mesh",
+            name,
+            "-o",
+            "c2.geojson",
+            "--interval",
+            "100",
+            "-q",
+        ]);
+        assert!(!o.status.success(), "{name}");
+        assert!(
+            crate::util::stderr(&o).contains(name),
+            "{}",
+            crate::util::stderr(&o)
+        );
     }
-    d.write("moved.obj", &moved);
-    let o = d.run(&[
-        "contour",
-        &dem,
-        "--mesh",
-        "moved.obj",
-        "-o",
-        "c2.geojson",
-        "--interval",
-        "100",
-        "-q",
-    ]);
-    assert!(!o.status.success());
-    assert!(crate::util::stderr(&o).contains("moved.obj"));
 }

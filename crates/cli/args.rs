@@ -169,7 +169,7 @@ pub struct MeshArgs {
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub extend_rounds: usize,
     /// Where vertices sit in height. The error bound holds at every sample either way.
-    #[arg(long, value_enum, default_value_t = VertexHeightsArg::Fitted)]
+    #[arg(long, value_enum, default_value_t = VertexHeightsArg::Raised)]
     pub vertex_heights: VertexHeightsArg,
     /// Shape the TIN for contour lines every I (plus --contour-offset) over the raster's
     /// heights, as `tinsmith contour --max-error` does: `contour --mesh` then draws lines
@@ -397,17 +397,17 @@ impl From<ErrorModelArg> for ErrorModel {
 pub enum VertexHeightsArg {
     /// Every vertex at its sample's value.
     Samples,
-    /// Each vertex moved towards its 3x3 neighbourhood's mean by at most a sixteenth of
-    /// --max-error (exact model, no count target, no contour levels): fewer triangles on
-    /// integer heights at small bounds. Vertices on the raster's edges (and tiles') stay.
-    Fitted,
+    /// Each vertex raised above its sample by 1/64 of --max-error (exact model, no count
+    /// target, no contour levels): fewer triangles on integer heights at small bounds.
+    /// Vertices on the raster's edges (and tiles') stay at their samples.
+    Raised,
 }
 
 impl From<VertexHeightsArg> for VertexHeights {
     fn from(h: VertexHeightsArg) -> VertexHeights {
         match h {
             VertexHeightsArg::Samples => VertexHeights::Samples,
-            VertexHeightsArg::Fitted => VertexHeights::Fitted,
+            VertexHeightsArg::Raised => VertexHeights::Raised,
         }
     }
 }

@@ -492,12 +492,14 @@ fn nothing_to_contour(args: &ContourArgs) -> anyhow::Error {
 
 /// Reads a mesh file written from `raster` (as `tinsmith verify` reads it: GeoJSON in
 /// WGS84 back to the raster's CRS) and maps its vertices back to grid positions, one
-/// vertex per position, with its sample's height.
+/// vertex per position, with its sample's height (or its raised height, see below).
 ///
 /// The mesh must be a TIN of this raster and band: every vertex's height is its sample's
 /// (within a millionth of the sample's magnitude or the mesh's height range, for text
 /// rounded by other tools; for STL and glTF, which store `f32` offsets from a local
-/// origin, within 2^-23 of the range more), and the verifier finds it a valid
+/// origin, within 2^-23 of the range more), or, off the raster's outer rows and columns,
+/// that raised by one amount for all (`mesh --vertex-heights raised`, within the same
+/// rounding; such vertices keep the file's height), and the verifier finds it a valid
 /// triangulation of the domain (no triangle over nodata, no gap, no overlap; GeoJSON and
 /// FlatGeobuf triangles may be wound either way). Otherwise its lines would not be the
 /// raster's.
@@ -530,8 +532,9 @@ fn mesh_from_file(
     };
     // Each file vertex's sample, as its row-major index.
     let mut samples: Vec<u64> = Vec::with_capacity(file.vertices.len());
-    // Each file vertex's height: its sample's, or the file's where it is fitted.
+    // Each file vertex's height: its sample's, or the file's where it is raised.
     let mut file_heights: Vec<f64> = Vec::with_capacity(file.vertices.len());
+    let mut first_raise: Option<f64> = None;
     let at = sample_positions(path, &file, georef)?;
     for (i, (v, &[x, y])) in file.vertices.iter().zip(&at).enumerate() {
         if !(0..grid.width() as i64).contains(&x) || !(0..grid.height() as i64).contains(&y) {
@@ -546,14 +549,15 @@ fn mesh_from_file(
         let tolerance = slack + 1e-6 * sample.abs().max(range);
         // False for a NaN sample (nodata under a vertex) too.
         let matches = (v[2] - sample).abs() <= tolerance;
-        // A fitted height lies between its sample and its neighbourhood's mean.
-        let fitted = !matches
-            && grid
-                .neighbourhood_mean(x as u32, y as u32)
-                .is_some_and(|mean| {
-                    (sample.min(mean) - tolerance..=sample.max(mean) + tolerance).contains(&v[2])
-                });
-        if !matches && !fitted {
+        // Raised heights (off the raster's outer rows and columns) are all the same amount
+        // above their samples: the first one's, within the rounding.
+        let inner =
+            (1..grid.width() as i64 - 1).contains(&x) && (1..grid.height() as i64 - 1).contains(&y);
+        let raised = !matches && inner && v[2] > sample && {
+            let raise = *first_raise.get_or_insert(v[2] - sample);
+            (v[2] - sample - raise).abs() <= 2.0 * tolerance
+        };
+        if !matches && !raised {
             bail!(
                 "{}: vertex {i} at column {x}, row {y} has height {}, but band {band} of {} \
                  has {} there (more than {:.2e} apart): `contour --mesh` needs a TIN of this \
@@ -576,7 +580,7 @@ fn mesh_from_file(
             );
         }
         samples.push(y as u64 * u64::from(grid.width()) + x as u64);
-        file_heights.push(if fitted { v[2] } else { sample });
+        file_heights.push(if raised { v[2] } else { sample });
     }
     if file.triangles.is_empty() {
         bail!("{}: the mesh has no triangles", path.display());

@@ -93,7 +93,7 @@ impl Plan {
     /// heights, the largest float32 rounding of a height, and the bound left for the
     /// decimator; fails when float32 cannot hold the positions to a sample or the heights
     /// within `max_error`. With the `grid` in memory and vertices at their samples the
-    /// rounding is measured at every valid sample; otherwise (the tiled engine, fitted
+    /// rounding is measured at every valid sample; otherwise (the tiled engine, raised
     /// vertex heights) it is bounded from the height range.
     pub fn new(
         format: MeshFormat,
@@ -137,9 +137,14 @@ impl Plan {
         }
         check_position_rounding(info, &georef, origin, min, max, out(args))?;
 
-        // Fitted vertex heights are not samples, but lie within the samples' range: the
-        // bound from the range covers them.
+        // Raised vertex heights are not samples: bound their rounding from the range, up
+        // to the highest sample raised.
         let samples_only = matches!(args.vertex_heights, VertexHeightsArg::Samples);
+        let raise = if samples_only || !max_error.is_finite() {
+            0.0
+        } else {
+            max_error / tinsmith_core::RAISED_HEIGHT_SHARE
+        };
         let height_rounding = match grid.filter(|_| samples_only) {
             Some(grid) => {
                 let mut rounding = 0.0f64;
@@ -149,7 +154,7 @@ impl Plan {
                 }
                 rounding
             }
-            None => height_rounding_bound(origin, min[2], max[2]),
+            None => height_rounding_bound(origin, min[2], max[2] + raise),
         };
         let decimation_bound = max_error - height_rounding;
         if decimation_bound < 0.0 {

@@ -141,15 +141,16 @@ pub fn effective_limit(max_error: f64, max_abs_value: f64) -> f64 {
     }
 }
 
-/// [`VertexHeights::Fitted`] moves a vertex by at most the bound over this.
-const FITTED_HEIGHT_SHARE: f64 = 16.0;
+/// [`VertexHeights::Raised`] raises a vertex by the enforced bound over this (so by less
+/// than `max_error / RAISED_HEIGHT_SHARE`).
+pub const RAISED_HEIGHT_SHARE: f64 = 64.0;
 
-/// Whether vertex heights are fitted: asked for, under the exact model (the paper's
+/// Whether vertex heights are raised: asked for, under the exact model (the paper's
 /// bounds start from vertices at their samples), with a bound to take the room from
 /// (count targets have none), and without contour levels (`contour --mesh` reads a
 /// level-shaped TIN back with its vertices at their samples).
-fn fits_heights(options: &DecimationOptions, limit: f64) -> bool {
-    options.vertex_heights == VertexHeights::Fitted
+fn raises_heights(options: &DecimationOptions, limit: f64) -> bool {
+    options.vertex_heights == VertexHeights::Raised
         && options.contour_levels.is_none()
         && options.error_model == ErrorModel::Exact
         && options.max_triangles.is_none()
@@ -185,10 +186,10 @@ fn run(
         return Err(Error::HeightsTooLarge(max_abs));
     }
     let limit = effective_limit(max_error, max_abs);
-    let fitted;
-    let grid = if fits_heights(options, limit) {
-        fitted = grid.with_fitted_heights(limit / FITTED_HEIGHT_SHARE);
-        &fitted
+    let raised;
+    let grid = if raises_heights(options, limit) {
+        raised = grid.with_raised_heights(limit / RAISED_HEIGHT_SHARE);
+        &raised
     } else {
         grid
     };

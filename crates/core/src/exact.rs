@@ -26,7 +26,7 @@ pub(crate) fn triangle_error(
     }
     if orient(a, b, c) == 1 {
         // Doubled area 1: by Pick's theorem the corners are the only samples.
-        if !grid.has_fitted_heights() {
+        if !grid.has_vertex_heights() {
             return error_at(a, b, c, [a, b, c], limit);
         }
         return error_at(a, b, c, &corner_samples(grid, [a, b, c]), limit);
@@ -34,7 +34,7 @@ pub(crate) fn triangle_error(
     if let Some(v) = flat_value(grid, a, b, c) {
         // Every sample, the corners included, is `v`: where the corners' heights are `v`
         // too, so is the plane, exactly as the scan below would find.
-        debug_assert!(grid.has_fitted_heights() || (a.z == v && b.z == v && c.z == v));
+        debug_assert!(grid.has_vertex_heights() || (a.z == v && b.z == v && c.z == v));
         if a.z == v && b.z == v && c.z == v {
             return Some(ErrorBound::default());
         }

@@ -88,19 +88,17 @@ impl Grid {
         })
     }
 
-    /// A copy whose vertices sit at fitted heights ([`Grid::vertex_height`]): each valid
-    /// sample off the grid's outer rows and columns moves towards the mean of the valid
-    /// samples of its 3 x 3 neighbourhood, by at most `delta`; the others keep their
-    /// values (so tiles sharing a border row agree on its heights). The copy does not
-    /// claim [`Grid::integral_heights`].
-    pub(crate) fn with_fitted_heights(&self, delta: f64) -> Grid {
+    /// A copy whose vertices sit `raise` above their samples ([`Grid::vertex_height`]),
+    /// except on the grid's outer rows and columns (so tiles sharing a border agree on its
+    /// heights without reading each other). The copy does not claim
+    /// [`Grid::integral_heights`].
+    pub(crate) fn with_raised_heights(&self, raise: f64) -> Grid {
+        let (w, h) = (self.width as usize, self.height as usize);
         let mut heights = self.values.clone();
-        for y in 1..self.height.saturating_sub(1) {
-            for x in 1..self.width - 1 {
-                let i = (y * self.width + x) as usize;
-                if let Some(mean) = self.neighbourhood_mean(x, y) {
-                    let s = self.values[i];
-                    heights[i] = s + (mean - s).clamp(-delta, delta);
+        if w >= 3 && h >= 3 {
+            for row in heights.chunks_exact_mut(w).take(h - 1).skip(1) {
+                for z in &mut row[1..w - 1] {
+                    *z += raise;
                 }
             }
         }
@@ -111,33 +109,8 @@ impl Grid {
         }
     }
 
-    /// The mean of the valid samples of the 3 x 3 neighbourhood of valid sample `(x, y)`,
-    /// which a fitted vertex height lies between the sample and (see
-    /// [`crate::VertexHeights::Fitted`]); `None` for an invalid sample or one on the grid's
-    /// outer rows and columns, whose vertices stay at their samples.
-    pub fn neighbourhood_mean(&self, x: u32, y: u32) -> Option<f64> {
-        if x == 0 || y == 0 || x + 1 >= self.width || y + 1 >= self.height {
-            return None;
-        }
-        let w = self.width as usize;
-        let i = y as usize * w + x as usize;
-        if !self.values[i].is_finite() {
-            return None;
-        }
-        let (mut sum, mut n) = (0.0, 0.0);
-        for row in [i - w, i, i + w] {
-            for &v in &self.values[row - 1..=row + 1] {
-                if v.is_finite() {
-                    sum += v;
-                    n += 1.0;
-                }
-            }
-        }
-        Some(sum / n)
-    }
-
-    /// The height of a TIN vertex at sample `i` (row-major): the sample's value, or
-    /// within the fitting's `delta` of it on a grid [`Grid::with_fitted_heights`] made.
+    /// The height of a TIN vertex at sample `i` (row-major): the sample's value, or that
+    /// raised on a grid [`Grid::with_raised_heights`] made.
     pub(crate) fn vertex_height(&self, i: usize) -> f64 {
         match &self.vertex_heights {
             Some(heights) => heights[i],
@@ -146,7 +119,7 @@ impl Grid {
     }
 
     /// Whether some vertex heights may differ from their samples' values.
-    pub(crate) fn has_fitted_heights(&self) -> bool {
+    pub(crate) fn has_vertex_heights(&self) -> bool {
         self.vertex_heights.is_some()
     }
 

@@ -358,11 +358,11 @@ impl Retriangulator {
             ErrorModel::Exact if self.unit_hole && in_hole && !scan_only => {
                 let centre = self.centre.expect("hole loaded");
                 let inside = in_closed_triangle(pa, pb, pc, &centre);
-                // The corners' samples: the vertices themselves unless heights are fitted.
-                let fitted;
-                let samples = if rules.grid.has_fitted_heights() {
-                    fitted = corner_samples(rules.grid, [pa, pb, pc]);
-                    [&fitted[0], &fitted[1], &fitted[2], &centre]
+                // The corners' samples: the vertices themselves unless heights are raised.
+                let raised;
+                let samples = if rules.grid.has_vertex_heights() {
+                    raised = corner_samples(rules.grid, [pa, pb, pc]);
+                    [&raised[0], &raised[1], &raised[2], &centre]
                 } else {
                     [pa, pb, pc, &centre]
                 };

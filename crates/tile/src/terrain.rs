@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use rayon::prelude::*;
-use tinsmith_core::{decimate_with_border, DecimationOptions, Grid};
+use tinsmith_core::{decimate_with_border, DecimationOptions, Grid, VertexHeights};
 use tinsmith_export::{gzip, GeoRectangle, QuantizedMeshTile, QUANTIZED_MAX};
 use tinsmith_raster::{geographic_bounds, GeoBounds};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
@@ -1011,7 +1011,10 @@ fn build_tile(
             true
         }
     };
-    let mut decimation_options = DecimationOptions::new(budget.decimation);
+    // Vertices at their samples: flat ground (the sea at 0, a tile the raster does not
+    // reach) stays exactly at its height in the quantized tiles.
+    let mut decimation_options =
+        DecimationOptions::new(budget.decimation).with_vertex_heights(VertexHeights::Samples);
     decimation_options.max_abs_value = Some(budget.max_abs);
     decimation_options.max_edge_length = budget.max_edge;
     let tin = decimate_with_border(&grid, &decimation_options, &keep_border, &mut |_| {})

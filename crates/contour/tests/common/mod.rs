@@ -27,11 +27,11 @@ pub fn levels_for(spec: &GridSpec, seed: u64) -> Vec<f64> {
 }
 
 /// The full grid's mesh and TINs of it decimated within `e`: with vertices at their
-/// samples (levels at sample values land on vertices), then with fitted heights.
+/// samples (levels at sample values land on vertices), then with raised heights.
 pub fn meshes(spec: &GridSpec, e: f64) -> Vec<ContourMesh> {
     let mut out = vec![ContourMesh::from_grid(spec.width, spec.height, &spec.values).unwrap()];
     let grid = Grid::new(spec.width, spec.height, spec.values.clone()).unwrap();
-    for heights in [VertexHeights::Samples, VertexHeights::Fitted] {
+    for heights in [VertexHeights::Samples, VertexHeights::Raised] {
         let options = DecimationOptions::new(e).with_vertex_heights(heights);
         let tin = decimate(&grid, &options).unwrap().tin;
         let v = tin

@@ -85,7 +85,7 @@ pub enum VertexHeights {
     /// sample, the vertices' own included. On integer heights many candidate triangles
     /// have a sample exactly the bound away from their plane (through integer vertices),
     /// which the rounding margin then refuses; raised, those with the sample above the
-    /// plane pass with room to spare: 4–10 % fewer triangles at bounds of a unit or less
+    /// plane pass with room to spare: 3–10 % fewer triangles at bounds of a unit or less
     /// (docs/results.md).
     #[default]
     Raised,

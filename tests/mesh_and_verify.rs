@@ -474,6 +474,11 @@ fn raised_vertex_heights_keep_fewer_triangles_on_integer_heights() {
         count(&raised),
         count(&samples)
     );
+    // The report says what came out: the paper's bounds keep vertices at their samples.
+    let mut bounds_args = untiled.to_vec();
+    bounds_args.extend(["--error-model", "bounds"]);
+    let bounds = mesh_then_verify(&dem, 0.5, &bounds_args, "ply");
+    assert_eq!(bounds["vertex_heights"], "samples");
     // Tiled, too: tiles agree on their shared edges (the engine checks the weld).
     let tiled = mesh_then_verify(&dem, 0.5, &["--tile-size", "128"], "ply");
     assert!(tiled["tiles"]["count"].as_u64().unwrap() > 4);

@@ -333,6 +333,18 @@ pub enum ErrorModelArg {
 }
 
 impl MeshArgs {
+    /// Whether decimation raises the vertex heights with these flags: asked for, exact
+    /// model, a bound above 0, no count target, no contour levels.
+    pub fn raises_vertex_heights(&self) -> bool {
+        matches!(self.vertex_heights, VertexHeightsArg::Raised)
+            && matches!(self.error_model, ErrorModelArg::Exact)
+            && self.max_error.is_some_and(|e| e > 0.0)
+            && self.max_triangles.is_none()
+            && self.max_vertices.is_none()
+            && self.contour_interval.is_none()
+            && self.contour_levels.is_empty()
+    }
+
     /// The decimation options the flags ask for, with `max_error` as the bound (the
     /// untiled path passes the bound less the output format's height rounding); contour
     /// levels from --contour-interval run over `heights`, the raster's valid range.

@@ -10,7 +10,7 @@ use tinsmith_core::Grid;
 use tinsmith_export::{CrsRef, LocalOrigin, MeshFormat, MeshRef, WriteOptions};
 use tinsmith_raster::RasterInfo;
 
-use crate::args::{MeshArgs, VertexHeightsArg};
+use crate::args::MeshArgs;
 use crate::georef::Georef;
 use crate::number::readable;
 
@@ -139,8 +139,8 @@ impl Plan {
 
         // Raised vertex heights are not samples: bound their rounding from the range, up
         // to the highest sample raised.
-        let samples_only = matches!(args.vertex_heights, VertexHeightsArg::Samples);
-        let raise = if samples_only || !max_error.is_finite() {
+        let samples_only = !args.raises_vertex_heights();
+        let raise = if samples_only {
             0.0
         } else {
             max_error / tinsmith_core::RAISED_HEIGHT_SHARE

@@ -97,7 +97,13 @@ impl<'a> MeshSummary<'a> {
             dp_max_ring: args.dp_max_ring,
             flip_rounds: args.flip_rounds,
             extend_rounds: args.extend_rounds,
-            vertex_heights: value_name(args.vertex_heights),
+            // As they came out: raised only where decimation raises them (see
+            // `VertexHeights::Raised`).
+            vertex_heights: if args.raises_vertex_heights() {
+                value_name(crate::args::VertexHeightsArg::Raised)
+            } else {
+                value_name(crate::args::VertexHeightsArg::Samples)
+            },
             contour_interval: args.contour_interval,
             contour_offset: args.contour_offset,
             contour_levels: &args.contour_levels,

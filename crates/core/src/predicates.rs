@@ -4,7 +4,8 @@
 //! determinant every product pairs an x-difference with a y-difference, so each product is
 //! below `width * height` and the determinant is exact in `i64`.
 
-/// A point of the grid: integer position and sample value.
+/// A point of the grid: integer position and a height (a sample's value, or a vertex's
+/// height, see [`crate::VertexHeights`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Point {
     pub x: i64,

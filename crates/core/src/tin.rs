@@ -1,19 +1,21 @@
 //! The decimated mesh handed to callers: kept samples and triangles.
 
-/// A vertex of the output TIN: a kept grid sample.
+/// A vertex of the output TIN: at a kept grid sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TinVertex {
     /// Column of the sample.
     pub x: u32,
     /// Row of the sample.
     pub y: u32,
-    /// The sample's value, unchanged.
+    /// The vertex's height: the sample's value, or that raised by less than
+    /// `max_error / RAISED_HEIGHT_SHARE` (see [`crate::VertexHeights`]).
     pub z: f64,
 }
 
 /// A triangulated irregular network over a grid's domain.
 ///
-/// Every vertex is a valid grid sample with its original value; every triangle is
+/// Every vertex is at a valid grid sample, with its value or raised above it (see
+/// [`crate::VertexHeights`]); every triangle is
 /// non-degenerate and counter-clockwise in grid coordinates (x = column, y = row, so
 /// `(b - a) x (c - a) > 0`); the triangles tile the grid's domain exactly.
 /// Vertices are ordered by row, then column; triangles by their position in the mesh.
@@ -24,7 +26,7 @@ pub struct Tin {
 }
 
 impl Tin {
-    /// The kept samples.
+    /// The vertices, at the kept samples.
     pub fn vertices(&self) -> &[TinVertex] {
         &self.vertices
     }

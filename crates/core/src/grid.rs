@@ -20,8 +20,8 @@ pub struct Grid {
     equal_runs: Option<Vec<u16>>,
     /// See [`Grid::flat_value`]; built with `equal_runs`.
     flat_blocks: Vec<FlatLevel>,
-    /// See [`Grid::vertex_height`]; `None` when vertices sit at their samples' values.
-    vertex_heights: Option<Vec<f64>>,
+    /// See [`Grid::vertex_height`]; 0 when vertices sit at their samples' values.
+    raise: f64,
 }
 
 /// Square blocks of one size, each with its samples' common value when they are all bit
@@ -84,7 +84,7 @@ impl Grid {
             integral_heights,
             equal_runs,
             flat_blocks,
-            vertex_heights: None,
+            raise: 0.0,
         })
     }
 
@@ -93,18 +93,9 @@ impl Grid {
     /// heights without reading each other). The copy does not claim
     /// [`Grid::integral_heights`].
     pub(crate) fn with_raised_heights(&self, raise: f64) -> Grid {
-        let (w, h) = (self.width as usize, self.height as usize);
-        let mut heights = self.values.clone();
-        if w >= 3 && h >= 3 {
-            for row in heights.chunks_exact_mut(w).take(h - 1).skip(1) {
-                for z in &mut row[1..w - 1] {
-                    *z += raise;
-                }
-            }
-        }
         Grid {
             integral_heights: false,
-            vertex_heights: Some(heights),
+            raise,
             ..self.clone()
         }
     }
@@ -112,15 +103,23 @@ impl Grid {
     /// The height of a TIN vertex at sample `i` (row-major): the sample's value, or that
     /// raised on a grid [`Grid::with_raised_heights`] made.
     pub(crate) fn vertex_height(&self, i: usize) -> f64 {
-        match &self.vertex_heights {
-            Some(heights) => heights[i],
-            None => self.values[i],
+        let w = self.width as usize;
+        self.vertex_height_at(i, i % w, i / w)
+    }
+
+    /// [`Grid::vertex_height`] of sample `i`, which is at column `x`, row `y`.
+    pub(crate) fn vertex_height_at(&self, i: usize, x: usize, y: usize) -> f64 {
+        let inner = x > 0 && y > 0 && x + 1 < self.width as usize && y + 1 < self.height as usize;
+        if self.raise != 0.0 && inner {
+            self.values[i] + self.raise
+        } else {
+            self.values[i]
         }
     }
 
     /// Whether some vertex heights may differ from their samples' values.
     pub(crate) fn has_vertex_heights(&self) -> bool {
-        self.vertex_heights.is_some()
+        self.raise != 0.0
     }
 
     /// For each sample, how many samples from it rightwards in its row are bit for bit

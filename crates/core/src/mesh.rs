@@ -359,10 +359,11 @@ impl<'g> Mesh<'g> {
     pub(crate) fn point(&self, v: u32) -> Point {
         let w = self.grid.width() as usize;
         let i = v as usize;
+        let (x, y) = (i % w, i / w);
         Point {
-            x: (i % w) as i64,
-            y: (i / w) as i64,
-            z: self.grid.vertex_height(i),
+            x: x as i64,
+            y: y as i64,
+            z: self.grid.vertex_height_at(i, x, y),
         }
     }
 

@@ -287,8 +287,13 @@ fn kept_samples(grid: &Grid, lines: Lines, limit: f64, full_border: bool) -> Kep
             }
             for (p, (zp, hp)) in (pos..=next).zip(z.iter_mut().zip(heights.iter_mut())) {
                 let i = lines.sample(line, p);
+                let (x, y) = if lines.along_rows {
+                    (p, line)
+                } else {
+                    (line, p)
+                };
                 *zp = values[i];
-                *hp = grid.vertex_height(i);
+                *hp = grid.vertex_height_at(i, x, y);
             }
             let n = next - pos + 1;
             simplify(&z[..n], &heights[..n], limit, &reciprocals, |p| {

@@ -484,6 +484,51 @@ fn raised_vertex_heights_keep_fewer_triangles_on_integer_heights() {
     assert!(tiled["tiles"]["count"].as_u64().unwrap() > 4);
 }
 
+/// Whether an OBJ height field is not a whole number (a raised vertex over integer data).
+fn off_integer_height(z: &str) -> bool {
+    z.parse::<f64>().expect("OBJ height").fract() != 0.0
+}
+
+#[test]
+fn the_report_says_which_vertex_heights_came_out_with_contour_levels() {
+    // Contour levels keep vertices at their samples; an interval with no level inside the
+    // raster's range (350 to 2,583 here) shapes nothing, so vertices are
+    // raised as without one. The report must say what the file holds, tiled or not.
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    for (interval, expected) in [("100", "samples"), ("100000", "raised")] {
+        for tile_size in ["1024", "128"] {
+            let d = Dir::new();
+            let o = d.run(&[
+                "mesh",
+                &dem,
+                "-o",
+                "m.obj",
+                "--max-error",
+                "1",
+                "--contour-interval",
+                interval,
+                "--tile-size",
+                tile_size,
+                "--report",
+                "r.json",
+                "-q",
+            ]);
+            assert!(o.status.success(), "{}", crate::util::stderr(&o));
+            let report: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(d.path("r.json")).unwrap()).unwrap();
+            let obj = std::fs::read_to_string(d.path("m.obj")).unwrap();
+            let off_integer = obj
+                .lines()
+                .filter(|l| l.starts_with("v "))
+                .filter(|l| l.split(' ').nth(3).is_some_and(off_integer_height))
+                .count();
+            let holds = if off_integer > 0 { "raised" } else { "samples" };
+            assert_eq!(holds, expected, "interval {interval}, tiles of {tile_size}");
+            assert_eq!(report["vertex_heights"], expected, "interval {interval}");
+        }
+    }
+}
+
 #[test]
 fn contour_reads_a_mesh_with_raised_heights_and_still_refuses_a_foreign_one() {
     let dem = fixture("becmodel_dem_bc_albers_50m.tif");
@@ -494,7 +539,7 @@ fn contour_reads_a_mesh_with_raised_heights_and_still_refuses_a_foreign_one() {
     let off_sample = obj
         .lines()
         .filter(|l| l.starts_with("v "))
-        .filter(|l| l.split(' ').nth(3).is_some_and(|z| z.contains('.')))
+        .filter(|l| l.split(' ').nth(3).is_some_and(off_integer_height))
         .count();
     assert!(
         off_sample > 100,

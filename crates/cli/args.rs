@@ -333,16 +333,14 @@ pub enum ErrorModelArg {
 }
 
 impl MeshArgs {
-    /// Whether decimation raises the vertex heights with these flags: asked for, exact
-    /// model, a bound above 0, no count target, no contour levels.
-    pub fn raises_vertex_heights(&self) -> bool {
-        matches!(self.vertex_heights, VertexHeightsArg::Raised)
-            && matches!(self.error_model, ErrorModelArg::Exact)
-            && self.max_error.is_some_and(|e| e > 0.0)
-            && self.max_triangles.is_none()
-            && self.max_vertices.is_none()
-            && self.contour_interval.is_none()
-            && self.contour_levels.is_empty()
+    /// Whether decimation raises the vertex heights with these flags on a raster whose
+    /// valid heights span `heights` (the core's rule,
+    /// [`DecimationOptions::raises_vertex_heights`], on the options the flags give).
+    pub fn raises_vertex_heights(&self, heights: Option<(f64, f64)>) -> bool {
+        let max_abs = heights.map_or(0.0, |(lo, hi)| lo.abs().max(hi.abs()));
+        let max_error = self.max_error.unwrap_or(f64::INFINITY);
+        self.decimation_options(max_error, heights)
+            .is_ok_and(|options| options.raises_vertex_heights(max_abs))
     }
 
     /// The decimation options the flags ask for, with `max_error` as the bound (the

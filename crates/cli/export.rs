@@ -139,7 +139,7 @@ impl Plan {
 
         // Raised vertex heights are not samples: bound their rounding from the range, up
         // to the highest sample raised.
-        let samples_only = !args.raises_vertex_heights();
+        let samples_only = !args.raises_vertex_heights(info.min.zip(info.max));
         let raise = if samples_only {
             0.0
         } else {

@@ -146,6 +146,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         after: (r.final_triangles as u64, r.final_vertices as u64),
         max_error_bound: r.max_bound,
         measured_max_error: check.max_error,
+        vertex_heights_raised: options.raises_vertex_heights(grid.max_abs_value()),
     };
     let report = MeshReport {
         summary: MeshSummary::new(args, output, outcome),

@@ -65,6 +65,9 @@ pub struct Outcome {
     pub max_error_bound: f64,
     /// The error the verifier measured.
     pub measured_max_error: f64,
+    /// Whether the decimation raised the vertex heights
+    /// ([`tinsmith_core::DecimationOptions::raises_vertex_heights`]).
+    pub vertex_heights_raised: bool,
 }
 
 impl<'a> MeshSummary<'a> {
@@ -97,9 +100,8 @@ impl<'a> MeshSummary<'a> {
             dp_max_ring: args.dp_max_ring,
             flip_rounds: args.flip_rounds,
             extend_rounds: args.extend_rounds,
-            // As they came out: raised only where decimation raises them (see
-            // `VertexHeights::Raised`).
-            vertex_heights: if args.raises_vertex_heights() {
+            // As they came out: raised only where decimation raises them.
+            vertex_heights: if outcome.vertex_heights_raised {
                 value_name(crate::args::VertexHeightsArg::Raised)
             } else {
                 value_name(crate::args::VertexHeightsArg::Samples)

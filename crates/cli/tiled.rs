@@ -156,6 +156,8 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let decimation = args
         .decimation_options(bound, heights)
         .naming_file(&args.input)?;
+    let vertex_heights_raised =
+        decimation.raises_vertex_heights(info.max_abs_value().unwrap_or(0.0));
     let options = TileOptions::new(decimation)
         .with_tile_size(args.tile_size)
         .with_threads(args.threads.map_or(0, |n| n as usize));
@@ -240,6 +242,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         after: (r.final_triangles, r.final_vertices),
         max_error_bound: r.max_bound,
         measured_max_error: r.measured_max_error,
+        vertex_heights_raised,
     };
     let json = TiledMeshReport {
         summary: MeshSummary::new(args, output, outcome),

@@ -11,7 +11,7 @@ use crate::rtin::{cheap_rtin_with_fewer_triangles, rtin_for_count, rtin_triangle
 use crate::strips::StripPlan;
 use crate::{
     DecimationOptions, Error, ErrorBound, ErrorModel, Grid, InitialMesh, Order, Result, Tin,
-    TinVertex, VertexHeights,
+    TinVertex,
 };
 
 /// Relative slack kept below the requested bound so that `f64` rounding in the bound
@@ -145,19 +145,6 @@ pub fn effective_limit(max_error: f64, max_abs_value: f64) -> f64 {
 /// than `max_error / RAISED_HEIGHT_SHARE`).
 pub const RAISED_HEIGHT_SHARE: f64 = 64.0;
 
-/// Whether vertex heights are raised: asked for, under the exact model (the paper's
-/// bounds start from vertices at their samples), with a bound to take the room from
-/// (count targets have none), and without contour levels (`contour --mesh` reads a
-/// level-shaped TIN back with its vertices at their samples).
-fn raises_heights(options: &DecimationOptions, limit: f64) -> bool {
-    options.vertex_heights == VertexHeights::Raised
-        && options.contour_levels.is_none()
-        && options.error_model == ErrorModel::Exact
-        && options.max_triangles.is_none()
-        && options.max_vertices.is_none()
-        && limit > 0.0
-}
-
 /// The largest |height| decimation accepts: error bounds are stored as `f32`, and between
 /// heights up to this they stay well within its range (and planes far from `f64` overflow).
 pub const MAX_ABS_HEIGHT: f64 = 1e37;
@@ -187,7 +174,7 @@ fn run(
     }
     let limit = effective_limit(max_error, max_abs);
     let raised;
-    let grid = if raises_heights(options, limit) {
+    let grid = if options.raises_vertex_heights(max_abs) {
         raised = grid.with_raised_heights(limit / RAISED_HEIGHT_SHARE);
         &raised
     } else {

@@ -237,8 +237,9 @@ impl Grid {
             && self.values[i + w + 1].is_finite()
     }
 
-    /// Largest absolute valid value (0 for a grid without valid samples).
-    pub(crate) fn max_abs_value(&self) -> f64 {
+    /// Largest absolute valid value (0 for a grid without valid samples): what
+    /// [`crate::effective_limit`] takes as `max_abs_value` for this grid.
+    pub fn max_abs_value(&self) -> f64 {
         self.max_abs
     }
 }

@@ -270,4 +270,22 @@ impl DecimationOptions {
         self.error_model = error_model;
         self
     }
+
+    /// Whether decimation with these options raises the vertex heights on data whose
+    /// largest |value| is `max_abs_value` (the larger of it and
+    /// [`DecimationOptions::max_abs_value`] counts): [`VertexHeights::Raised`] asked for,
+    /// under the exact model (the paper's bounds start from vertices at their samples),
+    /// with a bound to take the room from (above the rounding slack of
+    /// [`crate::effective_limit`]; count targets have none), and without contour levels
+    /// (`contour --mesh` reads a level-shaped TIN back with its vertices at their samples).
+    /// Where this is false, every vertex sits at its sample.
+    pub fn raises_vertex_heights(&self, max_abs_value: f64) -> bool {
+        let max_abs = self.max_abs_value.unwrap_or(0.0).max(max_abs_value);
+        self.vertex_heights == VertexHeights::Raised
+            && self.contour_levels.is_none()
+            && self.error_model == ErrorModel::Exact
+            && self.max_triangles.is_none()
+            && self.max_vertices.is_none()
+            && crate::effective_limit(self.max_error, max_abs) > 0.0
+    }
 }

@@ -188,6 +188,43 @@ fn a_singular_geotransform_is_refused_unless_pixel_coords() {
 }
 
 #[test]
+fn a_geotransform_that_cannot_place_samples_apart_is_refused() {
+    // Pixels of 1e-12 m at x = 500 km: mesh wrote every vertex at one point with exit 0
+    // (and verify then refused its own mesh); a NaN origin was called "singular".
+    let d = Dir::new();
+    for (transform, problem) in [
+        ("500000, 1e-12, 0, 4000000, 0, -1e-12", "pixels too small"),
+        ("nan, 10, 0, 4000000, 0, -10", "not a finite number"),
+    ] {
+        let vrt = stretched_dem(50, 40).replace(
+            "<VRTRasterBand",
+            &format!("<SRS>EPSG:32633</SRS><GeoTransform>{transform}</GeoTransform><VRTRasterBand"),
+        );
+        d.write("odd.vrt", &vrt);
+        let runs: [&[&str]; 3] = [
+            &["mesh", "odd.vrt", "-o", "m.ply", "--max-error", "1"],
+            &["contour", "odd.vrt", "-o", "c.geojson", "--interval", "10"],
+            &["verify", "odd.vrt", "m.ply"],
+        ];
+        for args in runs {
+            let o = d.run(args);
+            assert_fails_naming(&o, &["odd.vrt", problem]);
+        }
+        assert_eq!(d.files(), vec!["odd.vrt"]);
+    }
+    // Large but representable: 10 m pixels at 1e12 m still map back.
+    let vrt = stretched_dem(50, 40).replace(
+        "<VRTRasterBand",
+        "<SRS>EPSG:32633</SRS><GeoTransform>1e12, 10, 0, 1e12, 0, -10</GeoTransform><VRTRasterBand",
+    );
+    d.write("far.vrt", &vrt);
+    let o = d.run(&["mesh", "far.vrt", "-o", "m.ply", "--max-error", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = d.run(&["verify", "far.vrt", "m.ply", "--max-error", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
 fn small_cases_fail_early_and_clearly() {
     let d = Dir::new();
     // A trailing slash names a directory: refused before the work (it failed at the

@@ -17,20 +17,55 @@ pub enum Georef {
     World(GeoTransform),
 }
 
-/// Fails (before any long work) when the raster's geotransform is singular and world
-/// coordinates are to be written: every sample would land on one point or line, and the
-/// mesh could not be read back. `--pixel-coords` needs no geotransform.
+/// How far (in pixels) a file position may be from a sample centre and still name it
+/// ([`Georef::sample_at`]).
+const SAMPLE_TOLERANCE: f64 = 1e-3;
+
+/// Fails (before any long work) when world coordinates are to be written and the raster's
+/// geotransform cannot give every sample its own: a non-finite coefficient, a singular map
+/// (every sample on one point or line), or pixels so small against the origin that `f64`
+/// positions no longer map back to their samples (checked at the grid's corners, where
+/// positions are largest). The mesh could not be read back. `--pixel-coords` needs no
+/// geotransform.
 pub fn check_transform(info: &tinsmith_raster::RasterInfo, pixel_coords: bool) -> Result<()> {
-    match info.transform() {
-        Some(t) if !pixel_coords && t.is_singular() => bail!(
-            "{}: its geotransform {:?} is singular (a pixel size of 0: samples have no \
-             distinct positions); assign a real one (e.g. `gdal_translate -of VRT -a_ullr \
-             ULX ULY LRX LRY IN OUT.vrt`) or write --pixel-coords",
-            info.path.display(),
+    let Some(t) = info.transform().filter(|_| !pixel_coords) else {
+        return Ok(());
+    };
+    let input = info.path.display();
+    let fix = "assign a real one (e.g. `gdal_translate -of VRT -a_ullr ULX ULY LRX LRY IN \
+               OUT.vrt`) or write --pixel-coords";
+    if t.0.iter().any(|c| !c.is_finite()) {
+        bail!(
+            "{input}: its geotransform {:?} has a coefficient that is not a finite number; {fix}",
             t.0
-        ),
-        _ => Ok(()),
+        );
     }
+    if t.is_singular() {
+        bail!(
+            "{input}: its geotransform {:?} is singular (a pixel size of 0: samples have no \
+             distinct positions); {fix}",
+            t.0
+        );
+    }
+    let (w, h) = (
+        f64::from(info.width.max(1) - 1),
+        f64::from(info.height.max(1) - 1),
+    );
+    for (x, y) in [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)] {
+        let back = t.world_to_sample(t.sample_centre(x, y));
+        let lost = back.is_none_or(|[bx, by]| {
+            !((bx - x).abs() <= SAMPLE_TOLERANCE && (by - y).abs() <= SAMPLE_TOLERANCE)
+        });
+        if lost {
+            bail!(
+                "{input}: its geotransform {:?} has pixels too small for its origin: in f64 \
+                 the position of sample ({x}, {y}) does not map back to it, so samples would \
+                 share positions; {fix}",
+                t.0
+            );
+        }
+    }
+    Ok(())
 }
 
 /// [`check_transform`] on the band's metadata alone (no sample is read); returns the
@@ -101,7 +136,7 @@ impl Georef {
             },
         };
         let r = [s[0].round(), s[1].round()];
-        if !((s[0] - r[0]).abs() <= 1e-3 && (s[1] - r[1]).abs() <= 1e-3) {
+        if !((s[0] - r[0]).abs() <= SAMPLE_TOLERANCE && (s[1] - r[1]).abs() <= SAMPLE_TOLERANCE) {
             let grid = |v: f64| {
                 if v.abs() < 1e9 {
                     format!("{v:.4}")

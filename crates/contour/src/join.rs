@@ -2,6 +2,7 @@
 
 use crate::crossing::{crossing_point, segment};
 use crate::mesh::NONE;
+use crate::regularize::without_zero_width_parts;
 use crate::{levels::sorted_levels, ContourMesh, Error, Polyline, Result};
 
 /// The contour lines of `mesh` at each of `levels`, by marching triangles.
@@ -16,6 +17,9 @@ use crate::{levels::sorted_levels, ContourMesh, Error, Polyline, Result};
 /// into one point; a line running out along an edge at the level and back (`A, B, A`)
 /// loses the excursion; and a line that collapses to a point or a ring that encloses
 /// nothing (ground that only touches the level at a vertex or along edges) is dropped.
+/// Edges at the level walked once each way by different lines (a ridge at the level
+/// between a ring and a line, or reaching the boundary) are dropped from both, which are
+/// joined where the ridge left them: no segment is written twice.
 ///
 /// # Output order (deterministic)
 /// Sorted by level (ascending; `levels` may be in any order, duplicates are contoured
@@ -38,6 +42,7 @@ pub fn contour(mesh: &ContourMesh, levels: &[f64]) -> Result<Vec<Polyline>> {
         lines.extend(finish_line(level, walk.closed, walk.crossings));
         Ok(())
     })?;
+    let mut lines = without_zero_width_parts(lines);
     sort_lines(&mut lines);
     Ok(lines)
 }

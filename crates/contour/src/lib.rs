@@ -55,6 +55,7 @@ mod join;
 mod levels;
 mod mesh;
 mod polyline;
+mod regularize;
 mod simplify;
 mod stitch;
 

@@ -4,6 +4,7 @@
 use std::collections::{HashMap, VecDeque};
 
 use crate::join::{finish_line, sort_lines, walk_levels, Crossing};
+use crate::regularize::without_zero_width_parts;
 use crate::{levels::sorted_levels, ContourMesh, Error, Polyline, Result};
 
 /// The contour lines of a mesh given piece by piece: exactly what [`crate::contour`] gives
@@ -125,8 +126,9 @@ impl ContourStitcher {
             self.lines
                 .extend(finish_line(level, false, part.into_crossings()));
         }
-        sort_lines(&mut self.lines);
-        self.lines
+        let mut lines = without_zero_width_parts(self.lines);
+        sort_lines(&mut lines);
+        lines
     }
 
     /// Joins an open part (entry to exit) with the waiting parts it meets.

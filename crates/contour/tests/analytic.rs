@@ -217,6 +217,47 @@ fn a_ridge_that_only_touches_the_level_makes_no_line_and_no_spike() {
 }
 
 #[test]
+fn a_ridge_at_the_level_reaching_the_border_or_between_two_hills_is_not_drawn_twice() {
+    let n = 9;
+    // The ridge of the test above run out to the left border: it makes no line (it made
+    // two, one along each side, the same segments in opposite directions).
+    let to_border = |x: f64, y: f64| y == 4.0 && x <= 5.0;
+    let v = grid(n, n, |x, y| if to_border(x, y) { 1.0 } else { 0.0 });
+    assert!(contour(&full(n, n, &v), &[1.0]).unwrap().is_empty());
+    // The same ridge joining a hill on the right to the left border, and a ridge joining
+    // two hills: each hill keeps its own line, and no segment is drawn twice.
+    for (ridge_from, left_hill) in [(0.0, false), (3.0, true)] {
+        let v = grid(n, n, |x, y| {
+            if x >= 6.0 || (left_hill && x <= 1.0) {
+                2.0
+            } else if y == 4.0 && x >= ridge_from {
+                1.0
+            } else {
+                0.0
+            }
+        });
+        let lines = contour(&full(n, n, &v), &[1.0]).unwrap();
+        assert_eq!(lines.len(), if left_hill { 2 } else { 1 }, "{lines:?}");
+        let mut segments = std::collections::HashSet::new();
+        for line in &lines {
+            for w in line.points().windows(2) {
+                let key = |p: [f64; 2]| [p[0].to_bits(), p[1].to_bits()];
+                let (a, b) = (key(w[0]), key(w[1]));
+                assert!(segments.insert((a.min(b), a.max(b))), "{w:?} twice");
+            }
+            // Only the hills' outlines: no point on the ridge's inner samples.
+            for p in line.points() {
+                assert!(
+                    !(p[1] == 4.0 && p[0] > ridge_from.max(2.0) && p[0] < 5.0),
+                    "{p:?} on the ridge in {:?}",
+                    line.points()
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn a_vertex_that_only_touches_the_level_makes_no_line() {
     let n = 7;
     // A single peak at 1 in the middle, another on the border.

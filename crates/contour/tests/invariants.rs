@@ -33,6 +33,7 @@ fn check(mesh: &ContourMesh, levels: &[f64]) -> Result<(), TestCaseError> {
     prop_assert_eq!(&contour(mesh, &rev).unwrap(), &lines);
 
     let mut seen: HashMap<(u64, (u32, u32)), usize> = HashMap::new();
+    let mut segments = std::collections::HashSet::new();
     let mut prev: Option<(f64, [u32; 2])> = None;
     for line in &lines {
         let level = line.level();
@@ -57,6 +58,12 @@ fn check(mesh: &ContourMesh, levels: &[f64]) -> Result<(), TestCaseError> {
         }
         for w in pts.windows(2) {
             prop_assert_ne!(w[0], w[1], "repeated point");
+            // Every segment once per level, in either direction: none along a ridge at
+            // the level twice (once by each line beside it).
+            let ends = |p: [f64; 2]| [p[0].to_bits(), p[1].to_bits()];
+            let (a, b) = (ends(w[0]), ends(w[1]));
+            let segment = (level.to_bits(), a.min(b), a.max(b));
+            prop_assert!(segments.insert(segment), "segment {:?} twice", w);
         }
         let n = pts.len();
         for (i, (&p, &[a, b])) in pts.iter().zip(edges).enumerate() {

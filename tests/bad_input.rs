@@ -225,6 +225,52 @@ fn a_geotransform_that_cannot_place_samples_apart_is_refused() {
 }
 
 #[test]
+fn a_prj_sidecar_that_is_not_ours_is_not_replaced() {
+    // OBJ, STL and glTF write their CRS to a `.prj` beside them: that replaced a
+    // shapefile's `.prj` of the same name, and a read-only one, without a word; and
+    // `-o /dev/null` made /dev/null.prj.
+    let d = Dir::new();
+    d.write("roads.prj", "GEOGCS[\"elsewhere\"]");
+    d.write("roads.shp", "");
+    let o = d.run(&["mesh", &dem(), "-o", "roads.obj", "--max-error", "5"]);
+    assert_fails_naming(&o, &["roads.obj", "roads.prj", "another CRS"]);
+    assert_eq!(
+        std::fs::read_to_string(d.path("roads.prj")).unwrap(),
+        "GEOGCS[\"elsewhere\"]"
+    );
+    assert_eq!(d.files(), vec!["roads.prj", "roads.shp"]);
+    // An earlier mesh's sidecar is replaced, and one with the same CRS even without it.
+    let o = d.run(&["mesh", &dem(), "-o", "m.obj", "--max-error", "5", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = d.run(&["mesh", &dem(), "-o", "m.obj", "--max-error", "9", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_file(d.path("m.obj")).unwrap();
+    let o = d.run(&["mesh", &dem(), "-o", "m.obj", "--max-error", "9", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // A read-only one is refused before any work, as a read-only mesh is.
+    let prj = d.path("m.prj");
+    let mut mode = std::fs::metadata(&prj).unwrap().permissions();
+    mode.set_readonly(true);
+    std::fs::set_permissions(&prj, mode).unwrap();
+    let o = d.run(&["mesh", &dem(), "-o", "m.obj", "--max-error", "5"]);
+    assert_fails_naming(&o, &["m.obj", "m.prj", "read-only"]);
+    // A device gets no sidecar (nothing may be made in /dev by a test, so a FIFO with a
+    // reader stands in for it).
+    let fifo = d.path("pipe.obj");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(made.success());
+    let reader = std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap());
+    let o = d.run(&["mesh", &dem(), "-o", "pipe.obj", "--max-error", "9", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let obj = reader.join().unwrap();
+    assert!(obj.contains("\nv ") && obj.contains("\nf "), "{obj}");
+    assert!(!d.path("pipe.prj").exists());
+}
+
+#[test]
 fn small_cases_fail_early_and_clearly() {
     let d = Dir::new();
     // A trailing slash names a directory: refused before the work (it failed at the

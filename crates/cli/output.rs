@@ -56,11 +56,18 @@ pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
 }
 
 /// Fails when the `.prj` sidecar a georeferenced mesh in `format` writes beside `output`
-/// is the input's own `.prj` (an ESRI ASCII grid keeps its CRS there) or another file the
-/// input is read from: writing it would change the input. (With `--pixel-coords` no
-/// sidecar is written.)
-pub fn check_sidecar_not_input(output: &Path, input: &Path, format: MeshFormat) -> Result<()> {
-    if !format.uses_prj_sidecar() {
+/// should not be replaced: it is the input's own `.prj` (an ESRI ASCII grid keeps its CRS
+/// there) or another file the input is read from; it is read-only; or it holds another
+/// CRS than `crs_wkt` (the raster's) while no file is at `output`, so it is not from an
+/// earlier mesh there but another file's (a shapefile's of the same name). Output to a
+/// device or pipe writes no sidecar. (With `--pixel-coords` no sidecar is written.)
+pub fn check_sidecar(
+    output: &Path,
+    input: &Path,
+    format: MeshFormat,
+    crs_wkt: Option<&str>,
+) -> Result<()> {
+    if !format.uses_prj_sidecar() || tinsmith_export::is_special_file(output) {
         return Ok(());
     }
     let ours = tinsmith_export::prj_path(output);
@@ -75,6 +82,29 @@ pub fn check_sidecar_not_input(output: &Path, input: &Path, format: MeshFormat) 
                 input.display()
             );
         }
+    }
+    let (Some(wkt), Ok(meta)) = (crs_wkt, std::fs::metadata(&ours)) else {
+        // No CRS, no sidecar (see `note_prj_left_beside`); or none there yet.
+        return Ok(());
+    };
+    if meta.is_file() && meta.permissions().readonly() {
+        bail!(
+            "{}: its CRS would replace {}, which is read-only; make it writable (chmod u+w) \
+             or remove it, or choose another output name",
+            output.display(),
+            ours.display()
+        );
+    }
+    let same_crs = std::fs::read_to_string(&ours).is_ok_and(|held| held.trim() == wkt.trim());
+    if !same_crs && !output.exists() {
+        bail!(
+            "{}: its CRS would replace {}, which holds another CRS and is not from an \
+             earlier mesh here (there is no {}): it may be another file's (a shapefile's); \
+             remove it or choose another output name",
+            output.display(),
+            ours.display(),
+            output.display()
+        );
     }
     Ok(())
 }

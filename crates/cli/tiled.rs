@@ -33,10 +33,16 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
     // Checks the untiled path makes first, so that errors come in the same order.
     let format = crate::export::format(args)?;
     crate::output::check_writable_target(output, &args.input)?;
-    if !args.pixel_coords {
-        crate::output::check_sidecar_not_input(output, &args.input, format)?;
-    }
     let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
+    if !args.pixel_coords {
+        // The CRS written: none for a raster without a geotransform (pixel coordinates).
+        let info = reader.info();
+        let crs_wkt = info
+            .crs_wkt
+            .as_deref()
+            .filter(|_| info.transform().is_some());
+        crate::output::check_sidecar(output, &args.input, format, crs_wkt)?;
+    }
     crate::georef::check_transform(reader.info(), args.pixel_coords)?;
     crate::export::check_float32_positions(format, reader.info(), args)?;
     let fits = reader.width() <= args.tile_size && reader.height() <= args.tile_size;

@@ -26,7 +26,8 @@ where
 ///
 /// The sidecar is renamed first, then the main file. If the main file's rename fails, the
 /// new sidecar is removed again (a previous sidecar at that path is then gone too; the
-/// main file keeps its previous content).
+/// main file keeps its previous content). Output to a device or pipe (`/dev/null`, a
+/// FIFO) gets no sidecar: there is no file for it to describe.
 pub(crate) fn write_atomically_with_sidecar<F>(
     path: &Path,
     write: F,
@@ -35,6 +36,7 @@ pub(crate) fn write_atomically_with_sidecar<F>(
 where
     F: FnOnce(&mut BufWriter<&mut File>) -> io::Result<()>,
 {
+    let sidecar = sidecar.filter(|_| !is_special_file(path));
     let main = stage(path, write)?;
     let Some((sidecar_path, bytes)) = sidecar else {
         return main.commit();

@@ -565,7 +565,8 @@ fn contour_reads_a_mesh_with_raised_heights_and_still_refuses_a_foreign_one() {
         for line in obj.lines() {
             match line.strip_prefix("v ") {
                 Some(rest)
-                    if !done && (pick == 0 || rest.split(' ').nth(2).unwrap().contains('.')) =>
+                    if !done
+                        && (pick == 0 || off_integer_height(rest.split(' ').nth(2).unwrap())) =>
                 {
                     let f: Vec<f64> = rest.split(' ').map(|s| s.parse().unwrap()).collect();
                     moved.push_str(&format!("v {} {} {}\n", f[0], f[1], f[2] + 1.0));

@@ -407,8 +407,9 @@ impl From<ErrorModelArg> for ErrorModel {
 pub enum VertexHeightsArg {
     /// Every vertex at its sample's value.
     Samples,
-    /// Each vertex raised above its sample by 1/64 of --max-error (exact model, no count
-    /// target, no contour levels): fewer triangles on integer heights at small bounds.
+    /// Each vertex raised above its sample by a hair: 2^-24 of (--max-error + the largest
+    /// |height|), at most 1/64 of --max-error (exact model, no count target, no contour
+    /// levels): fewer triangles on integer heights at small bounds.
     /// Vertices on the raster's edges (and tiles') stay at their samples.
     Raised,
 }

@@ -498,7 +498,8 @@ fn nothing_to_contour(args: &ContourArgs) -> anyhow::Error {
 /// (within a millionth of the sample's magnitude or the mesh's height range, for text
 /// rounded by other tools; for STL and glTF, which store `f32` offsets from a local
 /// origin, within 2^-23 of the range more), or, off the raster's outer rows and columns,
-/// that raised by one amount for all (`mesh --vertex-heights raised`, within the same
+/// that raised by one amount for all (`mesh --vertex-heights raised`: in an f64 format to
+/// within f64 rounding, however small the raise; in STL and glTF beyond and within their
 /// rounding; such vertices keep the file's height), and the verifier finds it a valid
 /// triangulation of the domain (no triangle over nodata, no gap, no overlap; GeoJSON and
 /// FlatGeobuf triangles may be wound either way). Otherwise its lines would not be the
@@ -536,6 +537,35 @@ fn mesh_from_file(
     let mut file_heights: Vec<f64> = Vec::with_capacity(file.vertices.len());
     let mut first_raise: Option<f64> = None;
     let at = sample_positions(path, &file, georef)?;
+    let is_inner = |x: i64, y: i64| {
+        (1..grid.width() as i64 - 1).contains(&x) && (1..grid.height() as i64 - 1).contains(&y)
+    };
+    // A file in an f64 format whose inner vertices off their samples are all above them
+    // by one amount, to within the f64 rounding of height + raise, was raised by `mesh`
+    // (by a hair, possibly less than the tolerance below); those vertices keep the file's
+    // heights, the TIN that was measured within the bound. Heights rounded by another
+    // tool scatter both ways and are taken as their samples.
+    let magnitude = lo.abs().max(hi.abs());
+    let exact_spread = 16.0 * f64::EPSILON * magnitude;
+    let common_raise = if float32 {
+        None
+    } else {
+        let mut excess = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut below = false;
+        for (v, &[x, y]) in file.vertices.iter().zip(&at) {
+            if !is_inner(x, y) || x >= grid.width() as i64 || y >= grid.height() as i64 {
+                continue;
+            }
+            let sample = grid.values()[y as usize * grid.width() as usize + x as usize];
+            let d = v[2] - sample;
+            if d > 0.0 {
+                excess = (excess.0.min(d), excess.1.max(d));
+            } else if d < 0.0 {
+                below = true;
+            }
+        }
+        (!below && excess.0 <= excess.1 && excess.1 - excess.0 <= exact_spread).then_some(excess.0)
+    };
     for (i, (v, &[x, y])) in file.vertices.iter().zip(&at).enumerate() {
         if !(0..grid.width() as i64).contains(&x) || !(0..grid.height() as i64).contains(&y) {
             bail!(
@@ -547,16 +577,23 @@ fn mesh_from_file(
         }
         let sample = grid.values()[y as usize * grid.width() as usize + x as usize];
         let tolerance = slack + 1e-6 * sample.abs().max(range);
-        // False for a NaN sample (nodata under a vertex) too.
-        let matches = (v[2] - sample).abs() <= tolerance;
         // Raised heights (off the raster's outer rows and columns) are all the same amount
-        // above their samples: the first one's, within the rounding.
-        let inner =
-            (1..grid.width() as i64 - 1).contains(&x) && (1..grid.height() as i64 - 1).contains(&y);
-        let raised = !matches && inner && v[2] > sample && {
-            let raise = *first_raise.get_or_insert(v[2] - sample);
-            (v[2] - sample - raise).abs() <= 2.0 * tolerance
-        };
+        // above their samples: `common_raise` in an f64 format, else (float32, whose
+        // rounding hides a small raise) the first one's beyond the rounding.
+        let inner = is_inner(x, y);
+        let raised = inner
+            && v[2] > sample
+            && match common_raise {
+                Some(raise) => (v[2] - sample - raise).abs() <= exact_spread,
+                None => {
+                    float32 && (v[2] - sample).abs() > tolerance && {
+                        let raise = *first_raise.get_or_insert(v[2] - sample);
+                        (v[2] - sample - raise).abs() <= 2.0 * tolerance
+                    }
+                }
+            };
+        // False for a NaN sample (nodata under a vertex) too.
+        let matches = !raised && (v[2] - sample).abs() <= tolerance;
         if !matches && !raised {
             bail!(
                 "{}: vertex {i} at column {x}, row {y} has height {}, but band {band} of {} \

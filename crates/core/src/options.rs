@@ -79,8 +79,9 @@ pub enum EdgeSelection {
 pub enum VertexHeights {
     /// Every vertex at its sample's value, as the paper and hmm have them.
     Samples,
-    /// Each vertex off the grid's outer rows and columns raised above its sample by
-    /// 1/[`crate::RAISED_HEIGHT_SHARE`] of the bound (exact model with a bound and no
+    /// Each vertex off the grid's outer rows and columns raised above its sample by a hair
+    /// (2^-24 of the bound plus the largest |height|, at most
+    /// 1/[`crate::RAISED_HEIGHT_SHARE`] of the bound; exact model with a bound and no
     /// contour levels only; otherwise as `Samples`). The bound still holds at every
     /// sample, the vertices' own included. On integer heights many candidate triangles
     /// have a sample exactly the bound away from their plane (through integer vertices),

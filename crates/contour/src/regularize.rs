@@ -39,29 +39,29 @@ struct Segment {
 /// no segment (an open line) or fewer than three distinct points (a ring) go.
 ///
 /// The result depends only on the lines and their order within each level.
-pub(crate) fn without_zero_width_parts(lines: Vec<Polyline>) -> Vec<Polyline> {
-    let mut by_level: Vec<Polyline> = lines;
-    by_level.sort_by(|a, b| a.level.total_cmp(&b.level));
-    let mut out = Vec::with_capacity(by_level.len());
-    let mut start = 0;
-    while start < by_level.len() {
-        let level = by_level[start].level;
-        let mut end = start;
-        while end < by_level.len() && by_level[end].level.total_cmp(&level).is_eq() {
-            end += 1;
+pub(crate) fn without_zero_width_parts(mut lines: Vec<Polyline>) -> Vec<Polyline> {
+    // Lines are moved, never copied: a tiled run holds all of them.
+    lines.sort_by(|a, b| a.level.total_cmp(&b.level));
+    let mut out = Vec::with_capacity(lines.len());
+    let mut level_lines = Vec::new();
+    let mut lines = lines.into_iter().peekable();
+    while let Some(line) = lines.next() {
+        let level = line.level;
+        level_lines.push(line);
+        while let Some(next) = lines.next_if(|l| l.level.total_cmp(&level).is_eq()) {
+            level_lines.push(next);
         }
-        regularize_level(&by_level[start..end], &mut out);
-        start = end;
+        regularize_level(&mut level_lines, &mut out);
     }
     out
 }
 
-/// [`without_zero_width_parts`] on the lines of one level, appended to `out`.
-fn regularize_level(lines: &[Polyline], out: &mut Vec<Polyline>) {
+/// [`without_zero_width_parts`] on the lines of one level, moved to `out`.
+fn regularize_level(lines: &mut Vec<Polyline>, out: &mut Vec<Polyline>) {
     // Every segment, keyed by its two ends (the lower first) and direction.
     let mut keys: Vec<([u64; 4], bool, u32)> = Vec::new();
     let mut first_segment = Vec::with_capacity(lines.len() + 1);
-    for line in lines {
+    for line in lines.iter() {
         first_segment.push(keys.len() as u32);
         for w in line.points.windows(2) {
             let (a, b) = (bits(w[0]), bits(w[1]));
@@ -89,7 +89,7 @@ fn regularize_level(lines: &[Polyline], out: &mut Vec<Polyline>) {
         i = j;
     }
     if pairs.is_empty() {
-        out.extend_from_slice(lines);
+        out.append(lines);
         return;
     }
     drop(keys);
@@ -102,9 +102,10 @@ fn regularize_level(lines: &[Polyline], out: &mut Vec<Polyline>) {
     // The touched lines' segments, linked along their lines.
     let mut segments: Vec<Segment> = Vec::new();
     let mut local = vec![NONE; first_segment[lines.len()] as usize];
-    for (l, line) in lines.iter().enumerate() {
+    let level = lines[0].level;
+    for (l, line) in lines.drain(..).enumerate() {
         if !touched[l] {
-            out.push(line.clone());
+            out.push(line);
             continue;
         }
         let base = segments.len() as u32;
@@ -139,7 +140,7 @@ fn regularize_level(lines: &[Polyline], out: &mut Vec<Polyline>) {
     for &(s, t) in &pairs {
         cancel(&mut segments, local[s as usize], local[t as usize]);
     }
-    rebuild(lines[0].level, &mut segments, out);
+    rebuild(level, &mut segments, out);
 }
 
 /// Removes the opposite segments `s` and `t` and reconnects their lines: the line before

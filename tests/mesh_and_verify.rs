@@ -489,6 +489,14 @@ fn off_integer_height(z: &str) -> bool {
     z.parse::<f64>().expect("OBJ height").fract() != 0.0
 }
 
+/// How many of an OBJ's vertices are off whole-number heights.
+fn off_integer_vertices(obj: &str) -> usize {
+    obj.lines()
+        .filter(|l| l.starts_with("v "))
+        .filter(|l| l.split(' ').nth(3).is_some_and(off_integer_height))
+        .count()
+}
+
 #[test]
 fn the_report_says_which_vertex_heights_came_out_with_contour_levels() {
     // Contour levels keep vertices at their samples; an interval with no level inside the
@@ -517,12 +525,11 @@ fn the_report_says_which_vertex_heights_came_out_with_contour_levels() {
             let report: serde_json::Value =
                 serde_json::from_slice(&std::fs::read(d.path("r.json")).unwrap()).unwrap();
             let obj = std::fs::read_to_string(d.path("m.obj")).unwrap();
-            let off_integer = obj
-                .lines()
-                .filter(|l| l.starts_with("v "))
-                .filter(|l| l.split(' ').nth(3).is_some_and(off_integer_height))
-                .count();
-            let holds = if off_integer > 0 { "raised" } else { "samples" };
+            let holds = if off_integer_vertices(&obj) > 0 {
+                "raised"
+            } else {
+                "samples"
+            };
             assert_eq!(holds, expected, "interval {interval}, tiles of {tile_size}");
             assert_eq!(report["vertex_heights"], expected, "interval {interval}");
         }
@@ -536,11 +543,7 @@ fn contour_reads_a_mesh_with_raised_heights_and_still_refuses_a_foreign_one() {
     let o = d.run(&["mesh", &dem, "-o", "m.obj", "--max-error", "1", "-q"]);
     assert!(o.status.success(), "{}", crate::util::stderr(&o));
     let obj = std::fs::read_to_string(d.path("m.obj")).unwrap();
-    let off_sample = obj
-        .lines()
-        .filter(|l| l.starts_with("v "))
-        .filter(|l| l.split(' ').nth(3).is_some_and(off_integer_height))
-        .count();
+    let off_sample = off_integer_vertices(&obj);
     assert!(
         off_sample > 100,
         "{off_sample} vertices off their integer samples"

@@ -141,15 +141,16 @@ pub fn effective_limit(max_error: f64, max_abs_value: f64) -> f64 {
     }
 }
 
-/// [`VertexHeights::Raised`] raises a vertex by at most the enforced bound over this (so
-/// by less than `max_error / RAISED_HEIGHT_SHARE`); see [`vertex_raise`].
+/// [`crate::VertexHeights::Raised`] raises a vertex by at most the enforced bound over this (so
+/// by less than `max_error / RAISED_HEIGHT_SHARE`; below that, a hair: 2^-24 of the bound
+/// plus the largest |height|).
 pub const RAISED_HEIGHT_SHARE: f64 = 64.0;
 
 /// How many rounding slacks of [`effective_limit`] a raised vertex sits above its sample
 /// (when that is below the bound over [`RAISED_HEIGHT_SHARE`]).
 const RAISE_IN_SLACKS: f64 = 65536.0;
 
-/// How far [`VertexHeights::Raised`] puts a vertex above its sample for `max_error` on
+/// How far [`crate::VertexHeights::Raised`] puts a vertex above its sample for `max_error` on
 /// data whose largest |value| is `max_abs_value`: 2^16 rounding slacks (2^-24 of `max_error
 /// + max_abs_value`), at most the enforced bound over [`RAISED_HEIGHT_SHARE`].
 ///

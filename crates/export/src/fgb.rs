@@ -94,6 +94,12 @@ fn corners(geometry: &Geometry<'_>, feature: usize) -> Result<[[f64; 3]; 3], Pro
             return Err(bad("a non-finite coordinate"));
         }
     }
+    if points == 4 && [xy.get(6), xy.get(7), z.get(3)] != out[0] {
+        return Err(Problem::unsupported(format_args!(
+            "feature {feature} is not a triangle (its ring of 4 positions does not close: \
+             the last is not the first)"
+        )));
+    }
     Ok(out)
 }
 
@@ -236,6 +242,29 @@ mod tests {
         assert_eq!(mesh.epsg, Some(32610));
         assert_eq!(mesh.crs_wkt.as_deref(), Some("PROJCS[\"x\"]"));
         Ok(())
+    }
+
+    #[test]
+    fn a_ring_that_does_not_close_is_refused() {
+        // The closing position differs from the first in x, then in z: GDAL warns "Non
+        // closed ring detected"; the reader took the first three and said nothing.
+        let vertices = [[0.25, 0.75, 7.0], [0.0, 0.0, 1.0], [1.0, 0.0, 2.0]];
+        let bytes = write_to_vec(MeshRef::new(&vertices, &[[0, 1, 2]]));
+        assert_eq!(read(&bytes[..]).unwrap().triangles.len(), 1);
+        for (old, new) in [(0.25f64, 0.5f64), (7.0, 8.0)] {
+            let (old, new) = (old.to_le_bytes(), new.to_le_bytes());
+            let at = bytes
+                .windows(8)
+                .rposition(|w| w == old)
+                .expect("closing value");
+            let mut open = bytes.clone();
+            open[at..at + 8].copy_from_slice(&new);
+            let problem = read(&open[..]).expect_err("an open ring");
+            assert!(
+                format!("{problem:?}").contains("does not close"),
+                "{problem:?}"
+            );
+        }
     }
 
     #[test]

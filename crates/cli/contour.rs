@@ -553,7 +553,7 @@ fn mesh_from_file(
         let mut excess = (f64::INFINITY, f64::NEG_INFINITY);
         let mut below = false;
         for (v, &[x, y]) in file.vertices.iter().zip(&at) {
-            if !is_inner(x, y) || x >= grid.width() as i64 || y >= grid.height() as i64 {
+            if !is_inner(x, y) {
                 continue;
             }
             let sample = grid.values()[y as usize * grid.width() as usize + x as usize];

@@ -138,12 +138,13 @@ impl Plan {
         check_position_rounding(info, &georef, origin, min, max, out(args))?;
 
         // Raised vertex heights are not samples: bound their rounding from the range, up
-        // to the highest sample raised.
+        // to the highest sample raised (by at most the raise for the whole bound; the
+        // decimation's bound is smaller).
         let samples_only = !args.raises_vertex_heights(info.min.zip(info.max));
         let raise = if samples_only {
             0.0
         } else {
-            max_error / tinsmith_core::RAISED_HEIGHT_SHARE
+            tinsmith_core::vertex_raise(max_error, info.max_abs_value().unwrap_or(0.0))
         };
         let height_rounding = match grid.filter(|_| samples_only) {
             Some(grid) => {

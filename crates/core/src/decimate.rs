@@ -159,7 +159,9 @@ const RAISE_IN_SLACKS: f64 = 65536.0;
 /// below; it gains the same from 1/64 of the bound down to 2^-20 of it (session 17,
 /// docs/results.md). Kept small, it is invisible: a flat lake stays at its level to a
 /// fraction of a millimetre, and a bound far beyond the relief does not lift the mesh.
-pub(crate) fn vertex_raise(max_error: f64, max_abs_value: f64) -> f64 {
+/// It grows with `max_error`, so the raise for a bound also bounds a run's at any smaller
+/// one (the float32 formats' rounding margin relies on that).
+pub fn vertex_raise(max_error: f64, max_abs_value: f64) -> f64 {
     let slack = ROUNDING_SLACK * (max_error.min(f64::MAX) + max_abs_value);
     (RAISE_IN_SLACKS * slack).min(effective_limit(max_error, max_abs_value) / RAISED_HEIGHT_SHARE)
 }

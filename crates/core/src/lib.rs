@@ -44,8 +44,8 @@ mod strips;
 mod tin;
 
 pub use decimate::{
-    decimate, decimate_with_border, decimate_with_progress, effective_limit, Decimation,
-    DecimationReport, Progress, MAX_ABS_HEIGHT, RAISED_HEIGHT_SHARE,
+    decimate, decimate_with_border, decimate_with_progress, effective_limit, vertex_raise,
+    Decimation, DecimationReport, Progress, MAX_ABS_HEIGHT, RAISED_HEIGHT_SHARE,
 };
 pub use error::{Error, Result};
 pub use error_bound::ErrorBound;

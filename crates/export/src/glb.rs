@@ -242,10 +242,19 @@ pub(crate) fn read<R: Read>(mut r: R, file_len: Option<u64>) -> Result<Mesh, Pro
         )));
     }
     let length = u64::from(u32_at(&header, 8));
-    if file_len.is_some_and(|len| len < length) {
-        return Err(Problem::malformed(format_args!(
-            "the header announces {length} bytes, the file has fewer (truncated)"
-        )));
+    match file_len {
+        Some(len) if len < length => {
+            return Err(Problem::malformed(format_args!(
+                "the header announces {length} bytes, the file has fewer (truncated)"
+            )))
+        }
+        // Bytes past the declared end are no part of the GLB: a file cut or joined wrong.
+        Some(len) if len > length => {
+            return Err(Problem::malformed(format_args!(
+                "the header announces {length} bytes, the file has {len}"
+            )))
+        }
+        _ => {}
     }
     let (json_len, json_type) = (u32_at(&header, 12), u32_at(&header, 16));
     if json_type != CHUNK_JSON || json_len > MAX_JSON || u64::from(json_len) + 20 > length {
@@ -257,6 +266,20 @@ pub(crate) fn read<R: Read>(mut r: R, file_len: Option<u64>) -> Result<Mesh, Pro
     r.read_exact(&mut json_bytes)?;
     let root: Value = serde_json::from_slice(&json_bytes)
         .map_err(|e| Problem::malformed(format_args!("JSON chunk: {e}")))?;
+    // glTF requires `asset.version`; its major version must be 2, as the header's is.
+    match root["asset"]["version"].as_str() {
+        Some(version) if version.split('.').next() == Some("2") => {}
+        Some(version) => {
+            return Err(Problem::unsupported(format_args!(
+                "glTF asset version {version}; only 2.x is read"
+            )))
+        }
+        None => {
+            return Err(Problem::malformed(
+                "the JSON has no asset.version (required by glTF)",
+            ))
+        }
+    }
 
     let mut bin = Vec::new();
     let rest = length - 20 - u64::from(json_len);
@@ -719,6 +742,24 @@ mod tests {
         assert!(matches!(
             read(corrupt.as_slice(), None),
             Err(Problem::Malformed(_))
+        ));
+        let mut trailing = good.clone();
+        trailing.extend_from_slice(&[0; 8]);
+        assert!(matches!(
+            read(trailing.as_slice(), Some(trailing.len() as u64)),
+            Err(Problem::Malformed(m)) if m.contains("the file has")
+        ));
+        let (mut root, bin) = unpack(&good);
+        assert!(read(pack(&root, &bin).as_slice(), None).is_ok());
+        root["asset"]["version"] = Value::from("3.0");
+        assert!(matches!(
+            read(pack(&root, &bin).as_slice(), None),
+            Err(Problem::Unsupported(m)) if m.contains("3.0")
+        ));
+        root.as_object_mut().expect("object").remove("asset");
+        assert!(matches!(
+            read(pack(&root, &bin).as_slice(), None),
+            Err(Problem::Malformed(m)) if m.contains("asset.version")
         ));
         for position in (0..good.len()).step_by(7) {
             let mut corrupt = good.clone();

@@ -18,6 +18,45 @@ struct Side {
     left: bool,
 }
 
+/// A side stored under its `low` vertex: `high` and `left` packed as `high << 1 | left`,
+/// so the integer order is the order by `(high, left)`. `u32` holds ids below 2^31 (4
+/// bytes per side, where a [`Side`] takes 12: the sides are the verifier's largest array);
+/// `u64` holds any.
+trait PackedSide: Copy + Ord + Default {
+    /// The largest number of vertices whose ids fit.
+    const VERTICES: usize;
+    fn pack(high: u32, left: bool) -> Self;
+    fn high(self) -> u32;
+    fn left(self) -> bool;
+}
+
+impl PackedSide for u32 {
+    const VERTICES: usize = 1 << 31;
+    fn pack(high: u32, left: bool) -> u32 {
+        debug_assert!(high < 1 << 31);
+        high << 1 | u32::from(left)
+    }
+    fn high(self) -> u32 {
+        self >> 1
+    }
+    fn left(self) -> bool {
+        self & 1 == 1
+    }
+}
+
+impl PackedSide for u64 {
+    const VERTICES: usize = usize::MAX;
+    fn pack(high: u32, left: bool) -> u64 {
+        u64::from(high) << 1 | u64::from(left)
+    }
+    fn high(self) -> u32 {
+        (self >> 1) as u32
+    }
+    fn left(self) -> bool {
+        self & 1 == 1
+    }
+}
+
 /// Checks conformity over the `measured` triangles (non-degenerate, corners in the grid),
 /// welding vertices that share a position and height first (formats without shared
 /// vertices repeat them).
@@ -28,6 +67,22 @@ pub(crate) fn check_edges(
     report: &mut Report,
     log: &mut ProblemLog,
 ) {
+    if mesh.positions.len() <= u32::VERTICES {
+        check_packed_edges::<u32>(grid, mesh, measured, report, log);
+    } else {
+        check_packed_edges::<u64>(grid, mesh, measured, report, log);
+    }
+}
+
+/// [`check_edges`] with sides packed in `K`, which must hold every vertex id.
+fn check_packed_edges<K: PackedSide>(
+    grid: GridRef<'_>,
+    mesh: MeshRef<'_>,
+    measured: &[bool],
+    report: &mut Report,
+    log: &mut ProblemLog,
+) {
+    debug_assert!(mesh.positions.len() <= K::VERTICES);
     let welded = welded_ids(mesh);
     let triangles = || {
         mesh.triangles
@@ -36,7 +91,7 @@ pub(crate) fn check_edges(
             .filter(|(_, &m)| m)
             .map(|(corners, _)| corners.map(|v| welded[v as usize]))
     };
-    let sides = sorted_by_edge(
+    let (start, sides) = sorted_by_edge::<K, _>(
         triangles().flat_map(|c| (0..3).map(move |k| c[k].min(c[(k + 1) % 3]))),
         || {
             triangles().flat_map(|c| {
@@ -54,40 +109,39 @@ pub(crate) fn check_edges(
         },
         mesh.positions.len(),
     );
-    for group in sides.chunk_by(|a, b| (a.low, a.high) == (b.low, b.high)) {
-        let [p, q] = [group[0].low, group[0].high].map(|v| mesh.positions[v as usize]);
-        match group {
-            [one] => {
-                if !on_outline(grid, p, q, one.left) {
-                    report.open_edges += 1;
-                    log.push(Kind::OpenEdge, || {
+    for (low, range) in start.windows(2).enumerate() {
+        for group in sides[range[0]..range[1]].chunk_by(|a, b| a.high() == b.high()) {
+            let [p, q] = [low, group[0].high() as usize].map(|v| mesh.positions[v]);
+            match group {
+                [one] => {
+                    if !on_outline(grid, p, q, one.left()) {
+                        report.open_edges += 1;
+                        log.push(Kind::OpenEdge, || {
+                            format!(
+                                "edge ({}, {})-({}, {}) borders one triangle but is not on \
+                                 the domain's outline (a hole, crack or T-junction)",
+                                p[0], p[1], q[0], q[1]
+                            )
+                        });
+                    }
+                }
+                [a, b] if a.left() != b.left() => {}
+                _ => {
+                    report.overlapping_edges += 1;
+                    let left = group.iter().filter(|s| s.left()).count();
+                    log.push(Kind::OverlappingEdge, || {
                         format!(
-                            "edge ({}, {})-({}, {}) borders one triangle but is not on the \
-                             domain's outline (a hole, crack or T-junction)",
-                            p[0], p[1], q[0], q[1]
+                            "edge ({}, {})-({}, {}) is shared by {} triangles, {} on one side \
+                             (they overlap)",
+                            p[0],
+                            p[1],
+                            q[0],
+                            q[1],
+                            group.len(),
+                            left.max(group.len() - left)
                         )
                     });
                 }
-            }
-            [a, b] if a.left != b.left => {}
-            _ => {
-                report.overlapping_edges += 1;
-                log.push(Kind::OverlappingEdge, || {
-                    format!(
-                        "edge ({}, {})-({}, {}) is shared by {} triangles, {} on one side \
-                         (they overlap)",
-                        p[0],
-                        p[1],
-                        q[0],
-                        q[1],
-                        group.len(),
-                        group
-                            .iter()
-                            .filter(|s| s.left)
-                            .count()
-                            .max(group.iter().filter(|s| !s.left).count())
-                    )
-                });
             }
         }
     }
@@ -117,16 +171,17 @@ fn welded_ids(mesh: MeshRef<'_>) -> Vec<u32> {
         .collect()
 }
 
-/// The sides `sides()` yields, ordered by `(low, high, left)`, given `lows` (their `low`
-/// ids, in any order, all below `vertices`): counted by `low` in a first pass, placed in a
-/// second, then each vertex's few sides sorted on their own. Linear time, where a
+/// The sides `sides()` yields, grouped by `low` and ordered by `(high, left)` within each
+/// group, given `lows` (their `low` ids, in any order, all below `vertices`): vertex `v`'s
+/// sides are `sorted[start[v]..start[v + 1]]`. Counted by `low` in a first pass, placed in
+/// a second, then each vertex's few sides sorted on their own: linear time, where a
 /// comparison sort of all sides took a quarter of the verification, and one array of
-/// sides, not an unsorted copy besides.
-fn sorted_by_edge<I: Iterator<Item = Side>>(
+/// packed sides, not an unsorted copy besides.
+fn sorted_by_edge<K: PackedSide, I: Iterator<Item = Side>>(
     lows: impl Iterator<Item = u32>,
     sides: impl FnOnce() -> I,
     vertices: usize,
-) -> Vec<Side> {
+) -> (Vec<usize>, Vec<K>) {
     let mut start = vec![0usize; vertices + 1];
     for low in lows {
         start[low as usize + 1] += 1;
@@ -134,21 +189,21 @@ fn sorted_by_edge<I: Iterator<Item = Side>>(
     for v in 0..vertices {
         start[v + 1] += start[v];
     }
-    let mut next = start[..vertices].to_vec();
-    let unset = Side {
-        low: 0,
-        high: 0,
-        left: false,
-    };
-    let mut sorted = vec![unset; start[vertices]];
+    let mut sorted = vec![K::default(); start[vertices]];
     for s in sides() {
-        sorted[next[s.low as usize]] = s;
-        next[s.low as usize] += 1;
+        let at = &mut start[s.low as usize];
+        sorted[*at] = K::pack(s.high, s.left);
+        *at += 1;
     }
+    // Each `start[v]` has moved on to where `v + 1`'s sides start: shift them back.
+    for v in (0..vertices).rev() {
+        start[v + 1] = start[v];
+    }
+    start[0] = 0;
     for range in start.windows(2) {
-        sorted[range[0]..range[1]].sort_unstable_by_key(|s| (s.high, s.left));
+        sorted[range[0]..range[1]].sort_unstable();
     }
-    sorted
+    (start, sorted)
 }
 
 /// Whether segment `p -> q` runs along the domain's outline with the domain on its left
@@ -238,14 +293,24 @@ mod tests {
         let key = |s: &Side| (s.low, s.high, s.left);
         let mut expected = sides.clone();
         expected.sort_unstable_by_key(key);
-        let got = sorted_by_edge(
-            sides.iter().map(|s| s.low),
-            || sides.iter().copied(),
-            vertices as usize,
-        );
-        assert_eq!(
-            got.iter().map(key).collect::<Vec<_>>(),
-            expected.iter().map(key).collect::<Vec<_>>()
-        );
+        let expected: Vec<_> = expected.iter().map(key).collect();
+        fn unpacked<K: PackedSide>(start: &[usize], sorted: &[K]) -> Vec<(u32, u32, bool)> {
+            start
+                .windows(2)
+                .enumerate()
+                .flat_map(|(low, r)| {
+                    sorted[r[0]..r[1]]
+                        .iter()
+                        .map(move |s| (low as u32, s.high(), s.left()))
+                })
+                .collect()
+        }
+        let lows = || sides.iter().map(|s| s.low);
+        let (start, got) =
+            sorted_by_edge::<u32, _>(lows(), || sides.iter().copied(), vertices as usize);
+        assert_eq!(unpacked(&start, &got), expected);
+        let (start, got) =
+            sorted_by_edge::<u64, _>(lows(), || sides.iter().copied(), vertices as usize);
+        assert_eq!(unpacked(&start, &got), expected);
     }
 }

@@ -1,5 +1,7 @@
 //! A rectangular grid of scalar samples; NaN marks a sample outside the domain.
 
+use std::sync::Arc;
+
 use crate::{Error, Result};
 
 /// A `width` x `height` grid of samples in row-major order (row 0 first).
@@ -11,15 +13,16 @@ use crate::{Error, Result};
 pub struct Grid {
     width: u32,
     height: u32,
-    values: Vec<f64>,
+    /// Shared, so that a grid with raised heights is no copy of the samples.
+    values: Arc<Vec<f64>>,
     /// Largest absolute valid value (0 without valid samples).
     max_abs: f64,
     /// See [`Grid::integral_heights`].
     integral_heights: bool,
     /// See [`Grid::equal_runs`].
-    equal_runs: Option<Vec<u16>>,
+    equal_runs: Option<Arc<Vec<u16>>>,
     /// See [`Grid::flat_value`]; built with `equal_runs`.
-    flat_blocks: Vec<FlatLevel>,
+    flat_blocks: Arc<Vec<FlatLevel>>,
     /// See [`Grid::vertex_height`]; 0 when vertices sit at their samples' values.
     raise: f64,
 }
@@ -79,19 +82,19 @@ impl Grid {
         Ok(Grid {
             width,
             height,
-            values,
+            values: Arc::new(values),
             max_abs,
             integral_heights,
-            equal_runs,
-            flat_blocks,
+            equal_runs: equal_runs.map(Arc::new),
+            flat_blocks: Arc::new(flat_blocks),
             raise: 0.0,
         })
     }
 
-    /// A copy whose vertices sit `raise` above their samples ([`Grid::vertex_height`]),
+    /// The grid with its vertices `raise` above their samples ([`Grid::vertex_height`]),
     /// except on the grid's outer rows and columns (so tiles sharing a border agree on its
-    /// heights without reading each other). The copy does not claim
-    /// [`Grid::integral_heights`].
+    /// heights without reading each other); it shares the samples, not copies them, and
+    /// does not claim [`Grid::integral_heights`].
     pub(crate) fn with_raised_heights(&self, raise: f64) -> Grid {
         Grid {
             integral_heights: false,
@@ -128,7 +131,7 @@ impl Grid {
     /// ground (water, filled voids, the air around a CT slice) is where they pay: along
     /// a run the error against a plane is monotone, so only its two ends need measuring.
     pub(crate) fn equal_runs(&self) -> Option<&[u16]> {
-        self.equal_runs.as_deref()
+        self.equal_runs.as_deref().map(Vec::as_slice)
     }
 
     /// `Some(v)` when every sample of columns `x0..=x1`, rows `y0..=y1` (inside the grid)

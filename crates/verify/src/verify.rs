@@ -35,8 +35,8 @@ use crate::{ErrorLocation, GridRef, MeshRef, Report, Result, VerifyError, Verify
 /// # Runtime
 /// Linear in the number of samples plus the total number of samples inside triangles
 /// (plus one step per triangle row), and a counting sort of the triangles' edges by their
-/// lower vertex. Memory: one bit per sample plus a few rows, and about 45 bytes per
-/// triangle for the edges (the sides, bucket offsets and welded ids per vertex).
+/// lower vertex. Memory: one bit per sample plus a few rows, and about 20 bytes per
+/// triangle for the edges (4 per side, and bucket offsets and welded ids per vertex).
 pub fn verify(grid: GridRef<'_>, mesh: MeshRef<'_>, options: &VerifyOptions) -> Result<Report> {
     let expected = grid.sample_count();
     if u64::try_from(grid.values.len()) != Ok(expected) {

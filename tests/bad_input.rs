@@ -1167,4 +1167,31 @@ fn heights_beyond_1e37_are_refused_with_one_message() {
     assert_fails_naming(&o, &["huge.asc", "1e37"]);
     assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
     assert_eq!(d.files(), vec!["huge.asc"]);
+    // Tiled, with the huge sample in the last of 4 tiles: refused before any tile, so no
+    // tile is named (the first tile was, though its heights were fine).
+    let rows: String = (0..5)
+        .map(|y| {
+            let row: Vec<&str> = (0..5)
+                .map(|x| if (x, y) == (4, 4) { "2e37" } else { "1" })
+                .collect();
+            row.join(" ") + "\n"
+        })
+        .collect();
+    d.write(
+        "late.asc",
+        &format!("ncols 5\nnrows 5\nxllcorner 0\nyllcorner 0\ncellsize 1\n{rows}"),
+    );
+    let o = d.run(&[
+        "mesh",
+        "late.asc",
+        "-o",
+        "m.ply",
+        "--max-error",
+        "1",
+        "--tile-size",
+        "3",
+    ]);
+    assert_fails_naming(&o, &["late.asc", "1e37"]);
+    assert!(!stderr(&o).contains("tile"), "{}", stderr(&o));
+    assert_eq!(d.files(), vec!["huge.asc", "late.asc"]);
 }

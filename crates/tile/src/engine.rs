@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use tinsmith_core::{
     decimate_with_border, effective_limit, DecimationOptions, DecimationReport, ErrorModel, Grid,
-    TinVertex,
+    TinVertex, MAX_ABS_HEIGHT,
 };
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
@@ -171,6 +171,11 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
         })?;
     let threads = pool.current_num_threads();
     let max_abs_value = source.max_abs_value();
+    if max_abs_value > MAX_ABS_HEIGHT {
+        return Err(Error::Heights(tinsmith_core::Error::HeightsTooLarge(
+            max_abs_value,
+        )));
+    }
     let job = TileJob {
         plan,
         options: DecimationOptions {

@@ -60,6 +60,10 @@ pub enum Error {
         #[source]
         source: crate::ReadError,
     },
+    /// The raster's heights are beyond what decimation takes
+    /// ([`tinsmith_core::MAX_ABS_HEIGHT`]): refused before any tile, as an untiled run is.
+    #[error(transparent)]
+    Heights(tinsmith_core::Error),
     /// The core refused to decimate a tile (a shared edge sample it could not remove).
     #[error("{tile}: decimation failed")]
     Decimate {

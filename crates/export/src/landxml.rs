@@ -283,6 +283,12 @@ pub(crate) fn read<R: BufRead>(r: R) -> Result<Mesh, Problem> {
                 }
                 inside = Inside::Nothing;
             }
+            Event::Eof if !path.is_empty() => {
+                return Err(Problem::malformed(format_args!(
+                    "the file ends inside <{}> (truncated)",
+                    path.last().map_or("", String::as_str)
+                )))
+            }
             Event::Eof => break,
             _ => {}
         }
@@ -431,8 +437,10 @@ mod tests {
 
     #[test]
     fn bad_files_are_reported() {
-        let cases: [(&str, &str); 7] = [
+        let cases: [(&str, &str); 9] = [
             ("", "empty"),
+            ("<LandXML><Surfaces><Surface><Pnts><P id=\"1\">1 2 3</P>", "ends inside <Pnts>"),
+            ("<LandXML><Surfaces><Surface><Faces><F>1 2", "ends inside <F>"),
             ("<Other/>", "not LandXML"),
             ("<LandXML><Surfaces><Surface><Pnts><P>1 2 3</P></Pnts></Surface></Surfaces></LandXML>", "without an id"),
             ("<LandXML><Surfaces><Surface><Pnts><P id=\"1\">1 2</P></Pnts></Surface></Surfaces></LandXML>", "not 3 numbers"),

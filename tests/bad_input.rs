@@ -247,6 +247,17 @@ fn a_prj_sidecar_that_is_not_ours_is_not_replaced() {
     std::fs::remove_file(d.path("m.obj")).unwrap();
     let o = d.run(&["mesh", &dem(), "-o", "m.obj", "--max-error", "9", "-q"]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // The same CRS spelled otherwise (ESRI's WKT, as GIS tools write `.prj` files) too.
+    let esri = std::process::Command::new("gdalsrsinfo")
+        .args(["-o", "wkt_esri", "--single-line", "EPSG:3857"])
+        .output()
+        .expect("gdalsrsinfo (Debian gdal-bin, installed by `make deps`) must be on PATH");
+    let esri = String::from_utf8(esri.stdout).unwrap();
+    assert!(esri.contains("PROJCS["), "{esri}");
+    d.write("esri.prj", &esri);
+    let o = d.run(&["mesh", &dem(), "-o", "esri.obj", "--max-error", "9", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_ne!(std::fs::read_to_string(d.path("esri.prj")).unwrap(), esri);
     // A read-only one is refused before any work, as a read-only mesh is.
     let prj = d.path("m.prj");
     let mut mode = std::fs::metadata(&prj).unwrap().permissions();

@@ -95,7 +95,9 @@ pub fn check_sidecar(
             ours.display()
         );
     }
-    let same_crs = std::fs::read_to_string(&ours).is_ok_and(|held| held.trim() == wkt.trim());
+    // The same CRS in another spelling (ESRI's, GDAL's `.prj` of the input) counts.
+    let same_crs = std::fs::read_to_string(&ours)
+        .is_ok_and(|held| held.trim() == wkt.trim() || tinsmith_raster::same_crs(held.trim(), wkt));
     if !same_crs && !output.exists() {
         bail!(
             "{}: its CRS would replace {}, which holds another CRS and is not from an \

@@ -75,5 +75,5 @@ pub use geographic::{
 pub use info::{Raster, RasterInfo};
 pub use quiet::silence_gdal_errors;
 pub use read::{open_info, open_info_with_progress, read_grid};
-pub use reproject::{from_wgs84, is_geographic, is_wgs84_lon_lat, to_wgs84};
+pub use reproject::{from_wgs84, is_geographic, is_wgs84_lon_lat, same_crs, to_wgs84};
 pub use window::{read_window, WindowReader};

@@ -142,9 +142,34 @@ pub fn is_geographic(wkt: &str) -> Result<bool> {
     Ok(spatial_ref(wkt)?.is_geographic())
 }
 
+/// Whether two CRS texts (WKT in any dialect, ESRI's `.prj` included, or anything GDAL's
+/// `SetFromUserInput` takes) name the same CRS, by GDAL's `IsSame` (axis order aside).
+/// False when GDAL cannot read either.
+pub fn same_crs(a: &str, b: &str) -> bool {
+    match (spatial_ref(a), spatial_ref(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn same_crs_reads_through_spelling() {
+        let utm = SpatialRef::from_epsg(32632).expect("EPSG:32632");
+        let (wkt, pretty) = (
+            utm.to_wkt().expect("WKT"),
+            utm.to_pretty_wkt().expect("pretty WKT"),
+        );
+        assert!(same_crs(&wkt, "EPSG:32632"));
+        assert!(same_crs(&wkt, &pretty));
+        let esri_prj = "PROJCS[\"WGS_1984_UTM_Zone_32N\",GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137.0,298.257223563]],PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],PARAMETER[\"False_Easting\",500000.0],PARAMETER[\"False_Northing\",0.0],PARAMETER[\"Central_Meridian\",9.0],PARAMETER[\"Scale_Factor\",0.9996],PARAMETER[\"Latitude_Of_Origin\",0.0],UNIT[\"Meter\",1.0]]";
+        assert!(same_crs(&wkt, esri_prj));
+        assert!(!same_crs(&wkt, "EPSG:32633"));
+        assert!(!same_crs(&wkt, "not a CRS"));
+    }
 
     #[test]
     fn wgs84_lon_lat_is_recognised_in_any_spelling() {

@@ -1046,37 +1046,40 @@ fn an_interrupted_run_leaves_no_temporary_file() {
     // The fixture stretched 30 times and meshed at a zero bound: 12.8 M triangles, seconds
     // of work with temporary files open most of the time.
     d.write("big.vrt", &stretched_dem(3000, 2400));
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
-        .args(["mesh", "big.vrt", "-o", "out.ply", "--max-error", "0", "-q"])
-        .current_dir(d.path(""))
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("start tinsmith");
-    let temporary = || d.files().iter().any(|f| f.starts_with(".tinsmith-"));
-    let started = std::time::Instant::now();
-    while !temporary() {
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "finished before any temporary file was seen"
+    // Exit codes as a shell reports a process the signal ended: 128 + its number.
+    for (signal, code) in [("INT", 130), ("TERM", 143)] {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+            .args(["mesh", "big.vrt", "-o", "out.ply", "--max-error", "0", "-q"])
+            .current_dir(d.path(""))
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("start tinsmith");
+        let temporary = || d.files().iter().any(|f| f.starts_with(".tinsmith-"));
+        let started = std::time::Instant::now();
+        while !temporary() {
+            assert!(
+                child.try_wait().unwrap().is_none(),
+                "finished before any temporary file was seen"
+            );
+            assert!(started.elapsed().as_secs() < 120, "no temporary file");
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        let killed = std::process::Command::new("kill")
+            .args([&format!("-{signal}"), &child.id().to_string()])
+            .status()
+            .expect("kill");
+        assert!(killed.success());
+        let out = child.wait_with_output().expect("wait");
+        assert_eq!(
+            out.status.code(),
+            Some(code),
+            "SIG{signal}: {:?}: {}",
+            out.status,
+            crate::util::stderr(&out)
         );
-        assert!(started.elapsed().as_secs() < 120, "no temporary file");
-        std::thread::sleep(std::time::Duration::from_millis(5));
+        assert!(crate::util::stderr(&out).contains("interrupted"));
+        assert_eq!(d.files(), vec!["big.vrt"], "SIG{signal}");
     }
-    let killed = std::process::Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .expect("kill");
-    assert!(killed.success());
-    let out = child.wait_with_output().expect("wait");
-    assert_eq!(
-        out.status.code(),
-        Some(130),
-        "{:?}: {}",
-        out.status,
-        crate::util::stderr(&out)
-    );
-    assert!(crate::util::stderr(&out).contains("interrupted"));
-    assert_eq!(d.files(), vec!["big.vrt"]);
 }
 
 #[test]

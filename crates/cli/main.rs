@@ -38,29 +38,16 @@ use crate::args::{Cli, Command};
 const EXIT_VERIFY_FAILED: u8 = 1;
 /// Exit code for bad input and other errors.
 const EXIT_ERROR: u8 = 2;
-/// Exit code after Ctrl-C or SIGTERM (128 + SIGINT, as shells report an interrupt).
-const EXIT_INTERRUPTED: i32 = 130;
+/// Exit codes after a signal are 128 + its number, as shells report a process the signal
+/// ended: 130 after Ctrl-C (SIGINT), 143 after SIGTERM, 129 after SIGHUP.
+const EXIT_SIGNALLED: i32 = 128;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    // Ctrl-C or SIGTERM: no half-written temporary file or directory may stay behind
-    // (their owners' drops, which remove them on errors, do not run on a signal's exit).
-    let _ = ctrlc::set_handler(|| {
-        if tinsmith_export::finished() {
-            // Every output is complete and in place; only memory was being freed.
-            // SAFETY: as below.
-            unsafe { libc::_exit(0) }
-        }
-        if tinsmith_export::remove_pending() > 0 {
-            note!("\ntinsmith: interrupted; unfinished output removed");
-        } else {
-            note!("\ntinsmith: interrupted");
-        }
-        // SAFETY: `_exit` takes no pointers and never returns. Unlike `process::exit` it
-        // runs no atexit handlers, which would tear GDAL's global state down under the
-        // worker threads still reading (a segfault, seen in tests).
-        unsafe { libc::_exit(EXIT_INTERRUPTED) }
-    });
+    // Ctrl-C, SIGTERM or SIGHUP: no half-written temporary file or directory may stay
+    // behind (their owners' drops, which remove them on errors, do not run on a signal's
+    // exit). The signals are taken on a thread of their own, where files can be removed.
+    on_signal_remove_pending_output();
     // Errors come back as values with GDAL's message; GDAL need not print them too.
     tinsmith_raster::silence_gdal_errors();
     if matches!(cli.command, Command::Info(_) | Command::Verify(_)) {
@@ -137,4 +124,36 @@ fn is_broken_pipe(err: &anyhow::Error) -> bool {
         e.downcast_ref::<std::io::Error>()
             .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
     })
+}
+
+/// Starts the thread that, on SIGINT, SIGTERM or SIGHUP, removes unfinished output and
+/// exits with 128 + the signal's number (0 when every output is already complete). If
+/// the signals cannot be taken, they keep their default action (the process ends at once).
+fn on_signal_remove_pending_output() {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+        return;
+    };
+    let started = std::thread::Builder::new()
+        .name("tinsmith-signals".to_owned())
+        .spawn(move || {
+            let Some(signal) = signals.forever().next() else {
+                return;
+            };
+            if tinsmith_export::finished() {
+                // Every output is complete and in place; only memory was being freed.
+                // SAFETY: as below.
+                unsafe { libc::_exit(0) }
+            }
+            if tinsmith_export::remove_pending() > 0 {
+                note!("\ntinsmith: interrupted; unfinished output removed");
+            } else {
+                note!("\ntinsmith: interrupted");
+            }
+            // SAFETY: `_exit` takes no pointers and never returns. Unlike `process::exit`
+            // it runs no atexit handlers, which would tear GDAL's global state down under
+            // the worker threads still reading (a segfault, seen in tests).
+            unsafe { libc::_exit(EXIT_SIGNALLED + signal) }
+        });
+    drop(started);
 }

@@ -214,11 +214,18 @@ fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
 pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Result<Vec<f32>> {
     let opened = OpenBand::open(path, band)?;
     let b = raw_bounds(path, &opened)?;
-    let view = band_view(path, &opened)?;
+    let roll = global_roll(&opened);
+    let view = band_view(path, &opened, roll)?;
     let mut values = warp_pass(path, &opened, &view, lattice, 0.0)?;
     // Sources in 0..360 (or -360..0) longitudes: the part beyond the antimeridian is
     // warped again with the lattice shifted by a full turn, filling what is still empty.
-    for shift in [360.0, -360.0] {
+    // A rolled global view is already in -180..180 and whole.
+    let shifts: &[f64] = if roll.is_some() {
+        &[]
+    } else {
+        &[360.0, -360.0]
+    };
+    for &shift in shifts {
         let beyond = if shift > 0.0 {
             b[2] > 180.0
         } else {
@@ -236,6 +243,107 @@ pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Res
     Ok(values)
 }
 
+/// How a geographic raster covering the whole circle from about 0° (0..360°) is rolled
+/// into -180..180°: its first `columns` columns (one turn; a repeated last column is left
+/// out), the part from column `split` (the first whose centre is at or past 180°) moved a
+/// turn west in front of the rest. `None` for any other raster.
+///
+/// GDAL's warper sees such a raster's 0° meridian as an edge: lattice samples within half
+/// a pixel west of it got the edge value, not the bilinear one across it, and a warp chunk
+/// reaching past the edge computed its resampling scale from the part with data, blurring
+/// up to a chunk's width on either side (ETOPO5 at level 4: up to 2.8 km off at La Palma).
+/// Rolled, the raster is seamless there, as one stored in -180..180° is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct GlobalRoll {
+    split: usize,
+    columns: usize,
+}
+
+/// Columns repeated from the far side on each side of a rolled view, so that bilinear
+/// samples next to ±180° have both neighbours.
+const ROLL_MARGIN: usize = 1;
+
+impl GlobalRoll {
+    /// The view's columns.
+    fn width(self) -> usize {
+        self.columns + 2 * ROLL_MARGIN
+    }
+
+    /// How far the view's column 0 is east of the raster's, in columns (negative: west).
+    fn offset(self) -> f64 {
+        self.split as f64 - self.columns as f64 - ROLL_MARGIN as f64
+    }
+
+    /// The view's pieces as (raster column, view column, columns): the last columns before
+    /// the split (a margin), the part from the split, the part before it, then the first
+    /// columns from the split again (a margin).
+    fn pieces(self) -> [(usize, usize, usize); 4] {
+        let (m, split, east) = (ROLL_MARGIN, self.split, self.columns - self.split);
+        [
+            (split - m, 0, m),
+            (split, m, east),
+            (0, m + east, split),
+            (split, m + self.columns, m),
+        ]
+    }
+}
+
+fn global_roll(opened: &OpenBand) -> Option<GlobalRoll> {
+    let info = &opened.info;
+    let gt = info.geo_transform?;
+    let geographic = info
+        .crs_wkt
+        .as_deref()
+        .is_some_and(|wkt| crate::is_geographic(wkt).unwrap_or(false));
+    if !geographic || gt[2] != 0.0 || gt[4] != 0.0 || gt[1].is_nan() || gt[1] <= 0.0 {
+        return None;
+    }
+    let turn = 360.0 / gt[1];
+    let columns = turn.round();
+    let width = f64::from(info.width);
+    // One whole turn of columns (to a millionth of a pixel), within the raster, starting
+    // west of 180 and reaching past it.
+    if (turn - columns).abs() > 1e-6 || columns < 2.0 || columns > width {
+        return None;
+    }
+    let split = ((180.0 - gt[0]) / gt[1] - 0.5).ceil();
+    let margin = ROLL_MARGIN as f64;
+    if split.is_nan() || split < margin || split + margin > columns {
+        return None;
+    }
+    Some(GlobalRoll {
+        split: split as usize,
+        columns: columns as usize,
+    })
+}
+
+/// `xml` with its one source element (`SimpleSource` or `ComplexSource`) placed as `roll`
+/// says (see [`GlobalRoll::pieces`]). Unchanged without a roll.
+fn rolled(xml: &str, roll: Option<GlobalRoll>, height: u32) -> String {
+    let Some(roll) = roll else {
+        return xml.to_owned();
+    };
+    for tag in ["SimpleSource", "ComplexSource"] {
+        let close = format!("</{tag}>");
+        if let (Some(start), Some(end)) = (xml.find(&format!("<{tag}>")), xml.find(&close)) {
+            let element = &xml[start..end];
+            let placed: String = roll
+                .pieces()
+                .iter()
+                .map(|&(from, to, width)| {
+                    format!(
+                        "{element}<SrcRect xOff=\"{from}\" yOff=\"0\" xSize=\"{width}\" \
+                         ySize=\"{height}\"/><DstRect xOff=\"{to}\" yOff=\"0\" \
+                         xSize=\"{width}\" ySize=\"{height}\"/>{close}"
+                    )
+                })
+                .collect();
+            return format!("{}{placed}{}", &xml[..start], &xml[end + close.len()..]);
+        }
+    }
+    xml.to_owned()
+}
+
 /// The band alone, as GDAL's warper must see it: an in-memory VRT whose band 1 is the
 /// band (GDALReprojectImage warps band 1 of its source, whatever band was asked for), and
 /// whose band 2, when the band has a mask (a mask band, or an alpha band of any type), is
@@ -247,7 +355,7 @@ pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Res
 /// warper takes one nodata value, and a NaN it did not know as nodata would be blended
 /// into its valid neighbours. An integer band keeps its nodata value,
 /// written as an integer (GDAL reads an Int64 nodata with `strtoll`).
-fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
+fn band_view(path: &Path, opened: &OpenBand, roll: Option<GlobalRoll>) -> Result<Dataset> {
     let info = &opened.info;
     let escape = |text: &str| {
         text.replace('&', "&amp;")
@@ -293,8 +401,16 @@ fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
             info.band
         )
     };
-    let gt = info
-        .geo_transform
+    let band = rolled(&band, roll, info.height);
+    let (width, geo_transform) = match (roll, info.geo_transform) {
+        (Some(r), Some(mut g)) => {
+            // The raster's column `split` is a turn west of where it was: `columns` columns.
+            g[0] += r.offset() * g[1];
+            (r.width() as u32, Some(g))
+        }
+        _ => (info.width, info.geo_transform),
+    };
+    let gt = geo_transform
         .map(|g| g.map(|v| format!("{v:?}")).join(","))
         .unwrap_or_default();
     let srs = info.crs_wkt.as_deref().map(escape).unwrap_or_default();
@@ -311,18 +427,25 @@ fn band_view(path: &Path, opened: &OpenBand) -> Result<Dataset> {
     };
     // Any nonzero value is valid: 0 stays 0, everything else (negative too) becomes 255.
     let alpha = mask_band.map_or(String::new(), |mask| {
+        let source = rolled(
+            &format!(
+                "<ComplexSource>{file}<SourceBand>{mask}</SourceBand>\
+                 <LUT>-1.7976931348623157e308:255,-5e-324:255,0:0,5e-324:255</LUT>\
+                 </ComplexSource>"
+            ),
+            roll,
+            info.height,
+        );
         format!(
             "<VRTRasterBand dataType=\"Byte\" band=\"2\"><ColorInterp>Alpha</ColorInterp>\
-             <ComplexSource>{file}<SourceBand>{mask}</SourceBand>\
-             <LUT>-1.7976931348623157e308:255,-5e-324:255,0:0,5e-324:255</LUT>\
-             </ComplexSource></VRTRasterBand>"
+             {source}</VRTRasterBand>"
         )
     });
     let xml = format!(
-        "<VRTDataset rasterXSize=\"{}\" rasterYSize=\"{}\"><SRS>{srs}</SRS>\
+        "<VRTDataset rasterXSize=\"{width}\" rasterYSize=\"{}\"><SRS>{srs}</SRS>\
          <GeoTransform>{gt}</GeoTransform><VRTRasterBand dataType=\"{gdal_type}\" band=\"1\">\
          {band}</VRTRasterBand>{alpha}</VRTDataset>",
-        info.width, info.height
+        info.height
     );
     crate::quiet::silence_hdf5_on_this_thread();
     Dataset::open(Path::new(&xml)).map_err(|e| warp_error(path, e))

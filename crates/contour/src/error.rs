@@ -76,12 +76,13 @@ pub enum Error {
         /// The offset given.
         offset: f64,
     },
-    /// The levels `offset + k * interval` over the heights cannot be told apart in `f64`:
-    /// the interval is below the resolution of numbers that large.
+    /// The levels `offset + k * interval` over the heights cannot be told apart in `f64`,
+    /// or not placed within a thousandth of the interval of their exact values: the
+    /// interval is below the resolution of numbers that large.
     #[error(
-        "interval {} with offset {} over heights {}..{}: the levels are closer than f64 can \
-         tell apart at that magnitude; give a larger interval, an offset nearer the heights, \
-         or explicit --levels",
+        "interval {} with offset {} over heights {}..{}: f64 cannot tell the levels apart \
+         or place them evenly at that magnitude; give a larger interval, an offset nearer the \
+         heights, or explicit --levels",
         num(.interval),
         num(.offset),
         num(.min),

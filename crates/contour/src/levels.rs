@@ -57,15 +57,37 @@ pub fn interval_levels(interval: f64, offset: f64, min: f64, max: f64) -> Result
     // One step past each end, filtered by value, absorbs rounding in `first` and `last`.
     let steps = (last - first) as i64 + 3;
     for i in 0..steps.max(0) {
-        let level = offset + (first - 1.0 + i as f64) * interval;
+        let k = first - 1.0 + i as f64;
+        let level = offset + k * interval;
         if (min..=max).contains(&level) {
-            if levels.last().is_some_and(|&l| l >= level) {
+            // Neighbours must stay apart, and each level at `offset + k * interval` to
+            // within a thousandth of the interval (an offset of 1e16 with an interval of 3
+            // rounded levels by up to 2, unevenly).
+            if levels.last().is_some_and(|&l| l >= level)
+                || rounding_error(offset, k, interval).abs() > interval * MAX_LEVEL_ROUNDING
+            {
                 return Err(below_resolution);
             }
             levels.push(level);
         }
     }
     Ok(levels)
+}
+
+/// The largest rounding of an interval level from `offset + k * interval`, as a share of
+/// the interval.
+const MAX_LEVEL_ROUNDING: f64 = 1e-3;
+
+/// How far `offset + k * interval`, computed in f64, is from its exact value (to within
+/// the rounding of this sum of errors): the product's error by a fused multiply-add, the
+/// sum's by Knuth's two-sum.
+fn rounding_error(offset: f64, k: f64, interval: f64) -> f64 {
+    let product = k * interval;
+    let product_error = k.mul_add(interval, -product);
+    let sum = offset + product;
+    let product_part = sum - offset;
+    let sum_error = (offset - (sum - product_part)) + (product - product_part);
+    product_error + sum_error
 }
 
 /// `levels` sorted ascending without duplicates (`-0.0` and `0.0` count as one).
@@ -142,6 +164,8 @@ mod tests {
             (50.0, 0.0, 1e18, 1e18 + 4e6),
             (10.0, 1e17, 388.0, 3863.0),
             (1.0, 0.0, 2f64.powi(53), 2f64.powi(53) + 100.0),
+            // k below 2^53, but offset + k * 3 rounded to even numbers near 1e16.
+            (3.0, 1e16, 140.0, 400.0),
         ] {
             assert!(
                 matches!(
@@ -154,6 +178,13 @@ mod tests {
         // Large but resolvable: fine.
         let levels = interval_levels(1024.0, 0.0, 1e15, 1e15 + 10_240.0).unwrap();
         assert_eq!(levels.len(), 11);
+        let levels = interval_levels(3.0, 1e15 + 1.0, 140.0, 150.0).unwrap();
+        assert_eq!(levels, [140.0, 143.0, 146.0, 149.0]);
+        // Decimal steps round by an ulp, far below the interval: fine.
+        let levels = interval_levels(0.1, 0.3, 0.05, 0.95).unwrap();
+        assert_eq!(levels.len(), 9, "{levels:?}");
+        let levels = interval_levels(1e-5, 0.0, 1e6, 1e6 + 1e-3).unwrap();
+        assert!((100..=102).contains(&levels.len()), "{}", levels.len());
     }
 
     #[test]

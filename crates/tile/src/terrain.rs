@@ -274,11 +274,16 @@ fn max_edge_length(level: u8, bound: f64) -> Option<u32> {
 /// antimeridian `east` is wrapped back below 180, so west > east (as GeoJSON and TileJSON
 /// bounding boxes have it); a raster wholly east of 180 has both wrapped.
 fn bounds_array(bounds: &GeoBounds) -> [f64; 4] {
-    let wrap = |lon: f64| if lon > 180.0 { lon - 360.0 } else { lon };
+    // Into -180..180 by whole turns (a raster given on 530..550° too); an east edge at
+    // 180° stays there.
+    let wrap = |lon: f64, east: bool| match (lon + 180.0).rem_euclid(360.0) - 180.0 {
+        w if east && w == -180.0 => 180.0,
+        w => w,
+    };
     [
-        wrap(bounds.west),
+        wrap(bounds.west, false),
         bounds.south,
-        wrap(bounds.east),
+        wrap(bounds.east, true),
         bounds.north,
     ]
 }
@@ -1270,6 +1275,24 @@ fn write_layer_json(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn layer_bounds_are_in_minus_180_to_180() {
+        let bounds = |west: f64, east: f64| {
+            super::bounds_array(&tinsmith_raster::GeoBounds {
+                west,
+                south: 0.0,
+                east,
+                north: 10.0,
+                resolution: 0.1,
+            })
+        };
+        assert_eq!(bounds(530.0, 550.0), [170.0, 0.0, -170.0, 10.0]);
+        assert_eq!(bounds(170.0, 190.0), [170.0, 0.0, -170.0, 10.0]);
+        assert_eq!(bounds(-180.0, 180.0), [-180.0, 0.0, 180.0, 10.0]);
+        assert_eq!(bounds(10.0, 20.0), [10.0, 0.0, 20.0, 10.0]);
+        assert_eq!(bounds(180.0, 200.0), [-180.0, 0.0, -160.0, 10.0]);
+    }
+
     use super::*;
 
     #[test]

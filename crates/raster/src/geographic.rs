@@ -243,8 +243,8 @@ pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Res
     Ok(values)
 }
 
-/// How a geographic raster covering the whole circle from about 0° (0..360°) is rolled
-/// into -180..180°: its first `columns` columns (one turn; a repeated last column is left
+/// How a geographic raster covering the whole circle from about 0° (0..360°, or -360..0°)
+/// is rolled into -180..180°: its first `columns` columns (one turn; a repeated last column is left
 /// out), the part from column `split` (the first whose centre is at or past 180°) moved a
 /// turn west in front of the rest. `None` for any other raster.
 ///
@@ -257,6 +257,9 @@ pub fn warp_to_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Res
 struct GlobalRoll {
     split: usize,
     columns: usize,
+    /// The raster's west edge moved by whole turns into -180..180° (a raster on -360..0°
+    /// rolls as one on 0..360°).
+    west: f64,
 }
 
 /// Columns repeated from the far side on each side of a rolled view, so that bilinear
@@ -306,7 +309,8 @@ fn global_roll(opened: &OpenBand) -> Option<GlobalRoll> {
     if (turn - columns).abs() > 1e-6 || columns < 2.0 || columns > width {
         return None;
     }
-    let split = ((180.0 - gt[0]) / gt[1] - 0.5).ceil();
+    let west = gt[0] - 360.0 * ((gt[0] + 180.0) / 360.0).floor();
+    let split = ((180.0 - west) / gt[1] - 0.5).ceil();
     let margin = ROLL_MARGIN as f64;
     if split.is_nan() || split < margin || split + margin > columns {
         return None;
@@ -314,6 +318,7 @@ fn global_roll(opened: &OpenBand) -> Option<GlobalRoll> {
     Some(GlobalRoll {
         split: split as usize,
         columns: columns as usize,
+        west,
     })
 }
 
@@ -405,7 +410,7 @@ fn band_view(path: &Path, opened: &OpenBand, roll: Option<GlobalRoll>) -> Result
     let (width, geo_transform) = match (roll, info.geo_transform) {
         (Some(r), Some(mut g)) => {
             // The raster's column `split` is a turn west of where it was: `columns` columns.
-            g[0] += r.offset() * g[1];
+            g[0] = r.west + r.offset() * g[1];
             (r.width() as u32, Some(g))
         }
         _ => (info.width, info.geo_transform),

@@ -155,7 +155,7 @@ fn write_global(path: &Path, west: f64, values: Vec<f32>) {
 }
 
 #[test]
-fn a_global_raster_in_0_to_360_warps_as_the_same_in_minus_180_to_180() {
+fn a_global_raster_in_0_to_360_or_minus_360_to_0_warps_as_in_minus_180_to_180() {
     // GDAL's warper saw the 0° meridian of a 0..360 raster as an edge: samples within
     // half a pixel west of it got the edge value, and a coarser lattice's chunks reaching
     // past it were blurred far from it (ETOPO5 at level 4: kilometres off at La Palma).
@@ -169,6 +169,8 @@ fn a_global_raster_in_0_to_360_warps_as_the_same_in_minus_180_to_180() {
     let in_180: Vec<f32> = (0..72 * 36)
         .map(|k| value((k % 72 + 36) % 72, k / 72))
         .collect();
+    let far_west = dir.path().join("-360_0.tif");
+    write_global(&far_west, -360.0, in_0_360.clone());
     write_global(&east, 0.0, in_0_360);
     write_global(&west, -180.0, in_180);
     // Global lattices at least as fine as the raster, as a pyramid's finest level is
@@ -183,26 +185,29 @@ fn a_global_raster_in_0_to_360_warps_as_the_same_in_minus_180_to_180() {
             width,
             height: (160.0 / step) as u32 + 1,
         };
-        let a = warp_to_geographic(&east, 1, &lattice).expect("warp 0..360");
         let b = warp_to_geographic(&west, 1, &lattice).expect("warp -180..180");
-        // Within half a pixel of ±180° the -180..180 raster has an edge of its own.
-        let inner = |k: usize| (-180.0 + (k % width as usize) as f64 * step).abs() < 177.5;
-        let differ = (0..a.len())
-            .filter(|&k| inner(k) && !same(a[k], b[k]))
-            .count();
-        let (worst, at) = a
-            .iter()
-            .zip(&b)
-            .enumerate()
-            .filter(|&(k, _)| inner(k))
-            .map(|(k, (x, y))| ((x - y).abs(), k))
-            .fold((0.0f32, 0), |w, d| if d.0 > w.0 { d } else { w });
-        assert_eq!(
-            differ,
-            0,
-            "step {step}: {differ} of {} samples differ, by up to {worst} at longitude {}",
-            a.len(),
-            -180.0 + (at % width as usize) as f64 * step
-        );
+        for source in [&east, &far_west] {
+            let a = warp_to_geographic(source, 1, &lattice).expect("warp 0..360");
+            // Within half a pixel of ±180° the -180..180 raster has an edge of its own.
+            let inner = |k: usize| (-180.0 + (k % width as usize) as f64 * step).abs() < 177.5;
+            let differ = (0..a.len())
+                .filter(|&k| inner(k) && !same(a[k], b[k]))
+                .count();
+            let (worst, at) = a
+                .iter()
+                .zip(&b)
+                .enumerate()
+                .filter(|&(k, _)| inner(k))
+                .map(|(k, (x, y))| ((x - y).abs(), k))
+                .fold((0.0f32, 0), |w, d| if d.0 > w.0 { d } else { w });
+            assert_eq!(
+                differ,
+                0,
+                "{}, step {step}: {differ} of {} samples differ, by up to {worst} at longitude {}",
+                source.display(),
+                a.len(),
+                -180.0 + (at % width as usize) as f64 * step
+            );
+        }
     }
 }

@@ -128,12 +128,15 @@ fn is_broken_pipe(err: &anyhow::Error) -> bool {
 
 /// Starts the thread that, on SIGINT, SIGTERM or SIGHUP, removes unfinished output and
 /// exits with 128 + the signal's number (0 when every output is already complete). If
-/// the signals cannot be taken, they keep their default action (the process ends at once).
+/// the handlers cannot be registered, the signals keep their default action (the process
+/// ends at once, leaving its temporary files).
 fn on_signal_remove_pending_output() {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
         return;
     };
+    // A thread that cannot start (at the first lines of `main`, only short of memory)
+    // takes the registration with it when the closure is dropped.
     let started = std::thread::Builder::new()
         .name("tinsmith-signals".to_owned())
         .spawn(move || {

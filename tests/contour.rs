@@ -598,7 +598,7 @@ fn contour_bad_input_fails_cleanly() {
                 "--offset",
                 "1e17",
             ],
-            vec!["f64 can tell apart"],
+            vec!["f64 cannot tell the levels apart"],
         ),
         (
             vec![

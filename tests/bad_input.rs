@@ -247,6 +247,14 @@ fn a_prj_sidecar_that_is_not_ours_is_not_replaced() {
     std::fs::remove_file(d.path("m.obj")).unwrap();
     let o = d.run(&["mesh", &dem(), "-o", "m.obj", "--max-error", "9", "-q"]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // A GeoTIFF reads no `.prj`: the one named like it is an earlier mesh's sidecar, not
+    // the input's, so meshing into the input's name works again (it was refused).
+    std::fs::copy(dem(), d.path("g.tif")).unwrap();
+    for _ in 0..2 {
+        let o = d.run(&["mesh", "g.tif", "-o", "g.obj", "--max-error", "9", "-q"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(d.path("g.prj").is_file());
+    }
     // The same CRS spelled otherwise (ESRI's WKT, as GIS tools write `.prj` files) too.
     let esri = std::process::Command::new("gdalsrsinfo")
         .args(["-o", "wkt_esri", "--single-line", "EPSG:3857"])
@@ -1177,10 +1185,13 @@ fn heights_beyond_1e37_are_refused_with_one_message() {
         "huge.asc",
         "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n4 2e37 6\n7 8 9\n",
     );
-    let o = d.run(&["mesh", "huge.asc", "-o", "m.ply", "--max-error", "1"]);
-    assert_fails_naming(&o, &["huge.asc", "1e37"]);
-    assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
-    assert_eq!(d.files(), vec!["huge.asc"]);
+    // The float32 formats said first that float32 rounds such heights beyond the bound.
+    for out in ["m.ply", "m.glb", "m.stl"] {
+        let o = d.run(&["mesh", "huge.asc", "-o", out, "--max-error", "1"]);
+        assert_fails_naming(&o, &["huge.asc", "1e37"]);
+        assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
+        assert_eq!(d.files(), vec!["huge.asc"]);
+    }
     // Tiled, with the huge sample in the last of 4 tiles: refused before any tile, so no
     // tile is named (the first tile was, though its heights were fine).
     let rows: String = (0..5)
@@ -1199,7 +1210,7 @@ fn heights_beyond_1e37_are_refused_with_one_message() {
         "mesh",
         "late.asc",
         "-o",
-        "m.ply",
+        "m.glb",
         "--max-error",
         "1",
         "--tile-size",

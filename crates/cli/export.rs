@@ -13,6 +13,7 @@ use tinsmith_raster::RasterInfo;
 use crate::args::MeshArgs;
 use crate::georef::Georef;
 use crate::number::readable;
+use crate::output::NamingFile;
 
 /// Largest rounding of a float32 position, in pixels, accepted before decimating: 90 % of
 /// the 1e-3 pixel within which the verifier maps file positions to samples. Half a float32
@@ -105,6 +106,14 @@ impl Plan {
         if format == MeshFormat::GeoJson && !args.export.geojson_source_crs && !args.pixel_coords {
             // Before any work: what `write` would refuse for the raster as a whole.
             check_wgs84_mesh_possible(info, out(args))?;
+        }
+        // Decimation refuses such heights, whatever the format: say that, not that float32
+        // rounds them beyond the bound.
+        if let Some(max_abs) = info
+            .max_abs_value()
+            .filter(|&v| v > tinsmith_core::MAX_ABS_HEIGHT)
+        {
+            return Err(tinsmith_core::Error::HeightsTooLarge(max_abs)).naming_file(&args.input);
         }
         if !format.is_float32() {
             return Ok(Plan {
@@ -631,8 +640,8 @@ fn check_no_fold_in_lon_lat(
     if folded > 0 {
         bail!(
             "{}: {folded} of {} triangles fold over their neighbours in longitude/latitude \
-             (straight edges of the raster's CRS that pass close to a pole curve around it \
-             there), so RFC 7946 GeoJSON cannot hold the mesh; write with \
+             (straight edges of the raster's CRS curve in longitude/latitude, most near a \
+             pole or far from the projection's centre), so RFC 7946 GeoJSON cannot hold the mesh; write with \
              --geojson-source-crs (the raster's CRS) or to .fgb, or keep triangles small \
              with --max-edge-length",
             path.display(),

@@ -56,8 +56,8 @@ pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
 }
 
 /// Fails when the `.prj` sidecar a georeferenced mesh in `format` writes beside `output`
-/// should not be replaced: it is the input's own `.prj` (an ESRI ASCII grid keeps its CRS
-/// there) or another file the input is read from; it is read-only; or it holds another
+/// should not be replaced: it is one of the files GDAL reads the input from (an ESRI ASCII
+/// grid keeps its CRS in its `.prj`); it is read-only; or it holds another
 /// CRS than `crs_wkt` (the raster's) while no file is at `output`, so it is not from an
 /// earlier mesh there but another file's (a shapefile's of the same name). Output to a
 /// device or pipe writes no sidecar. (With `--pixel-coords` no sidecar is written.)
@@ -71,9 +71,11 @@ pub fn check_sidecar(
         return Ok(());
     }
     let ours = tinsmith_export::prj_path(output);
+    // GDAL's file list of the input names its `.prj` when it reads one (ESRI ASCII, EHdr);
+    // a `.prj` merely named like a GeoTIFF input is not the input's (it is usually the
+    // sidecar of an earlier mesh of it).
     if let Ok(a) = std::fs::canonicalize(&ours) {
-        let theirs = std::fs::canonicalize(tinsmith_export::prj_path(input)).ok();
-        if theirs.as_ref() == Some(&a) || input_files(input).contains(&a) {
+        if input_files(input).contains(&a) {
             bail!(
                 "{}: its CRS would go to {}, which belongs to the input {}; choose another \
                  output name",

@@ -50,12 +50,18 @@ fn crs_name(wkt: &str) -> Option<&str> {
 }
 
 /// The `Units` element for the CRS's linear unit: the last `UNIT`/`LENGTHUNIT` of the WKT
-/// that is not angular decides between metres (the default) and (US survey) feet.
-fn units_element(wkt: Option<&str>) -> &'static str {
-    const METRIC: &str = "<Metric areaUnit=\"squareMeter\" linearUnit=\"meter\" \
-        volumeUnit=\"cubicMeter\" temperatureUnit=\"celsius\" pressureUnit=\"milliBars\" \
-        diameterUnit=\"millimeter\" angularUnit=\"decimal degrees\" \
-        directionUnit=\"decimal degrees\"/>";
+/// that is not angular decides between metres (the default, also for units LandXML cannot
+/// name; the WKT is written too), kilometres, centimetres, millimetres and (US survey)
+/// feet.
+fn units_element(wkt: Option<&str>) -> String {
+    let metric = |unit: &str| {
+        format!(
+            "<Metric areaUnit=\"squareMeter\" linearUnit=\"{unit}\" \
+             volumeUnit=\"cubicMeter\" temperatureUnit=\"celsius\" pressureUnit=\"milliBars\" \
+             diameterUnit=\"millimeter\" angularUnit=\"decimal degrees\" \
+             directionUnit=\"decimal degrees\"/>"
+        )
+    };
     const FOOT: &str = "<Imperial areaUnit=\"squareFoot\" linearUnit=\"foot\" \
         volumeUnit=\"cubicYard\" temperatureUnit=\"fahrenheit\" pressureUnit=\"inHG\" \
         diameterUnit=\"inch\" angularUnit=\"decimal degrees\" \
@@ -65,7 +71,7 @@ fn units_element(wkt: Option<&str>) -> &'static str {
         diameterUnit=\"inch\" angularUnit=\"decimal degrees\" \
         directionUnit=\"decimal degrees\"/>";
     let Some(wkt) = wkt else {
-        return METRIC;
+        return metric("meter");
     };
     let mut factor = None;
     let upper = wkt.to_ascii_uppercase();
@@ -89,9 +95,12 @@ fn units_element(wkt: Option<&str>) -> &'static str {
         }
     }
     match factor {
-        Some(f) if (f - 0.3048).abs() < 1e-9 => FOOT,
-        Some(f) if (f - 1200.0 / 3937.0).abs() < 1e-9 => US_FOOT,
-        _ => METRIC,
+        Some(f) if (f - 0.3048).abs() < 1e-9 => FOOT.to_string(),
+        Some(f) if (f - 1200.0 / 3937.0).abs() < 1e-9 => US_FOOT.to_string(),
+        Some(1000.0) => metric("kilometer"),
+        Some(0.01) => metric("centimeter"),
+        Some(0.001) => metric("millimeter"),
+        _ => metric("meter"),
     }
 }
 
@@ -398,6 +407,8 @@ mod tests {
         assert!(units_element(Some(feet)).contains("USSurveyFoot"));
         let feet = "PROJCS[\"x\",LENGTHUNIT[\"foot\",0.3048]]";
         assert!(units_element(Some(feet)).contains("linearUnit=\"foot\""));
+        let km = "PROJCS[\"x\",GEOGCS[\"y\",UNIT[\"degree\",0.01745]],UNIT[\"kilometre\",1000]]";
+        assert!(units_element(Some(km)).contains("linearUnit=\"kilometer\""));
     }
 
     #[test]

@@ -4,7 +4,7 @@ use std::io;
 use std::path::Path;
 
 use gdal::raster::{ColorInterpretation, RasterBand};
-use gdal::spatial_ref::SpatialRef;
+use gdal::spatial_ref::{AxisMappingStrategy, SpatialRef};
 use gdal::{Dataset, DatasetOptions, GdalOpenFlags, Metadata};
 use tinsmith_core::Grid;
 
@@ -454,8 +454,10 @@ fn has_driver_prefix(text: &str) -> bool {
     })
 }
 
-/// The EPSG code of `srs`: its own authority code if that is EPSG, else whatever GDAL's
-/// auto-identification finds; `None` when neither works (e.g. a compound CRS "unknown").
+/// The EPSG code of `srs`: its own authority code if that is EPSG, else what GDAL's
+/// auto-identification finds, if that code's CRS is the same CRS (GDAL names a UTM zone in
+/// feet or kilometres by the zone's code in metres); `None` otherwise (e.g. a compound
+/// CRS "unknown").
 fn epsg_code(mut srs: SpatialRef) -> Option<u32> {
     fn from_authority(srs: &SpatialRef) -> Option<u32> {
         let name = srs.auth_name()?;
@@ -467,8 +469,14 @@ fn epsg_code(mut srs: SpatialRef) -> Option<u32> {
     if let Some(code) = from_authority(&srs) {
         return Some(code);
     }
+    let mut original = srs.clone();
     srs.auto_identify_epsg().ok()?;
-    from_authority(&srs)
+    let code = from_authority(&srs)?;
+    let mut identified = SpatialRef::from_epsg(code).ok()?;
+    for srs in [&mut original, &mut identified] {
+        srs.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+    }
+    (identified == original).then_some(code)
 }
 
 #[cfg(test)]
@@ -503,5 +511,33 @@ mod tests {
         )
         .expect("proj4");
         assert_eq!(epsg_code(srs), None);
+        // A UTM zone without its code (as GDAL reads `gdalwarp -t_srs "+proj=utm +zone=32
+        // +datum=WGS84 +units=us-ft"`'s GeoTIFF) is identified by the zone, in metres or not.
+        let utm = |false_easting: &str, unit: &str| {
+            format!(
+                "PROJCS[\"unknown\",GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",\
+                 6378137,298.257223563,AUTHORITY[\"EPSG\",\"7030\"]],AUTHORITY[\"EPSG\",\"6326\"]],\
+                 PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433,AUTHORITY[\"EPSG\",\
+                 \"9122\"]],AUTHORITY[\"EPSG\",\"4326\"]],PROJECTION[\"Transverse_Mercator\"],\
+                 PARAMETER[\"latitude_of_origin\",0],PARAMETER[\"central_meridian\",9],\
+                 PARAMETER[\"scale_factor\",0.9996],PARAMETER[\"false_easting\",{false_easting}],\
+                 PARAMETER[\"false_northing\",0],{unit},AXIS[\"Easting\",EAST],\
+                 AXIS[\"Northing\",NORTH]]"
+            )
+        };
+        let metres = utm("500000", "UNIT[\"metre\",1]");
+        let srs = SpatialRef::from_wkt(&metres).expect("WKT");
+        assert_eq!(epsg_code(srs), Some(32632));
+        for wkt in [
+            utm(
+                "1640416.66666667",
+                "UNIT[\"US survey foot\",0.304800609601219]",
+            ),
+            utm("500", "UNIT[\"kilometre\",1000]"),
+        ] {
+            let srs = SpatialRef::from_wkt(&wkt).expect("WKT");
+            let unit = wkt.split("UNIT").last().unwrap_or_default();
+            assert_eq!(epsg_code(srs), None, "{unit}");
+        }
     }
 }

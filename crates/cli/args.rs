@@ -510,7 +510,16 @@ fn parse_max_error(s: &str) -> Result<f64, String> {
     if !v.is_finite() || v < 0.0 {
         return Err(format!("must be a finite number >= 0, got {s}"));
     }
-    Ok(v)
+    Ok(positive_zero(v))
+}
+
+/// `v`, with -0 as 0 (so that reports, summaries and `elev` values never say "-0").
+fn positive_zero(v: f64) -> f64 {
+    if v == 0.0 {
+        0.0
+    } else {
+        v
+    }
 }
 
 fn parse_interval(s: &str) -> Result<f64, String> {
@@ -529,7 +538,7 @@ fn parse_finite(s: &str) -> Result<f64, String> {
     if !v.is_finite() {
         return Err(format!("must be a finite number, got {s}"));
     }
-    Ok(v)
+    Ok(positive_zero(v))
 }
 
 /// `--threads` of `tiles`: 0 (one per core) to 1024.
@@ -539,5 +548,24 @@ fn threads_or_all(s: &str) -> Result<usize, String> {
         _ => Err(format!(
             "{s} is not a thread count from 0 (one per core) to 1024"
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn minus_zero_is_read_as_zero() {
+        for parsed in [
+            parse_max_error("-0"),
+            parse_finite("-0"),
+            parse_finite("-0.0"),
+        ] {
+            let v = parsed.expect("a number");
+            assert!(v == 0.0 && v.is_sign_positive(), "{v}");
+        }
+        assert!(parse_max_error("-1").is_err());
+        assert_eq!(parse_finite("-2.5"), Ok(-2.5));
     }
 }

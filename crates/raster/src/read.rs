@@ -454,29 +454,71 @@ fn has_driver_prefix(text: &str) -> bool {
     })
 }
 
-/// The EPSG code of `srs`: its own authority code if that is EPSG, else what GDAL's
-/// auto-identification finds, if that code's CRS is the same CRS (GDAL names a UTM zone in
-/// feet or kilometres by the zone's code in metres); `None` otherwise (e.g. a compound
-/// CRS "unknown").
-fn epsg_code(mut srs: SpatialRef) -> Option<u32> {
-    fn from_authority(srs: &SpatialRef) -> Option<u32> {
-        let name = srs.auth_name()?;
-        if !name.eq_ignore_ascii_case("EPSG") {
-            return None;
-        }
-        u32::try_from(srs.auth_code().ok()?).ok()
-    }
-    if let Some(code) = from_authority(&srs) {
+/// The EPSG code of `srs`: its own authority code if that is EPSG, else a code that GDAL's
+/// auto-identification or, failing that, its matcher (PROJ's identification, which reads
+/// ESRI's `.prj` names) finds for it, if that code's CRS is the same CRS (GDAL names a UTM
+/// zone in feet or kilometres by the zone's code in metres); `None` otherwise (e.g. a
+/// compound CRS "unknown").
+fn epsg_code(srs: SpatialRef) -> Option<u32> {
+    if let Some(code) = epsg_authority(&srs) {
         return Some(code);
     }
     let mut original = srs.clone();
-    srs.auto_identify_epsg().ok()?;
-    let code = from_authority(&srs)?;
-    let mut identified = SpatialRef::from_epsg(code).ok()?;
-    for srs in [&mut original, &mut identified] {
-        srs.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+    original.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+    let same = |code: u32| {
+        SpatialRef::from_epsg(code).is_ok_and(|mut candidate| {
+            candidate.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+            candidate == original
+        })
+    };
+    let mut identified = srs.clone();
+    let auto = identified
+        .auto_identify_epsg()
+        .ok()
+        .and_then(|()| epsg_authority(&identified));
+    auto.filter(|&code| same(code))
+        .or_else(|| epsg_matches(&srs).into_iter().find(|&code| same(code)))
+}
+
+/// The code of `srs`'s own authority, if that is EPSG.
+fn epsg_authority(srs: &SpatialRef) -> Option<u32> {
+    let name = srs.auth_name()?;
+    if !name.eq_ignore_ascii_case("EPSG") {
+        return None;
     }
-    (identified == original).then_some(code)
+    u32::try_from(srs.auth_code().ok()?).ok()
+}
+
+/// The EPSG codes GDAL's `OSRFindMatches` offers for `srs`, best first.
+fn epsg_matches(srs: &SpatialRef) -> Vec<u32> {
+    let mut count = 0;
+    let mut confidence = std::ptr::null_mut();
+    // SAFETY: `srs` is a live handle; OSRFindMatches returns NULL or an array of `count`
+    // owned handles, freed with OSRFreeSRSArray, and a CPLMalloc'd array of confidences.
+    #[allow(unsafe_code)]
+    unsafe {
+        let matches = gdal_sys::OSRFindMatches(
+            srs.to_c_hsrs(),
+            std::ptr::null_mut(),
+            &mut count,
+            &mut confidence,
+        );
+        let mut codes = Vec::new();
+        if !matches.is_null() {
+            for i in 0..usize::try_from(count).unwrap_or(0) {
+                let candidate = *matches.add(i);
+                if candidate.is_null() {
+                    continue;
+                }
+                if let Ok(candidate) = SpatialRef::from_c_obj(candidate) {
+                    codes.extend(epsg_authority(&candidate));
+                }
+            }
+            gdal_sys::OSRFreeSRSArray(matches);
+        }
+        gdal_sys::VSIFree(confidence.cast());
+        codes
+    }
 }
 
 #[cfg(test)]
@@ -525,6 +567,15 @@ mod tests {
                  AXIS[\"Northing\",NORTH]]"
             )
         };
+        // ESRI's spelling (a `.prj` beside an ESRI ASCII grid), which only the matcher reads.
+        let esri = "PROJCS[\"WGS_1984_UTM_Zone_32N\",GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",\
+            SPHEROID[\"WGS_1984\",6378137.0,298.257223563]],PRIMEM[\"Greenwich\",0.0],\
+            UNIT[\"Degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],\
+            PARAMETER[\"False_Easting\",500000.0],PARAMETER[\"False_Northing\",0.0],\
+            PARAMETER[\"Central_Meridian\",9.0],PARAMETER[\"Scale_Factor\",0.9996],\
+            PARAMETER[\"Latitude_Of_Origin\",0.0],UNIT[\"Meter\",1.0]]";
+        let srs = SpatialRef::from_esri(esri).expect("ESRI WKT");
+        assert_eq!(epsg_code(srs), Some(32632));
         let metres = utm("500000", "UNIT[\"metre\",1]");
         let srs = SpatialRef::from_wkt(&metres).expect("WKT");
         assert_eq!(epsg_code(srs), Some(32632));

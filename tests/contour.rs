@@ -783,8 +783,8 @@ fn wgs84_geojson_meshes_across_the_antimeridian_verify_and_contour() {
     );
     let o = d.run(&["verify", "cone.asc", "m.geojson", "--max-error", "0.5"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    // The same lines as from the same mesh in PLY (the contour's GeoJSON kept in the
-    // raster's coordinates, uncut, to compare: this CRS has no EPSG code).
+    // The same lines as from the same mesh in PLY (the contour's GeoJSON in the raster's
+    // own EPSG:4326, so cut at the antimeridian alike; the parts are compared).
     for (mesh, out) in [("m.geojson", "a.geojson"), ("m.ply", "b.geojson")] {
         let args = [
             "contour",
@@ -801,11 +801,30 @@ fn wgs84_geojson_meshes_across_the_antimeridian_verify_and_contour() {
         run_ok(&d, &args);
     }
     let (a, b) = (
-        features(&d.path("a.geojson")),
-        features(&d.path("b.geojson")),
+        line_parts(&d.path("a.geojson")),
+        line_parts(&d.path("b.geojson")),
     );
     assert!(!a.is_empty());
     assert_eq!(canonical(a), canonical(b));
+}
+
+/// Every part of every (Multi)LineString of a GeoJSON file we wrote, as (elev, points).
+fn line_parts(path: &std::path::Path) -> Vec<(f64, Vec<[f64; 2]>)> {
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    let mut parts = Vec::new();
+    for f in v["features"].as_array().unwrap() {
+        let elev = f["properties"]["elev"].as_f64().unwrap();
+        let coordinates = f["geometry"]["coordinates"].clone();
+        match f["geometry"]["type"].as_str() {
+            Some("LineString") => parts.push((elev, serde_json::from_value(coordinates).unwrap())),
+            Some("MultiLineString") => {
+                let lines: Vec<Vec<[f64; 2]>> = serde_json::from_value(coordinates).unwrap();
+                parts.extend(lines.into_iter().map(|line| (elev, line)));
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    parts
 }
 
 #[test]
@@ -1066,9 +1085,10 @@ fn a_column_a_hair_off_180_is_put_on_it_in_wgs84_geojson() {
     }
     d.write("hair.asc", &asc);
     d.write("hair.prj", WGS84_PRJ);
-    run_ok(
-        &d,
-        &[
+    // The raster's own EPSG:4326 with --geojson-source-crs is RFC 7946 too, snapped alike
+    // (it was cut into slivers), for meshes and contour lines.
+    for flags in [&[][..], &["--geojson-source-crs"][..]] {
+        let mesh = [
             "mesh",
             "hair.asc",
             "--max-error",
@@ -1076,17 +1096,30 @@ fn a_column_a_hair_off_180_is_put_on_it_in_wgs84_geojson() {
             "-o",
             "m.geojson",
             "-q",
-        ],
-    );
-    let text = std::fs::read_to_string(d.path("m.geojson")).unwrap();
-    assert!(!text.contains("179.9999999999998"), "{text}");
-    assert!(
-        text.contains("[180.0,") && text.contains("[-180.0,"),
-        "{text}"
-    );
-    assert!(!text.contains("MultiPolygon"), "{text}");
-    let o = d.run(&["verify", "hair.asc", "m.geojson", "--max-error", "0"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+        ];
+        run_ok(&d, &[&mesh[..], flags].concat());
+        let text = std::fs::read_to_string(d.path("m.geojson")).unwrap();
+        assert!(!text.contains("179.9999999999998"), "{flags:?} {text}");
+        assert!(
+            text.contains("[180.0,") && text.contains("[-180.0,"),
+            "{flags:?} {text}"
+        );
+        assert!(!text.contains("MultiPolygon"), "{flags:?} {text}");
+        let o = d.run(&["verify", "hair.asc", "m.geojson", "--max-error", "0"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let contour = [
+            "contour",
+            "hair.asc",
+            "--levels",
+            "10",
+            "-o",
+            "c.geojson",
+            "-q",
+        ];
+        run_ok(&d, &[&contour[..], flags].concat());
+        let text = std::fs::read_to_string(d.path("c.geojson")).unwrap();
+        assert!(!text.contains("179.9999999999998"), "{flags:?} {text}");
+    }
 }
 
 /// An ESRI ASCII grid `n x n` of `f(column, row)` (`None`: nodata), in pixel units.

@@ -178,6 +178,9 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         &args.output,
         args.quiet,
     )?;
+    if format == LineFormat::GeoJson && crs.epsg == Some(4326) {
+        crate::export::snap_to_antimeridian(&mut points);
+    }
     let (points, ends) = without_repeated_points(points, &ends);
     let closed = ends.iter().filter(|&&(_, _, closed)| closed).count();
     let mut start = 0;

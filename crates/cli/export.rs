@@ -320,6 +320,9 @@ pub fn write(
         path,
         args.quiet,
     )?;
+    if plan.format == MeshFormat::GeoJson && crs.epsg == Some(4326) {
+        snap_to_antimeridian(&mut vertices);
+    }
     if let (Some(world), Some(crs_of_raster), Some(4326)) = (&world, projected, crs.epsg) {
         check_wgs84_maps_back(world, &vertices, crs_of_raster, path)?;
         check_no_fold_in_lon_lat(&vertices, triangles, path)?;
@@ -387,7 +390,6 @@ pub fn file_crs<'r>(
                     p[1]
                 );
             }
-            snap_to_antimeridian(points);
             Ok(CrsRef::new(None, Some(4326)))
         }
         None => {
@@ -497,11 +499,12 @@ fn unwrap_around_centre(info: &RasterInfo, wkt: &str, points: &mut [[f64; 3]]) -
     Ok(())
 }
 
-/// Longitudes within 1e-9° of the antimeridian (180 + 360 j) put on it: a 0..360 grid's
-/// "180" column computed through its geotransform can lie at 179.9999999999998, and the
-/// GeoJSON writers would cut the triangles beside it into slivers 1e-13° wide. (1e-9° is
-/// 0.1 mm, far below any raster's spacing and the verifier's 1e-3 pixel.)
-fn snap_to_antimeridian(points: &mut [[f64; 3]]) {
+/// Longitudes within 1e-9° of the antimeridian (180 + 360 j) put on it, for GeoJSON in
+/// EPSG:4326 (reprojected, or the raster's own with `--geojson-source-crs`): a 0..360
+/// grid's "180" column computed through its geotransform can lie at 179.9999999999998,
+/// and the GeoJSON writers would cut the triangles and lines beside it into slivers 1e-13°
+/// wide. (1e-9° is 0.1 mm, far below any raster's spacing and the verifier's 1e-3 pixel.)
+pub fn snap_to_antimeridian(points: &mut [[f64; 3]]) {
     for p in points {
         let meridian = 180.0 + 360.0 * ((p[0] - 180.0) / 360.0).round();
         if (p[0] - meridian).abs() < 1e-9 {

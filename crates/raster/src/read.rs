@@ -4,7 +4,7 @@ use std::io;
 use std::path::Path;
 
 use gdal::raster::{ColorInterpretation, RasterBand};
-use gdal::spatial_ref::{AxisMappingStrategy, SpatialRef};
+use gdal::spatial_ref::SpatialRef;
 use gdal::{Dataset, DatasetOptions, GdalOpenFlags, Metadata};
 use tinsmith_core::Grid;
 
@@ -463,13 +463,9 @@ fn epsg_code(srs: SpatialRef) -> Option<u32> {
     if let Some(code) = epsg_authority(&srs) {
         return Some(code);
     }
-    let mut original = srs.clone();
-    original.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
     let same = |code: u32| {
-        SpatialRef::from_epsg(code).is_ok_and(|mut candidate| {
-            candidate.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
-            candidate == original
-        })
+        SpatialRef::from_epsg(code)
+            .is_ok_and(|candidate| crate::reproject::equivalent(&candidate, &srs))
     };
     let mut identified = srs.clone();
     let auto = identified
@@ -576,6 +572,10 @@ mod tests {
             PARAMETER[\"Latitude_Of_Origin\",0.0],UNIT[\"Meter\",1.0]]";
         let srs = SpatialRef::from_esri(esri).expect("ESRI WKT");
         assert_eq!(epsg_code(srs), Some(32632));
+        let esri_wgs84 = "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",\
+            6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"Degree\",0.017453292519943295]]";
+        let srs = SpatialRef::from_esri(esri_wgs84).expect("ESRI WKT");
+        assert_eq!(epsg_code(srs), Some(4326));
         let metres = utm("500000", "UNIT[\"metre\",1]");
         let srs = SpatialRef::from_wkt(&metres).expect("WKT");
         assert_eq!(epsg_code(srs), Some(32632));

@@ -147,9 +147,25 @@ pub fn is_geographic(wkt: &str) -> Result<bool> {
 /// False when GDAL cannot read either.
 pub fn same_crs(a: &str, b: &str) -> bool {
     match (spatial_ref(a), spatial_ref(b)) {
-        (Ok(a), Ok(b)) => a == b,
+        (Ok(a), Ok(b)) => equivalent(&a, &b),
         _ => false,
     }
+}
+
+/// GDAL's `IsSame` with the axis order of geographic CRSs and the data axis mapping aside:
+/// ESRI's WGS84 (longitude, latitude axes) is EPSG:4326 (latitude, longitude), which plain
+/// `IsSame` denies once both are read in the same x, y order.
+pub(crate) fn equivalent(a: &SpatialRef, b: &SpatialRef) -> bool {
+    let options = [
+        c"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES".as_ptr(),
+        c"CRITERION=EQUIVALENT_EXCEPT_AXIS_ORDER_GEOGCRS".as_ptr(),
+        std::ptr::null(),
+    ];
+    // SAFETY: both handles are live; `options` is a NULL-terminated array of NUL-terminated
+    // strings that outlive the call, which only reads them.
+    #[allow(unsafe_code)]
+    let same = unsafe { gdal_sys::OSRIsSameEx(a.to_c_hsrs(), b.to_c_hsrs(), options.as_ptr()) };
+    same == 1
 }
 
 #[cfg(test)]
@@ -167,6 +183,11 @@ mod tests {
         assert!(same_crs(&wkt, &pretty));
         let esri_prj = "PROJCS[\"WGS_1984_UTM_Zone_32N\",GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137.0,298.257223563]],PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],PARAMETER[\"False_Easting\",500000.0],PARAMETER[\"False_Northing\",0.0],PARAMETER[\"Central_Meridian\",9.0],PARAMETER[\"Scale_Factor\",0.9996],PARAMETER[\"Latitude_Of_Origin\",0.0],UNIT[\"Meter\",1.0]]";
         assert!(same_crs(&wkt, esri_prj));
+        // ESRI's geographic WGS84 declares longitude, latitude axes; EPSG:4326 the reverse.
+        let esri_wgs84 = "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",\
+            6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"Degree\",0.017453292519943295]]";
+        assert!(same_crs("EPSG:4326", esri_wgs84));
+        assert!(!same_crs("EPSG:4269", esri_wgs84));
         assert!(!same_crs(&wkt, "EPSG:32633"));
         assert!(!same_crs(&wkt, "not a CRS"));
     }

@@ -353,7 +353,7 @@ fn ogrinfo_reads_flatgeobuf_triangles_equal_to_the_ply() {
     mesh(&d, &dem, "m.fgb", E, &[]);
     let fgb = d.path("m.fgb").to_string_lossy().into_owned();
     let summary = run("ogrinfo", &["-so", "-al", &fgb]);
-    assert_eq!(ogr_field(&summary, "Geometry:"), "3D Triangle");
+    assert_eq!(ogr_field(&summary, "Geometry:"), "3D Polygon");
     assert_eq!(
         ogr_field(&summary, "Feature Count:"),
         report["triangles_after"].to_string()
@@ -622,7 +622,7 @@ fn flags_for_another_format_are_refused_and_format_overrides_the_extension() {
         "ogrinfo",
         &["-so", "-al", &d.path("tin.dat").to_string_lossy()],
     );
-    assert_eq!(ogr_field(&summary, "Geometry:"), "3D Triangle");
+    assert_eq!(ogr_field(&summary, "Geometry:"), "3D Polygon");
     // Reading it back: the extension says nothing, so `verify` and `contour --mesh` say
     // so and take the format as `mesh` did, from an option.
     let o = d.run(&["verify", &dem, "tin.dat"]);

@@ -1,10 +1,12 @@
-//! FlatGeobuf through the `flatgeobuf` crate: one `Triangle` Z feature per triangle, an `id`
-//! column, the CRS in the header, a packed Hilbert R-tree index.
+//! FlatGeobuf through the `flatgeobuf` crate: one `Polygon` Z feature (a closed ring of 4)
+//! per triangle, an `id` column, the CRS in the header, a packed Hilbert R-tree index.
 //!
 //! With the index, the writer sorts features along a Hilbert curve, so the file's feature
 //! order is not the mesh's; the `id` column (`Long`: GDAL reads unsigned 64-bit columns as
 //! reals) holds each triangle's position and the reader puts them back in that order.
-//! `Triangle` rather than `PolyhedralSurface` or `TIN`: GDAL 3.6 reads it.
+//! `Polygon` rather than `Triangle`, `PolyhedralSurface` or `TIN`: GDAL reads all of them,
+//! but pyogrio (geopandas' default engine) and the flatgeobuf JavaScript reader (web maps)
+//! read no `Triangle`. Files of `Triangle` features, as tinsmith wrote before, are read.
 
 use std::io::{self, Read, Write};
 
@@ -50,13 +52,13 @@ pub(crate) fn write<W: Write>(w: W, mesh: MeshRef<'_>) -> io::Result<()> {
         ..FgbWriterOptions::default()
     };
     let mut fgb =
-        FgbWriter::create_with_options("tin", GeometryType::Triangle, options).map_err(io_error)?;
+        FgbWriter::create_with_options("tin", GeometryType::Polygon, options).map_err(io_error)?;
     fgb.add_column(ID, ColumnType::Long, |_, _| {});
     for (id, &[a, b, c]) in mesh.triangles.iter().enumerate() {
         let id64 = id as u64;
         fgb.property(0, ID, &ColumnValue::Long(id as i64))
             .map_err(io_error)?;
-        fgb.triangle_begin(true, 1, 0).map_err(io_error)?;
+        fgb.polygon_begin(true, 1, 0).map_err(io_error)?;
         fgb.linestring_begin(false, 4, 0).map_err(io_error)?;
         for (k, i) in [a, b, c, a].into_iter().enumerate() {
             let [x, y, z] = mesh.vertices[i as usize];
@@ -64,7 +66,7 @@ pub(crate) fn write<W: Write>(w: W, mesh: MeshRef<'_>) -> io::Result<()> {
                 .map_err(io_error)?;
         }
         fgb.linestring_end(false, 0).map_err(io_error)?;
-        fgb.triangle_end(true, 0).map_err(io_error)?;
+        fgb.polygon_end(true, 0).map_err(io_error)?;
         fgb.feature_end(id64).map_err(io_error)?;
     }
     fgb.write(w).map_err(io_error)
@@ -265,6 +267,41 @@ mod tests {
                 "{problem:?}"
             );
         }
+    }
+
+    #[test]
+    fn polygons_are_written_and_triangles_as_written_before_are_read() -> Result<(), Problem> {
+        let vertices = [[0.0, 0.0, 1.0], [1.0, 0.0, 2.0], [0.0, 1.0, 3.0]];
+        let bytes = write_to_vec(MeshRef::new(&vertices, &[[0, 1, 2]]));
+        let header = FgbReader::open(&bytes[..]).map_err(io_error)?;
+        assert_eq!(header.header().geometry_type(), GeometryType::Polygon);
+        // tinsmith's files before: `Triangle` features.
+        let options = FgbWriterOptions {
+            write_index: false,
+            detect_type: false,
+            has_z: true,
+            ..FgbWriterOptions::default()
+        };
+        let mut fgb = FgbWriter::create_with_options("tin", GeometryType::Triangle, options)
+            .map_err(io_error)?;
+        fgb.add_column(ID, ColumnType::Long, |_, _| {});
+        fgb.property(0, ID, &ColumnValue::Long(0))
+            .map_err(io_error)?;
+        fgb.triangle_begin(true, 1, 0).map_err(io_error)?;
+        fgb.linestring_begin(false, 4, 0).map_err(io_error)?;
+        for (k, [x, y, z]) in [0, 1, 2, 0].map(|i| vertices[i]).into_iter().enumerate() {
+            fgb.coordinate(x, y, Some(z), None, None, None, k)
+                .map_err(io_error)?;
+        }
+        fgb.linestring_end(false, 0).map_err(io_error)?;
+        fgb.triangle_end(true, 0).map_err(io_error)?;
+        fgb.feature_end(0).map_err(io_error)?;
+        let mut old = Vec::new();
+        fgb.write(&mut old).map_err(io_error)?;
+        let mesh = read(&old[..])?;
+        assert_eq!(mesh.vertices, vertices);
+        assert_eq!(mesh.triangles, [[0, 1, 2]]);
+        Ok(())
     }
 
     #[test]

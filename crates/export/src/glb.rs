@@ -85,7 +85,8 @@ pub(crate) fn write<W: Write>(
     let mut extras = json!({
         "generator": "tinsmith",
         "origin": [ox, oy, oz],
-        "axes": "glTF (x, y, z) = world (x east, z up, -y north)",
+        "axes": "glTF (x, y, z) = file (x, z, -y): x east, y north, z up; with \
+                 --pixel-coords x column, y row (south), z value, so mirrored north-south",
     });
     if let Some(crs) = mesh.crs_line() {
         extras["crs_wkt"] = Value::from(crs);

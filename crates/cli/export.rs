@@ -644,9 +644,9 @@ fn check_no_fold_in_lon_lat(
         bail!(
             "{}: {folded} of {} triangles fold over their neighbours in longitude/latitude \
              (straight edges of the raster's CRS curve in longitude/latitude, most near a \
-             pole or far from the projection's centre), so RFC 7946 GeoJSON cannot hold the mesh; write with \
-             --geojson-source-crs (the raster's CRS) or to .fgb, or keep triangles small \
-             with --max-edge-length",
+             pole or far from the projection's centre), so RFC 7946 GeoJSON cannot hold \
+             the mesh; write with --geojson-source-crs (the raster's CRS) or to .fgb, or \
+             keep triangles small with --max-edge-length",
             path.display(),
             triangles.len()
         );

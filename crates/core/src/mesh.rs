@@ -350,6 +350,11 @@ impl<'g> Mesh<'g> {
         self.vertex_triangle[v as usize] != NONE
     }
 
+    /// Samples per grid row (vertex `v` sits at column `v % width`, row `v / width`).
+    pub(crate) fn grid_width(&self) -> usize {
+        self.grid.width() as usize
+    }
+
     /// Number of vertex slots (grid samples).
     pub(crate) fn vertex_slots(&self) -> usize {
         self.vertex_triangle.len()

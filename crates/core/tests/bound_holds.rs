@@ -222,6 +222,29 @@ fn planar_grid_keeps_only_its_corners() {
 }
 
 #[test]
+fn planar_ground_decimates_in_rounds_not_chains() {
+    // The strips start keeps each row's two ends on a tilted plane. Removed one after
+    // another in a single sweep, each removal's new triangles covered all the rows before
+    // it, and every removal measured all their samples: cubic time (a 4000² plane took
+    // 155 s). Vertices beside a hole larger than 128 x 128 samples wait for the next
+    // sweep, so the plane goes in rounds (1.7 s). Both give the plane's two triangles.
+    let (w, h) = (400u32, 300u32);
+    let spec = GridSpec {
+        width: w,
+        height: h,
+        values: (0..w * h)
+            .map(|i| 0.37 * f64::from(i % w) + 1.13 * f64::from(i / w))
+            .collect(),
+    };
+    let options = DecimationOptions::new(1.0).with_initial_mesh(InitialMesh::Strips);
+    let tin = check_with(&spec, &options).unwrap();
+    assert_eq!(tin.triangles().len(), 2);
+    let grid = Grid::new(w, h, spec.values).unwrap();
+    let report = decimate(&grid, &options).unwrap().report;
+    assert!(report.sweeps > 4, "{report:?}");
+}
+
+#[test]
 fn heights_near_f64_overflow_are_refused_and_large_ones_keep_the_bound() {
     // A checkerboard of ±h: its errors overflow f32 (where bounds are kept) from about
     // 1e38, and planes through it overflow f64 near f64::MAX.

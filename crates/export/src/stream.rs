@@ -16,9 +16,10 @@ const BUFFER_SIZE: usize = 1 << 16;
 /// example tile by tile), and the file appears, complete, when [`MeshStreamWriter::finish`]
 /// succeeds.
 ///
-/// Vertices and triangles are spooled to two temporary files in the output directory (the
-/// PLY header needs both counts before any record); `finish` writes the header and both
-/// spools into a third temporary file and renames it over the target. The file is byte for
+/// Vertices and triangles are spooled to two unnamed temporary files in the output
+/// directory (the PLY header needs both counts before any record), which vanish however
+/// the process ends; `finish` writes the header and both spools into a third temporary
+/// file and renames it over the target. The file is byte for
 /// byte the one [`crate::write_mesh`] writes for the same vertices, triangles and CRS.
 ///
 /// # Guarantees
@@ -281,34 +282,28 @@ impl MeshStreamWriter {
     }
 }
 
-/// A temporary file (removed on drop) with a buffered writer.
+/// An unnamed temporary file with a buffered writer.
+///
+/// The file has no name in the output directory (`O_TMPFILE` on Linux; elsewhere it is
+/// unlinked right after creation), so it vanishes when its handles close, however the
+/// process ends: killed, aborted on a failed allocation, or out of disk.
 #[derive(Debug)]
 struct Spool {
-    file: tempfile::NamedTempFile,
+    file: File,
     writer: BufWriter<File>,
-    /// Keeps the spool registered for removal on a signal.
-    _pending: crate::PendingGuard,
 }
 
 impl Spool {
     fn new(dir: &Path) -> io::Result<Spool> {
-        let file = tempfile::Builder::new()
-            .prefix(".tinsmith-")
-            .suffix(".spool.tmp")
-            .tempfile_in(dir)?;
-        let writer = BufWriter::with_capacity(BUFFER_SIZE, file.as_file().try_clone()?);
-        let _pending = crate::track_pending(file.path());
-        Ok(Spool {
-            file,
-            writer,
-            _pending,
-        })
+        let file = tempfile::tempfile_in(dir)?;
+        let writer = BufWriter::with_capacity(BUFFER_SIZE, file.try_clone()?);
+        Ok(Spool { file, writer })
     }
 
     /// Flushes the writer and returns a handle reading the spool from its start.
     fn rewind(&mut self) -> io::Result<File> {
         self.writer.flush()?;
-        let mut file = self.file.as_file().try_clone()?;
+        let mut file = self.file.try_clone()?;
         file.rewind()?;
         Ok(file)
     }
@@ -379,7 +374,8 @@ mod tests {
         let path = dir.path().join("out.ply");
         let mut w = MeshStreamWriter::create(&path, MeshFormat::Ply, None)?;
         w.write_vertices(&[[0.0; 3]; 5])?;
-        assert!(!path.exists());
+        // The spools have no names: a run killed now (no drop) leaves nothing behind.
+        assert!(entries(dir.path()).is_empty());
         drop(w);
         assert!(entries(dir.path()).is_empty());
 

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use crate::hole::{Retriangulator, Rules};
 use crate::levels::triangle_levels;
-use crate::mesh::{CompactBound, Mesh, Star, VertexClass};
+use crate::mesh::{CompactBound, Mesh, Star, VertexClass, NONE};
 use crate::predicates::Point;
 use crate::rtin::{cheap_rtin_with_fewer_triangles, rtin_for_count, rtin_triangles};
 use crate::strips::StripPlan;
@@ -459,7 +459,41 @@ fn remove_border(
                 .map_err(|problem| Error::BorderSample { x, y, problem })?;
         }
     }
-    Ok(())
+    remover.measure_border_fans(mesh)
+}
+
+/// The border sample skipped by the fan triangle with these corners that lies farthest
+/// from the straight border edge between them (or the triangle's first corner, should no
+/// two corners on one side of the grid skip any).
+fn skipped_border_sample(mesh: &Mesh<'_>, corners: [u32; 3]) -> [u32; 2] {
+    let (w, h) = (mesh.width(), mesh.height());
+    let on_one_side = |a: u32, b: u32| {
+        let ([xa, ya], [xb, yb]) = ([a % w, a / w], [b % w, b / w]);
+        (ya == yb && (ya == 0 || ya == h - 1) && xa.abs_diff(xb) > 1)
+            || (xa == xb && (xa == 0 || xa == w - 1) && ya.abs_diff(yb) > 1)
+    };
+    let side = [(0, 1), (1, 2), (2, 0)]
+        .map(|(i, j)| (corners[i].min(corners[j]), corners[i].max(corners[j])))
+        .into_iter()
+        .find(|&(a, b)| on_one_side(a, b));
+    let Some((a, b)) = side else {
+        return [corners[0] % w, corners[0] / w];
+    };
+    let step = if a / w == b / w { 1 } else { w };
+    let (za, zb) = (mesh.point(a).z, mesh.point(b).z);
+    let n = (b - a) / step;
+    let worst = (1..n)
+        .map(|k| {
+            let line = za + (zb - za) * f64::from(k) / f64::from(n);
+            (k, (mesh.point(a + k * step).z - line).abs())
+        })
+        .fold(
+            (1, f64::NEG_INFINITY),
+            |best, c| if c.1 > best.1 { c } else { best },
+        )
+        .0;
+    let u = a + worst * step;
+    [u % w, u / w]
 }
 
 #[derive(Debug, Default)]
@@ -768,6 +802,11 @@ pub(crate) struct Remover<'g> {
     /// With contour levels: refuse a removal whose new triangles span more levels in all
     /// than the star's did (it would give the contour lines more segments).
     segments_may_not_grow: bool,
+    /// Slots of border-fan triangles made by [`Remover::force_remove`] whose errors are
+    /// measured once the border is done ([`Remover::measure_border_fans`]): along a run of
+    /// skipped border samples each fan's last triangle spans the whole run so far and is
+    /// replaced by the next removal, so measuring it each time would be quadratic.
+    unmeasured_fans: Vec<u32>,
 }
 
 impl<'g> Remover<'g> {
@@ -783,11 +822,13 @@ impl<'g> Remover<'g> {
             locked_border: None,
             max_ring: MAX_HOLE_RING,
             segments_may_not_grow: false,
+            unmeasured_fans: Vec::new(),
         }
     }
 
-    /// Removes border sample `v` whatever the error, then checks the new triangles' exact
-    /// errors against the limit.
+    /// Removes border sample `v` whatever the error. A fan's triangles are measured and
+    /// checked against the limit by [`Remover::measure_border_fans`]; any other hole's
+    /// triangles are measured and checked here.
     fn force_remove(
         &mut self,
         mesh: &mut Mesh<'_>,
@@ -795,13 +836,8 @@ impl<'g> Remover<'g> {
     ) -> std::result::Result<(), &'static str> {
         let limit = self.rules.limit;
         if self.plan_border_fan(mesh, v) {
-            let worst = self
-                .new_triangles
-                .iter()
-                .fold(0.0f64, |w, t| w.max(t.2.max()));
-            if worst > limit {
-                return Err("skipping it exceeds the error bound");
-            }
+            self.unmeasured_fans
+                .extend(self.new_triangles.iter().map(|t| t.0));
             self.apply(mesh, v);
             return Ok(());
         }
@@ -843,13 +879,9 @@ impl<'g> Remover<'g> {
     /// first along the border (already settled: kept, since border samples are removed in
     /// order). The next border vertex then keeps a small star, so a long run of removals
     /// stays linear. Returns false when `v` is not a boundary vertex or the fan is not a
-    /// valid triangulation of the hole; bounds are the exact errors.
+    /// valid triangulation of the hole. The new triangles' bounds are placeholders until
+    /// [`Remover::measure_border_fans`] measures them.
     fn plan_border_fan(&mut self, mesh: &Mesh<'_>, v: u32) -> bool {
-        let cap = if self.exact_zero() {
-            0.0
-        } else {
-            f64::INFINITY
-        };
         let star = &mut self.ring_star;
         mesh.star(v, star);
         if mesh.classify(v, star) != VertexClass::Boundary {
@@ -872,18 +904,50 @@ impl<'g> Remover<'g> {
             if crate::predicates::orient(&a, &b, &c) <= 0 {
                 return false;
             }
-            // At a bound of 0 on integer heights, planarity is decided exactly (as in
-            // `plan`); a fan off the plane gets an infinite bound and is refused.
-            let bound = crate::exact::triangle_error(self.rules.grid, &a, &b, &c, cap).unwrap_or(
-                ErrorBound {
-                    above: f64::INFINITY,
-                    below: f64::INFINITY,
-                },
-            );
             let corners = [apex, p, q].map(|i| star.ring[i]);
-            self.new_triangles.push((slot, corners, bound));
+            // Measured later, by `measure_border_fans`.
+            let unmeasured = ErrorBound {
+                above: 0.0,
+                below: 0.0,
+            };
+            self.new_triangles.push((slot, corners, unmeasured));
         }
         true
+    }
+
+    /// Measures the exact errors of the border-fan triangles [`Remover::force_remove`] made
+    /// that are still in the mesh, stores them as their bounds, and checks them against
+    /// the limit (at a bound of 0 on integer heights, planarity is decided exactly, as in
+    /// `plan`). Each is measured once, so a run of skipped border samples costs time
+    /// linear in its length.
+    fn measure_border_fans(&mut self, mesh: &mut Mesh<'_>) -> Result<()> {
+        let cap = if self.exact_zero() {
+            0.0
+        } else {
+            f64::INFINITY
+        };
+        let mut slots = std::mem::take(&mut self.unmeasured_fans);
+        slots.sort_unstable();
+        slots.dedup();
+        for t in slots {
+            let corners = mesh.corners(t);
+            if corners[0] == NONE {
+                continue;
+            }
+            let [a, b, c] = corners.map(|u| mesh.point(u));
+            let bound = crate::exact::triangle_error(self.rules.grid, &a, &b, &c, cap)
+                .filter(|bound| bound.max() <= self.rules.limit);
+            let Some(bound) = bound else {
+                let [x, y] = skipped_border_sample(mesh, corners);
+                return Err(Error::BorderSample {
+                    x,
+                    y,
+                    problem: "skipping it exceeds the error bound",
+                });
+            };
+            mesh.set_bound(t, bound);
+        }
+        Ok(())
     }
 
     /// Plans the removal of `v`: if it is interior or boundary and its hole can be

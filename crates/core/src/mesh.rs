@@ -389,6 +389,11 @@ impl<'g> Mesh<'g> {
         self.bounds[t as usize].into()
     }
 
+    /// Sets the bound of triangle `t` (stored rounded up, as every bound).
+    pub(crate) fn set_bound(&mut self, t: u32, bound: ErrorBound) {
+        self.bounds[t as usize] = bound.into();
+    }
+
     /// Live triangles in slot order, as corner triples.
     pub(crate) fn live_triangles(&self) -> impl Iterator<Item = (u32, [u32; 3])> + '_ {
         self.corners

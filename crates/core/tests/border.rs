@@ -254,6 +254,40 @@ fn whole_borders_skipped_on_a_plane() {
 }
 
 #[test]
+fn a_long_two_row_grid_is_all_border() {
+    // Every sample is on the border; the fans along both rows replace one another as the
+    // runs grow, and only the last are measured (each measurement of a run's fan scans the
+    // whole run), so this stays linear in the length.
+    let (w, h) = (30_000u32, 2u32);
+    let values: Vec<f64> = (0..w * h)
+        .map(|i| 0.125 * (i % w) as f64 + 3.0 * (i / w) as f64)
+        .collect();
+    let grid = Grid::new(w, h, values.clone()).unwrap();
+    let tin = decimate_with_border(
+        &grid,
+        &DecimationOptions::new(0.5),
+        &|_, _| false,
+        &mut |_| {},
+    )
+    .unwrap()
+    .tin;
+    assert_eq!(tin.triangles().len(), 2);
+    let positions: Vec<[i64; 2]> = tin
+        .vertices()
+        .iter()
+        .map(|v| [v.x as i64, v.y as i64])
+        .collect();
+    let heights: Vec<f64> = tin.vertices().iter().map(|v| v.z).collect();
+    let report = verify(
+        GridRef::new(w, h, &values),
+        MeshRef::new(&positions, &heights, tin.triangles()),
+        &VerifyOptions::new().with_max_error(0.5),
+    )
+    .unwrap();
+    assert!(report.passed(), "{:?}", report.problems);
+}
+
+#[test]
 fn a_skipped_sample_that_breaks_the_bound_is_an_error() {
     let mut spec = terrain(20, 20, 0.0, 3);
     spec.values[10] += 50.0; // a spike on the top border
@@ -265,5 +299,15 @@ fn a_skipped_sample_that_breaks_the_bound_is_an_error() {
         &mut |_| {},
     )
     .unwrap_err();
-    assert!(err.to_string().contains("border sample"), "{err}");
+    assert!(err.to_string().contains("border sample ("), "{err}");
+    assert!(err.to_string().contains("error bound"), "{err}");
+
+    // On a plane the spike is the only sample off the border edges, and it is named.
+    let (w, h) = (20u32, 20u32);
+    let mut values: Vec<f64> = (0..w * h).map(|i| 0.5 * (i % w) as f64).collect();
+    values[(h - 1) as usize * w as usize + 13] += 5.0;
+    let grid = Grid::new(w, h, values).unwrap();
+    let options = DecimationOptions::new(1.0);
+    let err = decimate_with_border(&grid, &options, &|_, _| false, &mut |_| {}).unwrap_err();
+    assert!(err.to_string().contains("border sample (13, 19)"), "{err}");
 }

@@ -105,9 +105,10 @@ impl EdgeProfile {
     /// The result depends only on the profile and `limit`.
     ///
     /// # Runtime
-    /// O(n * min(n, max_span)) for n samples.
+    /// O(n) for n samples (O(n * min(n, max_span)) in the worst case, only where rounding
+    /// puts a sample at exactly `limit` from a line; see `chord_reach`).
     pub fn simplify(&self, limit: f64, max_span: usize) -> Vec<bool> {
-        self.simplify_with(max_span, |v, a, c| chord_fits(v, a, c, limit))
+        self.simplify_with(max_span, |v, a, end| chord_reach(v, a, end, limit))
     }
 
     /// Which samples the edge keeps when only samples exactly on the straight line between
@@ -115,13 +116,15 @@ impl EdgeProfile {
     /// at `limit` 0, exact. For edges of integer values below 2^50 in magnitude (the core
     /// then measures an error of 0 exactly too; see `tinsmith_core::Grid::integral_heights`).
     pub fn simplify_collinear(&self, max_span: usize) -> Vec<bool> {
-        self.simplify_with(max_span, collinear)
+        self.simplify_with(max_span, collinear_reach)
     }
 
+    /// The kept samples, given `reach(values, a, end)`: the sample in `a + 1..=end` that
+    /// the kept sample `a` is joined to, all samples between them skipped.
     fn simplify_with(
         &self,
         max_span: usize,
-        fits: impl Fn(&[f64], usize, usize) -> bool,
+        reach: impl Fn(&[f64], usize, usize) -> usize,
     ) -> Vec<bool> {
         let v = &self.values;
         let n = v.len();
@@ -134,16 +137,16 @@ impl EdgeProfile {
                 keep[k + 1] = true;
             }
         }
+        // For each sample, the first sample after it that must be kept.
+        let mut next_kept = vec![n - 1; n];
+        for i in (0..n - 1).rev() {
+            next_kept[i] = if keep[i + 1] { i + 1 } else { next_kept[i + 1] };
+        }
         let mut a = 0;
         while a < n - 1 {
-            let mut b = a + 1;
-            while !keep[b] {
-                let c = b + 1;
-                if c - a > max_span || !fits(v, a, c) {
-                    break;
-                }
-                b = c;
-            }
+            let end = next_kept[a].min(a.saturating_add(max_span.max(1)));
+            let b = reach(v, a, end);
+            debug_assert!(a < b && b <= end);
             keep[b] = true;
             a = b;
         }
@@ -151,12 +154,52 @@ impl EdgeProfile {
     }
 }
 
-/// Whether every sample between `a` and `c` lies exactly on the straight line between
-/// them, for integer values: `(v[m] - v[a]) (c - a) == (v[c] - v[a]) (m - a)` in `i128`.
-fn collinear(v: &[f64], a: usize, c: usize) -> bool {
+/// The farthest `b` in `a + 1..=end` such that for every `c` in `a + 2..=b` the straight
+/// line from `a` to `c` is within `limit` of every sample between them, found in time
+/// linear in `b - a`.
+///
+/// The line from `a` to `c` passes within `limit` of sample `m` when its slope lies in
+/// `[(v[m] - v[a] - limit) / (m - a), (v[m] - v[a] + limit) / (m - a)]`; the samples up
+/// to `c - 1` narrow that interval step by step. Rounding can make that test disagree with
+/// the direct one at the interval's ends, so the line to the `b` found is then checked
+/// directly; should it fail, each `c` is checked directly from `a` instead (quadratic, and
+/// only then).
+fn chord_reach(v: &[f64], a: usize, end: usize, limit: f64) -> usize {
+    let za = v[a];
+    let (mut low, mut high) = (f64::NEG_INFINITY, f64::INFINITY);
+    let mut b = a + 1;
+    while b < end {
+        let c = b + 1;
+        let k = (b - a) as f64;
+        low = low.max((v[b] - za - limit) / k);
+        high = high.min((v[b] - za + limit) / k);
+        let slope = (v[c] - za) / (c - a) as f64;
+        if !(low <= slope && slope <= high) {
+            break;
+        }
+        b = c;
+    }
+    if b == a + 1 || chord_fits(v, a, b, limit) {
+        return b;
+    }
+    let mut b = a + 1;
+    while b < end && chord_fits(v, a, b + 1, limit) {
+        b += 1;
+    }
+    b
+}
+
+/// The farthest `b` in `a + 1..=end` such that every sample from `a` to `b` lies exactly on
+/// one straight line, for integer values: `v[m] - v[a] == (m - a) (v[a + 1] - v[a])` in
+/// `i128` (two samples always do).
+fn collinear_reach(v: &[f64], a: usize, end: usize) -> usize {
     let int = |x: f64| x as i128;
-    let (za, rise, run) = (int(v[a]), int(v[c]) - int(v[a]), (c - a) as i128);
-    (a + 1..c).all(|m| (int(v[m]) - za) * run == rise * (m - a) as i128)
+    let rise = int(v[a + 1]) - int(v[a]);
+    let mut b = a + 1;
+    while b < end && int(v[b + 1]) - int(v[a]) == (b + 1 - a) as i128 * rise {
+        b += 1;
+    }
+    b
 }
 
 /// Whether the straight line from sample `a` to sample `c` is within `limit` of every

@@ -545,7 +545,7 @@ impl Gltf<'_> {
             0 => 0,
             n => (n - 1)
                 .checked_mul(stride)
-                .and_then(|v| v.checked_add(offset + element))
+                .and_then(|v| v.checked_add(offset.checked_add(element)?))
                 .ok_or_else(|| bad("too large"))?,
         };
         if stride < element || needed > view_len {
@@ -752,6 +752,12 @@ mod tests {
         ));
         let (mut root, bin) = unpack(&good);
         assert!(read(pack(&root, &bin).as_slice(), None).is_ok());
+        let mut far = root.clone();
+        far["accessors"][0]["byteOffset"] = Value::from(u64::MAX);
+        assert!(matches!(
+            read(pack(&far, &bin).as_slice(), None),
+            Err(Problem::Malformed(m)) if m.contains("too large")
+        ));
         root["asset"]["version"] = Value::from("3.0");
         assert!(matches!(
             read(pack(&root, &bin).as_slice(), None),

@@ -43,11 +43,11 @@ use crate::output::NamingFile;
 use crate::output::{check_distinct, check_writable_target};
 use crate::verify::{expected_orientation, read_mesh_file, sample_positions};
 
-/// Builds the TIN, contours it and writes the lines; `Ok(true)` on success.
 /// Memory per line segment while contouring and writing: its point in the joiner, the
 /// polyline and the file coordinates (measured about 50 bytes on ETOPO5).
 const BYTES_PER_SEGMENT: u64 = 64;
 
+/// Builds the TIN, contours it and writes the lines; `Ok(true)` on success.
 pub fn run(args: &ContourArgs) -> Result<bool> {
     let started = Instant::now();
     if args.offset.is_some() && args.interval.is_none() {

@@ -22,10 +22,11 @@ struct MeshReport<'a> {
     summary: MeshSummary<'a>,
     #[serde(flatten)]
     output_format: crate::export::PlanReport,
-    /// Vertices of the initial mesh (the RTIN's, or every domain sample).
+    /// Vertices of the mesh decimation started from (the start's, see `--initial-mesh`).
     start_vertices: usize,
-    /// Sweeps until nothing could be removed, and removal attempts in all.
+    /// Sweeps until nothing could be removed (the greedy order counts as one).
     sweeps: usize,
+    /// Removal attempts in all.
     removal_attempts: usize,
     seconds: Seconds,
 }

@@ -34,8 +34,8 @@ pub struct DecimationReport {
     pub initial_vertices: usize,
     /// Triangles of the full mesh (two per valid cell).
     pub initial_triangles: usize,
-    /// Vertices of the mesh decimation started from (fewer than `initial_vertices` for
-    /// [`crate::InitialMesh::Rtin`]).
+    /// Vertices of the mesh decimation started from (fewer than `initial_vertices` unless
+    /// the start is [`crate::InitialMesh::Full`]).
     pub start_vertices: usize,
     /// Vertices kept.
     pub final_vertices: usize,
@@ -43,7 +43,8 @@ pub struct DecimationReport {
     pub final_triangles: usize,
     /// Largest error bound of any kept triangle: an upper bound on the true error.
     pub max_bound: f64,
-    /// Sweeps over the candidate vertices until none could be removed.
+    /// Sweeps over the candidate vertices until none could be removed; the greedy order
+    /// counts as one more.
     pub sweeps: usize,
     /// Removal attempts (vertex retriangulations tried).
     pub attempts: usize,
@@ -56,10 +57,18 @@ pub struct DecimationReport {
 /// Decimates `grid` into a TIN whose linear interpolation is within
 /// `options.max_error` of every domain sample.
 ///
-/// The initial mesh splits every valid cell into two triangles; vertices are then removed
-/// by the paper's algorithm: classify (§3.2), propagate error bounds (§3.3), retriangulate
-/// the hole by ear selection (§3.4), in repeated sweeps in row-major order until a sweep
-/// removes nothing. Corner vertices are never removed, so the domain is unchanged.
+/// Decimation starts from `options.initial_mesh`: by default a coarse start already within
+/// the bound (strips, or the RTIN where it is cheap); the paper's start,
+/// [`crate::InitialMesh::Full`], splits every valid cell into two triangles. Vertices are
+/// then removed as in the paper: classify (§3.2); bound the new triangles' errors
+/// (`options.error_model`: by default the exact error over the samples each covers; the
+/// paper's propagated bounds, §3.3, with [`ErrorModel::Bounds`]); retriangulate the hole
+/// (`options.retriangulation`: by default the triangulation of least maximum error by
+/// dynamic programming, ear selection, §3.4, for larger rings or with
+/// [`crate::Retriangulation::Ears`]); in repeated row-major sweeps until a sweep removes
+/// nothing, or smallest error first with [`crate::Order::Greedy`] (count targets).
+/// Corner vertices are never removed, so the domain is unchanged.
+/// [`DecimationOptions::paper`] gives the paper's configuration.
 ///
 /// # Guarantee
 /// Every triangle's [`ErrorBound`] bounds the error of every original sample it contains.
@@ -92,8 +101,9 @@ pub struct Progress {
     pub removed: usize,
 }
 
-/// [`decimate`], calling `progress` now and then (every 65,536 removal attempts and at
-/// each sweep's start). The result is the same as [`decimate`]'s.
+/// [`decimate`], calling `progress` now and then (at each sweep's start, then every 65,536
+/// removal attempts of a sweep or removals of the greedy order). The result is the same as
+/// [`decimate`]'s.
 pub fn decimate_with_progress(
     grid: &Grid,
     options: &DecimationOptions,
@@ -712,11 +722,13 @@ fn greedy(
     let n = mesh.vertex_slots();
     let mut version = vec![0u32; n];
     let mut heap = BinaryHeap::new();
-    stats.sweeps = 1;
+    // After a count target's first sweeps, if any.
+    stats.sweeps += 1;
+    let sweep = stats.sweeps;
     progress(Progress {
-        sweep: 1,
+        sweep,
         sweep_fraction: 0.0,
-        removed: 0,
+        removed: stats.removed,
     });
     for v in 0..n as u32 {
         if mesh.contains_vertex(v) {
@@ -757,7 +769,7 @@ fn greedy(
         if stats.removed.is_multiple_of(65_536) {
             let sweep_fraction = (stats.removed as f64 / expected_removals as f64).min(1.0);
             progress(Progress {
-                sweep: 1,
+                sweep,
                 sweep_fraction,
                 removed: stats.removed,
             });

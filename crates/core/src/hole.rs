@@ -734,12 +734,7 @@ impl Retriangulator {
             return out;
         }
         // The centre is on the segment: it touches every star triangle there.
-        let (first, count) = (0, m);
-        for k in 0..count.min(m) {
-            let i = (first + k) % m;
-            if i >= stars {
-                continue;
-            }
+        for i in 0..m.min(stars) {
             let (star_bound, g) = (&self.star_bounds[i], &self.star_gradients[i]);
             let tri = [centre, self.ring[i], self.ring[(i + 1) % m]];
             let Some((t_lo, t_hi)) = clip_segment(&p, &q, &tri) else {

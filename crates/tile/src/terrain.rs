@@ -39,7 +39,7 @@ pub const METADATA_AVAILABILITY: u8 = 10;
 
 /// The largest `--quality`: the level-0 bound is then 7.7e10 m, beyond any height; larger
 /// values only risk overflowing the bounds.
-pub const MAX_QUALITY: f64 = 1e6;
+const MAX_QUALITY: f64 = 1e6;
 
 /// The finest level [`build_terrain`] will go to.
 pub const MAX_LEVEL: u8 = 24;

@@ -1,31 +1,22 @@
-//! Retriangulation of the hole left by removing one vertex, with the paper's error
-//! propagation (§3.3) and ear selection (§3.4).
+//! Retriangulation of the hole left by removing one vertex: the paper's ear selection
+//! (§3.4, in [`ears`]) or the triangulation of least maximum error by dynamic programming
+//! ([`dp`]), each new triangle's error either propagated from the star's bounds as the
+//! paper does (§3.3, in [`propagation`]) or measured exactly over the samples it covers.
 //!
 //! The hole is the star of the removed vertex `c`: the ring `r_0 .. r_{m-1}` of its
 //! neighbours, counter-clockwise. For an interior vertex the ring is closed and star
 //! triangle `i` is `(c, r_i, r_{i+1 mod m})`; for a boundary vertex `c` lies on the domain
 //! edge `r_{m-1} r_0` and star triangle `i` is `(c, r_i, r_{i+1})` for `i < m - 1`.
-//!
-//! # Error propagation
-//! Each star triangle `T` carries an [`ErrorBound`] valid for every original sample in it.
-//! For a new triangle `N`, every sample in `N ∩ T` satisfies
-//! `sample - new ≤ T.above - min δ` and `new - sample ≤ T.below + max δ`, where
-//! `δ = new - old` is linear on the convex polygon `N ∩ T`, so its extremes sit at that
-//! polygon's corners. Those corners are (a) the entry and exit points of `N`'s edges in `T`
-//! (the paper's §3.3.1 rule, computed here by exact clipping of each edge against each
-//! closed star triangle), and (b) the removed vertex `c` when it lies in `N`.
-//!
-//! Case (b) is not in the paper, which propagates errors along edges only. Without it the
-//! removed vertex's own error is not counted (a peak removed from the middle of its ring
-//! is lower than its ring's chords suggest), and for a boundary vertex only the two
-//! outermost star triangles would feed the new boundary edge. Counting (b) keeps the
-//! bound a true bound; the paper's boundary rule (§3.3.2) is the special case of (a) and
-//! (b) on the new boundary edge, which passes through `c`.
+
+mod dp;
+mod ears;
+mod propagation;
 
 use crate::exact::{corner_samples, error_at, triangle_error};
-use crate::levels::{dirichlet_energy, triangle_levels};
 use crate::predicates::{in_closed_triangle, orient, plane_gradient, Point};
 use crate::{EdgeSelection, ErrorBound, ErrorModel, Grid, Retriangulation};
+use dp::Solved;
+use ears::Ear;
 
 /// A triangle of the retriangulated hole: ring positions (counter-clockwise) and bound.
 #[derive(Debug, Clone, Copy)]
@@ -40,13 +31,6 @@ struct SegmentError {
     bound: ErrorBound,
     /// Largest |new - old| at the segment's entry and exit points (§3.4 "introduced").
     introduced: f64,
-}
-
-/// An ear at ring vertex `q`, cutting off `(prev q, q, next q)`.
-#[derive(Debug, Clone, Copy)]
-struct Ear {
-    diagonal: SegmentError,
-    triangle: ErrorBound,
 }
 
 /// Reusable buffers for [`Retriangulator::retriangulate`]; one per thread.
@@ -84,18 +68,6 @@ pub(crate) struct Retriangulator {
     solved: Vec<Solved>,
     /// Intervals still to rebuild after the DP.
     stack: Vec<(usize, usize)>,
-}
-
-/// How much the top-down DP knows about an interval's optimum.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Solved {
-    /// Not yet asked.
-    Unknown,
-    /// `cost`, `cost_sum` and `split` hold the optimum (`split == u32::MAX`: no
-    /// triangulation within the limit).
-    Exact,
-    /// The optimum's largest error exceeds the value in `cost`.
-    Above,
 }
 
 /// What the retriangulation needs besides the hole: the rules and the grid.
@@ -171,20 +143,6 @@ impl Retriangulator {
         Some((&self.triangles, worst))
     }
 
-    /// The star triangles' gradients and an empty table of segment errors, for the error
-    /// propagation of §3.3 and the ears' introduced error.
-    fn prepare_segments(&mut self) {
-        let centre = self.centre.expect("hole loaded");
-        let m = self.ring.len();
-        self.segments.clear();
-        self.segments.resize(m * m, None);
-        self.star_gradients.clear();
-        for i in 0..self.star_bounds.len() {
-            let g = plane_gradient(&centre, &self.ring[i], &self.ring[(i + 1) % m]);
-            self.star_gradients.push(g);
-        }
-    }
-
     /// A necessary condition, cheap to test: whatever the triangulation, the removed vertex
     /// lies in a triangle of ring vertices, and its own error there must be within the
     /// limit (both error models count it). Tries every such triangle for small rings.
@@ -220,102 +178,6 @@ impl Retriangulator {
             }
         }
         false
-    }
-
-    fn clip_ears(&mut self, rule: EdgeSelection, rules: &Rules<'_>) -> bool {
-        let m = self.ring.len();
-        self.triangles.clear();
-        self.prev.clear();
-        self.next.clear();
-        self.edge.clear();
-        self.ears.clear();
-        for i in 0..m {
-            self.prev.push(((i + m - 1) % m) as u32);
-            self.next.push(((i + 1) % m) as u32);
-            let e = self.ring_edge_error(i);
-            self.edge.push(e);
-            self.ears.push(None);
-        }
-        let mut remaining = m;
-        let mut start = 0usize;
-        while remaining > 3 {
-            let mut best: Option<(usize, f64)> = None;
-            let mut q = start;
-            for _ in 0..remaining {
-                if self.ears[q].is_none() {
-                    let ear = self.ear(q, rules);
-                    self.ears[q] = Some(ear);
-                }
-                // Geometric validity can change as other vertices leave the polygon, so it
-                // is re-tested every round; the error part is cached per ear.
-                if let Some(Some(ear)) = self.ears[q] {
-                    if self.ear_is_empty(q) {
-                        let key = match (rule, rules.model) {
-                            (EdgeSelection::MinIntroduced, _) => ear.diagonal.introduced,
-                            (_, ErrorModel::Bounds) => ear.diagonal.bound.max(),
-                            (_, ErrorModel::Exact) => ear.triangle.max(),
-                        };
-                        if best.is_none_or(|(_, k)| key < k) {
-                            best = Some((q, key));
-                        }
-                    }
-                }
-                q = self.next[q] as usize;
-            }
-            let Some((q, _)) = best else { return false };
-            let Some(Some(ear)) = self.ears[q] else {
-                return false;
-            };
-            let (p, r) = (self.prev[q] as usize, self.next[q] as usize);
-            self.triangles.push(HoleTriangle {
-                corners: [p as u32, q as u32, r as u32],
-                bound: ear.triangle,
-            });
-            self.next[p] = r as u32;
-            self.prev[r] = p as u32;
-            self.edge[p] = ear.diagonal;
-            self.ears[p] = None;
-            self.ears[r] = None;
-            remaining -= 1;
-            start = p;
-        }
-        let a = start;
-        let (b, c) = (
-            self.next[a] as usize,
-            self.next[self.next[a] as usize] as usize,
-        );
-        if orient(&self.ring[a], &self.ring[b], &self.ring[c]) <= 0 {
-            return false;
-        }
-        let Some(bound) =
-            self.triangle_cost(a, b, c, [self.edge[a], self.edge[b], self.edge[c]], rules)
-        else {
-            return false;
-        };
-        self.triangles.push(HoleTriangle {
-            corners: [a as u32, b as u32, c as u32],
-            bound,
-        });
-        true
-    }
-
-    /// The ear at `q` if it is convex and its triangle's bound is within the limit.
-    fn ear(&mut self, q: usize, rules: &Rules<'_>) -> Option<Ear> {
-        let (p, r) = (self.prev[q] as usize, self.next[q] as usize);
-        if orient(&self.ring[p], &self.ring[q], &self.ring[r]) <= 0 {
-            return None;
-        }
-        // The exact model needs the diagonal only for its introduced error.
-        let needs_diagonal =
-            rules.model == ErrorModel::Bounds || rules.selection != EdgeSelection::MinError;
-        let diagonal = if needs_diagonal {
-            self.segment(p.min(r), p.max(r))
-        } else {
-            SegmentError::default()
-        };
-        let triangle =
-            self.triangle_cost(p, q, r, [self.edge[p], self.edge[q], diagonal], rules)?;
-        Some(Ear { diagonal, triangle })
     }
 
     /// The bound of new triangle `abc` under the error model, if within the limit. For
@@ -411,404 +273,6 @@ impl Retriangulator {
         };
         within(bound, cap).then_some(bound)
     }
-
-    /// Min-max-error triangulation of the hole by dynamic programming over ring intervals:
-    /// `cost(i, j) = min over k of max(cost(i, k), cost(k, j), error(i, k, j))`, optimal for
-    /// the error model (with levels: the fewest levels spanned among triangulations within
-    /// the limit). Ties within an interval go to the smallest summed error (least Dirichlet
-    /// energy), then the smallest `k`. Solved top-down from the whole ring (see
-    /// [`Retriangulator::solve_interval`]).
-    fn dynamic_programming(&mut self, rules: &Rules<'_>) -> bool {
-        let m = self.ring.len();
-        self.triangles.clear();
-        self.diagonal.clear();
-        self.diagonal.resize(m * m, None);
-        self.cost.clear();
-        self.cost.resize(m * m, f64::INFINITY);
-        self.cost_sum.clear();
-        self.cost_sum.resize(m * m, 0.0);
-        self.split.clear();
-        self.split.resize(m * m, u32::MAX);
-        self.solved.clear();
-        self.solved.resize(m * m, Solved::Unknown);
-        let cap = match rules.levels {
-            Some(_) => f64::INFINITY,
-            None => rules.limit,
-        };
-        if self.solve_interval(0, m - 1, cap, rules).is_none() {
-            return false;
-        }
-        // Rebuild the triangles, recomputing each one's bound.
-        let mut stack = std::mem::take(&mut self.stack);
-        stack.clear();
-        stack.push((0usize, m - 1));
-        while let Some((i, j)) = stack.pop() {
-            if j < i + 2 {
-                continue;
-            }
-            let k = self.split[i * m + j] as usize;
-            let edges = match rules.model {
-                ErrorModel::Bounds => [self.segment(i, k), self.segment(k, j), self.segment(i, j)],
-                ErrorModel::Exact => [SegmentError::default(); 3],
-            };
-            let bound = self
-                .triangle_cost_capped([i, k, j], edges, rules, rules.limit, true)
-                .expect("chosen triangle is within the limit");
-            self.triangles.push(HoleTriangle {
-                corners: [i as u32, k as u32, j as u32],
-                bound,
-            });
-            stack.push((k, j));
-            stack.push((i, k));
-        }
-        self.stack = stack;
-        true
-    }
-
-    /// The min-max optimum (largest error, then summed error, ties to the smallest split)
-    /// of interval `i < j`, if its largest error is at most `cap`; memoized in `solved`.
-    /// With levels, costs are level counts and `cap` bounds them instead.
-    ///
-    /// A sub-interval is only explored through a split triangle within the cap, and only
-    /// asked for what could still beat the best split so far, so a hole that cannot be
-    /// triangulated is usually refuted after few triangles, where filling the whole table
-    /// bottom-up measured them all (15-18 % of the decimation's time, same output).
-    fn solve_interval(
-        &mut self,
-        i: usize,
-        j: usize,
-        cap: f64,
-        rules: &Rules<'_>,
-    ) -> Option<(f64, f64)> {
-        let m = self.ring.len();
-        if j == i + 1 {
-            return Some((0.0, 0.0));
-        }
-        let at = i * m + j;
-        match self.solved[at] {
-            Solved::Exact => {
-                let found = self.split[at] != u32::MAX && self.cost[at] <= cap;
-                return found.then_some((self.cost[at], self.cost_sum[at]));
-            }
-            Solved::Above if cap <= self.cost[at] => return None,
-            _ => {}
-        }
-        let mut best = (f64::INFINITY, f64::INFINITY, u32::MAX);
-        let joinable = self.joinable(i, j);
-        if joinable {
-            for k in i + 1..j {
-                if !self.joinable(i, k) || !self.joinable(k, j) {
-                    continue;
-                }
-                if orient(&self.ring[i], &self.ring[k], &self.ring[j]) <= 0 {
-                    continue;
-                }
-                let spanned = rules.levels.map(|levels| {
-                    let (pi, pk, pj) = (&self.ring[i], &self.ring[k], &self.ring[j]);
-                    (
-                        triangle_levels(levels, pi, pk, pj) as f64,
-                        dirichlet_energy(pi, pk, pj),
-                    )
-                });
-                // With levels the sub-intervals only add levels: a triangle spanning more
-                // than the best cannot win, and needs no error.
-                if spanned.is_some_and(|(n, _)| n > best.0) {
-                    continue;
-                }
-                // Sub-intervals costlier than the best cannot win (costs only grow). With
-                // levels, costs are level counts and the error is only a limit.
-                let within = cap.min(best.0);
-                let triangle_cap = match rules.levels {
-                    Some(_) => rules.limit,
-                    None => within,
-                };
-                let edges = match rules.model {
-                    ErrorModel::Bounds => {
-                        [self.segment(i, k), self.segment(k, j), self.segment(i, j)]
-                    }
-                    ErrorModel::Exact => [SegmentError::default(); 3],
-                };
-                let Some(t) =
-                    self.triangle_cost_capped([i, k, j], edges, rules, triangle_cap, true)
-                else {
-                    continue;
-                };
-                let Some(left) = self.solve_interval(i, k, within, rules) else {
-                    continue;
-                };
-                let Some(right) = self.solve_interval(k, j, within, rules) else {
-                    continue;
-                };
-                let (c, sum) = match spanned {
-                    Some((n, energy)) => (left.0 + right.0 + n, left.1 + right.1 + energy),
-                    None => (left.0.max(right.0).max(t.max()), left.1 + right.1 + t.max()),
-                };
-                if c < best.0 || (c == best.0 && sum < best.1) {
-                    best = (c, sum, k as u32);
-                }
-            }
-        }
-        let uncapped = match rules.levels {
-            Some(_) => cap == f64::INFINITY,
-            None => cap >= rules.limit,
-        };
-        // With levels a sum of children within the cap can exceed it; a result above the
-        // cap came from a search pruned at the cap, so it is only a bound.
-        if (best.2 != u32::MAX && best.0 <= cap) || uncapped || !joinable {
-            self.solved[at] = Solved::Exact;
-            self.cost[at] = best.0;
-            self.cost_sum[at] = best.1;
-            self.split[at] = best.2;
-            (best.2 != u32::MAX).then_some((best.0, best.1))
-        } else {
-            self.solved[at] = Solved::Above;
-            self.cost[at] = cap;
-            None
-        }
-    }
-
-    /// Whether ring vertices `i < j` may be joined by a new triangle's side: a ring edge
-    /// (the open ring's ends included) or a diagonal of the hole. Memoized.
-    fn joinable(&mut self, i: usize, j: usize) -> bool {
-        let m = self.ring.len();
-        if let Some(ok) = self.diagonal[i * m + j] {
-            return ok;
-        }
-        let ok = j == i + 1 || (i == 0 && j == m - 1) || self.is_diagonal(i, j);
-        self.diagonal[i * m + j] = Some(ok);
-        ok
-    }
-
-    /// The cached error of the segment between ring vertices `i < j` (a ring edge or a
-    /// diagonal).
-    fn segment(&mut self, i: usize, j: usize) -> SegmentError {
-        let m = self.ring.len();
-        if let Some(e) = self.segments[i * m + j] {
-            return e;
-        }
-        let e = if j == i + 1 {
-            self.ring_edge_error(i)
-        } else if i == 0 && j == m - 1 {
-            self.ring_edge_error(m - 1)
-        } else {
-            self.segment_error(j, i)
-        };
-        self.segments[i * m + j] = Some(e);
-        e
-    }
-
-    /// Whether the segment between ring vertices `i` and `j` (not neighbours) is a diagonal
-    /// of the hole polygon: inside it and touching its boundary only at its ends. Exact.
-    fn is_diagonal(&self, i: usize, j: usize) -> bool {
-        // The hole is star-shaped from the removed vertex c, ring sorted around it. With c
-        // strictly left of r_i -> r_j, the segment crosses exactly the spokes of the ring
-        // vertices strictly between i and j (counter-clockwise), and lies in the hole iff
-        // it crosses each of them strictly between c and its ring vertex, that is iff those
-        // vertices lie strictly right of it. Through c, the segment is two half-spokes.
-        let m = self.ring.len();
-        let (i, j) = if i < j { (i, j) } else { (j, i) };
-        let centre = self.centre.expect("hole loaded");
-        let (a, b) = (&self.ring[i], &self.ring[j]);
-        match orient(a, b, &centre).cmp(&0) {
-            std::cmp::Ordering::Greater => (i + 1..j).all(|k| orient(a, b, &self.ring[k]) < 0),
-            std::cmp::Ordering::Less => {
-                !self.boundary
-                    && (j + 1..m)
-                        .chain(0..i)
-                        .all(|k| orient(a, b, &self.ring[k]) > 0)
-            }
-            std::cmp::Ordering::Equal => !self.boundary,
-        }
-    }
-
-    /// The general test, for any simple polygon: no crossing of a polygon edge, inside the
-    /// corner cones at both ends. Checks [`Retriangulator::is_diagonal`] in the tests.
-    #[cfg(test)]
-    fn is_diagonal_general(&self, i: usize, j: usize) -> bool {
-        let m = self.ring.len();
-        let (a, b) = (&self.ring[i], &self.ring[j]);
-        for k in 0..m {
-            let k1 = (k + 1) % m;
-            if k == i || k == j || k1 == i || k1 == j {
-                continue;
-            }
-            if segments_meet(a, b, &self.ring[k], &self.ring[k1]) {
-                return false;
-            }
-        }
-        // Collinear with an edge at its end, or leaving the polygon at i.
-        in_cone(&self.ring[(i + m - 1) % m], a, &self.ring[(i + 1) % m], b)
-            && in_cone(&self.ring[(j + m - 1) % m], b, &self.ring[(j + 1) % m], a)
-    }
-
-    /// Whether no other vertex of the current polygon lies in the closed ear at `q`.
-    fn ear_is_empty(&self, q: usize) -> bool {
-        let (p, r) = (self.prev[q] as usize, self.next[q] as usize);
-        let (a, b, c) = (&self.ring[p], &self.ring[q], &self.ring[r]);
-        let mut s = self.next[r] as usize;
-        while s != p {
-            if in_closed_triangle(a, b, c, &self.ring[s]) {
-                return false;
-            }
-            s = self.next[s] as usize;
-        }
-        true
-    }
-
-    /// Bound of new triangle `abc` from its edges' bounds and, when the removed vertex lies
-    /// in it, from the removed vertex's own error against every star triangle.
-    fn triangle_bound(&self, a: usize, b: usize, c: usize, edges: [SegmentError; 3]) -> ErrorBound {
-        let mut bound = edges[0].bound;
-        for e in &edges[1..] {
-            bound.above = bound.above.max(e.bound.above);
-            bound.below = bound.below.max(e.bound.below);
-        }
-        let centre = self.centre.expect("hole loaded");
-        let (pa, pb, pc) = (&self.ring[a], &self.ring[b], &self.ring[c]);
-        if in_closed_triangle(pa, pb, pc, &centre) {
-            let g = plane_gradient(pa, pb, pc);
-            let new_at_centre =
-                pa.z + g[0] * (centre.x - pa.x) as f64 + g[1] * (centre.y - pa.y) as f64;
-            let delta = new_at_centre - centre.z;
-            bound.above = bound.above.max(self.max_star_above - delta);
-            bound.below = bound.below.max(self.max_star_below + delta);
-        }
-        bound
-    }
-
-    /// Error of the segment from ring vertex `from` to ring vertex `to`: for each closed
-    /// star triangle it meets, the signed introduced error at its entry and exit points
-    /// folded into that triangle's bound (paper §3.3.1).
-    fn segment_error(&self, from: usize, to: usize) -> SegmentError {
-        let centre = self.centre.expect("hole loaded");
-        let (p, q) = (self.ring[from], self.ring[to]);
-        let m = self.ring.len();
-        let stars = self.star_bounds.len();
-        let mut out = SegmentError {
-            bound: ErrorBound {
-                above: f64::NEG_INFINITY,
-                below: f64::NEG_INFINITY,
-            },
-            introduced: 0.0,
-        };
-        // A diagonal of the (star-shaped) hole splits it in two; it crosses the spokes of
-        // the chain on the far side from the centre and touches the two star triangles
-        // beyond its ends at a shared corner. Walking it with the centre on its left, the
-        // introduced error is linear between consecutive spoke crossings, so each crossed
-        // triangle's extremes are at the crossings on its two spokes.
-        let side = orient(&p, &q, &centre);
-        if side != 0 {
-            let (a, b) = if side > 0 { (from, to) } else { (to, from) };
-            let (p, q) = (self.ring[a], self.ring[b]);
-            let side = side.abs() as f64;
-            let span = (b + m - a) % m;
-            let mut previous = 0.0f64; // introduced error at the last crossing (0 at p)
-            let fold = |i: usize, lo: f64, hi: f64, out: &mut SegmentError| {
-                if i < stars {
-                    let bound = &self.star_bounds[i];
-                    out.bound.above = out.bound.above.max(bound.above - lo);
-                    out.bound.below = out.bound.below.max(bound.below + hi);
-                }
-            };
-            fold((a + m - 1) % m, 0.0, 0.0, &mut out);
-            for step in 1..=span {
-                let k = (a + step) % m;
-                let current = if step == span {
-                    0.0
-                } else {
-                    let r = &self.ring[k];
-                    let (fp, fq) = (orient(&centre, r, &p) as f64, orient(&centre, r, &q) as f64);
-                    let t = fp / (fp - fq);
-                    let u = side / (side - orient(&p, &q, r) as f64);
-                    let new = p.z + t * (q.z - p.z);
-                    let old = centre.z + u * (r.z - centre.z);
-                    new - old
-                };
-                let i = (k + m - 1) % m;
-                fold(i, previous.min(current), previous.max(current), &mut out);
-                out.introduced = out.introduced.max(current.abs());
-                previous = current;
-            }
-            fold(b, 0.0, 0.0, &mut out);
-            debug_assert!(out.bound.above.is_finite(), "a ring segment meets its star");
-            return out;
-        }
-        // The centre is on the segment: it touches every star triangle there.
-        for i in 0..m.min(stars) {
-            let (star_bound, g) = (&self.star_bounds[i], &self.star_gradients[i]);
-            let tri = [centre, self.ring[i], self.ring[(i + 1) % m]];
-            let Some((t_lo, t_hi)) = clip_segment(&p, &q, &tri) else {
-                continue;
-            };
-            let delta = |t: f64| {
-                let sx = p.x as f64 + t * (q.x - p.x) as f64;
-                let sy = p.y as f64 + t * (q.y - p.y) as f64;
-                let new = p.z + t * (q.z - p.z);
-                let old = centre.z + g[0] * (sx - centre.x as f64) + g[1] * (sy - centre.y as f64);
-                new - old
-            };
-            let (d0, d1) = (delta(t_lo), delta(t_hi));
-            let (lo, hi) = (d0.min(d1), d0.max(d1));
-            out.bound.above = out.bound.above.max(star_bound.above - lo);
-            out.bound.below = out.bound.below.max(star_bound.below + hi);
-            out.introduced = out.introduced.max(lo.abs()).max(hi.abs());
-        }
-        debug_assert!(out.bound.above.is_finite(), "a ring segment meets its star");
-        out
-    }
-
-    /// Error of ring edge `i` (from ring vertex `i` to the next): the surface does not
-    /// change along it, so it carries the bounds of the star triangles that contain it or
-    /// touch its ends. The domain edge of a boundary star goes through the centre and is
-    /// computed in full.
-    fn ring_edge_error(&self, i: usize) -> SegmentError {
-        let m = self.ring.len();
-        let stars = self.star_bounds.len();
-        if i >= stars {
-            return self.segment_error(i, (i + 1) % m);
-        }
-        let mut bound = self.star_bounds[i];
-        for j in [(i + m - 1) % m, (i + 1) % m] {
-            if j < stars {
-                bound.above = bound.above.max(self.star_bounds[j].above);
-                bound.below = bound.below.max(self.star_bounds[j].below);
-            }
-        }
-        SegmentError {
-            bound,
-            introduced: 0.0,
-        }
-    }
-}
-
-/// Whether closed segments `ab` and `cd` share a point. Exact.
-#[cfg(test)]
-fn segments_meet(a: &Point, b: &Point, c: &Point, d: &Point) -> bool {
-    let (d1, d2) = (orient(a, b, c), orient(a, b, d));
-    let (d3, d4) = (orient(c, d, a), orient(c, d, b));
-    if ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)) {
-        return true;
-    }
-    let on = |p: &Point, q: &Point, r: &Point| {
-        orient(p, q, r) == 0
-            && r.x >= p.x.min(q.x)
-            && r.x <= p.x.max(q.x)
-            && r.y >= p.y.min(q.y)
-            && r.y <= p.y.max(q.y)
-    };
-    on(a, b, c) || on(a, b, d) || on(c, d, a) || on(c, d, b)
-}
-
-/// Whether `b` lies strictly inside the interior angle at polygon vertex `a` (with
-/// neighbours `prev` and `next`, counter-clockwise polygon). Exact.
-#[cfg(test)]
-fn in_cone(prev: &Point, a: &Point, next: &Point, b: &Point) -> bool {
-    if orient(prev, a, next) >= 0 {
-        // Convex (or straight) corner.
-        orient(a, next, b) > 0 && orient(a, b, prev) > 0
-    } else {
-        !(orient(a, next, b) <= 0 && orient(a, b, prev) <= 0)
-    }
 }
 
 /// Squared length of the segment `pq` in sample spacings.
@@ -821,48 +285,9 @@ fn within(bound: ErrorBound, limit: f64) -> bool {
     bound.above <= limit && bound.below <= limit
 }
 
-/// The parameter interval `[t_lo, t_hi]` of segment `p + t (q - p)`, `t ∈ [0, 1]`, inside
-/// the closed counter-clockwise triangle `tri`, or `None` when they do not meet. Whether
-/// they meet is decided exactly; the interval ends are then rounded to `f64`.
-fn clip_segment(p: &Point, q: &Point, tri: &[Point; 3]) -> Option<(f64, f64)> {
-    // Rationals num/den with den > 0; numerators and denominators are differences of
-    // orientations (below 2^34), their cross products are compared in i128.
-    let (mut lo_n, mut lo_d) = (0i64, 1i64);
-    let (mut hi_n, mut hi_d) = (1i64, 1i64);
-    let less = |n1: i64, d1: i64, n2: i64, d2: i64| {
-        (n1 as i128) * (d2 as i128) < (n2 as i128) * (d1 as i128)
-    };
-    for k in 0..3 {
-        let (a, b) = (&tri[k], &tri[(k + 1) % 3]);
-        let f0 = orient(a, b, p);
-        let f1 = orient(a, b, q);
-        match (f0 >= 0, f1 >= 0) {
-            (true, true) => {}
-            (false, false) => return None,
-            (true, false) => {
-                // t <= f0 / (f0 - f1)
-                let (n, d) = (f0, f0 - f1);
-                if less(n, d, hi_n, hi_d) {
-                    (hi_n, hi_d) = (n, d);
-                }
-            }
-            (false, true) => {
-                // t >= -f0 / (f1 - f0)
-                let (n, d) = (-f0, f1 - f0);
-                if less(lo_n, lo_d, n, d) {
-                    (lo_n, lo_d) = (n, d);
-                }
-            }
-        }
-    }
-    if less(hi_n, hi_d, lo_n, lo_d) {
-        return None;
-    }
-    Some((lo_n as f64 / lo_d as f64, hi_n as f64 / hi_d as f64))
-}
-
 #[cfg(test)]
 mod tests {
+    use super::propagation::clip_segment;
     use super::*;
 
     fn pt(x: i64, y: i64, z: f64) -> Point {

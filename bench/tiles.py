@@ -21,11 +21,16 @@ under /usr/bin/time, and prints a Markdown report (also written to --out):
             GeoTIFF), so every size has the same terrain per sample; 1 thread, as scaling.
   sizes     tile size sweep on a 4096^2 crop (how the default was chosen), 1 thread,
             defaults otherwise.
+  shapes    time per sample on narrow rasters against a square one of as many samples
+            (2 x 2,000,000 and 16 x 250,000 against 2000^2), in tiles of 512 and 8192, on
+            a tilted plane and on flat ground (where whole tile borders are skipped), 1
+            thread: the ratio narrow / square in CPU seconds per sample (every sample of
+            a 2-wide raster is on a tile border).
 
 Usage (from the repository root; GDAL command-line tools from Debian's gdal-bin):
     cargo build --release
     python3 bench/tiles.py [--shared ../shared] [--work /tmp/tinsmith-bench]
-        [--sections main,ratio,scaling,mosaic,sizes] [--repeat 1] [--out FILE.md]
+        [--sections main,ratio,scaling,mosaic,sizes,shapes] [--repeat 1] [--out FILE.md]
 
 The machine is shared: each run records its CPU seconds (user + sys) beside the wall
 time, and the load average before it, so that contention shows. With --repeat N the
@@ -96,6 +101,20 @@ def mosaic(work, tile, tile_size, size):
     return path
 
 
+def synthetic(work, name, width, height, value):
+    """A Float32 ESRI .hdr/.bil raster of `value(x, y)` (stdlib only), 1 unit per sample."""
+    import array
+    path = work / f"{name}_{width}x{height}.bil"
+    if not path.exists():
+        with open(path, "wb") as f:
+            for y in range(height):
+                array.array("f", (value(x, y) for x in range(width))).tofile(f)
+        (work / f"{name}_{width}x{height}.hdr").write_text(
+            f"BYTEORDER I\nLAYOUT BIL\nNROWS {height}\nNCOLS {width}\nNBANDS 1\n"
+            "NBITS 32\nPIXELTYPE FLOAT\nULXMAP 0.5\nULYMAP -0.5\nXDIM 1\nYDIM 1\n")
+    return path
+
+
 def load():
     return os.getloadavg()[0]
 
@@ -151,7 +170,7 @@ def main():
     ap.add_argument("--shared", default="../shared")
     ap.add_argument("--work", default="/tmp/tinsmith-bench")
     ap.add_argument("--bin", default="target/release/tinsmith")
-    ap.add_argument("--sections", default="main,ratio,scaling,mosaic,sizes")
+    ap.add_argument("--sections", default="main,ratio,scaling,mosaic,sizes,shapes")
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--scaling-sizes", default="1024,2048,4096,8192,16384")
     ap.add_argument("--out")
@@ -254,6 +273,26 @@ def main():
         for size in ["128", "256", "512", "1024", "2048", "4096"]:
             r = mesh(binary, dem, work, ["--threads", "1", "--tile-size", size], args.repeat)
             emit(row(f"--tile-size {size}", r))
+        emit()
+
+    if "shapes" in sections:
+        emit("### Narrow rasters against a square one of as many samples, 1 thread")
+        emit()
+        emit(HEADER + " CPU us / sample | vs square |")
+        emit(RULE + "---|---|")
+        grounds = {"plane": lambda x, y: 0.01 * x + 0.02 * y, "flat": lambda x, y: 0.0}
+        for ground, value in grounds.items():
+            for tile_size in ["512", "8192"]:
+                ref = None
+                for width, height in [(2000, 2000), (2_000_000, 2), (250_000, 16)]:
+                    dem = synthetic(work, ground, width, height, value)
+                    extra = ["--threads", "1", "--tile-size", tile_size]
+                    r = mesh(binary, dem, work, extra, args.repeat)
+                    # CPU time: one thread, and robust to other work on the machine.
+                    per = r["cpu"] / samples(r)
+                    ref = ref or per
+                    emit(row(f"{ground} {width} x {height}", r,
+                             f" {per * 1e6:.3f} | {per / ref:.2f} |"))
         emit()
 
     if args.out:

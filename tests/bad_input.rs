@@ -1220,3 +1220,52 @@ fn heights_beyond_1e37_are_refused_with_one_message() {
     assert!(!stderr(&o).contains("tile"), "{}", stderr(&o));
     assert_eq!(d.files(), vec!["huge.asc", "late.asc"]);
 }
+
+#[test]
+fn a_pipe_closed_early_ends_the_run_quietly_with_141() {
+    // The reader of `-o /dev/stdout` stops after a few bytes: exit 128 + SIGPIPE, as a
+    // shell reports it, in every writer (FlatGeobuf's error hid the broken pipe: exit 2
+    // with a message; the others exited 0 as if the file had been written).
+    use std::io::Read;
+    let d = Dir::new();
+    for (format, tile_size) in [
+        ("obj", "64"),
+        ("ply", "64"),
+        ("ply", "1000"),
+        ("geojson", "1000"),
+        ("fgb", "1000"),
+    ] {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+            .args(["mesh", &dem(), "-o", "/dev/stdout", "--format", format])
+            .args(["--max-error", "0", "-q", "--tile-size", tile_size])
+            .current_dir(d.path(""))
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut stdout = child.stdout.take().unwrap();
+        let mut first = [0u8; 16];
+        stdout.read_exact(&mut first).unwrap();
+        drop(stdout);
+        let o = child.wait_with_output().unwrap();
+        assert_eq!(o.status.code(), Some(141), "{format}: {}", stderr(&o));
+        assert_eq!(stderr(&o), "", "{format}");
+    }
+    // Standard output redirected to a file is written in place: no temporary file or
+    // rename in the file's directory, and no `.prj` beside /dev/stdout.
+    for (format, tile_size) in [("obj", "64"), ("stl", "1000")] {
+        let name = format!("v.{format}");
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+            .args(["mesh", &dem(), "-o", "/dev/stdout", "--format", format])
+            .args(["--max-error", "5", "-q", "--tile-size", tile_size])
+            .current_dir(d.path(""))
+            .stdout(std::fs::File::create(d.path(&name)).unwrap())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(!std::path::Path::new("/dev/stdout.prj").exists());
+        let len = std::fs::metadata(d.path(&name)).unwrap().len();
+        assert!(len >= 134, "{name}: {len} bytes, {}", stderr(&o));
+    }
+    assert_eq!(d.files(), vec!["v.obj", "v.stl"]);
+}

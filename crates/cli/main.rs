@@ -38,6 +38,9 @@ use crate::args::{Cli, Command};
 const EXIT_VERIFY_FAILED: u8 = 1;
 /// Exit code for bad input and other errors.
 const EXIT_ERROR: u8 = 2;
+/// Exit code when the output was a pipe whose reader closed it early: 128 + SIGPIPE, what
+/// a shell reports for a process the signal ended.
+const EXIT_BROKEN_PIPE: u8 = 141;
 /// Exit codes after a signal are 128 + its number, as shells report a process the signal
 /// ended: 130 after Ctrl-C (SIGINT), 143 after SIGTERM, 129 after SIGHUP.
 const EXIT_SIGNALLED: i32 = 128;
@@ -79,7 +82,9 @@ fn main() -> ExitCode {
         Ok(false) => ExitCode::from(EXIT_VERIFY_FAILED),
         Err(err) => {
             if is_broken_pipe(&err) {
-                return ExitCode::SUCCESS;
+                // The reader of a pipe stopped early: quiet, but not a success (a shell
+                // reports a process killed by SIGPIPE so, and `set -o pipefail` sees it).
+                return ExitCode::from(EXIT_BROKEN_PIPE);
             }
             note!("tinsmith: {}", one_line(&err));
             ExitCode::from(EXIT_ERROR)
@@ -119,11 +124,19 @@ fn one_line(err: &anyhow::Error) -> String {
     line.replace('\n', " ")
 }
 
+/// Whether a write to a closed pipe caused `err`, also where a library wrapped the
+/// `io::Error` inside another (FlatGeobuf's writer does).
 fn is_broken_pipe(err: &anyhow::Error) -> bool {
-    err.chain().any(|e| {
-        e.downcast_ref::<std::io::Error>()
-            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
-    })
+    fn broken(e: &(dyn std::error::Error + 'static)) -> bool {
+        let Some(io) = e.downcast_ref::<std::io::Error>() else {
+            return false;
+        };
+        io.kind() == std::io::ErrorKind::BrokenPipe
+            || io
+                .get_ref()
+                .is_some_and(|inner| broken(inner) || inner.source().is_some_and(broken))
+    }
+    err.chain().any(broken)
 }
 
 /// Starts the thread that, on SIGINT, SIGTERM or SIGHUP, removes unfinished output and

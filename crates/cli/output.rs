@@ -237,7 +237,7 @@ impl ReservedReport {
     /// [`REPORT_RESERVE_BYTES`] spaces (a device or pipe is written in place, later).
     pub fn reserve(path: &Path) -> Result<ReservedReport> {
         let target = tinsmith_export::resolve_output(path);
-        if tinsmith_export::is_special_file(&target) {
+        if tinsmith_export::is_special_file(path) {
             return Ok(ReservedReport {
                 path: path.to_path_buf(),
                 target,
@@ -267,7 +267,7 @@ impl ReservedReport {
     pub fn write(self, bytes: &[u8]) -> Result<()> {
         let failed = || format!("{}: write failed", self.path.display());
         let Some((mut tmp, _guard)) = self.file else {
-            return std::fs::write(&self.target, bytes).with_context(failed);
+            return std::fs::write(&self.path, bytes).with_context(failed);
         };
         tmp.seek(SeekFrom::Start(0))
             .and_then(|_| tmp.write_all(bytes))

@@ -116,11 +116,16 @@ pub fn resolve_output(path: &Path) -> PathBuf {
     }
 }
 
-/// Whether `path` exists and is neither a regular file nor a directory: a device, FIFO or
-/// socket, written in place (a rename would replace it, and all-or-nothing means nothing
-/// for a pipe).
+/// Whether `path`, as given, is a device, FIFO or socket, or a name under `/dev` or
+/// `/proc` (`/dev/stdout`, `/dev/fd/3`: a descriptor the caller opened, which may be a
+/// regular file a shell redirected): written in place, without a temporary file, a rename
+/// or a sidecar (a rename would replace the device, and all-or-nothing means nothing for a
+/// pipe).
 pub fn is_special_file(path: &Path) -> bool {
-    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+    let named_stream = path.is_absolute()
+        && (path.starts_with("/dev") || path.starts_with("/proc"))
+        && path.exists();
+    named_stream || std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
 /// A temporary file `.tinsmith-*.tmp` in `dir`, to be renamed over an output: its mode is
@@ -185,10 +190,10 @@ where
         _ => {}
     }
 
-    if is_special_file(&target) {
+    if is_special_file(path) {
         let mut file = File::options()
             .write(true)
-            .open(&target)
+            .open(path)
             .map_err(io_error("open"))?;
         let mut writer = BufWriter::with_capacity(BUFFER_SIZE, &mut file);
         write(&mut writer).map_err(io_error("write"))?;

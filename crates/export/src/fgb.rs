@@ -33,9 +33,24 @@ pub(crate) fn crs<'a>(wkt: Option<&'a str>, epsg: Option<u32>) -> FgbCrs<'a> {
     }
 }
 
-/// A flatgeobuf or geozero error as an I/O error for the atomic writer.
-pub(crate) fn io_error(error: impl std::fmt::Display) -> io::Error {
-    io::Error::other(error.to_string())
+/// A flatgeobuf or geozero error as an I/O error for the atomic writer: the I/O error
+/// inside it when there is one (a broken pipe, a full disk), so that its kind survives.
+pub(crate) fn io_error(error: impl std::error::Error + Send + Sync + 'static) -> io::Error {
+    let boxed: Box<dyn std::error::Error + Send + Sync> = Box::new(error);
+    let boxed = match boxed.downcast::<flatgeobuf::Error>() {
+        Ok(error) => match *error {
+            flatgeobuf::Error::IO(io) => return io,
+            other => Box::new(other),
+        },
+        Err(other) => other,
+    };
+    match boxed.downcast::<geozero::error::GeozeroError>() {
+        Ok(error) => match *error {
+            geozero::error::GeozeroError::IoError(io) => io,
+            other => io::Error::other(other),
+        },
+        Err(other) => io::Error::other(other),
+    }
 }
 
 /// Writes `mesh` as FlatGeobuf. The writer keeps the features in an anonymous temporary

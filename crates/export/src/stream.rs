@@ -17,8 +17,8 @@ const BUFFER_SIZE: usize = 1 << 16;
 /// succeeds.
 ///
 /// Vertices and triangles are spooled to two unnamed temporary files in the output
-/// directory (the PLY header needs both counts before any record), which vanish however
-/// the process ends; `finish` writes the header and both spools into a third temporary
+/// directory (the system's temporary directory for a device or pipe; the PLY header needs
+/// both counts before any record), which vanish however the process ends; `finish` writes the header and both spools into a third temporary
 /// file and renames it over the target. The file is byte for
 /// byte the one [`crate::write_mesh`] writes for the same vertices, triangles and CRS.
 ///
@@ -88,8 +88,14 @@ impl MeshStreamWriter {
                 dir: dir.to_path_buf(),
             });
         }
+        // A device or pipe (`/dev/stdout`) has no directory of its own to spool in.
+        let spool_dir = if crate::is_special_file(path) {
+            std::env::temp_dir()
+        } else {
+            dir.to_path_buf()
+        };
         let spool = || {
-            Spool::new(dir).map_err(|source| Error::Io {
+            Spool::new(&spool_dir).map_err(|source| Error::Io {
                 path: path.to_path_buf(),
                 action: "create a temporary file in the output directory",
                 source,

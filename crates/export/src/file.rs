@@ -237,7 +237,12 @@ pub fn read_mesh_as(path: &Path, format: MeshFormat) -> Result<Mesh> {
         action: "open",
         source,
     })?;
-    let file_len = file.metadata().ok().map(|metadata| metadata.len());
+    // Only a regular file's length is its content's: a pipe or device reports 0.
+    let file_len = file
+        .metadata()
+        .ok()
+        .filter(|metadata| metadata.is_file())
+        .map(|metadata| metadata.len());
     let reader = BufReader::with_capacity(BUFFER_SIZE, file);
     let result: std::result::Result<Mesh, Problem> = match format {
         MeshFormat::Ply => ply::read(reader, file_len),

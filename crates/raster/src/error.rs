@@ -42,6 +42,16 @@ pub enum Error {
         /// The path.
         path: PathBuf,
     },
+    /// The file's name is not valid UTF-8, and GDAL is given file names as UTF-8 text.
+    #[error(
+        "{}: the file name is not valid UTF-8, which cannot be passed to GDAL; rename the file \
+         (or link to it under a UTF-8 name)",
+        path.display()
+    )]
+    NameNotUtf8 {
+        /// The path.
+        path: PathBuf,
+    },
     /// The file has no band of its own, only subdatasets (a netCDF or HDF5 container).
     #[error(
         "{}: has no raster band of its own but {count} subdataset(s), such as {first}; give \

@@ -387,6 +387,11 @@ impl OpenBand {
 
 /// Opens `path` read-only with GDAL's raster drivers, asking GDAL to say why it cannot.
 pub(crate) fn open_dataset(path: &Path) -> Result<Dataset> {
+    if path.to_str().is_none() && path.exists() {
+        return Err(Error::NameNotUtf8 {
+            path: path.to_path_buf(),
+        });
+    }
     if is_missing_file(path) {
         return Err(Error::NotFound {
             path: path.to_path_buf(),

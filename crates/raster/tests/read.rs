@@ -914,3 +914,17 @@ fn vrt_nodata_scale_and_offset_are_honoured() {
     assert!((v - 1001.0).abs() < 1e-9, "{v}");
     assert!((raster.info.max.expect("max") - 1003.0).abs() < 1e-9);
 }
+
+#[cfg(unix)]
+#[test]
+fn a_file_name_that_is_not_utf8_is_named_as_the_problem() {
+    // GDAL is given names as UTF-8: a Latin-1 name was reported as "No such file".
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempdir();
+    let name = std::ffi::OsStr::from_bytes(b"h\xf6he.asc");
+    let path = dir.path().join(name);
+    std::fs::copy(fixture("landlab_hugo_site.asc"), &path).unwrap();
+    let (err, text) = err_text(open_info(&path, 1));
+    assert!(matches!(err, Error::NameNotUtf8 { .. }), "{err:?}");
+    assert!(text.contains("not valid UTF-8"), "{text}");
+}

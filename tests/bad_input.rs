@@ -1297,3 +1297,51 @@ fn a_mesh_read_from_a_pipe_is_read_whole() {
         assert!(o.status.success(), "{format}: {}", stderr(&o));
     }
 }
+
+#[test]
+fn a_report_that_cannot_be_written_stops_the_run_before_the_outputs() {
+    // The report is moved into place after the mesh: a report name too long for the file
+    // system failed there, with the old mesh already replaced.
+    let d = Dir::new();
+    d.write("y.ply", "OLD");
+    let long = format!("{}.json", "b".repeat(252));
+    let o = d.run(&[
+        "mesh",
+        &dem(),
+        "-o",
+        "y.ply",
+        "--report",
+        &long,
+        "--max-error",
+        "5",
+    ]);
+    assert_fails_naming(&o, &[&long, "too long"]);
+    assert_eq!(std::fs::read_to_string(d.path("y.ply")).unwrap(), "OLD");
+    assert_eq!(d.files(), vec!["y.ply"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn an_output_name_that_is_not_utf8_is_reported_as_well_as_it_can_be() {
+    // serde refused the path in the report, after the mesh was written: exit 2, no report.
+    use std::os::unix::ffi::OsStrExt;
+    let d = Dir::new();
+    let name = std::ffi::OsStr::from_bytes(b"m\xe9sh.ply");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+        .args([
+            std::ffi::OsStr::new("mesh"),
+            dem().as_ref(),
+            "-o".as_ref(),
+            name,
+        ])
+        .args(["--report", "r.json", "--max-error", "5", "-q"])
+        .current_dir(d.path(""))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = std::fs::read_to_string(d.path("r.json")).unwrap();
+    assert!(
+        report.contains("\"output\": \"m\u{fffd}sh.ply\""),
+        "{report}"
+    );
+}

@@ -7,8 +7,9 @@ use anyhow::{bail, Context, Result};
 use tinsmith_export::MeshFormat;
 
 /// Fails early, before long work, when `path` ends with '/', is a looping symbolic link,
-/// is the `input` file or one the input is read from (see [`check_not_input`]), is a
-/// directory, is a read-only file, or its directory is missing.
+/// has a name too long for its file system, is the `input` file or one the input is read
+/// from (see [`check_not_input`]), is a directory, is a read-only file or one the
+/// directory's sticky bit keeps this user from replacing, or its directory is missing.
 pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
     if path.as_os_str().as_encoded_bytes().ends_with(b"/") {
         bail!(
@@ -20,6 +21,13 @@ pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
         bail!(
             "{}: is a symbolic link that loops (or a chain of too many); point it at a file \
              or remove it",
+            path.display()
+        );
+    }
+    if std::fs::symlink_metadata(path).is_err_and(|e| e.raw_os_error() == Some(libc::ENAMETOOLONG))
+    {
+        bail!(
+            "{}: the name is too long for its file system; choose a shorter one",
             path.display()
         );
     }
@@ -52,7 +60,36 @@ pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
             path.display()
         );
     }
+    if sticky_keeps(&target) {
+        bail!(
+            "{}: belongs to another user in a directory where only a file's owner may \
+             replace it (sticky bit, as in /tmp); choose another name",
+            path.display()
+        );
+    }
     Ok(())
+}
+
+/// Whether `target` exists in a sticky directory (mode +t) that keeps this process from
+/// renaming a new file over it: neither the file nor the directory is this user's, and
+/// the user is not root.
+#[cfg(unix)]
+fn sticky_keeps(target: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    // SAFETY: geteuid has no preconditions and cannot fail.
+    let user = unsafe { libc::geteuid() };
+    let (Ok(file), Ok(dir)) = (
+        std::fs::symlink_metadata(target),
+        std::fs::metadata(parent_dir(target)),
+    ) else {
+        return false;
+    };
+    user != 0 && dir.mode() & 0o1000 != 0 && file.uid() != user && dir.uid() != user
+}
+
+#[cfg(not(unix))]
+fn sticky_keeps(_target: &Path) -> bool {
+    false
 }
 
 /// Fails when the `.prj` sidecar a georeferenced mesh in `format` writes beside `output`

@@ -11,6 +11,7 @@ use crate::number::readable;
 /// bound and the independently measured error, and where the mesh went.
 #[derive(Debug, Serialize)]
 pub struct MeshSummary<'a> {
+    #[serde(serialize_with = "lossy_path")]
     input: &'a Path,
     band: usize,
     width: u32,
@@ -46,7 +47,14 @@ pub struct MeshSummary<'a> {
     decimation_percent: f64,
     max_error_bound: f64,
     measured_max_error: f64,
+    #[serde(serialize_with = "lossy_path")]
     output: &'a Path,
+}
+
+/// A path as JSON text, bytes that are not UTF-8 replaced by U+FFFD (serde refuses such a
+/// path, which failed the run after its outputs were written).
+fn lossy_path<S: serde::Serializer>(path: &&Path, serializer: S) -> Result<S::Ok, S::Error> {
+    serializer.serialize_str(&path.to_string_lossy())
 }
 
 /// Counts and errors of a finished run, for [`MeshSummary::new`].

@@ -239,6 +239,11 @@ fn a_prj_sidecar_that_is_not_ours_is_not_replaced() {
         "GEOGCS[\"elsewhere\"]"
     );
     assert_eq!(d.files(), vec!["roads.prj", "roads.shp"]);
+    // A directory in the sidecar's place is named as one (it said "another CRS").
+    std::fs::create_dir(d.path("dirs.prj")).unwrap();
+    let o = d.run(&["mesh", &dem(), "-o", "dirs.obj", "--max-error", "5"]);
+    assert_fails_naming(&o, &["dirs.obj", "dirs.prj", "is a directory"]);
+    std::fs::remove_dir(d.path("dirs.prj")).unwrap();
     // An earlier mesh's sidecar is replaced, and one with the same CRS even without it.
     let o = d.run(&["mesh", &dem(), "-o", "m.obj", "--max-error", "5", "-q"]);
     assert!(o.status.success(), "{}", stderr(&o));

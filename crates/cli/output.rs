@@ -126,6 +126,13 @@ pub fn check_sidecar(
         // No CRS, no sidecar (see `note_prj_left_beside`); or none there yet.
         return Ok(());
     };
+    if meta.is_dir() {
+        bail!(
+            "{}: its CRS would go to {}, which is a directory; choose another output name",
+            output.display(),
+            ours.display()
+        );
+    }
     if meta.is_file() && meta.permissions().readonly() {
         bail!(
             "{}: its CRS would replace {}, which is read-only; make it writable (chmod u+w) \

@@ -42,9 +42,11 @@ where
         return main.commit();
     };
     let side = stage(sidecar_path, |w| w.write_all(bytes))?;
-    side.commit()?;
-    main.commit().inspect_err(|_| {
-        let _ = std::fs::remove_file(sidecar_path);
+    crate::pending::commit_together(|| {
+        side.commit()?;
+        main.commit().inspect_err(|_| {
+            let _ = std::fs::remove_file(sidecar_path);
+        })
     })
 }
 

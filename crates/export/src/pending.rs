@@ -10,6 +10,19 @@ static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 static MADE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 static FINISHED: AtomicBool = AtomicBool::new(false);
+/// Held while files that belong together are renamed into place (see [`commit_together`]),
+/// and for good by [`remove_pending`].
+static COMMITTING: Mutex<()> = Mutex::new(());
+
+/// Runs `commit` (renames that must all happen or none, such as a mesh and its `.prj`)
+/// so that [`remove_pending`], on a signal, waits for it to end and then lets no other
+/// commit start: an interrupt never leaves half of such a pair in place.
+pub(crate) fn commit_together<T>(commit: impl FnOnce() -> T) -> T {
+    let _guard = COMMITTING
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    commit()
+}
 
 /// Records that every output of the run is complete and in place: a signal from now on
 /// (the process tearing its memory down) interrupts nothing.
@@ -72,12 +85,20 @@ impl Drop for MadeDirsGuard {
 
 /// Removes every registered temporary file and directory (for a signal handler, just
 /// before the process exits), and from then on [`interrupted`] is true; returns how many
-/// were registered. Paths that are gone already are skipped.
+/// were registered. Paths that are gone already are skipped. It first waits for a
+/// rename of files that belong together to end, and from then on no such rename starts.
 ///
 /// Writers check [`interrupted`] before each file they add, but one may be between its
 /// check and its write when the flag goes up (and `create_dir_all` would make a removed
 /// directory again), so the paths are removed a second time after a short pause.
 pub fn remove_pending() -> usize {
+    // Wait for renames under way to end, and keep any other from starting (the process
+    // exits after this).
+    std::mem::forget(
+        COMMITTING
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner()),
+    );
     INTERRUPTED.store(true, Ordering::SeqCst);
     // Read again for the second pass: a path registered meanwhile (its owner was
     // between creating it and registering it) is removed too.

@@ -2,40 +2,34 @@
 //! tiles, y = 0 in the south), each decimated within `quality x e(level)`, with shared
 //! edges simplified once so that same-level neighbours keep identical edge vertices.
 
+mod budget;
+mod error;
+mod layer;
 mod rows;
+mod staging;
 mod stream;
+mod tile;
+mod tms;
 
 use std::collections::BTreeSet;
-use std::fmt::Write as _;
 use std::ops::Range;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use tinsmith_core::{decimate_with_border, DecimationOptions, Grid, VertexHeights};
-use tinsmith_export::{gzip, GeoRectangle, QuantizedMeshTile, QUANTIZED_MAX};
 use tinsmith_raster::{geographic_bounds, GeoBounds};
-use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
-use crate::edge::{edge_limit, edge_span, EdgeProfile};
+pub use budget::LEVEL_ZERO_ERROR;
+use budget::{level_budget, LevelBudget};
+pub use error::{TerrainError, TerrainResult};
+pub use layer::METADATA_AVAILABILITY;
+use layer::{write_layer_json, Available};
 use rows::LevelRows;
+use staging::{write_atomic, Staging};
 use stream::{band_tile_rows, stream_levels, LevelSink, RowSource, Warp};
-
-/// Cesium's level-zero geometric error for the geographic scheme, in metres:
-/// `maximumRadius * 2 pi * 0.25 / (65 * 2)` (`TerrainProvider`
-/// `getEstimatedLevelZeroGeometricErrorForAHeightmap`). Level L allows `e0 / 2^L`.
-pub const LEVEL_ZERO_ERROR: f64 = 77_067.339_771_939_23;
-
-/// Cells along each side of a tile's sample grid: each tile samples
-/// `(TILE_CELLS + 1)^2` lattice points. 217 divides 32767 (= 7 x 31 x 151), so sample `i`
-/// is at `u = 151 i` exactly: decoded vertices sit exactly on their source samples.
-pub const TILE_CELLS: u32 = 217;
-
-/// `u` (and `v`) per cell of the tile grid.
-const U_PER_CELL: u32 = QUANTIZED_MAX as u32 / TILE_CELLS;
-
-/// Levels whose tiles carry the metadata extension: 0, N, 2N, ... (`metadataAvailability`).
-pub const METADATA_AVAILABILITY: u8 = 10;
+use tile::{build_tile, TileOut};
+use tms::{bounds_array, step};
+pub use tms::{tile_rectangle, TILE_CELLS};
 
 /// The largest `--quality`: the level-0 bound is then 7.7e10 m, beyond any height; larger
 /// values only risk overflowing the bounds.
@@ -43,92 +37,6 @@ const MAX_QUALITY: f64 = 1e6;
 
 /// The finest level [`build_terrain`] will go to.
 pub const MAX_LEVEL: u8 = 24;
-
-/// The smallest height quantum (2^-8 m), so that tile minima stay exact in float32.
-const MIN_HEIGHT_STEP: f64 = 1.0 / 256.0;
-
-/// What can go wrong while building a pyramid.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum TerrainError {
-    /// Reading or reprojecting the input failed.
-    #[error(transparent)]
-    Raster(#[from] tinsmith_raster::Error),
-    /// The options make no sense (the message says which).
-    #[error("{0}")]
-    Options(String),
-    /// Heights (largest magnitude, widest range of a tile) beyond what quantized-mesh
-    /// tiles, whose height ranges are stored in `f32`, can hold.
-    #[error(
-        "heights up to {max_abs:e} in magnitude (tiles spanning up to {widest:e}) are beyond what \
-         quantized-mesh tiles can hold (their height range is stored in f32)"
-    )]
-    HeightsBeyondF32 {
-        /// The largest magnitude of a valid height.
-        max_abs: f64,
-        /// The widest range of valid heights of a tile.
-        widest: f64,
-    },
-    /// The thread pool could not start.
-    #[error("cannot start {threads} worker threads")]
-    Threads {
-        /// Threads asked for.
-        threads: usize,
-        /// Rayon's reason.
-        #[source]
-        source: rayon::ThreadPoolBuildError,
-    },
-    /// The core refused a tile.
-    #[error("tile {z}/{x}/{y}: decimation failed")]
-    Decimate {
-        /// Level.
-        z: u8,
-        /// Column.
-        x: u32,
-        /// TMS row.
-        y: u32,
-        /// The core's reason.
-        #[source]
-        source: tinsmith_core::Error,
-    },
-    /// The verifier refused a tile, or found it outside the bound (an internal error).
-    #[error("tile {z}/{x}/{y}: verification failed ({problems})")]
-    Verify {
-        /// Level.
-        z: u8,
-        /// Column.
-        x: u32,
-        /// TMS row.
-        y: u32,
-        /// What the verifier found.
-        problems: String,
-    },
-    /// The encoder refused a tile (an internal error).
-    #[error("tile {z}/{x}/{y}: encoding failed")]
-    Encode {
-        /// Level.
-        z: u8,
-        /// Column.
-        x: u32,
-        /// TMS row.
-        y: u32,
-        /// The encoder's reason.
-        #[source]
-        source: tinsmith_export::EncodeError,
-    },
-    /// Writing the output failed.
-    #[error("{}: cannot write", path.display())]
-    Output {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        #[source]
-        source: std::io::Error,
-    },
-}
-
-/// Result of [`build_terrain`].
-pub type TerrainResult<T> = std::result::Result<T, TerrainError>;
 
 /// Options of [`build_terrain`].
 #[derive(Debug, Clone, PartialEq)]
@@ -244,135 +152,6 @@ pub struct TerrainReport {
     /// Per level, coarsest first.
     pub levels: Vec<LevelReport>,
 }
-
-/// Lattice spacing of a level, in degrees.
-fn step(level: u8) -> f64 {
-    180.0 / (f64::from(TILE_CELLS) * (1u64 << level) as f64)
-}
-
-/// WGS84 semi-major axis, metres.
-const EARTH_RADIUS: f64 = 6_378_137.0;
-
-/// The longest triangle edge, in lattice spacings of `level`, whose chord sinks no deeper
-/// than `bound` metres below the ellipsoid: CesiumJS draws each triangle flat between its
-/// ECEF corners, so an edge spanning `t` radians of arc cuts `R (1 - cos(t / 2))` below the
-/// surface, an error the height check (made in longitude/latitude) does not see. Measured
-/// along the equator (where a lattice step spans the most arc); `None` when even the
-/// tile's diagonal is short enough.
-fn max_edge_length(level: u8, bound: f64) -> Option<u32> {
-    let arc = 2.0 * (1.0 - (bound / EARTH_RADIUS).min(1.0)).acos();
-    let spacing = step(level).to_radians();
-    let length = (arc / spacing).floor();
-    if length >= f64::from(TILE_CELLS) * std::f64::consts::SQRT_2 {
-        None
-    } else {
-        Some((length as u32).max(2))
-    }
-}
-
-/// `[west, south, east, north]` in degrees, longitudes in [-180, 180]: across the
-/// antimeridian `east` is wrapped back below 180, so west > east (as GeoJSON and TileJSON
-/// bounding boxes have it); a raster wholly east of 180 has both wrapped.
-fn bounds_array(bounds: &GeoBounds) -> [f64; 4] {
-    // Into -180..180 by whole turns (a raster given on 530..550° too); an east edge at
-    // 180° stays there.
-    let wrap = |lon: f64, east: bool| match (lon + 180.0).rem_euclid(360.0) - 180.0 {
-        w if east && w == -180.0 => 180.0,
-        w => w,
-    };
-    [
-        wrap(bounds.west, false),
-        bounds.south,
-        wrap(bounds.east, true),
-        bounds.north,
-    ]
-}
-
-/// The tile column of lattice tile column `x` (which is past the last column across the
-/// antimeridian, see [`tile_range`]).
-fn tile_column(z: u8, x: u32) -> u32 {
-    x % (2u32 << z)
-}
-
-/// The tile rectangle `z/x/y` (TMS y) in degrees (east of 180 for `x` past the last
-/// column: the same tile a turn east).
-pub fn tile_rectangle(z: u8, x: u32, y: u32) -> GeoRectangle {
-    let size = 180.0 / (1u64 << z) as f64;
-    GeoRectangle {
-        west: -180.0 + f64::from(x) * size,
-        south: -90.0 + f64::from(y) * size,
-        east: -180.0 + f64::from(x + 1) * size,
-        north: -90.0 + f64::from(y + 1) * size,
-    }
-}
-
-/// The tiles of `level` that the bounds touch: columns and rows, inclusive. Across the
-/// antimeridian the last column is past the level's last (`2^(level+1)` columns): column
-/// `x` is then tile `x mod 2^(level+1)` (see [`tile_column`]), at most one full turn.
-fn tile_range(bounds: &GeoBounds, level: u8) -> ([u32; 2], [u32; 2]) {
-    let n = 1u64 << level;
-    let size = 180.0 / n as f64;
-    let clamp = |v: f64, max: u64| (v.floor().max(0.0) as u64).min(max - 1) as u32;
-    let west = clamp((bounds.west + 180.0) / size, 2 * n);
-    let x = [
-        west,
-        clamp((bounds.east + 180.0) / size, u64::from(west) + 2 * n),
-    ];
-    let y = [
-        clamp((bounds.south + 90.0) / size, n),
-        clamp((bounds.north + 90.0) / size, n),
-    ];
-    (x, y)
-}
-
-/// The level's bound and its height quantum.
-#[derive(Debug, Clone, Copy)]
-struct LevelBudget {
-    /// The bound asked for, `quality x e(level)`.
-    bound: f64,
-    /// The height quantum.
-    step: f64,
-    /// Longest edge, in lattice spacings (see [`max_edge_length`]).
-    max_edge: Option<u32>,
-    /// What decimation may use: the bound less the quantization error (half a step).
-    decimation: f64,
-    /// What the verifier checks: the bound, or half a step (and a margin) when larger.
-    verify: f64,
-    /// The finest level's largest |height| (every level's rounding slack).
-    max_abs: f64,
-}
-
-/// How many 16-bit height quanta a tile gives each height step: the largest power of two
-/// up to 2^14 that keeps `top` steps (its highest vertex above its minimum, `k_min`
-/// steps above 0) within 32767 quanta, and its maximum height exact in float32
-/// (`k_min * quanta + 32767` below 2^24 in magnitude). The header's maximum, the top of
-/// the 16-bit range, is then within twice the tile's own height range (plus a step) instead
-/// of 32767 steps up, which the level's widest tile sets; CesiumJS builds each tile's
-/// bounding box from it. Heights stay multiples of the step, exactly, as neighbours
-/// decode them.
-fn quanta_per_step(k_min: f64, top: f64) -> u32 {
-    let mut quanta = 1u32;
-    while quanta < 1 << 14
-        && top * f64::from(2 * quanta) <= f64::from(QUANTIZED_MAX)
-        && k_min.abs() * f64::from(2 * quanta) + f64::from(QUANTIZED_MAX) < f64::from(1u32 << 24)
-    {
-        quanta *= 2;
-    }
-    quanta
-}
-
-/// One tile done on a worker.
-struct TileOut {
-    x: u32,
-    y: u32,
-    bytes: Vec<u8>,
-    vertices: usize,
-    triangles: usize,
-    max_error: f64,
-}
-
-/// Which tiles exist, per level.
-type Available = Vec<BTreeSet<(u32, u32)>>;
 
 /// Builds the pyramid of `input` into `out_dir`: `z/x/y.terrain` tiles and `layer.json`.
 ///
@@ -585,108 +364,6 @@ pub fn build_terrain(
     })
 }
 
-/// The temporary directory a pyramid is built in, beside `out_dir` (which must not exist,
-/// or be an empty directory), and the missing parents made for it, as `mkdir -p` would.
-/// Dropped unfinished (an error), it removes the directory and the parents it made while
-/// they are empty; on a signal, the pending-output registry does the same.
-struct Staging {
-    temp: Option<tempfile::TempDir>,
-    _pending: tinsmith_export::PendingGuard,
-    /// The parent directories made here, deepest first, and their registration; `None`
-    /// once the pyramid is in place.
-    made: Option<(Vec<PathBuf>, tinsmith_export::MadeDirsGuard)>,
-}
-
-impl Staging {
-    fn new(out_dir: &Path) -> TerrainResult<Staging> {
-        let refuse = |reason: String| {
-            TerrainError::Options(format!("output {}: {reason}", out_dir.display()))
-        };
-        if let Some(reason) = crate::per_tile::occupied_reason(out_dir) {
-            return Err(refuse(format!(
-                "{reason}; give a new directory (the pyramid is written whole, never mixed \
-                 with other files)"
-            )));
-        }
-        let (parent, file_in_the_way) = tinsmith_export::output_parent(out_dir);
-        if let Some(file) = file_in_the_way {
-            return Err(refuse(format!(
-                "{} is a file, so no directory can be made there",
-                file.display()
-            )));
-        }
-        let output = |source| TerrainError::Output {
-            path: out_dir.to_path_buf(),
-            source,
-        };
-        let made: Vec<PathBuf> = parent
-            .ancestors()
-            .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
-            .map(Path::to_path_buf)
-            .collect();
-        let guard = tinsmith_export::track_made_dirs(&made);
-        let temp = std::fs::create_dir_all(parent)
-            .and_then(|()| tinsmith_export::output_temp_dir(parent))
-            .map_err(|source| {
-                remove_empty(&made);
-                output(source)
-            })?;
-        let staging = Staging {
-            _pending: tinsmith_export::track_pending(temp.path()),
-            temp: Some(temp),
-            made: Some((made, guard)),
-        };
-        if tinsmith_export::interrupted() {
-            // The signal handler may have passed already: dropping `staging` removes it.
-            return Err(output(std::io::Error::from(
-                std::io::ErrorKind::Interrupted,
-            )));
-        }
-        Ok(staging)
-    }
-
-    fn path(&self) -> &Path {
-        self.temp.as_ref().expect("not finished").path()
-    }
-
-    /// Renames the directory to `out_dir`; on failure it is removed (with the parents
-    /// made for it, when dropped).
-    fn finish(&mut self, out_dir: &Path) -> TerrainResult<()> {
-        let staged = self.temp.take().expect("finished once").keep();
-        match std::fs::rename(&staged, out_dir) {
-            Ok(()) => {
-                self.made = None;
-                Ok(())
-            }
-            Err(source) => {
-                let _ = std::fs::remove_dir_all(&staged);
-                Err(TerrainError::Output {
-                    path: out_dir.to_path_buf(),
-                    source,
-                })
-            }
-        }
-    }
-}
-
-impl Drop for Staging {
-    fn drop(&mut self) {
-        drop(self.temp.take());
-        if let Some((made, _)) = &self.made {
-            remove_empty(made);
-        }
-    }
-}
-
-/// Removes directories `made` (deepest first) while they are empty.
-fn remove_empty(made: &[PathBuf]) {
-    for dir in made {
-        if std::fs::remove_dir(dir).is_err() {
-            break;
-        }
-    }
-}
-
 /// The tiles of [`build_terrain`] from `source`, its finest level read in bands of
 /// `band_rows` tile rows: the level reports, coarsest first, and the tiles written.
 fn build_pyramid(
@@ -785,30 +462,6 @@ fn tiles_of(level: &LevelRows, tile_rows: Range<u32>) -> Vec<(u32, u32)> {
     tile_rows
         .flat_map(|j| (0..level.tiles_x).map(move |i| (level.tx0 + i, level.ty0 + j)))
         .collect()
-}
-
-/// The level's bound and height quantum, from its widest tile and the finest level's
-/// largest |height|.
-fn level_budget(level: u8, widest: f64, quality: f64, max_abs: f64) -> LevelBudget {
-    // The height quantum: the smallest power of two that fits every tile's range in
-    // 32766 steps (so a minimum rounded down to the lattice still leaves room).
-    let mut height_step = MIN_HEIGHT_STEP;
-    while height_step * f64::from(QUANTIZED_MAX - 1) < widest {
-        height_step *= 2.0;
-    }
-    let bound = quality * LEVEL_ZERO_ERROR / (1u64 << level) as f64;
-    let half_step = height_step / 2.0;
-    // The quantization error is at most half a step; keep a relative margin of 2^-30 for
-    // the float arithmetic of interpolation.
-    let margin = (bound + max_abs) / (1u64 << 30) as f64;
-    LevelBudget {
-        bound,
-        step: height_step,
-        max_edge: max_edge_length(level, bound),
-        decimation: (bound - half_step - margin).max(0.0),
-        verify: bound.max(half_step + margin),
-        max_abs,
-    }
 }
 
 /// The second pass: builds, checks and writes the tiles, row by row of each level.
@@ -958,321 +611,6 @@ impl TileWriter<'_> {
     }
 }
 
-fn write_atomic(path: &Path, bytes: &[u8]) -> TerrainResult<()> {
-    let output = |source| TerrainError::Output {
-        path: path.to_path_buf(),
-        source,
-    };
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let mut file = tinsmith_export::output_temp_file(dir).map_err(output)?;
-    std::io::Write::write_all(&mut file, bytes).map_err(output)?;
-    file.persist(path).map_err(|e| output(e.error))?;
-    Ok(())
-}
-
-fn build_tile(
-    raster: &LevelRows,
-    x: u32,
-    y: u32,
-    budget: &LevelBudget,
-    options: &TerrainOptions,
-    metadata_available: Option<&Available>,
-) -> TerrainResult<Option<TileOut>> {
-    let z = raster.level;
-    // Where the tile is written (`x` may be a turn east, see `tile_range`).
-    let column = tile_column(z, x);
-    let n = TILE_CELLS as usize;
-    let (i0, j0) = raster.tile_origin(x, y);
-    let values = raster.tile_values(x, y);
-    let grid = Grid::new(TILE_CELLS + 1, TILE_CELLS + 1, values).expect("a 218 x 218 grid");
-    if grid.valid_cell_count() == 0 {
-        return Ok(None);
-    }
-
-    // Shared edges, each decided from the level raster alone: both neighbours agree.
-    let limit = edge_limit(budget.decimation, budget.max_abs);
-    let keep = |edge: EdgeProfile| {
-        if limit > 0.0 {
-            edge.simplify(limit, edge_span(budget.max_edge))
-        } else {
-            vec![true; n + 1]
-        }
-    };
-    let south = keep(raster.edge(i0, j0, true));
-    let north = keep(raster.edge(i0, j0 + n, true));
-    let west = keep(raster.edge(i0, j0, false));
-    let east = keep(raster.edge(i0 + n, j0, false));
-    let last = TILE_CELLS;
-    let keep_border = |gx: u32, gy: u32| {
-        if gy == 0 {
-            south[gx as usize]
-        } else if gy == last {
-            north[gx as usize]
-        } else if gx == 0 {
-            west[gy as usize]
-        } else if gx == last {
-            east[gy as usize]
-        } else {
-            true
-        }
-    };
-    // Vertices at their samples: flat ground (the sea at 0, a tile the raster does not
-    // reach) stays exactly at its height in the quantized tiles.
-    let mut decimation_options =
-        DecimationOptions::new(budget.decimation).with_vertex_heights(VertexHeights::Samples);
-    decimation_options.max_abs_value = Some(budget.max_abs);
-    decimation_options.max_edge_length = budget.max_edge;
-    let tin = decimate_with_border(&grid, &decimation_options, &keep_border, &mut |_| {})
-        .map_err(|source| TerrainError::Decimate {
-            z,
-            x: column,
-            y,
-            source,
-        })?
-        .tin;
-    if tin.triangles().is_empty() {
-        return Ok(None);
-    }
-
-    // Heights on the level's lattice: tile minimum rounded down to a multiple of the step.
-    let s = budget.step;
-    let (lo, hi) = tin
-        .vertices()
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(v.z), hi.max(v.z))
-        });
-    let k_min = (lo / s).floor();
-    let min_height = k_min * s;
-    let per_step = quanta_per_step(k_min, (hi / s).round() - k_min);
-    let max_height = min_height + f64::from(QUANTIZED_MAX) * s / f64::from(per_step);
-    let quantized: Vec<[u16; 3]> = tin
-        .vertices()
-        .iter()
-        .map(|v| {
-            let h = ((v.z / s).round() - k_min) * f64::from(per_step);
-            [
-                (v.x * U_PER_CELL) as u16,
-                (v.y * U_PER_CELL) as u16,
-                h.clamp(0.0, f64::from(QUANTIZED_MAX)) as u16,
-            ]
-        })
-        .collect();
-
-    // The promise, checked on what the decoder will compute.
-    let positions: Vec<[i64; 2]> = tin
-        .vertices()
-        .iter()
-        .map(|v| [i64::from(v.x), i64::from(v.y)])
-        .collect();
-    let decoded: Vec<f64> = quantized
-        .iter()
-        .map(|q| min_height + f64::from(q[2] / per_step as u16) * s)
-        .collect();
-    let check = tinsmith_verify::verify(
-        GridRef::new(grid.width(), grid.height(), grid.values()),
-        MeshRef::new(&positions, &decoded, tin.triangles()),
-        &VerifyOptions::new().with_max_error(budget.verify),
-    )
-    .map_err(|e| TerrainError::Verify {
-        z,
-        x: column,
-        y,
-        problems: e.to_string(),
-    })?;
-    if !check.passed() {
-        return Err(TerrainError::Verify {
-            z,
-            x: column,
-            y,
-            problems: check.problems.join("; "),
-        });
-    }
-
-    let rect = tile_rectangle(z, x, y);
-    let normals: Option<Vec<[f64; 3]>> = options.normals.then(|| {
-        let d = step(z);
-        tin.vertices()
-            .iter()
-            .map(|v| {
-                let (gi, gj) = (i0 + v.x as usize, j0 + v.y as usize);
-                raster.normal(
-                    gi,
-                    gj,
-                    rect.west + f64::from(v.x) * d,
-                    rect.south + f64::from(v.y) * d,
-                )
-            })
-            .collect()
-    });
-    let metadata = metadata_available.map(|available| metadata_json(available, z, column, y));
-    let mut tile = QuantizedMeshTile::new(
-        rect,
-        min_height as f32,
-        max_height as f32,
-        &quantized,
-        tin.triangles(),
-    );
-    if let Some(normals) = &normals {
-        tile = tile.with_normals(normals);
-    }
-    if let Some(metadata) = &metadata {
-        tile = tile.with_metadata(metadata);
-    }
-    let mut bytes = tile.encode().map_err(|source| TerrainError::Encode {
-        z,
-        x: column,
-        y,
-        source,
-    })?;
-    if options.gzip {
-        bytes = gzip(&bytes);
-    }
-    Ok(Some(TileOut {
-        x: column,
-        y,
-        bytes,
-        vertices: quantized.len(),
-        triangles: tin.triangles().len(),
-        max_error: check.max_error,
-    }))
-}
-
-/// `available` tiles of one level as `{startX, startY, endX, endY}` rectangles (runs of
-/// columns along each row, merged with identical runs of the rows above), restricted to
-/// columns `x_range` and rows `y_range`.
-fn rectangles(tiles: &BTreeSet<(u32, u32)>, x_range: [u32; 2], y_range: [u32; 2]) -> Vec<[u32; 4]> {
-    let mut by_row: std::collections::BTreeMap<u32, Vec<[u32; 2]>> = Default::default();
-    for &(x, y) in tiles {
-        if x < x_range[0] || x > x_range[1] || y < y_range[0] || y > y_range[1] {
-            continue;
-        }
-        let runs = by_row.entry(y).or_default();
-        match runs.last_mut() {
-            Some(run) if run[1] + 1 == x => run[1] = x,
-            _ => runs.push([x, x]),
-        }
-    }
-    // The set is ordered by x first, so each row's columns arrive in increasing order.
-    let mut out: Vec<[u32; 4]> = Vec::new();
-    let mut open: Vec<[u32; 4]> = Vec::new();
-    for (&y, runs) in &by_row {
-        let mut next_open = Vec::new();
-        for run in runs {
-            match open
-                .iter()
-                .position(|r| r[0] == run[0] && r[2] == run[1] && r[3] + 1 == y)
-            {
-                Some(k) => {
-                    let mut r = open.swap_remove(k);
-                    r[3] = y;
-                    next_open.push(r);
-                }
-                None => next_open.push([run[0], y, run[1], y]),
-            }
-        }
-        out.append(&mut open);
-        open = next_open;
-    }
-    out.append(&mut open);
-    out.sort_by_key(|r| (r[1], r[0]));
-    out
-}
-
-fn rectangles_json(rects: &[[u32; 4]]) -> String {
-    let mut s = String::from("[");
-    for (k, r) in rects.iter().enumerate() {
-        if k > 0 {
-            s.push(',');
-        }
-        let _ = write!(
-            s,
-            r#"{{"startX":{},"startY":{},"endX":{},"endY":{}}}"#,
-            r[0], r[1], r[2], r[3]
-        );
-    }
-    s.push(']');
-    s
-}
-
-/// The metadata extension of tile z/x/y: availability of levels z+1 ..= z+10 below it.
-fn metadata_json(available: &Available, z: u8, x: u32, y: u32) -> String {
-    let mut levels = Vec::new();
-    for k in 1..=u32::from(METADATA_AVAILABILITY) {
-        let level = usize::from(z) + k as usize;
-        let Some(tiles) = available.get(level) else {
-            break;
-        };
-        let f = 1u32 << k;
-        let rects = rectangles(tiles, [x * f, (x + 1) * f - 1], [y * f, (y + 1) * f - 1]);
-        levels.push(rectangles_json(&rects));
-    }
-    // Trailing empty levels say nothing; CesiumJS needs no entry for them.
-    while levels.last().is_some_and(|l| l == "[]") {
-        levels.pop();
-    }
-    format!(r#"{{"available":[{}]}}"#, levels.join(","))
-}
-
-fn write_layer_json(
-    input: &Path,
-    out_dir: &Path,
-    options: &TerrainOptions,
-    bounds: &GeoBounds,
-    max_zoom: u8,
-    available: &Available,
-) -> TerrainResult<()> {
-    let name = input
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "terrain".into());
-    let mut extensions = Vec::new();
-    if options.normals {
-        extensions.push(serde_json::json!("octvertexnormals"));
-    }
-    if options.metadata {
-        extensions.push(serde_json::json!("metadata"));
-    }
-    let all = [0, u32::MAX];
-    // The deepest level that has tiles (a tiny raster's finest levels may have none).
-    let max_zoom = available
-        .iter()
-        .rposition(|tiles| !tiles.is_empty())
-        .map_or(max_zoom, |z| z as u8);
-    let available: Vec<serde_json::Value> = available[..=usize::from(max_zoom)]
-        .iter()
-        .map(|tiles| {
-            rectangles(tiles, all, all)
-                .iter()
-                .map(|r| {
-                    serde_json::json!({"startX": r[0], "startY": r[1], "endX": r[2], "endY": r[3]})
-                })
-                .collect()
-        })
-        .collect();
-    let mut layer = serde_json::json!({
-        "tilejson": "2.1.0",
-        "name": name,
-        "description": "made by tinsmith",
-        "version": "1.0.0",
-        "format": "quantized-mesh-1.0",
-        "scheme": "tms",
-        "projection": "EPSG:4326",
-        "tiles": ["{z}/{x}/{y}.terrain?v={version}"],
-        "minzoom": options.min_zoom,
-        "maxzoom": max_zoom,
-        "bounds": bounds_array(bounds),
-        "extensions": extensions,
-        "available": available,
-        "attribution": "",
-    });
-    if options.metadata {
-        layer["metadataAvailability"] = serde_json::json!(METADATA_AVAILABILITY);
-    }
-    let text = serde_json::to_string_pretty(&layer).expect("JSON values serialize");
-    write_atomic(&out_dir.join("layer.json"), text.as_bytes())
-}
-
 #[cfg(test)]
 mod tests {
     #[test]
@@ -1293,7 +631,11 @@ mod tests {
         assert_eq!(bounds(180.0, 200.0), [-180.0, 0.0, -160.0, 10.0]);
     }
 
+    use super::layer::{metadata_json, rectangles};
+    use super::tms::{max_edge_length, EARTH_RADIUS, U_PER_CELL};
     use super::*;
+    use std::path::PathBuf;
+    use tinsmith_export::QUANTIZED_MAX;
 
     #[test]
     fn u_lands_exactly_on_the_edges() {

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use tinsmith_export::surface_normal;
 use tinsmith_raster::{GeoBounds, GeoLattice};
 
-use super::{step, tile_range, TILE_CELLS};
+use super::tms::{step, tile_range, TILE_CELLS};
 use crate::edge::EdgeProfile;
 
 /// `TILE_CELLS` as a row or column count.

@@ -1,6 +1,6 @@
 //! `tinsmith mesh` then `tinsmith verify` on real rasters, in every coordinate mode.
 
-use crate::util::{fixture, stdout, Dir};
+use crate::util::{fixture, stderr, stdout, Dir};
 
 /// Meshes `input` at `e` and verifies the written file independently; returns the report.
 fn mesh_then_verify(input: &str, e: f64, extra: &[&str], ext: &str) -> serde_json::Value {
@@ -135,6 +135,71 @@ fn verify_rejects_a_mesh_beyond_the_bound() {
     let o = d.run(&["verify", &dem, "m.ply", "--max-error", "0.01"]);
     assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
     assert!(stdout(&o).contains("FAIL"));
+}
+
+#[test]
+fn verify_measures_the_mesh_as_written_not_moved_onto_the_samples() {
+    // The centre sample stands 1000 above the rest. With the centre vertex 0.0009 pixel
+    // off (or a corner vertex, leaving its sample uncovered) the mesh breaks the bound,
+    // but verify moved vertices within 0.001 pixel onto their samples and passed it. In an
+    // f64 format only rounding-sized offsets are taken for their samples now.
+    let d = Dir::new();
+    let asc = d.write(
+        "g.asc",
+        "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n\
+         0 0 0\n0 1000 0\n0 0 0\n",
+    );
+    let asc = asc.to_str().unwrap();
+    let mesh = |dx: [f64; 2]| {
+        let mut v = String::new();
+        for (i, (x, y)) in (0..3).flat_map(|y| (0..3).map(move |x| (x, y))).enumerate() {
+            let z = if (x, y) == (1, 1) { 1000 } else { 0 };
+            let shift = if i == 4 {
+                dx[0]
+            } else if i == 0 {
+                dx[1]
+            } else {
+                0.0
+            };
+            v += &format!("v {} {} {z}\n", f64::from(x) + shift, f64::from(y));
+        }
+        // Two triangles per cell, as verify expects them in (column, row) coordinates.
+        for (x, y) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            let a = 1 + x + 3 * y;
+            v += &format!("f {a} {} {}\nf {a} {} {}\n", a + 1, a + 4, a + 4, a + 3);
+        }
+        v
+    };
+    for (dx, code) in [
+        ([0.0, 0.0], 0),
+        ([1e-9, 1e-9], 0),
+        ([0.0009, 0.0], 2),
+        ([0.0, 0.0009], 2),
+    ] {
+        d.write("m.obj", &mesh(dx));
+        let o = d.run(&[
+            "verify",
+            asc,
+            "m.obj",
+            "--pixel-coords",
+            "--max-error",
+            "0.5",
+        ]);
+        assert_eq!(
+            o.status.code(),
+            Some(code),
+            "{dx:?}: {}{}",
+            stdout(&o),
+            stderr(&o)
+        );
+        if code == 2 {
+            assert!(
+                stderr(&o).contains("not on a sample centre"),
+                "{}",
+                stderr(&o)
+            );
+        }
+    }
 }
 
 #[test]

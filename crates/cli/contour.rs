@@ -539,7 +539,7 @@ fn mesh_from_file(
     // Each file vertex's height: its sample's, or the file's where it is raised.
     let mut file_heights: Vec<f64> = Vec::with_capacity(file.vertices.len());
     let mut first_raise: Option<f64> = None;
-    let at = sample_positions(path, &file, georef)?;
+    let at = sample_positions(path, &file, format, raster, georef)?;
     let is_inner = |x: i64, y: i64| {
         (1..grid.width() as i64 - 1).contains(&x) && (1..grid.height() as i64 - 1).contains(&y)
     };

@@ -503,7 +503,9 @@ fn unwrap_around_centre(info: &RasterInfo, wkt: &str, points: &mut [[f64; 3]]) -
 /// EPSG:4326 (reprojected, or the raster's own with `--geojson-source-crs`): a 0..360
 /// grid's "180" column computed through its geotransform can lie at 179.9999999999998,
 /// and the GeoJSON writers would cut the triangles and lines beside it into slivers 1e-13°
-/// wide. (1e-9° is 0.1 mm, far below any raster's spacing and the verifier's 1e-3 pixel.)
+/// wide. (1e-9° is 0.1 mm, far below any raster's spacing; the longitudes it moves are
+/// off the meridian by rounding alone, about 1e-13°, well within what the verifier
+/// allows.)
 pub fn snap_to_antimeridian(points: &mut [[f64; 3]]) {
     for p in points {
         let meridian = 180.0 + 360.0 * ((p[0] - 180.0) / 360.0).round();
@@ -685,7 +687,8 @@ fn check_positions_map_back(
     let georef = Georef::new(info.transform(), args.pixel_coords);
     for (i, &v) in vertices.iter().enumerate() {
         let q = origin.quantize(v);
-        georef.sample_at([q[0], q[1]]).with_context(|| {
+        let tolerance = crate::georef::F32_SAMPLE_TOLERANCE;
+        georef.sample_at([q[0], q[1]], tolerance).with_context(|| {
             format!(
                 "{}: vertex {i} would not map back to its sample in float32; nothing written",
                 out(args).display()

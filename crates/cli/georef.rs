@@ -17,9 +17,20 @@ pub enum Georef {
     World(GeoTransform),
 }
 
-/// How far (in pixels) a file position may be from a sample centre and still name it
-/// ([`Georef::sample_at`]).
-const SAMPLE_TOLERANCE: f64 = 1e-3;
+/// How far (in pixels) a position in a double-precision file may be from a sample centre
+/// and still name it ([`Georef::sample_at`]): far above the rounding of `f64` positions
+/// and of the geotransform's inverse (about 1e-10 pixel on the rasters measured), far
+/// below a shift of the mesh that could move its error at a sample.
+pub const F64_SAMPLE_TOLERANCE: f64 = 1e-7;
+
+/// The same for the float32 formats (STL, glTF), whose positions are rounded to `f32`
+/// around the raster's centre: `mesh` refuses a raster too wide for its positions to land
+/// this close to their samples.
+pub const F32_SAMPLE_TOLERANCE: f64 = 1e-3;
+
+/// The same for a GeoJSON mesh in WGS84 transformed back into a projected raster's CRS:
+/// the two transforms' rounding (about 1e-9 degree) is a fraction of a millimetre.
+pub const WGS84_SAMPLE_TOLERANCE: f64 = 1e-5;
 
 /// Fails (before any long work) when world coordinates are to be written and the raster's
 /// geotransform cannot give every sample its own: a non-finite coefficient, a singular map
@@ -54,7 +65,7 @@ pub fn check_transform(info: &tinsmith_raster::RasterInfo, pixel_coords: bool) -
     for (x, y) in [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)] {
         let back = t.world_to_sample(t.sample_centre(x, y));
         let lost = back.is_none_or(|[bx, by]| {
-            !((bx - x).abs() <= SAMPLE_TOLERANCE && (by - y).abs() <= SAMPLE_TOLERANCE)
+            !((bx - x).abs() <= F64_SAMPLE_TOLERANCE && (by - y).abs() <= F64_SAMPLE_TOLERANCE)
         });
         if lost {
             bail!(
@@ -125,9 +136,9 @@ impl Georef {
         }
     }
 
-    /// The sample whose file coordinates are `p`; fails when `p` is not (within a
-    /// thousandth of a pixel) on a sample centre.
-    pub fn sample_at(self, p: [f64; 2]) -> Result<[i64; 2]> {
+    /// The sample whose file coordinates are `p`; fails when `p` is not within `tolerance`
+    /// pixels of a sample centre (one of the `*_SAMPLE_TOLERANCE`s, for the file's format).
+    pub fn sample_at(self, p: [f64; 2], tolerance: f64) -> Result<[i64; 2]> {
         let s = match self {
             Georef::Pixel => p,
             Georef::World(t) => match t.world_to_sample(p) {
@@ -136,7 +147,7 @@ impl Georef {
             },
         };
         let r = [s[0].round(), s[1].round()];
-        if !((s[0] - r[0]).abs() <= SAMPLE_TOLERANCE && (s[1] - r[1]).abs() <= SAMPLE_TOLERANCE) {
+        if !((s[0] - r[0]).abs() <= tolerance && (s[1] - r[1]).abs() <= tolerance) {
             let grid = |v: f64| {
                 if v.abs() < 1e9 {
                     format!("{v:.4}")

@@ -28,7 +28,7 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
     crate::georef::check_transform(&raster.info, args.pixel_coords)?;
     let georef = Georef::new(raster.info.transform(), args.pixel_coords);
     let mesh = read_mesh_file(&args.mesh, format, &raster, georef)?;
-    let positions = sample_positions(&args.mesh, &mesh, georef)?;
+    let positions = sample_positions(&args.mesh, &mesh, format, &raster, georef)?;
     let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();
     let orientation = expected_orientation(&georef);
     let mut triangles = mesh.triangles;
@@ -108,18 +108,45 @@ pub fn read_mesh_file(
     Ok(mesh)
 }
 
-/// The sample (column, row) under each vertex of `mesh`, read from `path`; fails naming
-/// the first vertex that is not on a sample centre.
-pub fn sample_positions(path: &Path, mesh: &Mesh, georef: Georef) -> Result<Vec<[i64; 2]>> {
+/// The sample (column, row) under each vertex of `mesh`, read from `path` in `format`;
+/// fails naming the first vertex that is not on a sample centre, to within the rounding
+/// of the format's positions (see [`position_tolerance`]).
+pub fn sample_positions(
+    path: &Path,
+    mesh: &Mesh,
+    format: MeshFormat,
+    raster: &Raster,
+    georef: Georef,
+) -> Result<Vec<[i64; 2]>> {
+    let tolerance = position_tolerance(format, mesh, raster, georef);
     mesh.vertices
         .iter()
         .enumerate()
         .map(|(i, v)| {
             georef
-                .sample_at([v[0], v[1]])
+                .sample_at([v[0], v[1]], tolerance)
                 .with_context(|| format!("{}: vertex {i}", path.display()))
         })
         .collect()
+}
+
+/// How far (in pixels) a vertex of `mesh`, read in `format`, may be from its sample
+/// centre: the rounding of float32 positions for STL and glTF, of the transforms for a
+/// GeoJSON file in WGS84 read back into a projected raster's CRS, else of `f64`. A vertex
+/// further off is not taken for its sample: verify measures the mesh as written.
+pub fn position_tolerance(format: MeshFormat, mesh: &Mesh, raster: &Raster, georef: Georef) -> f64 {
+    use crate::georef::{F32_SAMPLE_TOLERANCE, F64_SAMPLE_TOLERANCE, WGS84_SAMPLE_TOLERANCE};
+    let transformed = mesh.epsg == Some(4326)
+        && matches!(georef, Georef::World(_))
+        && raster.info.epsg != Some(4326)
+        && raster.info.crs_wkt.is_some();
+    if format.is_float32() {
+        F32_SAMPLE_TOLERANCE
+    } else if transformed {
+        WGS84_SAMPLE_TOLERANCE
+    } else {
+        F64_SAMPLE_TOLERANCE
+    }
 }
 
 /// Moves longitudes read from RFC 7946 GeoJSON (in [-180, 180]) by whole turns into a

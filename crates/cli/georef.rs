@@ -63,10 +63,11 @@ pub fn check_transform(info: &tinsmith_raster::RasterInfo, pixel_coords: bool) -
         f64::from(info.height.max(1) - 1),
     );
     for (x, y) in [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)] {
-        let back = t.world_to_sample(t.sample_centre(x, y));
-        let lost = back.is_none_or(|[bx, by]| {
-            !((bx - x).abs() <= F64_SAMPLE_TOLERANCE && (by - y).abs() <= F64_SAMPLE_TOLERANCE)
-        });
+        let position = t.sample_centre(x, y);
+        let tolerance = F64_SAMPLE_TOLERANCE.max(Georef::World(t).f64_rounding(position));
+        let back = t.world_to_sample(position);
+        let lost = back
+            .is_none_or(|[bx, by]| !((bx - x).abs() <= tolerance && (by - y).abs() <= tolerance));
         if lost {
             bail!(
                 "{input}: its geotransform {:?} has pixels too small for its origin: in f64 \
@@ -137,8 +138,10 @@ impl Georef {
     }
 
     /// The sample whose file coordinates are `p`; fails when `p` is not within `tolerance`
-    /// pixels of a sample centre (one of the `*_SAMPLE_TOLERANCE`s, for the file's format).
+    /// pixels of a sample centre (one of the `*_SAMPLE_TOLERANCE`s, for the file's format),
+    /// or within the rounding of `f64` coordinates as large as `p`'s, when that is more.
     pub fn sample_at(self, p: [f64; 2], tolerance: f64) -> Result<[i64; 2]> {
+        let tolerance = tolerance.max(self.f64_rounding(p));
         let s = match self {
             Georef::Pixel => p,
             Georef::World(t) => match t.world_to_sample(p) {
@@ -171,9 +174,61 @@ impl Georef {
         Ok([r[0] as i64, r[1] as i64])
     }
 
+    /// A bound, in pixels, on how far `f64` rounding can put the file position `p` of a
+    /// sample from it through the inverse geotransform: 64 units of rounding of `p`'s
+    /// coordinates, scaled by the inverse's largest row sum. It matters only where pixels
+    /// are tiny against the coordinates (millimetre pixels in UTM: about 2e-5 pixel).
+    fn f64_rounding(self, p: [f64; 2]) -> f64 {
+        let Georef::World(GeoTransform([x0, a, b, y0, c, d])) = self else {
+            return 0.0;
+        };
+        let det = (a * d - b * c).abs();
+        let scale = (d.abs() + b.abs()).max(c.abs() + a.abs()) / det;
+        let size = p[0].abs() + p[1].abs() + x0.abs() + y0.abs();
+        let rounding = 64.0 * f64::EPSILON * size * scale;
+        if rounding.is_finite() {
+            rounding
+        } else {
+            0.0
+        }
+    }
+
     /// Whether triangles counter-clockwise in grid coordinates are clockwise in file
     /// coordinates (a north-up raster's rows run south).
     pub fn flips_orientation(self) -> bool {
         matches!(self, Georef::World(t) if t.flips_orientation())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn positions_map_to_samples_within_their_rounding_only() {
+        // Millimetre pixels at a UTM northing: f64 positions are off by up to ~1e-4 pixel,
+        // which is rounding, so they still name their samples.
+        let mm = GeoTransform([500_000.0, 0.001, 0.0, 5_000_000.0, 0.0, -0.001]);
+        let georef = Georef::World(mm);
+        for (x, y) in [(0.0, 0.0), (429.0, 515.0), (17.0, 300.0)] {
+            let p = mm.sample_centre(x, y);
+            assert_eq!(
+                georef.sample_at(p, F64_SAMPLE_TOLERANCE).unwrap(),
+                [x as i64, y as i64]
+            );
+        }
+        // Metre pixels: a shift of 1e-4 pixel is no rounding and is refused, 1e-9 is.
+        let m = GeoTransform([500_000.0, 1.0, 0.0, 5_000_000.0, 0.0, -1.0]);
+        let georef = Georef::World(m);
+        let p = m.sample_centre(10.0, 20.0);
+        assert!(georef
+            .sample_at([p[0] + 1e-4, p[1]], F64_SAMPLE_TOLERANCE)
+            .is_err());
+        assert!(georef
+            .sample_at([p[0] + 1e-9, p[1]], F64_SAMPLE_TOLERANCE)
+            .is_ok());
+        assert!(georef
+            .sample_at([p[0] + 1e-4, p[1]], F32_SAMPLE_TOLERANCE)
+            .is_ok());
     }
 }

@@ -1350,3 +1350,17 @@ fn an_output_name_that_is_not_utf8_is_reported_as_well_as_it_can_be() {
         "{report}"
     );
 }
+
+#[test]
+fn verify_refuses_a_raster_with_nothing_to_measure() {
+    // One row of samples has no valid cell: `mesh` refuses it, and an empty mesh passed
+    // `verify` with "max error: 0" though no sample was measured.
+    let d = Dir::new();
+    let asc = d.write(
+        "row.asc",
+        "ncols 5\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n1 2 3 4 5\n",
+    );
+    d.write("empty.obj", "# no vertices\n");
+    let o = d.run(&["verify", asc.to_str().unwrap(), "empty.obj", "--max-error", "0"]);
+    assert_fails_naming(&o, &["row.asc", "no valid cell", "nothing to measure"]);
+}

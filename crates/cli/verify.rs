@@ -44,6 +44,15 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
         &options,
     )
     .with_context(|| format!("{}: cannot verify", args.mesh.display()))?;
+    if report.domain_samples == 0 {
+        // `mesh` refuses such a raster: a pass here would measure nothing.
+        anyhow::bail!(
+            "{}: has no valid cell (a 2 x 2 block of valid samples), so no triangle can \
+             cover any of its {} valid samples and there is nothing to measure",
+            args.input.display(),
+            report.valid_samples
+        );
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

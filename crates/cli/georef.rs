@@ -176,8 +176,10 @@ impl Georef {
 
     /// A bound, in pixels, on how far `f64` rounding can put the file position `p` of a
     /// sample from it through the inverse geotransform: 64 units of rounding of `p`'s
-    /// coordinates, scaled by the inverse's largest row sum. It matters only where pixels
-    /// are tiny against the coordinates (millimetre pixels in UTM: about 2e-5 pixel).
+    /// coordinates, scaled by the inverse's largest row sum, at most 1e-3 pixel (where
+    /// rounding is coarser, positions cannot keep samples apart, and [`check_transform`]
+    /// refuses the raster). It matters only where pixels are tiny against the coordinates
+    /// (millimetre pixels in UTM: about 1e-4 pixel).
     fn f64_rounding(self, p: [f64; 2]) -> f64 {
         let Georef::World(GeoTransform([x0, a, b, y0, c, d])) = self else {
             return 0.0;
@@ -187,7 +189,7 @@ impl Georef {
         let size = p[0].abs() + p[1].abs() + x0.abs() + y0.abs();
         let rounding = 64.0 * f64::EPSILON * size * scale;
         if rounding.is_finite() {
-            rounding
+            rounding.min(F32_SAMPLE_TOLERANCE)
         } else {
             0.0
         }

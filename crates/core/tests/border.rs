@@ -238,19 +238,7 @@ fn whole_borders_skipped_on_a_plane() {
         .unwrap()
         .tin;
     assert_eq!(tin.triangles().len(), 2);
-    let positions: Vec<[i64; 2]> = tin
-        .vertices()
-        .iter()
-        .map(|v| [v.x as i64, v.y as i64])
-        .collect();
-    let heights: Vec<f64> = tin.vertices().iter().map(|v| v.z).collect();
-    let report = verify(
-        GridRef::new(n, n, &values),
-        MeshRef::new(&positions, &heights, tin.triangles()),
-        &VerifyOptions::new().with_max_error(0.01),
-    )
-    .unwrap();
-    assert!(report.passed(), "{:?}", report.problems);
+    assert_within(n, n, &values, &tin, 0.01);
 }
 
 #[test]
@@ -272,6 +260,12 @@ fn a_long_two_row_grid_is_all_border() {
     .unwrap()
     .tin;
     assert_eq!(tin.triangles().len(), 2);
+    assert_within(w, h, &values, &tin, 0.5);
+}
+
+/// Asserts that the independent verifier passes `tin` on the `w` x `h` grid `values` at
+/// `max_error`.
+fn assert_within(w: u32, h: u32, values: &[f64], tin: &Tin, max_error: f64) {
     let positions: Vec<[i64; 2]> = tin
         .vertices()
         .iter()
@@ -279,9 +273,9 @@ fn a_long_two_row_grid_is_all_border() {
         .collect();
     let heights: Vec<f64> = tin.vertices().iter().map(|v| v.z).collect();
     let report = verify(
-        GridRef::new(w, h, &values),
+        GridRef::new(w, h, values),
         MeshRef::new(&positions, &heights, tin.triangles()),
-        &VerifyOptions::new().with_max_error(0.5),
+        &VerifyOptions::new().with_max_error(max_error),
     )
     .unwrap();
     assert!(report.passed(), "{:?}", report.problems);

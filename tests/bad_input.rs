@@ -1361,6 +1361,12 @@ fn verify_refuses_a_raster_with_nothing_to_measure() {
         "ncols 5\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n1 2 3 4 5\n",
     );
     d.write("empty.obj", "# no vertices\n");
-    let o = d.run(&["verify", asc.to_str().unwrap(), "empty.obj", "--max-error", "0"]);
+    let o = d.run(&[
+        "verify",
+        asc.to_str().unwrap(),
+        "empty.obj",
+        "--max-error",
+        "0",
+    ]);
     assert_fails_naming(&o, &["row.asc", "no valid cell", "nothing to measure"]);
 }

@@ -118,16 +118,19 @@ pub fn resolve_output(path: &Path) -> PathBuf {
     }
 }
 
-/// Whether `path`, as given, is a device, FIFO or socket, or a name under `/dev` or
-/// `/proc` (`/dev/stdout`, `/dev/fd/3`: a descriptor the caller opened, which may be a
-/// regular file a shell redirected): written in place, without a temporary file, a rename
-/// or a sidecar (a rename would replace the device, and all-or-nothing means nothing for a
-/// pipe).
+/// Whether `path`, as given, is a device, FIFO or socket, or names a descriptor the caller
+/// opened (`/dev/stdout`, `/dev/fd/3`, `/proc/self/fd/3`; it may be a regular file a shell
+/// redirected): written in place, without a temporary file, a rename or a sidecar (a
+/// rename would replace the device, and all-or-nothing means nothing for a pipe). Regular
+/// files elsewhere under `/dev` (`/dev/shm`) are ordinary outputs.
 pub fn is_special_file(path: &Path) -> bool {
-    let named_stream = path.is_absolute()
-        && (path.starts_with("/dev") || path.starts_with("/proc"))
-        && path.exists();
-    named_stream || std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+    let descriptor = ["/dev/stdout", "/dev/stderr", "/dev/stdin"]
+        .iter()
+        .any(|name| path == Path::new(name))
+        || path.starts_with("/dev/fd")
+        || (path.starts_with("/proc") && path.parent().is_some_and(|p| p.ends_with("fd")));
+    (descriptor && path.exists())
+        || std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
 /// A temporary file `.tinsmith-*.tmp` in `dir`, to be renamed over an output: its mode is
@@ -244,6 +247,19 @@ mod tests {
             .collect();
         entries.sort();
         entries
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn descriptors_and_devices_are_special_but_files_under_dev_are_not() {
+        assert!(is_special_file(Path::new("/dev/null")));
+        assert!(is_special_file(Path::new("/dev/stdout")));
+        assert!(is_special_file(Path::new("/proc/self/fd/2")));
+        // /dev/shm holds ordinary files: written through a temporary file and a rename.
+        let shm = tempfile::NamedTempFile::new_in("/dev/shm").expect("a file in /dev/shm");
+        assert!(!is_special_file(shm.path()));
+        let dir = tempfile::tempdir().expect("temp dir");
+        assert!(!is_special_file(&dir.path().join("new.ply")));
     }
 
     #[test]

@@ -18,9 +18,10 @@ const BUFFER_SIZE: usize = 1 << 16;
 ///
 /// Vertices and triangles are spooled to two unnamed temporary files in the output
 /// directory (the system's temporary directory for a device or pipe; the PLY header needs
-/// both counts before any record), which vanish however the process ends; `finish` writes the header and both spools into a third temporary
-/// file and renames it over the target. The file is byte for
-/// byte the one [`crate::write_mesh`] writes for the same vertices, triangles and CRS.
+/// both counts before any record), which vanish however the process ends; `finish` writes
+/// the header and both spools into a third temporary file and renames it over the target.
+/// The file is byte for byte the one [`crate::write_mesh`] writes for the same vertices,
+/// triangles and CRS.
 ///
 /// # Guarantees
 /// - **Atomic output.** Until `finish` returns `Ok`, nothing exists at the target path (or

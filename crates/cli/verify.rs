@@ -97,7 +97,7 @@ pub fn read_mesh_file(
     if let (Some(4326), Georef::World(transform), Some(wkt)) =
         (mesh.epsg, georef, raster.info.crs_wkt.as_deref())
     {
-        if raster.info.epsg != Some(4326) {
+        if transformed_from_wgs84(&mesh, raster, georef) {
             tinsmith_raster::from_wgs84(wkt, &mut mesh.vertices).with_context(|| {
                 format!(
                     "{}: cannot transform WGS84 back to the raster's CRS",
@@ -145,17 +145,23 @@ pub fn sample_positions(
 /// further off is not taken for its sample: verify measures the mesh as written.
 pub fn position_tolerance(format: MeshFormat, mesh: &Mesh, raster: &Raster, georef: Georef) -> f64 {
     use crate::georef::{F32_SAMPLE_TOLERANCE, F64_SAMPLE_TOLERANCE, WGS84_SAMPLE_TOLERANCE};
-    let transformed = mesh.epsg == Some(4326)
-        && matches!(georef, Georef::World(_))
-        && raster.info.epsg != Some(4326)
-        && raster.info.crs_wkt.is_some();
     if format.is_float32() {
         F32_SAMPLE_TOLERANCE
-    } else if transformed {
+    } else if transformed_from_wgs84(mesh, raster, georef) {
         WGS84_SAMPLE_TOLERANCE
     } else {
         F64_SAMPLE_TOLERANCE
     }
+}
+
+/// Whether [`read_mesh_file`] transforms `mesh`'s vertices from WGS84 into the raster's
+/// CRS: a WGS84 mesh, world coordinates, and a raster with a CRS of its own other than
+/// EPSG:4326.
+fn transformed_from_wgs84(mesh: &Mesh, raster: &Raster, georef: Georef) -> bool {
+    mesh.epsg == Some(4326)
+        && matches!(georef, Georef::World(_))
+        && raster.info.epsg != Some(4326)
+        && raster.info.crs_wkt.is_some()
 }
 
 /// Moves longitudes read from RFC 7946 GeoJSON (in [-180, 180]) by whole turns into a

@@ -60,7 +60,9 @@ pub struct Report {
     /// Triangles with the orientation opposite to [`Report::orientation`].
     pub flipped_triangles: u64,
     /// Triangles not measured because a corner index is out of range or a corner lies
-    /// outside the grid; their samples count as uncovered and their area as zero.
+    /// outside the grid (their samples count as uncovered and their area as zero), or
+    /// because the triangles before them already cover twice the grid's area (their area
+    /// counts).
     pub unmeasured_triangles: u64,
     /// Distinct nodata samples inside at least one triangle.
     pub nodata_covered_samples: u64,

@@ -24,8 +24,9 @@ use crate::{ErrorLocation, GridRef, MeshRef, Report, Result, VerifyError, Verify
 ///    same position and height are welded first).
 ///
 /// Triangles with a bad index or a corner outside the grid are counted as unmeasured and
-/// otherwise skipped; degenerate triangles cover nothing; flipped triangles are still
-/// measured. Findings never make this
+/// otherwise skipped, as are those past the point where the triangles' summed area exceeds
+/// twice the grid's (they overlap; their area still counts); degenerate triangles cover
+/// nothing; flipped triangles are still measured. Findings never make this
 /// function fail: they go in the [`Report`]. Deterministic: same input, same report.
 ///
 /// # Errors
@@ -33,8 +34,9 @@ use crate::{ErrorLocation, GridRef, MeshRef, Report, Result, VerifyError, Verify
 /// [`VerifyError::MeshSize`] if `mesh.heights.len() != mesh.positions.len()`.
 ///
 /// # Runtime
-/// Linear in the number of samples plus the total number of samples inside triangles
-/// (plus one step per triangle row), and a counting sort of the triangles' edges by their
+/// Linear in the number of samples plus the total number of samples inside measured
+/// triangles (at most about three times the grid's, see above; plus one step per triangle
+/// row), and a counting sort of the triangles' edges by their
 /// lower vertex. Memory: one bit per sample plus a few rows, and about 20 bytes per
 /// triangle for the edges (4 per side, and bucket offsets and welded ids per vertex).
 pub fn verify(grid: GridRef<'_>, mesh: MeshRef<'_>, options: &VerifyOptions) -> Result<Report> {
@@ -184,6 +186,9 @@ fn check_triangles(
 ) -> Vec<bool> {
     let vertex_count = mesh.positions.len();
     let mut measured = vec![false; mesh.triangles.len()];
+    // Twice the doubled area of the grid's rectangle of sample centres.
+    let overlap_cap_x2 =
+        4 * u128::from(grid.width.saturating_sub(1)) * u128::from(grid.height.saturating_sub(1));
     for (t, &corners) in mesh.triangles.iter().enumerate() {
         let mut measurable = true;
         for (corner, &v) in corners.iter().enumerate() {
@@ -228,6 +233,19 @@ fn check_triangles(
             });
         }
         report.mesh_area_x2 += area_x2.unsigned_abs();
+        if report.mesh_area_x2 > overlap_cap_x2 {
+            // No valid mesh gets here (its area is the domain's, at most the grid's), and
+            // measuring on would let a small file of stacked copies of one large triangle
+            // cost (triangles x grid samples).
+            report.unmeasured_triangles += 1;
+            log.push(Kind::Unmeasured, || {
+                format!(
+                    "triangle {t} not measured: with it the triangles cover more than twice \
+                     the grid's area, so they overlap"
+                )
+            });
+            continue;
+        }
         measured[t] = true;
 
         let z = corners.map(|v| mesh.heights[v as usize]);
@@ -989,5 +1007,24 @@ mod tests {
         let report = flat_3x3(&triangles);
         assert_eq!(report.mesh_area_x2, 9);
         assert!(!report.mesh_is_valid());
+        assert_eq!(
+            report.unmeasured_triangles, 0,
+            "still measured within twice the area"
+        );
+    }
+
+    #[test]
+    fn stacked_copies_stop_being_measured_past_twice_the_grid_area() {
+        // Each copy of the eight triangles covers the whole 3x3 grid (area x2 = 8): the
+        // first two copies are measured, the rest are counted as unmeasured overlaps.
+        let triangles: Vec<[u32; 3]> = eight_triangles().repeat(5);
+        let report = flat_3x3(&triangles);
+        assert_eq!(report.mesh_area_x2, 40);
+        assert_eq!(report.unmeasured_triangles, 24);
+        assert!(!report.passed());
+        assert!(report
+            .problems
+            .iter()
+            .any(|p| p.contains("triangle 16 not measured")));
     }
 }

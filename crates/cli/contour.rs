@@ -19,7 +19,7 @@
 //! With `--simplify D` each line is then simplified by Douglas–Peucker within `D` in those
 //! file coordinates ([`tinsmith_contour::simplify_indices`]). GeoJSON is then reprojected
 //! to WGS84 unless `--geojson-source-crs`, as `tinsmith mesh` does
-//! ([`crate::export::file_crs`]).
+//! ([`crate::wgs84::file_crs`]).
 
 use std::path::Path;
 use std::time::Instant;
@@ -36,12 +36,12 @@ use tinsmith_tile::{mesh_tiles, FinishedTile, RasterSource, SinkError, TileOptio
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
 use crate::args::ContourArgs;
-use crate::export::{file_crs, LineEnd, Pieces};
 use crate::georef::Georef;
+use crate::mesh_file::{expected_orientation, read_mesh_file, sample_positions};
 use crate::number::readable;
 use crate::output::NamingFile;
 use crate::output::{check_distinct, check_writable_target};
-use crate::verify::{expected_orientation, read_mesh_file, sample_positions};
+use crate::wgs84::{file_crs, LineEnd, Pieces};
 
 /// Memory per line segment while contouring and writing: its point in the joiner, the
 /// polyline and the file coordinates (measured about 50 bytes on ETOPO5).
@@ -83,7 +83,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
                     bytes_per_sample: 24,
                     extra_bytes: crate::memory::mesh_file_memory(
                         mesh,
-                        crate::verify::mesh_format(mesh, args.mesh_format)?,
+                        crate::mesh_file::mesh_format(mesh, args.mesh_format)?,
                     ),
                 },
                 "contouring a --mesh",
@@ -179,7 +179,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         args.quiet,
     )?;
     if format == LineFormat::GeoJson && crs.epsg == Some(4326) {
-        crate::export::snap_to_antimeridian(&mut points);
+        crate::wgs84::snap_to_antimeridian(&mut points);
     }
     let (points, ends) = without_repeated_points(points, &ends);
     let closed = ends.iter().filter(|&&(_, _, closed)| closed).count();
@@ -319,7 +319,7 @@ fn untiled_tin(
     let grid = &raster.grid;
     if let Some(path) = &args.mesh {
         let georef = Georef::new(raster.info.transform(), args.pixel_coords);
-        let format = crate::verify::mesh_format(path, args.mesh_format)?;
+        let format = crate::mesh_file::mesh_format(path, args.mesh_format)?;
         let mesh = mesh_from_file(path, format, raster, georef, args.band)?;
         let levels = levels_for(args, mesh.height_range())?;
         return Ok((mesh, "mesh file".to_owned(), levels));
@@ -652,7 +652,7 @@ fn mesh_from_file(
         .map(|t| t.map(|v| index[v as usize]))
         .collect();
     let orientation = expected_orientation(&georef);
-    crate::verify::orient_polygon_triangles(format, &positions, &mut triangles, orientation);
+    crate::mesh_file::orient_polygon_triangles(format, &positions, &mut triangles, orientation);
     let options = VerifyOptions::new().with_orientation(orientation);
     let report = tinsmith_verify::verify(
         GridRef::new(grid.width(), grid.height(), grid.values()),

@@ -19,6 +19,7 @@ mod georef;
 mod info;
 mod memory;
 mod mesh;
+mod mesh_file;
 mod number;
 mod output;
 mod progress;
@@ -27,6 +28,7 @@ mod serve;
 mod terrain;
 mod tiled;
 mod verify;
+mod wgs84;
 
 use std::process::ExitCode;
 

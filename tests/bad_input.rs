@@ -1095,6 +1095,58 @@ fn an_interrupted_run_leaves_no_temporary_file() {
     }
 }
 
+#[cfg(unix)]
+#[test]
+fn a_killed_runs_temporary_file_is_removed_by_the_next_run_there() {
+    // SIGKILL (the out-of-memory killer) gives no chance to clean up: the temporary file
+    // stays, and the next run writing in that directory removes it once it is a minute
+    // old (its lock died with the process). A young one may be a live run's: it stays.
+    let d = Dir::new();
+    d.write("big.vrt", &stretched_dem(3000, 2400));
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+        .args(["mesh", "big.vrt", "-o", "out.ply", "--max-error", "0", "-q"])
+        .current_dir(d.path(""))
+        .spawn()
+        .expect("start tinsmith");
+    let temporaries = || -> Vec<String> {
+        d.files()
+            .into_iter()
+            .filter(|f| f.starts_with(".tinsmith-"))
+            .collect()
+    };
+    let started = std::time::Instant::now();
+    while temporaries().is_empty() {
+        assert!(child.try_wait().unwrap().is_none(), "finished too soon");
+        assert!(started.elapsed().as_secs() < 120, "no temporary file");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().expect("SIGKILL");
+    child.wait().expect("wait");
+    let left = temporaries();
+    assert_eq!(left.len(), 1, "{left:?}");
+    let two_hours_ago = std::time::SystemTime::now() - std::time::Duration::from_secs(7200);
+    std::fs::File::options()
+        .write(true)
+        .open(d.path(&left[0]))
+        .and_then(|f| f.set_modified(two_hours_ago))
+        .expect("age the left file");
+    d.write(".tinsmith-young1.tmp", "x");
+
+    let o = d.run(&["mesh", &dem(), "--max-error", "2", "-o", "m.ply"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("removed 1 temporary output(s) that killed runs left behind")
+            && err.contains(&left[0]),
+        "{err}"
+    );
+    assert_eq!(
+        d.files(),
+        vec![".tinsmith-young1.tmp", "big.vrt", "m.ply"],
+        "{err}"
+    );
+}
+
 #[test]
 fn info_and_verify_end_quietly_when_stdout_is_closed() {
     // `tinsmith verify ... | head -1`: the reader is gone before the report is printed.

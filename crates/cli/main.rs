@@ -64,6 +64,12 @@ fn main() -> ExitCode {
         // blocks never read again (`info` on a 40k x 40k raster peaked at 1.16 GB).
         tinsmith_raster::limit_block_cache(BLOCK_CACHE_MB);
     }
+    let quiet = match &cli.command {
+        Command::Mesh(a) => a.quiet,
+        Command::Contour(a) => a.quiet,
+        Command::Tiles(a) => a.quiet,
+        Command::Info(_) | Command::Verify(_) | Command::Serve(_) => true,
+    };
     let result = match cli.command {
         Command::Info(a) => info::run(&a),
         Command::Mesh(a) => mesh::run(&a),
@@ -79,6 +85,7 @@ fn main() -> ExitCode {
             std::thread::park();
         }
     }
+    note_removed_stale(quiet);
     match result {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(EXIT_VERIFY_FAILED),
@@ -92,6 +99,37 @@ fn main() -> ExitCode {
             ExitCode::from(EXIT_ERROR)
         }
     }
+}
+
+/// Notes (unless `quiet`) the temporary outputs of killed runs that writing this run's
+/// outputs removed (see `tinsmith_export::take_removed_stale`).
+fn note_removed_stale(quiet: bool) {
+    let removed = tinsmith_export::take_removed_stale();
+    if quiet || removed.is_empty() {
+        return;
+    }
+    let bytes: u64 = removed.iter().map(|r| r.bytes).sum();
+    let shown: Vec<String> = removed
+        .iter()
+        .take(3)
+        .map(|r| r.path.display().to_string())
+        .collect();
+    let more = match removed.len() {
+        n if n > 3 => format!(" and {} more", n - 3),
+        _ => String::new(),
+    };
+    let size = match bytes {
+        b if b >= 1_000_000_000 => format!("{:.1} GB", b as f64 / 1e9),
+        b if b >= 1_000_000 => format!("{:.1} MB", b as f64 / 1e6),
+        b if b >= 1_000 => format!("{:.1} kB", b as f64 / 1e3),
+        b => format!("{b} bytes"),
+    };
+    note!(
+        "tinsmith: note: removed {} temporary output(s) that killed runs left behind \
+         ({size}): {}{more}",
+        removed.len(),
+        shown.join(", ")
+    );
 }
 
 /// GDAL block cache, in MB, for the commands that read each block once: several rows of

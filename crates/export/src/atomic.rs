@@ -136,15 +136,53 @@ pub fn is_special_file(path: &Path) -> bool {
 /// A temporary file `.tinsmith-*.tmp` in `dir`, to be renamed over an output: its mode is
 /// what `File::create` would give (the umask decides), not tempfile's private 0600, so the
 /// output is readable as any other file the user writes (a web server serving tiles runs
-/// as another user).
+/// as another user). It is locked while open, and the first temporary in `dir` sweeps
+/// the stale ones killed runs left there (see [`crate::take_removed_stale`]).
 pub fn output_temp_file(dir: &Path) -> io::Result<tempfile::NamedTempFile> {
-    temp_builder(0o666).tempfile_in(dir)
+    crate::stale::sweep_once(dir);
+    let temp = temp_builder(0o666).tempfile_in(dir)?;
+    crate::stale::hold(temp.as_file());
+    Ok(temp)
 }
 
 /// A temporary directory `.tinsmith-*.tmp` in `parent`, to be renamed into place as an
 /// output directory: its mode is what `create_dir` would give, not tempfile's 0700.
-pub fn output_temp_dir(parent: &Path) -> io::Result<tempfile::TempDir> {
-    temp_builder(0o777).tempdir_in(parent)
+/// Locked and swept as [`output_temp_file`]'s files are.
+pub fn output_temp_dir(parent: &Path) -> io::Result<OutputTempDir> {
+    crate::stale::sweep_once(parent);
+    let dir = temp_builder(0o777).tempdir_in(parent)?;
+    let lock = File::open(dir.path())?;
+    crate::stale::hold(&lock);
+    Ok(OutputTempDir { dir, _lock: lock })
+}
+
+/// A temporary output directory (see [`output_temp_dir`]): removed with its contents when
+/// dropped, unless [`OutputTempDir::keep`] was called.
+#[derive(Debug)]
+pub struct OutputTempDir {
+    // Dropped first: the directory goes while the lock is still held.
+    dir: tempfile::TempDir,
+    _lock: File,
+}
+
+impl OutputTempDir {
+    /// The directory's path.
+    pub fn path(&self) -> &Path {
+        self.dir.path()
+    }
+
+    /// Renames the directory to `target`, still locked (a sweep cannot take it between).
+    /// On failure it is removed with its contents.
+    ///
+    /// # Errors
+    /// The rename's error (`target` is a non-empty directory, on another file system...).
+    pub fn rename_into_place(self, target: &Path) -> io::Result<()> {
+        let OutputTempDir { dir, _lock } = self;
+        let staged = dir.keep();
+        std::fs::rename(&staged, target).inspect_err(|_| {
+            let _ = std::fs::remove_dir_all(&staged);
+        })
+    }
 }
 
 /// `.tinsmith-*.tmp`, created with `mode` before the umask (Unix).

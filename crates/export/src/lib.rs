@@ -73,6 +73,7 @@ mod origin;
 mod pending;
 mod ply;
 mod quantized_mesh;
+mod stale;
 mod stl;
 mod stream;
 mod weld;
@@ -80,7 +81,7 @@ mod weld;
 pub use antimeridian::cut_at_antimeridian;
 pub use atomic::{
     is_special_file, keep_permissions, output_parent, output_temp_dir, output_temp_file,
-    resolve_output,
+    resolve_output, OutputTempDir,
 };
 pub use error::{Error, Result};
 pub use file::{prj_path, read_mesh, read_mesh_as, write_mesh, write_mesh_with};
@@ -98,6 +99,7 @@ pub use quantized_mesh::{
     QuantizedMeshTile, EXTENSION_METADATA, EXTENSION_NORMALS, HEADER_BYTES, MAX_16BIT_VERTICES,
     QUANTIZED_MAX, WGS84_A, WGS84_B,
 };
+pub use stale::{take_removed_stale, RemovedTemp, MIN_STALE_AGE};
 pub use stream::MeshStreamWriter;
 
 /// EPSG 4326 for EPSG 4979 (WGS84 with ellipsoidal heights, as ogr2ogr labels WGS84 files

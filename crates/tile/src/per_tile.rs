@@ -21,7 +21,7 @@ use crate::sink::{FinishedTile, SinkError, TileSink};
 #[derive(Debug)]
 pub struct PerTileWriter {
     dir: PathBuf,
-    temp: tempfile::TempDir,
+    temp: tinsmith_export::OutputTempDir,
     /// Keeps the temporary directory registered for removal on a signal.
     _pending: tinsmith_export::PendingGuard,
     format: MeshFormat,
@@ -93,15 +93,13 @@ impl PerTileWriter {
     /// [`Error::Output`] when the rename fails (for example because the directory was
     /// created meanwhile and is not empty); the temporary directory is then removed.
     pub fn finish(self) -> Result<()> {
-        let temp = self.temp.keep();
-        std::fs::rename(&temp, &self.dir).map_err(|e| {
-            let _ = std::fs::remove_dir_all(&temp);
-            Error::Output {
+        self.temp
+            .rename_into_place(&self.dir)
+            .map_err(|e| Error::Output {
                 path: self.dir.clone(),
                 reason: "cannot move the finished tiles into place".to_owned(),
                 source: Some(e),
-            }
-        })
+            })
     }
 }
 

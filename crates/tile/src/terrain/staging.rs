@@ -10,7 +10,7 @@ use super::{TerrainError, TerrainResult};
 /// Dropped unfinished (an error), it removes the directory and the parents it made while
 /// they are empty; on a signal, the pending-output registry does the same.
 pub(super) struct Staging {
-    temp: Option<tempfile::TempDir>,
+    temp: Option<tinsmith_export::OutputTempDir>,
     _pending: tinsmith_export::PendingGuard,
     /// The parent directories made here, deepest first, and their registration; `None`
     /// once the pyramid is in place.
@@ -72,19 +72,16 @@ impl Staging {
     /// Renames the directory to `out_dir`; on failure it is removed (with the parents
     /// made for it, when dropped).
     pub(super) fn finish(&mut self, out_dir: &Path) -> TerrainResult<()> {
-        let staged = self.temp.take().expect("finished once").keep();
-        match std::fs::rename(&staged, out_dir) {
+        let staged = self.temp.take().expect("finished once");
+        match staged.rename_into_place(out_dir) {
             Ok(()) => {
                 self.made = None;
                 Ok(())
             }
-            Err(source) => {
-                let _ = std::fs::remove_dir_all(&staged);
-                Err(TerrainError::Output {
-                    path: out_dir.to_path_buf(),
-                    source,
-                })
-            }
+            Err(source) => Err(TerrainError::Output {
+                path: out_dir.to_path_buf(),
+                source,
+            }),
         }
     }
 }

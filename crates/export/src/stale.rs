@@ -48,12 +48,13 @@ fn is_temp_name(name: &str) -> bool {
 /// Sweeps `dir` once per process (see the module docs). Best effort: anything that cannot
 /// be read, locked or removed (another user's file in a shared directory) is left.
 pub(crate) fn sweep_once(dir: &Path) {
+    // Keyed by the canonical path, so that the sweep comes before this process's own
+    // first temporary there, however the directory is spelled: where locks are POSIX
+    // record locks (NFS), a process's own locks do not stop it.
+    let key = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
     {
         let mut swept = SWEPT.lock().unwrap_or_else(|p| p.into_inner());
-        if !swept
-            .get_or_insert_with(HashSet::new)
-            .insert(dir.to_path_buf())
-        {
+        if !swept.get_or_insert_with(HashSet::new).insert(key) {
             return;
         }
     }

@@ -194,7 +194,7 @@ fn verify_measures_the_mesh_as_written_not_moved_onto_the_samples() {
         );
         if code == 2 {
             assert!(
-                stderr(&o).contains("not on a sample centre"),
+                stderr(&o).contains("9.0e-4 pixel off the sample centre"),
                 "{}",
                 stderr(&o)
             );
@@ -666,4 +666,45 @@ fn contour_reads_a_mesh_with_raised_heights_and_still_refuses_a_foreign_one() {
             crate::util::stderr(&o)
         );
     }
+}
+
+#[test]
+fn wgs84_geojson_rounded_by_another_tool_is_named_as_rounded() {
+    // ogr2ogr rewrites RFC 7946 GeoJSON with 7 decimals (about 1 cm): too coarse for
+    // verify to take 50 m pixels' vertices for their samples. The message says so, and
+    // how to keep the digits; rounded to 12 decimals the file still verifies.
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let d = Dir::new();
+    let o = d.run(&["mesh", &dem, "-o", "m.geojson", "--max-error", "5", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(d.path("m.geojson")).unwrap();
+    let rounded = |decimals: i32| -> String {
+        let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let scale = 10f64.powi(decimals);
+        for feature in json["features"].as_array_mut().unwrap() {
+            for ring in feature["geometry"]["coordinates"].as_array_mut().unwrap() {
+                for point in ring.as_array_mut().unwrap() {
+                    for k in 0..2 {
+                        let v = point[k].as_f64().unwrap();
+                        point[k] = serde_json::json!((v * scale).round() / scale);
+                    }
+                }
+            }
+        }
+        json.to_string()
+    };
+    d.write("r7.geojson", &rounded(7));
+    d.write("r12.geojson", &rounded(12));
+    let o = d.run(&["verify", &dem, "r7.geojson", "--max-error", "5"]);
+    assert_eq!(o.status.code(), Some(2), "{}{}", stdout(&o), stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("r7.geojson: vertex")
+            && err.contains("pixel off the sample centre")
+            && err.contains("rounded or moved after the mesh was written")
+            && err.contains("COORDINATE_PRECISION=15"),
+        "{err}"
+    );
+    let o = d.run(&["verify", &dem, "r12.geojson", "--max-error", "5"]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
 }

@@ -23,6 +23,11 @@ pub enum Georef {
 /// below a shift of the mesh that could move its error at a sample.
 pub const F64_SAMPLE_TOLERANCE: f64 = 1e-7;
 
+/// Up to this far (in pixels) from a sample centre, a position beyond its format's
+/// tolerance is named as a sample's, rounded or moved, rather than as a position from
+/// another raster or coordinate system.
+const NEAR_MISS_PX: f64 = 0.01;
+
 /// The same for the float32 formats (STL, glTF), whose positions are rounded to `f32`
 /// around the raster's centre: `mesh` refuses a raster too wide for its positions to land
 /// this close to their samples.
@@ -139,15 +144,24 @@ impl Georef {
     /// or within the rounding of `f64` coordinates as large as `p`'s, when that is more.
     pub fn sample_at(self, p: [f64; 2], tolerance: f64) -> Result<[i64; 2]> {
         let tolerance = tolerance.max(self.f64_rounding(p));
-        let s = match self {
-            Georef::Pixel => p,
-            Georef::World(t) => match t.world_to_sample(p) {
-                Some(s) => s,
-                None => bail!("the raster's geotransform is singular"),
-            },
+        let Some(s) = self.grid_position(p) else {
+            bail!("the raster's geotransform is singular");
         };
         let r = [s[0].round(), s[1].round()];
-        if !((s[0] - r[0]).abs() <= tolerance && (s[1] - r[1]).abs() <= tolerance) {
+        let off = (s[0] - r[0]).abs().max((s[1] - r[1]).abs());
+        if off > tolerance && off <= NEAR_MISS_PX {
+            bail!(
+                "({}, {}) is {off:.1e} pixel off the sample centre ({}, {}), more than the \
+                 {tolerance:.0e} pixel its format's rounding allows: its coordinates were \
+                 rounded or moved after the mesh was written, and verify measures the mesh \
+                 as written",
+                readable(p[0]),
+                readable(p[1]),
+                r[0],
+                r[1]
+            );
+        }
+        if off > tolerance {
             let grid = |v: f64| {
                 if v.abs() < 1e9 {
                     format!("{v:.4}")
@@ -169,6 +183,27 @@ impl Georef {
             );
         }
         Ok([r[0] as i64, r[1] as i64])
+    }
+
+    /// The grid position (column, row, fractional) of the file position `p`; `None` when
+    /// the geotransform is singular.
+    fn grid_position(self, p: [f64; 2]) -> Option<[f64; 2]> {
+        match self {
+            Georef::Pixel => Some(p),
+            Georef::World(t) => t.world_to_sample(p),
+        }
+    }
+
+    /// Whether the file position `p` is off its nearest sample centre by more than
+    /// `tolerance` (and the `f64` rounding [`Georef::sample_at`] allows) but no more than
+    /// a hundredth of a pixel: a sample's position rounded or moved, which
+    /// [`Georef::sample_at`] names as such.
+    pub fn near_miss(self, p: [f64; 2], tolerance: f64) -> bool {
+        let tolerance = tolerance.max(self.f64_rounding(p));
+        self.grid_position(p).is_some_and(|s| {
+            let off = (s[0] - s[0].round()).abs().max((s[1] - s[1].round()).abs());
+            off > tolerance && off <= NEAR_MISS_PX
+        })
     }
 
     /// A bound, in pixels, on how far `f64` rounding can put the file position `p` of a

@@ -70,13 +70,24 @@ pub fn sample_positions(
     georef: Georef,
 ) -> Result<Vec<[i64; 2]>> {
     let tolerance = position_tolerance(format, mesh, raster, georef);
+    // Other tools rewrite RFC 7946 GeoJSON with 7 decimals (ogr2ogr's default), about
+    // 1 cm: too coarse for the mesh's vertices to name their samples on fine rasters.
+    let wgs84 = transformed_from_wgs84(mesh, raster, georef);
     mesh.vertices
         .iter()
         .enumerate()
         .map(|(i, v)| {
-            georef
-                .sample_at([v[0], v[1]], tolerance)
-                .with_context(|| format!("{}: vertex {i}", path.display()))
+            let p = [v[0], v[1]];
+            georef.sample_at(p, tolerance).map_err(|e| {
+                let hint = match wgs84 && georef.near_miss(p, tolerance) {
+                    true => {
+                        "; ogr2ogr writes RFC 7946 GeoJSON with 7 decimals unless given -lco \
+                         COORDINATE_PRECISION=15"
+                    }
+                    false => "",
+                };
+                anyhow::anyhow!("{}: vertex {i}: {e:#}{hint}", path.display())
+            })
         })
         .collect()
 }

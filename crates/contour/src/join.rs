@@ -34,7 +34,7 @@ use crate::{levels::sorted_levels, ContourMesh, Error, Polyline, Result};
 /// loop or a panic).
 ///
 /// # Runtime
-/// `O(triangles × log(levels) + segments)` after the mesh is built.
+/// `O(vertices × log(levels) + triangles + segments)` after the mesh is built.
 pub fn contour(mesh: &ContourMesh, levels: &[f64]) -> Result<Vec<Polyline>> {
     let levels = sorted_levels(levels)?;
     let mut lines = Vec::new();
@@ -86,13 +86,17 @@ pub(crate) fn walk_levels(
 ) -> Result<()> {
     let vertices = mesh.vertices();
     let triangles = mesh.triangles();
-    // Which triangles each level cuts: those with min z < level <= max z.
+    // Which triangles each level cuts: those with min z < level <= max z, i.e. the levels
+    // at or below the highest corner but not at or below the lowest (counted per vertex:
+    // the count is monotone in the height).
+    let at_or_below: Vec<u32> = vertices
+        .iter()
+        .map(|v| levels.partition_point(|&l| l <= v[2]) as u32)
+        .collect();
     let mut cut: Vec<Vec<u32>> = vec![Vec::new(); levels.len()];
     for (t, tri) in triangles.iter().enumerate() {
-        let z = tri.map(|v| vertices[v as usize][2]);
-        let (lo, hi) = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
-        let first = levels.partition_point(|&l| l <= lo);
-        let end = levels.partition_point(|&l| l <= hi);
+        let [a, b, c] = tri.map(|v| at_or_below[v as usize]);
+        let (first, end) = (a.min(b).min(c) as usize, a.max(b).max(c) as usize);
         for bucket in &mut cut[first..end] {
             bucket.push(t as u32);
         }

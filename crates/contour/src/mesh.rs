@@ -105,19 +105,47 @@ impl ContourMesh {
             .enumerate()
             .map(|(i, &z)| [(i % w) as f64, (i / w) as f64, z])
             .collect();
-        let mut triangles = Vec::new();
-        for y in 0..h.saturating_sub(1) {
-            for x in 0..w - 1 {
+        let (cw, ch) = (w.saturating_sub(1), h.saturating_sub(1));
+        let max = (NONE / 3) as usize;
+        let valid_cells = (0..ch * cw)
+            .filter(|&i| {
+                let a = (i / cw) * w + i % cw;
+                [a, a + 1, a + w + 1, a + w]
+                    .iter()
+                    .all(|&j| values[j].is_finite())
+            })
+            .count();
+        if 2 * valid_cells > max {
+            return Err(Error::TooManyTriangles {
+                triangles: 2 * valid_cells,
+                max,
+            });
+        }
+        // `first[cell]`: the cell's first triangle (the second follows it), or NONE.
+        let mut first = vec![NONE; cw * ch];
+        let mut triangles = Vec::with_capacity(2 * valid_cells);
+        for y in 0..ch {
+            for x in 0..cw {
                 let a = y * w + x;
                 let (b, c, d) = (a + 1, a + w + 1, a + w);
                 if [a, b, c, d].iter().all(|&i| values[i].is_finite()) {
+                    first[y * cw + x] = triangles.len() as u32;
                     let [a, b, c, d] = [a, b, c, d].map(|i| i as u32);
                     triangles.push([a, b, c]);
                     triangles.push([a, c, d]);
                 }
             }
         }
-        ContourMesh::new(vertices, triangles)
+        let twins = grid_twins(cw, ch, &first, triangles.len());
+        debug_assert!(
+            build_twins(vertices.len(), &triangles).is_ok_and(|general| general == twins),
+            "the grid's twins are those of any mesh"
+        );
+        Ok(ContourMesh {
+            vertices,
+            triangles,
+            twins,
+        })
     }
 
     /// The vertices, `[x, y, z]`.
@@ -149,14 +177,18 @@ impl ContourMesh {
     /// at a level counts as above it, as [`crate::contour`] has it). Cheap, for sizing the
     /// output before making it.
     pub fn segment_count(&self, levels: &[f64]) -> u64 {
+        // The levels at or below each vertex (`partition_point` is monotone in the height,
+        // so a triangle's lowest and highest corners give its least and greatest counts).
+        let at_or_below: Vec<u32> = self
+            .vertices
+            .iter()
+            .map(|v| levels.partition_point(|&l| l <= v[2]) as u32)
+            .collect();
         self.triangles
             .iter()
             .map(|t| {
-                let z = t.map(|v| self.vertices[v as usize][2]);
-                let (lo, hi) = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
-                let above_lo = levels.partition_point(|&l| l <= lo);
-                let up_to_hi = levels.partition_point(|&l| l <= hi);
-                up_to_hi.saturating_sub(above_lo) as u64
+                let [a, b, c] = t.map(|v| at_or_below[v as usize]);
+                u64::from(a.max(b).max(c) - a.min(b).min(c))
             })
             .sum()
     }
@@ -179,6 +211,41 @@ impl ContourMesh {
     pub(crate) fn twin(&self, h: u32) -> u32 {
         self.twins[h as usize]
     }
+}
+
+/// The twin half-edges of [`ContourMesh::from_grid`]'s mesh, read off the grid: `first`
+/// holds each of the `cw x ch` cells' first triangle `(a, b, c)` (its second, `(a, c, d)`,
+/// follows) or [`NONE`]. The same twins [`build_twins`] finds, without bucketing.
+fn grid_twins(cw: usize, ch: usize, first: &[u32], triangles: usize) -> Vec<u32> {
+    let mut twins = vec![NONE; 3 * triangles];
+    let cell = |x: usize, y: usize| first[y * cw + x];
+    for y in 0..ch {
+        for x in 0..cw {
+            let lower = cell(x, y);
+            if lower == NONE {
+                continue;
+            }
+            let upper = lower + 1;
+            let (l, u) = (3 * lower as usize, 3 * upper as usize);
+            // (a, b, c): top edge a-b, right edge b-c, diagonal c-a.
+            if y > 0 && cell(x, y - 1) != NONE {
+                twins[l] = 3 * (cell(x, y - 1) + 1) + 1;
+            }
+            if x + 1 < cw && cell(x + 1, y) != NONE {
+                twins[l + 1] = 3 * (cell(x + 1, y) + 1) + 2;
+            }
+            twins[l + 2] = 3 * upper;
+            // (a, c, d): diagonal a-c, bottom edge c-d, left edge d-a.
+            twins[u] = 3 * lower + 2;
+            if y + 1 < ch && cell(x, y + 1) != NONE {
+                twins[u + 1] = 3 * cell(x, y + 1);
+            }
+            if x > 0 && cell(x - 1, y) != NONE {
+                twins[u + 2] = 3 * cell(x - 1, y) + 1;
+            }
+        }
+    }
+    twins
 }
 
 /// Twin half-edges from the triangle list, in linear time: half-edges are bucketed by their
@@ -265,6 +332,23 @@ mod tests {
         assert_eq!(m.twin(4), 6);
         assert_eq!(m.twin(6), 4);
         assert_eq!(m.twin(1), NONE);
+    }
+
+    #[test]
+    fn grid_twins_are_the_twins_of_the_triangle_list() {
+        // Nodata scattered so that cells are missing beside, above and below others.
+        let (w, h) = (9u32, 7u32);
+        let values: Vec<f64> = (0..w * h)
+            .map(|i| match (i * 7 + 3) % 11 {
+                0 => f64::NAN,
+                r => f64::from(r),
+            })
+            .collect();
+        let m = ContourMesh::from_grid(w, h, &values).unwrap();
+        assert!(m.triangles().len() > 20, "{}", m.triangles().len());
+        let general = build_twins(m.vertices().len(), m.triangles()).unwrap();
+        assert_eq!(m.twins, general);
+        assert!(general.contains(&NONE) && general.iter().any(|&t| t != NONE));
     }
 
     #[test]

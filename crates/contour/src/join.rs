@@ -154,7 +154,8 @@ impl Joiner<'_> {
     ) -> Result<()> {
         // Open lines first, from each not yet used segment on a boundary edge...
         for (i, &t) in bucket.iter().enumerate() {
-            if self.used[i] {
+            let on_boundary = (0..3).any(|k| self.mesh.twin(3 * t + k) == NONE);
+            if self.used[i] || !on_boundary {
                 continue;
             }
             let (entry, exit) = self.segment(t, level);

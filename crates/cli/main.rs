@@ -118,6 +118,10 @@ fn note_removed_stale(quiet: bool) {
         n if n > 3 => format!(" and {} more", n - 3),
         _ => String::new(),
     };
+    let partly = match removed.iter().filter(|r| !r.complete).count() {
+        0 => String::new(),
+        n => format!(" ({n} only in part: some files in them could not be removed)"),
+    };
     let size = match bytes {
         b if b >= 1_000_000_000 => format!("{:.1} GB", b as f64 / 1e9),
         b if b >= 1_000_000 => format!("{:.1} MB", b as f64 / 1e6),
@@ -126,7 +130,7 @@ fn note_removed_stale(quiet: bool) {
     };
     note!(
         "tinsmith: note: removed {} temporary output(s) that killed runs left behind \
-         ({size}): {}{more}",
+         ({size}): {}{more}{partly}",
         removed.len(),
         shown.join(", ")
     );

@@ -177,8 +177,22 @@ impl OutputTempDir {
     /// # Errors
     /// The rename's error (`target` is a non-empty directory, on another file system...).
     pub fn rename_into_place(self, target: &Path) -> io::Result<()> {
+        use std::os::unix::fs::MetadataExt;
         let OutputTempDir { dir, _lock } = self;
         let staged = dir.keep();
+        // Still the directory made and locked (a program that took it for a killed run's
+        // may have removed it, and the writers made a new one in its place).
+        let made = _lock.metadata()?;
+        let same = std::fs::symlink_metadata(&staged)
+            .is_ok_and(|now| (now.dev(), now.ino()) == (made.dev(), made.ino()));
+        if !same {
+            let _ = std::fs::remove_dir_all(&staged);
+            return Err(io::Error::other(format!(
+                "the temporary directory {} was removed by another program while the run \
+                 wrote into it",
+                staged.display()
+            )));
+        }
         std::fs::rename(&staged, target).inspect_err(|_| {
             let _ = std::fs::remove_dir_all(&staged);
         })
@@ -276,6 +290,29 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_staging_directory_replaced_under_the_run_is_not_renamed_into_place() {
+        let parent = tempfile::tempdir().expect("temp dir");
+        let staged = output_temp_dir(parent.path()).expect("staging dir");
+        let path = staged.path().to_path_buf();
+        // Another program removes it; a writer makes the path again (a new directory).
+        std::fs::remove_dir(&path).expect("rmdir");
+        std::fs::create_dir(&path).expect("mkdir");
+        std::fs::write(path.join("part"), b"x").expect("write");
+        let target = parent.path().join("out");
+        let err = staged.rename_into_place(&target).expect_err("refused");
+        assert!(
+            err.to_string().contains("removed by another program"),
+            "{err}"
+        );
+        assert!(!target.exists() && !path.exists());
+
+        let staged = output_temp_dir(parent.path()).expect("staging dir");
+        std::fs::write(staged.path().join("part"), b"x").expect("write");
+        staged.rename_into_place(&target).expect("renamed");
+        assert!(target.join("part").is_file());
+    }
     use std::path::PathBuf;
 
     fn entries(dir: &Path) -> Vec<PathBuf> {

@@ -8,7 +8,15 @@
 //! whose lock can be taken belongs to no live run. Before a run's first temporary in a
 //! directory, the others there are swept: those that can be locked and were last modified
 //! more than [`MIN_STALE_AGE`] ago (the time between a temporary's creation and its lock
-//! is not atomic) are removed and recorded for [`take_removed_stale`].
+//! is not atomic) are removed and recorded for [`take_removed_stale`]. Only the user's own
+//! are touched, and a directory with another file system mounted inside is left whole.
+//!
+//! Where locks do not work as on a local file system (NFS emulates `flock` with record
+//! locks, which a read-only handle cannot take), nothing can be locked by the sweep, so
+//! nothing is removed there. Where a lock is local to one host but the directory is shared
+//! (NFS with `local_lock=flock`), a run on another host may take a live run's staging
+//! directory for stale: that run then fails ([`crate::OutputTempDir::rename_into_place`]
+//! checks its directory is still the one it made) rather than publish a partial pyramid.
 
 use std::collections::HashSet;
 use std::fs::File;
@@ -30,8 +38,11 @@ static REMOVED: Mutex<Vec<RemovedTemp>> = Mutex::new(Vec::new());
 pub struct RemovedTemp {
     /// Where it was.
     pub path: PathBuf,
-    /// Its size in bytes (a directory's files summed).
+    /// Its size in bytes (a directory's files summed) before the removal.
     pub bytes: u64,
+    /// Whether all of it went (a directory's removal can stop partway, on a file the
+    /// user may not remove).
+    pub complete: bool,
 }
 
 /// The stale temporaries removed so far (each returned once).
@@ -79,39 +90,72 @@ fn sweep(dir: &Path, now: SystemTime) -> Vec<RemovedTemp> {
             continue;
         }
         let path = entry.path();
-        let Ok(meta) = std::fs::symlink_metadata(&path) else {
-            continue;
-        };
-        let old_enough = meta
-            .modified()
-            .ok()
-            .and_then(|m| now.duration_since(m).ok())
-            .is_some_and(|age| age >= MIN_STALE_AGE);
-        if !old_enough || !(meta.is_file() || meta.is_dir()) {
-            continue;
-        }
-        // Opening read-only is enough to take an flock, on files and directories alike.
-        let Ok(handle) = File::open(&path) else {
-            continue;
-        };
-        if handle.try_lock().is_err() {
-            continue; // A live run holds it (or locks are not supported here).
-        }
-        let (bytes, gone) = if meta.is_dir() {
-            (dir_bytes(&path), std::fs::remove_dir_all(&path).is_ok())
-        } else {
-            (meta.len(), std::fs::remove_file(&path).is_ok())
-        };
-        if gone {
-            removed.push(RemovedTemp { path, bytes });
+        if let Some(r) = remove_if_stale(&path, now) {
+            removed.push(r);
         }
     }
     removed.sort_by(|a, b| a.path.cmp(&b.path));
     removed
 }
 
-/// The summed size of the files under `dir` (symbolic links not followed).
-fn dir_bytes(dir: &Path) -> u64 {
+/// Removes the temporary at `path` if it is stale (see the module docs).
+fn remove_if_stale(path: &Path, now: SystemTime) -> Option<RemovedTemp> {
+    use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
+    let meta = std::fs::symlink_metadata(path).ok()?;
+    let old_enough = meta
+        .modified()
+        .ok()
+        .and_then(|m| now.duration_since(m).ok())
+        .is_some_and(|age| age >= MIN_STALE_AGE);
+    let own = effective_uid() == Some(meta.uid());
+    if !old_enough || !own || !(meta.is_file() || meta.is_dir()) {
+        return None;
+    }
+    // Read-only is enough to take an flock, on files and directories alike. Not following
+    // a link and not waiting on a FIFO, in case the name changed since it was looked at;
+    // the handle must be the entry looked at.
+    let handle = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK)
+        .open(path)
+        .ok()?;
+    let opened = handle.metadata().ok()?;
+    if (opened.dev(), opened.ino()) != (meta.dev(), meta.ino()) {
+        return None;
+    }
+    if handle.try_lock().is_err() {
+        return None; // A live run holds it (or locks do not work here).
+    }
+    if meta.is_dir() {
+        // A file system mounted inside would be emptied too: leave such a directory.
+        let bytes = dir_bytes(path, meta.dev())?;
+        let complete = std::fs::remove_dir_all(path).is_ok();
+        Some(RemovedTemp {
+            path: path.to_path_buf(),
+            bytes,
+            complete,
+        })
+    } else {
+        std::fs::remove_file(path).ok()?;
+        Some(RemovedTemp {
+            path: path.to_path_buf(),
+            bytes: meta.len(),
+            complete: true,
+        })
+    }
+}
+
+/// The process's effective user id, as the owner of `/proc/self` (Linux gives a process's
+/// directory there its effective ids); `None` without `/proc`, and nothing is swept then.
+fn effective_uid() -> Option<u32> {
+    use std::os::unix::fs::MetadataExt;
+    std::fs::metadata("/proc/self").ok().map(|m| m.uid())
+}
+
+/// The summed size of the files under `dir` (symbolic links not followed), or `None` when
+/// some directory inside is on another device than `dev` (a mount point).
+fn dir_bytes(dir: &Path, dev: u64) -> Option<u64> {
+    use std::os::unix::fs::MetadataExt;
     let mut total = 0;
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
@@ -120,13 +164,14 @@ fn dir_bytes(dir: &Path) -> u64 {
         };
         for entry in entries.flatten() {
             match entry.metadata() {
+                Ok(m) if m.is_dir() && m.dev() != dev => return None,
                 Ok(m) if m.is_dir() => stack.push(entry.path()),
                 Ok(m) => total += m.len(),
                 Err(_) => {}
             }
         }
     }
-    total
+    Some(total)
 }
 
 /// Locks `handle` (a temporary's file or directory) for as long as it stays open: see the
@@ -146,6 +191,18 @@ mod tests {
         File::open(path)
             .and_then(|f| f.set_modified(when))
             .expect("set mtime");
+    }
+
+    #[test]
+    fn a_directory_with_another_device_inside_is_not_sized_for_removal() {
+        use std::os::unix::fs::MetadataExt;
+        let dir = tempfile::tempdir().expect("temp dir");
+        std::fs::create_dir(dir.path().join("sub")).expect("mkdir");
+        std::fs::write(dir.path().join("sub/f"), b"1234").expect("write");
+        let dev = std::fs::metadata(dir.path()).expect("stat").dev();
+        assert_eq!(dir_bytes(dir.path(), dev), Some(4));
+        // As if `sub` were a mount point: its device differs from the top's.
+        assert_eq!(dir_bytes(dir.path(), dev.wrapping_add(1)), None);
     }
 
     #[test]
@@ -186,11 +243,13 @@ mod tests {
             vec![
                 RemovedTemp {
                     path: old_file.clone(),
-                    bytes: 5
+                    bytes: 5,
+                    complete: true,
                 },
                 RemovedTemp {
                     path: old_dir.clone(),
-                    bytes: 3
+                    bytes: 3,
+                    complete: true,
                 },
             ]
         );

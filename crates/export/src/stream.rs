@@ -302,6 +302,9 @@ struct Spool {
 
 impl Spool {
     fn new(dir: &Path) -> io::Result<Spool> {
+        // Before the spools fill the disk, not at the end, when the output's temporary
+        // file is made: a killed run's leftover may be what would fill it.
+        crate::stale::sweep_once(dir);
         let file = tempfile::tempfile_in(dir)?;
         let writer = BufWriter::with_capacity(BUFFER_SIZE, file.try_clone()?);
         Ok(Spool { file, writer })

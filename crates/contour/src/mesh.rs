@@ -26,6 +26,16 @@ pub struct ContourMesh {
     /// `twins[3 t + k]`: the half-edge `3 t' + k'` across triangle `t`'s edge `k`, or
     /// [`NONE`].
     twins: Vec<u32>,
+    /// Lowest and highest height of the vertices the triangles use.
+    height_range: Option<(f64, f64)>,
+}
+
+/// `range` widened to take in `z`.
+fn widen(range: Option<(f64, f64)>, z: f64) -> Option<(f64, f64)> {
+    Some(match range {
+        None => (z, z),
+        Some((lo, hi)) => (lo.min(z), hi.max(z)),
+    })
 }
 
 impl ContourMesh {
@@ -48,6 +58,7 @@ impl ContourMesh {
                 max,
             });
         }
+        let mut height_range = None;
         for (t, tri) in triangles.iter().enumerate() {
             for (k, &v) in tri.iter().enumerate() {
                 let Some(p) = vertices.get(v as usize) else {
@@ -66,6 +77,7 @@ impl ContourMesh {
                         vertex: v,
                     });
                 }
+                height_range = widen(height_range, p[2]);
             }
         }
         let twins = build_twins(vertices.len(), &triangles)?;
@@ -73,6 +85,7 @@ impl ContourMesh {
             vertices,
             triangles,
             twins,
+            height_range,
         })
     }
 
@@ -124,11 +137,17 @@ impl ContourMesh {
         // `first[cell]`: the cell's first triangle (the second follows it), or NONE.
         let mut first = vec![NONE; cw * ch];
         let mut triangles = Vec::with_capacity(2 * valid_cells);
+        let mut height_range = None;
         for y in 0..ch {
             for x in 0..cw {
                 let a = y * w + x;
                 let (b, c, d) = (a + 1, a + w + 1, a + w);
                 if [a, b, c, d].iter().all(|&i| values[i].is_finite()) {
+                    // In the order `height_range` of `new` would meet them (the sign a
+                    // zero range end gets depends on it).
+                    for i in [a, b, c, a, c, d] {
+                        height_range = widen(height_range, values[i]);
+                    }
                     first[y * cw + x] = triangles.len() as u32;
                     let [a, b, c, d] = [a, b, c, d].map(|i| i as u32);
                     triangles.push([a, b, c]);
@@ -145,6 +164,7 @@ impl ContourMesh {
             vertices,
             triangles,
             twins,
+            height_range,
         })
     }
 
@@ -161,15 +181,7 @@ impl ContourMesh {
     /// Lowest and highest height of the vertices the triangles use, or `None` without
     /// triangles.
     pub fn height_range(&self) -> Option<(f64, f64)> {
-        let mut range: Option<(f64, f64)> = None;
-        for &v in self.triangles.iter().flatten() {
-            let z = self.vertices[v as usize][2];
-            range = Some(match range {
-                None => (z, z),
-                Some((lo, hi)) => (lo.min(z), hi.max(z)),
-            });
-        }
-        range
+        self.height_range
     }
 
     /// How many line segments contouring at `levels` (sorted ascending) makes, at most:

@@ -157,7 +157,7 @@ pub fn output_temp_dir(parent: &Path) -> io::Result<OutputTempDir> {
 }
 
 /// A temporary output directory (see [`output_temp_dir`]): removed with its contents when
-/// dropped, unless [`OutputTempDir::keep`] was called.
+/// dropped, unless [`OutputTempDir::rename_into_place`] moved it.
 #[derive(Debug)]
 pub struct OutputTempDir {
     // Dropped first: the directory goes while the lock is still held.

@@ -701,7 +701,7 @@ fn wgs84_geojson_rounded_by_another_tool_is_named_as_rounded() {
     assert!(
         err.contains("r7.geojson: vertex")
             && err.contains("pixel off the sample centre")
-            && err.contains("rounded or moved after the mesh was written")
+            && err.contains("changed after it was written, and the mesh is measured as written")
             && err.contains("COORDINATE_PRECISION=15"),
         "{err}"
     );

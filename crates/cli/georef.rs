@@ -152,9 +152,7 @@ impl Georef {
         if off > tolerance && off <= NEAR_MISS_PX {
             bail!(
                 "({}, {}) is {off:.1e} pixel off the sample centre ({}, {}), more than the \
-                 {tolerance:.0e} pixel its format's rounding allows: its coordinates were \
-                 rounded or moved after the mesh was written, and verify measures the mesh \
-                 as written",
+                 {tolerance:.0e} pixel its format's rounding allows (rounded or moved off it)",
                 readable(p[0]),
                 readable(p[1]),
                 r[0],

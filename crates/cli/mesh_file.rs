@@ -79,12 +79,17 @@ pub fn sample_positions(
         .map(|(i, v)| {
             let p = [v[0], v[1]];
             georef.sample_at(p, tolerance).map_err(|e| {
-                let hint = match wgs84 && georef.near_miss(p, tolerance) {
-                    true => {
-                        "; ogr2ogr writes RFC 7946 GeoJSON with 7 decimals unless given -lco \
-                         COORDINATE_PRECISION=15"
+                let hint = match (georef.near_miss(p, tolerance), wgs84) {
+                    (false, _) => "",
+                    (true, false) => {
+                        ": the file's positions were changed after it was written, and the \
+                         mesh is measured as written"
                     }
-                    false => "",
+                    (true, true) => {
+                        ": the file's positions were changed after it was written, and the \
+                         mesh is measured as written (ogr2ogr writes RFC 7946 GeoJSON with 7 \
+                         decimals unless given -lco COORDINATE_PRECISION=15)"
+                    }
                 };
                 anyhow::anyhow!("{}: vertex {i}: {e:#}{hint}", path.display())
             })

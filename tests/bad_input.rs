@@ -1103,8 +1103,11 @@ fn a_killed_runs_temporary_file_is_removed_by_the_next_run_there() {
     // old (its lock died with the process). A young one may be a live run's: it stays.
     let d = Dir::new();
     d.write("big.vrt", &stretched_dem(3000, 2400));
+    // The report's temporary file is made before the raster is read: it is there at once,
+    // however slowly a loaded machine gets to the mesh's.
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
         .args(["mesh", "big.vrt", "-o", "out.ply", "--max-error", "0", "-q"])
+        .args(["--report", "r.json"])
         .current_dir(d.path(""))
         .spawn()
         .expect("start tinsmith");
@@ -1123,21 +1126,26 @@ fn a_killed_runs_temporary_file_is_removed_by_the_next_run_there() {
     child.kill().expect("SIGKILL");
     child.wait().expect("wait");
     let left = temporaries();
-    assert_eq!(left.len(), 1, "{left:?}");
+    assert!(!left.is_empty() && left.len() <= 2, "{left:?}");
     let two_hours_ago = std::time::SystemTime::now() - std::time::Duration::from_secs(7200);
-    std::fs::File::options()
-        .write(true)
-        .open(d.path(&left[0]))
-        .and_then(|f| f.set_modified(two_hours_ago))
-        .expect("age the left file");
+    for name in &left {
+        std::fs::File::options()
+            .write(true)
+            .open(d.path(name))
+            .and_then(|f| f.set_modified(two_hours_ago))
+            .expect("age the left file");
+    }
     d.write(".tinsmith-young1.tmp", "x");
 
     let o = d.run(&["mesh", &dem(), "--max-error", "2", "-o", "m.ply"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let err = stderr(&o);
+    let removed = format!(
+        "removed {} temporary output(s) that killed runs left behind",
+        left.len()
+    );
     assert!(
-        err.contains("removed 1 temporary output(s) that killed runs left behind")
-            && err.contains(&left[0]),
+        err.contains(&removed) && left.iter().all(|name| err.contains(name.as_str())),
         "{err}"
     );
     assert_eq!(

@@ -1074,7 +1074,10 @@ fn an_interrupted_run_leaves_no_temporary_file() {
                 child.try_wait().unwrap().is_none(),
                 "finished before any temporary file was seen"
             );
-            assert!(started.elapsed().as_secs() < 120, "no temporary file");
+            // The mesh's temporary file is made when writing starts, after the whole
+            // decimation: minutes on a loaded CI machine (120 s was once not enough for
+            // the same run in the killed-run test).
+            assert!(started.elapsed().as_secs() < 900, "no temporary file");
             std::thread::sleep(std::time::Duration::from_millis(5));
         }
         let killed = std::process::Command::new("kill")

@@ -178,13 +178,14 @@ impl OutputTempDir {
     /// The rename's error (`target` is a non-empty directory, on another file system...).
     pub fn rename_into_place(self, target: &Path) -> io::Result<()> {
         use std::os::unix::fs::MetadataExt;
-        let OutputTempDir { dir, _lock } = self;
+        let OutputTempDir { dir, _lock: lock } = self;
         let staged = dir.keep();
         // Still the directory made and locked (a program that took it for a killed run's
         // may have removed it, and the writers made a new one in its place).
-        let made = _lock.metadata()?;
-        let same = std::fs::symlink_metadata(&staged)
-            .is_ok_and(|now| (now.dev(), now.ino()) == (made.dev(), made.ino()));
+        let same = match (lock.metadata(), std::fs::symlink_metadata(&staged)) {
+            (Ok(made), Ok(now)) => (now.dev(), now.ino()) == (made.dev(), made.ino()),
+            _ => false,
+        };
         if !same {
             let _ = std::fs::remove_dir_all(&staged);
             return Err(io::Error::other(format!(
@@ -290,6 +291,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::PathBuf;
 
     #[test]
     fn a_staging_directory_replaced_under_the_run_is_not_renamed_into_place() {
@@ -313,7 +315,6 @@ mod tests {
         staged.rename_into_place(&target).expect("renamed");
         assert!(target.join("part").is_file());
     }
-    use std::path::PathBuf;
 
     fn entries(dir: &Path) -> Vec<PathBuf> {
         let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)

@@ -144,11 +144,9 @@ impl Georef {
     /// or within the rounding of `f64` coordinates as large as `p`'s, when that is more.
     pub fn sample_at(self, p: [f64; 2], tolerance: f64) -> Result<[i64; 2]> {
         let tolerance = tolerance.max(self.f64_rounding(p));
-        let Some(s) = self.grid_position(p) else {
+        let Some((s, r, off)) = self.nearest_sample(p) else {
             bail!("the raster's geotransform is singular");
         };
-        let r = [s[0].round(), s[1].round()];
-        let off = (s[0] - r[0]).abs().max((s[1] - r[1]).abs());
         if off > tolerance && off <= NEAR_MISS_PX {
             bail!(
                 "({}, {}) is {off:.1e} pixel off the sample centre ({}, {}), more than the \
@@ -183,13 +181,16 @@ impl Georef {
         Ok([r[0] as i64, r[1] as i64])
     }
 
-    /// The grid position (column, row, fractional) of the file position `p`; `None` when
-    /// the geotransform is singular.
-    fn grid_position(self, p: [f64; 2]) -> Option<[f64; 2]> {
-        match self {
-            Georef::Pixel => Some(p),
-            Georef::World(t) => t.world_to_sample(p),
-        }
+    /// The grid position (column, row, fractional) of the file position `p`, the nearest
+    /// sample centre and how far off it `p` is in pixels (the larger of the two axes);
+    /// `None` when the geotransform is singular.
+    fn nearest_sample(self, p: [f64; 2]) -> Option<([f64; 2], [f64; 2], f64)> {
+        let s = match self {
+            Georef::Pixel => p,
+            Georef::World(t) => t.world_to_sample(p)?,
+        };
+        let r = [s[0].round(), s[1].round()];
+        Some((s, r, (s[0] - r[0]).abs().max((s[1] - r[1]).abs())))
     }
 
     /// Whether the file position `p` is off its nearest sample centre by more than
@@ -198,10 +199,8 @@ impl Georef {
     /// [`Georef::sample_at`] names as such.
     pub fn near_miss(self, p: [f64; 2], tolerance: f64) -> bool {
         let tolerance = tolerance.max(self.f64_rounding(p));
-        self.grid_position(p).is_some_and(|s| {
-            let off = (s[0] - s[0].round()).abs().max((s[1] - s[1].round()).abs());
-            off > tolerance && off <= NEAR_MISS_PX
-        })
+        self.nearest_sample(p)
+            .is_some_and(|(_, _, off)| off > tolerance && off <= NEAR_MISS_PX)
     }
 
     /// A bound, in pixels, on how far `f64` rounding can put the file position `p` of a

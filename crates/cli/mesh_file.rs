@@ -79,19 +79,21 @@ pub fn sample_positions(
         .map(|(i, v)| {
             let p = [v[0], v[1]];
             georef.sample_at(p, tolerance).map_err(|e| {
-                let hint = match (georef.near_miss(p, tolerance), wgs84) {
-                    (false, _) => "",
-                    (true, false) => {
-                        ": the file's positions were changed after it was written, and the \
-                         mesh is measured as written"
+                if !georef.near_miss(p, tolerance) {
+                    return anyhow::anyhow!("{}: vertex {i}: {e:#}", path.display());
+                }
+                let ogr2ogr = match wgs84 {
+                    true => {
+                        " (ogr2ogr writes RFC 7946 GeoJSON with 7 decimals unless given -lco \
+                         COORDINATE_PRECISION=15)"
                     }
-                    (true, true) => {
-                        ": the file's positions were changed after it was written, and the \
-                         mesh is measured as written (ogr2ogr writes RFC 7946 GeoJSON with 7 \
-                         decimals unless given -lco COORDINATE_PRECISION=15)"
-                    }
+                    false => "",
                 };
-                anyhow::anyhow!("{}: vertex {i}: {e:#}{hint}", path.display())
+                anyhow::anyhow!(
+                    "{}: vertex {i}: {e:#}: the file's positions were changed after it was \
+                     written, and the mesh is measured as written{ogr2ogr}",
+                    path.display()
+                )
             })
         })
         .collect()

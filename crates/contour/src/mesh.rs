@@ -120,13 +120,14 @@ impl ContourMesh {
             .collect();
         let (cw, ch) = (w.saturating_sub(1), h.saturating_sub(1));
         let max = (NONE / 3) as usize;
+        // Whether the cell whose top-left sample is `a` has four finite corners.
+        let valid = |a: usize| {
+            [a, a + 1, a + w + 1, a + w]
+                .iter()
+                .all(|&j| values[j].is_finite())
+        };
         let valid_cells = (0..ch * cw)
-            .filter(|&i| {
-                let a = (i / cw) * w + i % cw;
-                [a, a + 1, a + w + 1, a + w]
-                    .iter()
-                    .all(|&j| values[j].is_finite())
-            })
+            .filter(|&i| valid((i / cw) * w + i % cw))
             .count();
         if 2 * valid_cells > max {
             return Err(Error::TooManyTriangles {
@@ -142,7 +143,7 @@ impl ContourMesh {
             for x in 0..cw {
                 let a = y * w + x;
                 let (b, c, d) = (a + 1, a + w + 1, a + w);
-                if [a, b, c, d].iter().all(|&i| values[i].is_finite()) {
+                if valid(a) {
                     // In the order `height_range` of `new` would meet them (the sign a
                     // zero range end gets depends on it).
                     for i in [a, b, c, a, c, d] {

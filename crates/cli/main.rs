@@ -13,22 +13,10 @@ macro_rules! note {
 }
 
 mod args;
-mod contour;
-mod export;
-mod georef;
+mod commands;
 mod info;
-mod memory;
-mod mesh;
-mod mesh_file;
-mod number;
-mod output;
 mod progress;
-mod report;
-mod serve;
-mod terrain;
-mod tiled;
 mod verify;
-mod wgs84;
 
 use std::process::ExitCode;
 
@@ -72,11 +60,11 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Info(a) => info::run(&a),
-        Command::Mesh(a) => mesh::run(&a),
+        Command::Mesh(a) => commands::mesh(&a),
         Command::Verify(a) => verify::run(&a),
-        Command::Contour(a) => contour::run(&a),
-        Command::Tiles(a) => terrain::run(&a),
-        Command::Serve(a) => serve::run(&a),
+        Command::Contour(a) => commands::contour(&a),
+        Command::Tiles(a) => commands::tiles(&a),
+        Command::Serve(a) => commands::serve(&a),
     };
     if tinsmith_export::interrupted() {
         // The signal handler is removing the unfinished output (the error, if any, comes

@@ -1,18 +1,23 @@
-//! A one-line progress display on stderr, shown only when stderr is a terminal.
+//! The pipeline's feedback on stderr: notes, a one-line progress display and a tile
+//! bar, the last two shown only when stderr is a terminal.
 
+use std::cell::RefCell;
 use std::io::{IsTerminal, Write};
 use std::time::{Duration, Instant};
 
+use indicatif::{ProgressBar, ProgressStyle};
+use tinsmith_pipeline::Feedback;
+
 /// Rewrites one stderr line at most five times a second; silent when quiet or when stderr
 /// is not a terminal (pipes and CI logs stay clean).
-pub struct Progress {
+struct Progress {
     enabled: bool,
     last: Option<Instant>,
     shown: bool,
 }
 
 impl Progress {
-    pub fn new(quiet: bool) -> Progress {
+    fn new(quiet: bool) -> Progress {
         Progress {
             enabled: !quiet && std::io::stderr().is_terminal(),
             last: None,
@@ -20,7 +25,7 @@ impl Progress {
         }
     }
 
-    pub fn show(&mut self, line: &str) {
+    fn show(&mut self, line: &str) {
         if !self.enabled
             || self
                 .last
@@ -33,7 +38,7 @@ impl Progress {
         let _ = write!(std::io::stderr(), "\r\x1b[2K{line}");
     }
 
-    pub fn clear(&mut self) {
+    fn clear(&mut self) {
         if self.shown {
             let _ = write!(std::io::stderr(), "\r\x1b[2K");
             self.shown = false;
@@ -41,21 +46,79 @@ impl Progress {
     }
 }
 
-/// Scans band `band` of `input` for its statistics ([`tinsmith_raster::open_info`]: a full
-/// read, long on a large raster), showing the share of rows done unless `quiet`.
-pub fn scan_raster(
-    input: &std::path::Path,
-    band: usize,
+/// The pipeline's notes and progress on stderr: notes unless quiet; the progress line and
+/// the tile bar only on a terminal.
+pub struct Stderr {
     quiet: bool,
-) -> tinsmith_raster::Result<tinsmith_raster::RasterInfo> {
-    let mut progress = Progress::new(quiet);
-    let name = input.display();
-    let info = tinsmith_raster::open_info_with_progress(input, band, &mut |done, rows| {
-        progress.show(&format!(
-            "{name}: scanning, {} % of the rows",
-            done * 100 / rows.max(1)
-        ));
-    });
-    progress.clear();
-    info
+    line: RefCell<Progress>,
+    bar: RefCell<Option<ProgressBar>>,
+}
+
+impl Stderr {
+    /// Feedback for a run with `--quiet` as `quiet`.
+    pub fn new(quiet: bool) -> Stderr {
+        Stderr {
+            quiet,
+            line: RefCell::new(Progress::new(quiet)),
+            bar: RefCell::new(None),
+        }
+    }
+}
+
+impl Feedback for Stderr {
+    fn note(&self, text: &str) {
+        if !self.quiet {
+            note!("{text}");
+        }
+    }
+
+    fn status(&self, line: &str) {
+        self.line.borrow_mut().show(line);
+    }
+
+    fn clear_status(&self) {
+        self.line.borrow_mut().clear();
+    }
+
+    fn tiles_start(&self, label: &str) {
+        let bar = tile_bar(self.quiet);
+        bar.set_message(label.to_owned());
+        bar.reset_eta();
+        *self.bar.borrow_mut() = Some(bar);
+    }
+
+    fn tiles_done(&self, done: u64, total: u64) {
+        if let Some(bar) = &*self.bar.borrow() {
+            bar.set_length(total);
+            bar.set_position(done);
+        }
+    }
+
+    fn tiles_label(&self, label: &str) {
+        if let Some(bar) = &*self.bar.borrow() {
+            bar.set_message(label.to_owned());
+        }
+    }
+
+    fn tiles_end(&self) {
+        if let Some(bar) = self.bar.borrow_mut().take() {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// Tiles done / total with the ETA on stderr; hidden when quiet or when stderr is not a
+/// terminal.
+fn tile_bar(quiet: bool) -> ProgressBar {
+    if quiet || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(0);
+    if let Ok(style) = ProgressStyle::with_template(
+        "{msg:>8} [{bar:32}] {pos}/{len} tiles, {elapsed_precise} elapsed, ETA {eta}",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.enable_steady_tick(Duration::from_millis(200));
+    bar
 }

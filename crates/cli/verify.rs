@@ -1,69 +1,28 @@
 //! `tinsmith verify`: measure a mesh file's true error against its raster.
 
-use anyhow::{Context, Result};
-use tinsmith_verify::{GridRef, MeshRef, Report, VerifyOptions};
+use anyhow::Result;
+use tinsmith_pipeline::readable;
+use tinsmith_verify::Report;
 
 use crate::args::VerifyArgs;
-use crate::georef::Georef;
-use crate::mesh_file::{
-    expected_orientation, mesh_format, orient_polygon_triangles, read_mesh_file, sample_positions,
-};
-use crate::number::readable;
 
-/// Runs the verifier; `Ok(false)` when the mesh is invalid or exceeds `--max-error`.
+/// Runs the verifier and prints its report; `Ok(false)` when the mesh is invalid or
+/// exceeds `--max-error`.
 pub fn run(args: &VerifyArgs) -> Result<bool> {
-    let format = mesh_format(&args.mesh, args.format)?;
-    crate::memory::check_whole_raster_fits(
-        &args.input,
-        crate::memory::raster_size(&args.input, args.band)?,
-        crate::memory::Need {
-            bytes_per_sample: 24,
-            extra_bytes: crate::memory::mesh_file_memory(&args.mesh, format),
-        },
-        "verify",
-        "verification has no tiled mode; use a machine with more memory",
-    )?;
-    let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
-    crate::georef::check_transform(&raster.info, args.pixel_coords)?;
-    let georef = Georef::new(raster.info.transform(), args.pixel_coords);
-    let mesh = read_mesh_file(&args.mesh, format, &raster, georef)?;
-    let positions = sample_positions(&args.mesh, &mesh, format, &raster, georef)?;
-    let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();
-    let orientation = expected_orientation(&georef);
-    let mut triangles = mesh.triangles;
-    orient_polygon_triangles(format, &positions, &mut triangles, orientation);
-    let grid = &raster.grid;
-    let mut options = VerifyOptions::new().with_orientation(orientation);
-    if let Some(e) = args.max_error {
-        options = options.with_max_error(e);
-    }
-    let report = tinsmith_verify::verify(
-        GridRef::new(grid.width(), grid.height(), grid.values()),
-        MeshRef::new(&positions, &heights, &triangles),
-        &options,
-    )
-    .with_context(|| format!("{}: cannot verify", args.mesh.display()))?;
-    if report.domain_samples == 0 {
-        // `mesh` refuses such a raster: a pass here would measure nothing.
-        anyhow::bail!(
-            "{}: has no valid cell (a 2 x 2 block of valid samples), so no triangle can \
-             cover any of its {} valid samples and there is nothing to measure",
-            args.input.display(),
-            report.valid_samples
-        );
-    }
+    let verified = tinsmith_pipeline::verify(&args.job())?;
+    let report = &verified.report;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        println!("{}", serde_json::to_string_pretty(report)?);
     } else {
-        print_report(&report, args);
+        print_report(report, args);
     }
-    if !report.passed() && raster.info.band_count > 1 {
+    if !report.passed() && verified.band_count > 1 {
         note!(
             "{}: note: verified against band {} of {}; a mesh of another band fails here \
              (--band picks another)",
             args.mesh.display(),
             args.band,
-            raster.info.band_count
+            verified.band_count
         );
     }
     Ok(report.passed())

@@ -92,6 +92,69 @@ pub enum VertexHeights {
     Raised,
 }
 
+impl ErrorModel {
+    /// Its name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Bounds => "bounds",
+            Self::Exact => "exact",
+        }
+    }
+}
+
+impl EdgeSelection {
+    /// Its name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Hybrid => "hybrid",
+            Self::MinError => "min-error",
+            Self::MinIntroduced => "min-introduced",
+        }
+    }
+}
+
+impl Order {
+    /// Its name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Sweep => "sweep",
+            Self::Greedy => "greedy",
+        }
+    }
+}
+
+impl Retriangulation {
+    /// Its name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Ears => "ears",
+            Self::Dp => "dp",
+        }
+    }
+}
+
+impl InitialMesh {
+    /// Its name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Full => "full",
+            Self::Rtin => "rtin",
+            Self::Strips => "strips",
+            Self::Auto => "auto",
+        }
+    }
+}
+
+impl VertexHeights {
+    /// Its name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Samples => "samples",
+            Self::Raised => "raised",
+        }
+    }
+}
+
 /// Options of [`crate::decimate`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct DecimationOptions {

@@ -26,8 +26,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use tinsmith_contour::{
-    contour, interval_levels, simplify_indices, sorted_levels, ContourMesh, ContourStitcher,
-    Polyline,
+    interval_levels, simplify_indices, sorted_levels, ContourMesh, ContourStitcher, Polyline,
 };
 use tinsmith_core::{decimate, DecimationOptions, Grid};
 use tinsmith_export::LineFormat;
@@ -35,55 +34,57 @@ use tinsmith_raster::{Raster, RasterInfo};
 use tinsmith_tile::{mesh_tiles, FinishedTile, RasterSource, SinkError, TileOptions, TileSink};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
-use crate::args::ContourArgs;
 use crate::georef::Georef;
+use crate::jobs::ContourJob;
 use crate::mesh_file::{expected_orientation, read_mesh_file, sample_positions};
 use crate::number::readable;
 use crate::output::NamingFile;
 use crate::output::{check_distinct, check_writable_target};
 use crate::wgs84::{file_crs, LineEnd, Pieces};
+use crate::Feedback;
 
 /// Memory per line segment while contouring and writing: its point in the joiner, the
 /// polyline and the file coordinates (measured about 50 bytes on ETOPO5).
 const BYTES_PER_SEGMENT: u64 = 64;
 
-/// Builds the TIN, contours it and writes the lines; `Ok(true)` on success.
-pub fn run(args: &ContourArgs) -> Result<bool> {
+/// Builds the TIN, contours it and writes the lines (see the module documentation for
+/// which TIN); fails, naming the file, before any work when the output cannot be written
+/// or the lines would not fit in memory.
+pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
     let started = Instant::now();
-    if args.offset.is_some() && args.interval.is_none() {
+    if job.offset.is_some() && job.interval.is_none() {
         bail!("--offset shifts --interval levels; with --levels, give the levels themselves");
     }
-    let format = LineFormat::from_path(&args.output)?;
-    if args.geojson_source_crs && format != LineFormat::GeoJson {
+    let format = LineFormat::from_path(&job.output)?;
+    if job.geojson_source_crs && format != LineFormat::GeoJson {
         bail!(
             "{}: --geojson-source-crs applies to GeoJSON output only",
-            args.output.display()
+            job.output.display()
         );
     }
-    check_writable_target(&args.output, &args.input)?;
-    if let Some(mesh) = &args.mesh {
-        check_distinct(mesh, &args.output, "the --mesh input")?;
+    check_writable_target(&job.output, &job.input)?;
+    if let Some(mesh) = &job.mesh {
+        check_distinct(mesh, &job.output, "the --mesh input")?;
     }
-    let e = args.max_error.unwrap_or(0.0);
-    let size = crate::georef::check_input_transform(&args.input, args.band, args.pixel_coords)?;
-    let tiled =
-        args.mesh.is_none() && e > 0.0 && (size.0 > args.tile_size || size.1 > args.tile_size);
+    let e = job.max_error.unwrap_or(0.0);
+    let size = crate::georef::check_input_transform(&job.input, job.band, job.pixel_coords)?;
+    let tiled = job.mesh.is_none() && e > 0.0 && (size.0 > job.tile_size || size.1 > job.tile_size);
     // A TIN decimated here is shaped for the levels (fewer segments, same bound), so they
     // come from the raster's height range first; a --mesh file's come from its own heights.
     let (contoured, info, source, levels) = if tiled {
-        let info = crate::progress::scan_raster(&args.input, args.band, args.quiet)?;
-        let levels = levels_for(args, info.min.zip(info.max))?;
-        let (contoured, tiles) = tiled_lines(args, e, &info, &levels)?;
+        let info = crate::progress::scan_raster(&job.input, job.band, feedback)?;
+        let levels = levels_for(job, info.min.zip(info.max))?;
+        let (contoured, tiles) = tiled_lines(job, e, &info, &levels, feedback)?;
         let source = format!("TIN within {} ({tiles} tiles)", readable(e));
         (contoured, info, source, levels)
     } else {
-        let (need, what, instead) = match &args.mesh {
+        let (need, what, instead) = match &job.mesh {
             Some(mesh) => (
                 crate::memory::Need {
                     bytes_per_sample: 24,
                     extra_bytes: crate::memory::mesh_file_memory(
                         mesh,
-                        crate::mesh_file::mesh_format(mesh, args.mesh_format)?,
+                        crate::mesh_file::mesh_format(mesh, job.mesh_format)?,
                     ),
                 },
                 "contouring a --mesh",
@@ -108,16 +109,16 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
                 (need, what, instead)
             }
         };
-        crate::memory::check_whole_raster_fits(&args.input, size, need, what, instead)?;
-        let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
-        let (mesh, source, levels) = untiled_tin(args, e, &raster)?;
+        crate::memory::check_whole_raster_fits(&job.input, size, need, what, instead)?;
+        let raster = tinsmith_raster::read_grid(&job.input, job.band)?;
+        let (mesh, source, levels) = untiled_tin(job, e, &raster)?;
         // The lines are held whole before writing: refuse levels that would not fit.
         let segments = mesh.segment_count(&levels);
         crate::memory::check_fits(
             segments.saturating_mul(BYTES_PER_SEGMENT),
             |needed, available| {
                 lines_refusal(
-                    args,
+                    job,
                     levels.len(),
                     &format!("about {segments} times"),
                     needed,
@@ -125,8 +126,8 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
                 )
             },
         )?;
-        let lines = contour(&mesh, &levels)
-            .with_context(|| format!("{}: contouring failed", args.input.display()))?;
+        let lines = tinsmith_contour::contour(&mesh, &levels)
+            .with_context(|| format!("{}: contouring failed", job.input.display()))?;
         let contoured = Contoured {
             lines,
             triangles: mesh.triangles().len(),
@@ -134,8 +135,8 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         };
         (contoured, raster.info, source, levels)
     };
-    let georef = Georef::new(info.transform(), args.pixel_coords);
-    crate::output::note_gcps_unused(&info, args.pixel_coords, args.quiet);
+    let georef = Georef::new(info.transform(), job.pixel_coords);
+    crate::output::note_gcps_unused(&info, job.pixel_coords, feedback);
     let polylines = contoured.lines;
 
     // Grid coordinates -> file coordinates, with the level as z for the reprojection, then
@@ -156,7 +157,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             let [x, y] = georef.file_point(p);
             [x, y, level]
         }));
-        if let Some(tolerance) = args.simplify {
+        if let Some(tolerance) = job.simplify {
             let file: Vec<[f64; 2]> = points[start..].iter().map(|p| [p[0], p[1]]).collect();
             let kept = simplify_indices(&file, tolerance);
             let count = kept.len();
@@ -168,15 +169,15 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         }
         ends.push((points.len(), level, closed));
     }
-    let wgs84 = format == LineFormat::GeoJson && !args.geojson_source_crs;
+    let wgs84 = format == LineFormat::GeoJson && !job.geojson_source_crs;
     let crs = file_crs(
         &info,
-        args.pixel_coords,
+        job.pixel_coords,
         wgs84,
         &mut points,
         Pieces::Lines(&ends),
-        &args.output,
-        args.quiet,
+        &job.output,
+        feedback,
     )?;
     if format == LineFormat::GeoJson && crs.epsg == Some(4326) {
         crate::wgs84::snap_to_antimeridian(&mut points);
@@ -211,47 +212,45 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             .zip(&cut)
             .map(|(parts, &(_, level))| (parts.as_slice(), level))
             .collect();
-        tinsmith_export::write_multilines(&args.output, format, &lines, crs)?;
+        tinsmith_export::write_multilines(&job.output, format, &lines, crs)?;
     } else {
-        tinsmith_export::write_lines(&args.output, format, &lines, crs)?;
+        tinsmith_export::write_lines(&job.output, format, &lines, crs)?;
     }
     tinsmith_export::mark_finished();
 
-    if !args.quiet {
-        note!(
-            "{}: {} lines ({} closed), {} segments{} at {} levels from the {} ({} triangles) in {:.2} s",
-            args.output.display(),
-            lines.len(),
-            closed,
-            segments,
-            args.simplify
-                .map(|d| format!(" (simplified within {})", readable(d)))
-                .unwrap_or_default(),
-            levels.len(),
-            source,
-            contoured.triangles,
-            started.elapsed().as_secs_f64()
-        );
-        if lines.is_empty() {
-            if let Some((lo, hi)) = contoured.height_range {
-                let why = if levels.is_empty() {
-                    "no level of the --interval lies within the TIN's heights"
-                } else if levels.iter().all(|&l| l < lo || l > hi) {
-                    "the levels miss the TIN's heights"
-                } else {
-                    "no level crosses the TIN (ground that only touches a level makes no \
-                     line, and lines too small to keep a point apart are dropped); its heights"
-                };
-                note!(
-                    "{}: no line: {why}, {} .. {}",
-                    args.output.display(),
-                    readable(lo),
-                    readable(hi)
-                );
-            }
+    feedback.note(&format!(
+        "{}: {} lines ({} closed), {} segments{} at {} levels from the {} ({} triangles) in {:.2} s",
+        job.output.display(),
+        lines.len(),
+        closed,
+        segments,
+        job.simplify
+            .map(|d| format!(" (simplified within {})", readable(d)))
+            .unwrap_or_default(),
+        levels.len(),
+        source,
+        contoured.triangles,
+        started.elapsed().as_secs_f64()
+    ));
+    if lines.is_empty() {
+        if let Some((lo, hi)) = contoured.height_range {
+            let why = if levels.is_empty() {
+                "no level of the --interval lies within the TIN's heights"
+            } else if levels.iter().all(|&l| l < lo || l > hi) {
+                "the levels miss the TIN's heights"
+            } else {
+                "no level crosses the TIN (ground that only touches a level makes no \
+                 line, and lines too small to keep a point apart are dropped); its heights"
+            };
+            feedback.note(&format!(
+                "{}: no line: {why}, {} .. {}",
+                job.output.display(),
+                readable(lo),
+                readable(hi)
+            ));
         }
     }
-    Ok(true)
+    Ok(())
 }
 
 /// The lines (`ends`: each line's end in `points`, its level, whether it is a closed ring)
@@ -296,14 +295,15 @@ fn without_repeated_points(
 
 /// The levels to contour: `--levels`, or `--interval` levels over the height range `lo,
 /// hi` (none without a range).
-fn levels_for(args: &ContourArgs, range: Option<(f64, f64)>) -> Result<Vec<f64>> {
-    match args.interval {
+fn levels_for(job: &ContourJob, range: Option<(f64, f64)>) -> Result<Vec<f64>> {
+    match job.interval {
         Some(interval) => match range {
-            Some((lo, hi)) => interval_levels(interval, args.offset.unwrap_or(0.0), lo, hi)
-                .naming_file(&args.input),
+            Some((lo, hi)) => {
+                interval_levels(interval, job.offset.unwrap_or(0.0), lo, hi).naming_file(&job.input)
+            }
             None => Ok(Vec::new()),
         },
-        None => Ok(sorted_levels(&args.levels)?),
+        None => Ok(sorted_levels(&job.levels)?),
     }
 }
 
@@ -312,36 +312,36 @@ fn levels_for(args: &ContourArgs, range: Option<(f64, f64)>) -> Result<Vec<f64>>
 /// or the grid decimated within `e > 0` and shaped for the levels (over the raster's
 /// heights).
 fn untiled_tin(
-    args: &ContourArgs,
+    job: &ContourJob,
     e: f64,
     raster: &Raster,
 ) -> Result<(ContourMesh, String, Vec<f64>)> {
     let grid = &raster.grid;
-    if let Some(path) = &args.mesh {
-        let georef = Georef::new(raster.info.transform(), args.pixel_coords);
-        let format = crate::mesh_file::mesh_format(path, args.mesh_format)?;
-        let mesh = mesh_from_file(path, format, raster, georef, args.band)?;
-        let levels = levels_for(args, mesh.height_range())?;
+    if let Some(path) = &job.mesh {
+        let georef = Georef::new(raster.info.transform(), job.pixel_coords);
+        let format = crate::mesh_file::mesh_format(path, job.mesh_format)?;
+        let mesh = mesh_from_file(path, format, raster, georef, job.band)?;
+        let levels = levels_for(job, mesh.height_range())?;
         return Ok((mesh, "mesh file".to_owned(), levels));
     }
-    let levels = levels_for(args, raster.info.min.zip(raster.info.max))?;
+    let levels = levels_for(job, raster.info.min.zip(raster.info.max))?;
     if grid.valid_cell_count() == 0 {
-        return Err(nothing_to_contour(args));
+        return Err(nothing_to_contour(job));
     }
     if e == 0.0 {
         let mesh = ContourMesh::from_grid(grid.width(), grid.height(), grid.values())
-            .naming_file(&args.input)?;
+            .naming_file(&job.input)?;
         return Ok((mesh, "full grid".to_owned(), levels));
     }
     let options = DecimationOptions::new(e).with_contour_levels(&levels);
-    let tin = decimate(grid, &options).naming_file(&args.input)?.tin;
+    let tin = decimate(grid, &options).naming_file(&job.input)?.tin;
     let vertices = tin
         .vertices()
         .iter()
         .map(|v| [v.x as f64, v.y as f64, v.z])
         .collect();
     let mesh = ContourMesh::new(vertices, tin.triangles().to_vec())
-        .with_context(|| format!("{}: decimated TIN", args.input.display()))?;
+        .with_context(|| format!("{}: decimated TIN", job.input.display()))?;
     Ok((mesh, format!("TIN within {}", readable(e)), levels))
 }
 
@@ -355,7 +355,7 @@ struct Contoured {
 /// The refusal for lines that would not fit in memory: `crossing` says how often the
 /// levels cross the TIN.
 fn lines_refusal(
-    args: &ContourArgs,
+    job: &ContourJob,
     levels: usize,
     crossing: &str,
     needed: f64,
@@ -365,7 +365,7 @@ fn lines_refusal(
         "{}: the {levels} levels cross the TIN {crossing}; the lines would need about \
          {needed:.1} GB and {available:.1} GB is available; give a larger --interval or fewer \
          --levels (or a larger --max-error)",
-        args.input.display(),
+        job.input.display(),
     )
 }
 
@@ -375,37 +375,36 @@ fn lines_refusal(
 /// their shared edges (the lines `contour` gives on the welded TIN, which is never held).
 /// Returns them with the number of tiles.
 fn tiled_lines(
-    args: &ContourArgs,
+    job: &ContourJob,
     e: f64,
     info: &RasterInfo,
     levels: &[f64],
+    feedback: &dyn Feedback,
 ) -> Result<(Contoured, usize)> {
     let source = RasterSource::new(info)?;
     let options = TileOptions::new(DecimationOptions::new(e).with_contour_levels(levels))
-        .with_tile_size(args.tile_size)
-        .with_threads(args.threads.map_or(0, |n| n as usize));
+        .with_tile_size(job.tile_size)
+        .with_threads(job.threads.map_or(0, |n| n as usize));
     let mut sink = StitchingSink {
-        stitcher: ContourStitcher::new(levels).naming_file(&args.input)?,
+        stitcher: ContourStitcher::new(levels).naming_file(&job.input)?,
         levels,
         triangles: 0,
         height_range: None,
         stopped: None,
-        args,
+        job,
     };
-    let bar = crate::tiled::progress_bar(args.quiet);
-    bar.set_message("tiles");
+    feedback.tiles_start("tiles");
     let mut progress = |p: tinsmith_tile::TileProgress| {
-        bar.set_length(p.total as u64);
-        bar.set_position(p.done as u64);
+        feedback.tiles_done(p.done as u64, p.total as u64);
     };
     let report = mesh_tiles(&source, &options, &mut sink, &mut progress);
-    bar.finish_and_clear();
+    feedback.tiles_end();
     if let Some(stopped) = sink.stopped.take() {
         return Err(stopped);
     }
-    let report = report.naming_file(&args.input)?;
+    let report = report.naming_file(&job.input)?;
     if report.final_triangles == 0 {
-        return Err(nothing_to_contour(args));
+        return Err(nothing_to_contour(job));
     }
     let contoured = Contoured {
         lines: sink.stitcher.finish(),
@@ -425,7 +424,7 @@ struct StitchingSink<'a> {
     /// Why the run was stopped (lines that would not fit, or a contouring failure), for the
     /// caller to report as is.
     stopped: Option<anyhow::Error>,
-    args: &'a ContourArgs,
+    job: &'a ContourJob,
 }
 
 /// Bytes a held crossing takes while tiles are still coming (its edge and point).
@@ -433,7 +432,7 @@ const BYTES_PER_HELD_CROSSING: u64 = 24;
 
 impl StitchingSink<'_> {
     fn contour_tile(&mut self, tile: &FinishedTile) -> Result<()> {
-        let input = self.args.input.display();
+        let input = self.job.input.display();
         let vertices = tile
             .vertices()
             .iter()
@@ -453,7 +452,7 @@ impl StitchingSink<'_> {
                 bail!(
                     "{}",
                     lines_refusal(
-                        self.args,
+                        self.job,
                         self.levels.len(),
                         &format!("about {segments} times or more"),
                         needed as f64 / 1e9,
@@ -485,11 +484,11 @@ impl TileSink for StitchingSink<'_> {
 }
 
 /// The error for a band without a valid 2x2 block of samples.
-fn nothing_to_contour(args: &ContourArgs) -> anyhow::Error {
+fn nothing_to_contour(job: &ContourJob) -> anyhow::Error {
     anyhow::anyhow!(
         "{}: band {} has no 2x2 block of valid samples, so there is nothing to contour",
-        args.input.display(),
-        args.band
+        job.input.display(),
+        job.band
     )
 }
 

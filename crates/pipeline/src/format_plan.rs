@@ -1,4 +1,4 @@
-//! How `tinsmith mesh` writes each format: the format and its flags, the float32 origin
+//! How a mesh run writes each format: the format and its choices, the float32 origin
 //! and the tighter bound that keeps the promise in float32 files (WGS84 for GeoJSON is
 //! [`crate::wgs84`]'s).
 
@@ -10,14 +10,15 @@ use tinsmith_core::Grid;
 use tinsmith_export::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
 use tinsmith_raster::RasterInfo;
 
-use crate::args::MeshArgs;
 use crate::georef::Georef;
+use crate::jobs::MeshJob;
 use crate::number::readable;
 use crate::output::NamingFile;
 use crate::wgs84::{
     check_no_fold_in_lon_lat, check_wgs84_maps_back, check_wgs84_mesh_possible, file_crs,
     is_geographic, projected_crs, snap_to_antimeridian, Pieces,
 };
+use crate::Feedback;
 
 /// Largest rounding of a float32 position, in pixels, accepted before decimating: 90 % of
 /// the 1e-3 pixel within which the verifier maps file positions to samples. Half a float32
@@ -26,12 +27,12 @@ const MAX_POSITION_ROUNDING_PX: f64 = 9e-4;
 
 /// The format `mesh` writes: `--format` or the extension; fails when a format-specific
 /// flag is given for another format.
-pub fn format(args: &MeshArgs) -> Result<MeshFormat> {
-    let format = match args.export.format {
+pub fn format(job: &MeshJob) -> Result<MeshFormat> {
+    let format = match job.export.format {
         Some(format) => format,
-        None => MeshFormat::from_path(out(args))?,
+        None => MeshFormat::from_path(out(job))?,
     };
-    let e = &args.export;
+    let e = &job.export;
     let misplaced = [
         (e.base.is_some(), "--base", MeshFormat::Stl),
         (e.normals, "--normals", MeshFormat::Glb),
@@ -45,7 +46,7 @@ pub fn format(args: &MeshArgs) -> Result<MeshFormat> {
         if given && format != only {
             bail!(
                 "{}: {flag} applies to {only} output only, not {format}",
-                out(args).display()
+                out(job).display()
             );
         }
     }
@@ -57,9 +58,12 @@ pub fn format(args: &MeshArgs) -> Result<MeshFormat> {
     Ok(format)
 }
 
-/// What the output format needs decided before decimation.
+/// What the output format needs decided before decimation: the float32 budget. A mesh
+/// decimated within `decimation_bound`, with heights as [`FormatPlan::file_height`] gives
+/// them, is within the job's `max_error` of every sample in the file itself.
 #[derive(Debug, Clone, Copy)]
-pub struct Plan {
+pub struct FormatPlan {
+    /// The format written.
     pub format: MeshFormat,
     /// The float32 formats' origin.
     pub origin: Option<LocalOrigin>,
@@ -79,18 +83,18 @@ pub struct PlanReport {
     decimation_max_error: f64,
 }
 
-impl Plan {
+impl FormatPlan {
     /// Notes on stderr the float32 formats' origin and height rounding for `output`
     /// (nothing for the double-precision formats).
-    pub fn note_origin(&self, output: &Path) {
+    pub fn note_origin(&self, output: &Path, feedback: &dyn Feedback) {
         if let Some(origin) = self.origin {
             let [x, y, z] = origin.offset();
-            note!(
+            feedback.note(&format!(
                 "{}: float32 positions relative to the local origin ({x}, {y}, {z}); \
                  heights round by at most {}",
                 output.display(),
                 self.height_rounding
-            );
+            ));
         }
     }
 
@@ -104,12 +108,13 @@ impl Plan {
         format: MeshFormat,
         info: &RasterInfo,
         grid: Option<&Grid>,
-        args: &MeshArgs,
-    ) -> Result<Plan> {
-        let max_error = args.max_error.unwrap_or(f64::INFINITY);
-        if format == MeshFormat::GeoJson && !args.export.geojson_source_crs && !args.pixel_coords {
+        job: &MeshJob,
+        feedback: &dyn Feedback,
+    ) -> Result<FormatPlan> {
+        let max_error = job.max_error.unwrap_or(f64::INFINITY);
+        if format == MeshFormat::GeoJson && !job.export.geojson_source_crs && !job.pixel_coords {
             // Before any work: what `write` would refuse for the raster as a whole.
-            check_wgs84_mesh_possible(info, out(args))?;
+            check_wgs84_mesh_possible(info, out(job))?;
         }
         // Decimation refuses such heights, whatever the format: say that, not that float32
         // rounds them beyond the bound.
@@ -117,43 +122,43 @@ impl Plan {
             .max_abs_value()
             .filter(|&v| v > tinsmith_core::MAX_ABS_HEIGHT)
         {
-            return Err(tinsmith_core::Error::HeightsTooLarge(max_abs)).naming_file(&args.input);
+            return Err(tinsmith_core::Error::HeightsTooLarge(max_abs)).naming_file(&job.input);
         }
         if !format.is_float32() {
-            return Ok(Plan {
+            return Ok(FormatPlan {
                 format,
                 origin: None,
                 height_rounding: 0.0,
                 decimation_bound: max_error,
             });
         }
-        if let (Some(base), Some(min)) = (args.export.base, info.min) {
+        if let (Some(base), Some(min)) = (job.export.base, info.min) {
             if base >= min {
                 bail!(
                     "{}: --base {base} must be below the lowest height ({min})",
-                    out(args).display()
+                    out(job).display()
                 );
             }
         }
-        let georef = Georef::new(info.transform(), args.pixel_coords);
-        note_degrees_in_a_3d_format(info, &georef, args)?;
+        let georef = Georef::new(info.transform(), job.pixel_coords);
+        note_degrees_in_a_3d_format(info, &georef, job, feedback)?;
         let (min, max) = extent(info, &georef);
         let origin = LocalOrigin::around(min, max);
-        if let Some(base) = args.export.base {
+        if let Some(base) = job.export.base {
             // The solid's floor is written as float32 like every other coordinate.
             if !((base - origin.offset()[2]) as f32).is_finite() {
                 bail!(
                     "{}: --base {base} is beyond the range of the format's float32 coordinates",
-                    out(args).display()
+                    out(job).display()
                 );
             }
         }
-        check_position_rounding(info, &georef, origin, min, max, out(args))?;
+        check_position_rounding(info, &georef, origin, min, max, out(job))?;
 
         // Raised vertex heights are not samples: bound their rounding from the range, up
         // to the highest sample raised (by at most the raise for the whole bound; the
         // decimation's bound is smaller).
-        let samples_only = !args.raises_vertex_heights(info.min.zip(info.max));
+        let samples_only = !job.raises_vertex_heights(info.min.zip(info.max));
         let raise = if samples_only {
             0.0
         } else {
@@ -176,12 +181,12 @@ impl Plan {
                 "{}: --max-error {} is smaller than the float32 rounding of the heights ({}) \
                  in {format}; use a larger bound or a double-precision format (.ply, .obj, \
                  .fgb, .geojson, .xml)",
-                out(args).display(),
+                out(job).display(),
                 readable(max_error),
                 readable(height_rounding)
             );
         }
-        Ok(Plan {
+        Ok(FormatPlan {
             format,
             origin: Some(origin),
             height_rounding,
@@ -219,20 +224,16 @@ fn height_rounding_bound(origin: LocalOrigin, min: f64, max: f64) -> f64 {
 }
 
 /// For STL and glTF, before reading any sample: fails when the raster is too wide for
-/// float32 positions (see [`Plan::new`]; the positions depend only on the size and the
+/// float32 positions (see [`FormatPlan::new`]; the positions depend only on the size and the
 /// geotransform, so a huge raster is refused before its statistics scan).
-pub fn check_float32_positions(
-    format: MeshFormat,
-    info: &RasterInfo,
-    args: &MeshArgs,
-) -> Result<()> {
+pub fn check_float32_positions(format: MeshFormat, info: &RasterInfo, job: &MeshJob) -> Result<()> {
     if !format.is_float32() {
         return Ok(());
     }
-    let georef = Georef::new(info.transform(), args.pixel_coords);
+    let georef = Georef::new(info.transform(), job.pixel_coords);
     let (min, max) = extent(info, &georef);
     let origin = LocalOrigin::around(min, max);
-    check_position_rounding(info, &georef, origin, min, max, out(args))
+    check_position_rounding(info, &georef, origin, min, max, out(job))
 }
 
 /// Min and max of the raster's file coordinates (sample centres) and valid heights.
@@ -298,17 +299,18 @@ fn check_position_rounding(
 /// plan's format with the raster's CRS: reprojected to WGS84 for GeoJSON unless
 /// `--geojson-source-crs`; a `.prj` sidecar for OBJ, STL and glTF.
 pub fn write(
-    plan: &Plan,
-    args: &MeshArgs,
+    plan: &FormatPlan,
+    job: &MeshJob,
     info: &RasterInfo,
     mut vertices: Vec<[f64; 3]>,
     triangles: &[[u32; 3]],
+    feedback: &dyn Feedback,
 ) -> Result<()> {
-    let path = out(args);
+    let path = out(job);
     if plan.format == MeshFormat::FlatGeobuf {
         check_flatgeobuf_fits(path, triangles.len())?;
     }
-    let wgs84 = plan.format == MeshFormat::GeoJson && !args.export.geojson_source_crs;
+    let wgs84 = plan.format == MeshFormat::GeoJson && !job.export.geojson_source_crs;
     // A projected raster's positions, to check they come back from WGS84.
     let projected = match wgs84 {
         true => projected_crs(info)?,
@@ -317,12 +319,12 @@ pub fn write(
     let world = projected.map(|_| vertices.clone());
     let crs = file_crs(
         info,
-        args.pixel_coords,
+        job.pixel_coords,
         wgs84,
         &mut vertices,
         Pieces::Mesh,
         path,
-        args.quiet,
+        feedback,
     )?;
     if plan.format == MeshFormat::GeoJson && crs.epsg == Some(4326) {
         snap_to_antimeridian(&mut vertices);
@@ -332,25 +334,30 @@ pub fn write(
         check_no_fold_in_lon_lat(&vertices, triangles, path)?;
     }
     if let Some(origin) = plan.origin {
-        check_positions_map_back(&vertices, origin, info, args)?;
+        check_positions_map_back(&vertices, origin, info, job)?;
     }
     let options = WriteOptions::new()
         .with_origin(plan.origin)
-        .with_base(args.export.base)
-        .with_normals(args.export.normals);
+        .with_base(job.export.base)
+        .with_normals(job.export.normals);
     let mesh = MeshRef::new(&vertices, triangles)
         .with_crs_wkt(crs.wkt)
         .with_epsg(crs.epsg);
     tinsmith_export::write_mesh_with(path, plan.format, mesh, &options)?;
     let crs_written = crs.wkt.is_some_and(|w| !w.trim().is_empty());
-    crate::output::note_prj_left_beside(path, plan.format, crs_written, args.quiet);
+    crate::output::note_prj_left_beside(path, plan.format, crs_written, feedback);
     Ok(())
 }
 
-/// Notes (unless quiet) that STL and glTF, formats for 3D viewers and printers, get
+/// Notes that STL and glTF, formats for 3D viewers and printers, get
 /// positions in degrees beside heights in metres from a geographic raster: true to the
 /// raster, but drawn stretched by about 100,000 vertically.
-fn note_degrees_in_a_3d_format(info: &RasterInfo, georef: &Georef, args: &MeshArgs) -> Result<()> {
+fn note_degrees_in_a_3d_format(
+    info: &RasterInfo,
+    georef: &Georef,
+    job: &MeshJob,
+    feedback: &dyn Feedback,
+) -> Result<()> {
     let Georef::World(_) = georef else {
         return Ok(());
     };
@@ -358,13 +365,13 @@ fn note_degrees_in_a_3d_format(info: &RasterInfo, georef: &Georef, args: &MeshAr
         Some(wkt) => is_geographic(info, wkt)?,
         None => false,
     };
-    if geographic && !args.quiet {
-        note!(
+    if geographic {
+        feedback.note(&format!(
             "{}: the raster's CRS is geographic, so x and y are written in degrees and z in \
              its height unit: a 3D viewer draws the TIN stretched (for true proportions, \
              reproject the raster to a projected CRS first, e.g. with gdalwarp -t_srs)",
-            out(args).display()
-        );
+            out(job).display()
+        ));
     }
     Ok(())
 }
@@ -395,16 +402,16 @@ fn check_positions_map_back(
     vertices: &[[f64; 3]],
     origin: LocalOrigin,
     info: &RasterInfo,
-    args: &MeshArgs,
+    job: &MeshJob,
 ) -> Result<()> {
-    let georef = Georef::new(info.transform(), args.pixel_coords);
+    let georef = Georef::new(info.transform(), job.pixel_coords);
     for (i, &v) in vertices.iter().enumerate() {
         let q = origin.quantize(v);
         let tolerance = crate::georef::F32_SAMPLE_TOLERANCE;
         georef.sample_at([q[0], q[1]], tolerance).with_context(|| {
             format!(
                 "{}: vertex {i} would not map back to its sample in float32; nothing written",
-                out(args).display()
+                out(job).display()
             )
         })?;
     }
@@ -418,6 +425,6 @@ pub fn parse_format(name: &str) -> std::result::Result<MeshFormat, String> {
 
 /// The output path of a `mesh` run that writes one file (`--per-tile` runs do not come
 /// here).
-fn out(args: &MeshArgs) -> &std::path::Path {
-    args.output.as_deref().unwrap_or(std::path::Path::new("-"))
+fn out(job: &MeshJob) -> &std::path::Path {
+    job.output.as_deref().unwrap_or(std::path::Path::new("-"))
 }

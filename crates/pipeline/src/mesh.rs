@@ -9,11 +9,12 @@ use tinsmith_core::decimate_with_progress;
 use tinsmith_export::MeshFormat;
 use tinsmith_verify::{GridRef, VerifyOptions};
 
-use crate::args::MeshArgs;
 use crate::georef::Georef;
+use crate::jobs::MeshJob;
 use crate::output::NamingFile;
 use crate::output::{check_distinct, check_writable_target, ReservedReport};
 use crate::report::{MeshSummary, Outcome, Seconds};
+use crate::Feedback;
 
 /// The `--report` JSON.
 #[derive(Debug, Serialize)]
@@ -21,7 +22,7 @@ struct MeshReport<'a> {
     #[serde(flatten)]
     summary: MeshSummary<'a>,
     #[serde(flatten)]
-    output_format: crate::export::PlanReport,
+    output_format: crate::format_plan::PlanReport,
     /// Vertices of the mesh decimation started from (the start's, see `--initial-mesh`).
     start_vertices: usize,
     /// Sweeps until nothing could be removed (the greedy order counts as one).
@@ -31,17 +32,18 @@ struct MeshReport<'a> {
     seconds: Seconds,
 }
 
-/// Reads, decimates, verifies in memory and writes; the mesh is written only if the
-/// independent verifier confirms the bound.
-pub fn run(args: &MeshArgs) -> Result<bool> {
-    if args.tile_format.is_some() && args.per_tile.is_none() {
+/// Reads, decimates, verifies in memory and writes (tile by tile when the raster is larger
+/// than `job.tile_size` or with `job.per_tile`); the mesh is written only if the
+/// independent verifier confirms the bound, with its heights as the file holds them.
+pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
+    if job.tile_format.is_some() && job.per_tile.is_none() {
         anyhow::bail!(
             "--tile-format sets the format of the --per-tile files; without --per-tile the \
              format follows -o's extension (or --format)"
         );
     }
-    if args.per_tile.is_some() {
-        let export = &args.export;
+    if job.per_tile.is_some() {
+        let export = &job.export;
         let ignored = [
             (
                 export.format.is_some(),
@@ -60,50 +62,50 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             );
         }
     }
-    let Some(output) = crate::tiled::untiled_output(args)? else {
-        return crate::tiled::run(args);
+    let Some(output) = crate::tiled_mesh::untiled_output(job)? else {
+        return crate::tiled_mesh::run(job, feedback);
     };
     let total = Instant::now();
     // `untiled_output` has checked the output path and its sidecar.
-    let format = crate::export::format(args)?;
-    let reserved = reserve_report(args, Some((output, format)))?;
+    let format = crate::format_plan::format(job)?;
+    let reserved = reserve_report(job, Some((output, format)))?;
 
     let t = Instant::now();
-    let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
+    let raster = tinsmith_raster::read_grid(&job.input, job.band)?;
     let read_seconds = t.elapsed().as_secs_f64();
-    crate::output::note_gcps_unused(&raster.info, args.pixel_coords, args.quiet);
+    crate::output::note_gcps_unused(&raster.info, job.pixel_coords, feedback);
     let grid = &raster.grid;
     if grid.valid_cell_count() == 0 {
         bail!(
             "{}: band {} has no 2x2 block of valid samples, so there is nothing to triangulate",
-            args.input.display(),
-            args.band
+            job.input.display(),
+            job.band
         );
     }
 
-    let max_error = args.max_error.unwrap_or(f64::INFINITY);
-    let plan = crate::export::Plan::new(format, &raster.info, Some(grid), args)?;
+    let max_error = job.max_error.unwrap_or(f64::INFINITY);
+    let plan =
+        crate::format_plan::FormatPlan::new(format, &raster.info, Some(grid), job, feedback)?;
     // Float32 formats leave the decimator the bound less their height rounding.
     let heights = raster.info.min.zip(raster.info.max);
-    crate::report::note_rounding_margin(&args.input, plan.decimation_bound, heights, args.quiet);
-    let options = args
+    crate::report::note_rounding_margin(&job.input, plan.decimation_bound, heights, feedback);
+    let options = job
         .decimation_options(plan.decimation_bound, heights)
-        .naming_file(&args.input)?;
-    let mut bar = crate::progress::Progress::new(args.quiet);
+        .naming_file(&job.input)?;
     let result = decimate_with_progress(grid, &options, &mut |p| {
-        bar.show(&format!(
+        feedback.status(&format!(
             "decimating: sweep {}, {:3.0}% of its vertices tried, {} removed",
             p.sweep,
             100.0 * p.sweep_fraction,
             p.removed
         ))
     })
-    .naming_file(&args.input)?;
-    bar.clear();
+    .naming_file(&job.input)?;
+    feedback.clear_status();
     let tin = &result.tin;
 
     // The promise is checked, independently, before anything is written.
-    let georef = Georef::new(raster.info.transform(), args.pixel_coords);
+    let georef = Georef::new(raster.info.transform(), job.pixel_coords);
     let t = Instant::now();
     let positions: Vec<[i64; 2]> = tin
         .vertices()
@@ -125,7 +127,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     if !check.passed() {
         bail!(
             "{}: internal error, the decimated mesh failed verification ({}); nothing written",
-            args.input.display(),
+            job.input.display(),
             check.problems.join("; ")
         );
     }
@@ -135,7 +137,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         tin.vertices().iter().map(|v| (v.x, v.y, v.z)),
         tin.triangles().iter().copied(),
     );
-    crate::export::write(&plan, args, &raster.info, vertices, &triangles)?;
+    crate::format_plan::write(&plan, job, &raster.info, vertices, &triangles, feedback)?;
     let write_seconds = t.elapsed().as_secs_f64();
 
     let r = &result.report;
@@ -150,7 +152,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         vertex_heights_raised: options.raises_vertex_heights(grid.max_abs_value()),
     };
     let report = MeshReport {
-        summary: MeshSummary::new(args, output, outcome),
+        summary: MeshSummary::new(job, output, outcome),
         output_format: plan.report(),
         start_vertices: r.start_vertices,
         sweeps: r.sweeps,
@@ -164,34 +166,32 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             total: total.elapsed().as_secs_f64(),
         },
     };
-    if !args.quiet {
-        report.summary.print("");
-        plan.note_origin(output);
-    }
+    report.summary.print("", feedback);
+    plan.note_origin(output, feedback);
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&report)?)?;
     }
     tinsmith_export::mark_finished();
-    Ok(true)
+    Ok(())
 }
 
 /// Checks `--report` before the work (writable; not the input, the output, its `.prj`
 /// sidecar, or inside the `--per-tile` directory) and takes its room (see
 /// [`ReservedReport`]); `None` without `--report`.
 pub fn reserve_report(
-    args: &MeshArgs,
+    job: &MeshJob,
     output: Option<(&Path, MeshFormat)>,
 ) -> Result<Option<ReservedReport>> {
-    let Some(report) = &args.report else {
+    let Some(report) = &job.report else {
         return Ok(None);
     };
-    if let Some(dir) = &args.per_tile {
+    if let Some(dir) = &job.per_tile {
         crate::output::check_not_inside(dir, report, "the --per-tile directory")?;
     }
-    check_writable_target(report, &args.input)?;
+    check_writable_target(report, &job.input)?;
     if let Some((output, format)) = output {
         check_distinct(output, report, "the output")?;
-        crate::output::check_distinct_from_sidecar(output, report, format, args.pixel_coords)?;
+        crate::output::check_distinct_from_sidecar(output, report, format, job.pixel_coords)?;
     }
     ReservedReport::reserve(report).map(Some)
 }

@@ -6,6 +6,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use tinsmith_export::MeshFormat;
 
+use crate::Feedback;
+
 /// Fails early, before long work, when `path` ends with '/', is a looping symbolic link,
 /// has a name too long for its file system, is the `input` file or one the input is read
 /// from (see [`check_not_input`]), is a directory, is a read-only file or one the
@@ -157,21 +159,26 @@ pub fn check_sidecar(
     Ok(())
 }
 
-/// Notes on stderr (unless `quiet`) that the `.prj` beside `output` was left as it is,
+/// Notes that the `.prj` beside `output` was left as it is,
 /// when a mesh in a sidecar format (OBJ, STL, glTF) was written there without a CRS:
 /// readers would take that file for the mesh's CRS. It is never removed, since it may
 /// belong to another file (the input's grid, a shapefile of the same name).
-pub fn note_prj_left_beside(output: &Path, format: MeshFormat, crs_written: bool, quiet: bool) {
+pub fn note_prj_left_beside(
+    output: &Path,
+    format: MeshFormat,
+    crs_written: bool,
+    feedback: &dyn Feedback,
+) {
     let prj = tinsmith_export::prj_path(output);
-    if quiet || crs_written || !format.uses_prj_sidecar() || !prj.is_file() {
+    if crs_written || !format.uses_prj_sidecar() || !prj.is_file() {
         return;
     }
-    note!(
+    feedback.note(&format!(
         "{}: written without a CRS, but {} is beside it and was left as it is; readers \
          may take it for this mesh's CRS (remove it if it came from an earlier run)",
         output.display(),
         prj.display()
-    );
+    ));
 }
 
 /// [`tinsmith_raster::input_files`] of `input`, opened once per run: every output path of
@@ -187,11 +194,15 @@ fn input_files(input: &Path) -> std::borrow::Cow<'static, [PathBuf]> {
     }
 }
 
-/// Notes on stderr (unless `quiet` or `pixel_coords`) that a raster placed only by ground
+/// Notes (unless `pixel_coords`) that a raster placed only by ground
 /// control points or geolocation arrays is written in pixel coordinates: tinsmith
 /// georeferences by a geotransform only.
-pub fn note_gcps_unused(info: &tinsmith_raster::RasterInfo, pixel_coords: bool, quiet: bool) {
-    if quiet || pixel_coords || info.geo_transform.is_some() {
+pub fn note_gcps_unused(
+    info: &tinsmith_raster::RasterInfo,
+    pixel_coords: bool,
+    feedback: &dyn Feedback,
+) {
+    if pixel_coords || info.geo_transform.is_some() {
         return;
     }
     let (by, warp) = match (info.gcp_count, info.geolocation) {
@@ -199,13 +210,13 @@ pub fn note_gcps_unused(info: &tinsmith_raster::RasterInfo, pixel_coords: bool, 
         (0, true) => ("geolocation arrays".to_owned(), "gdalwarp -geoloc"),
         (n, _) => (format!("{n} ground control points (GCPs)"), "gdalwarp"),
     };
-    note!(
+    feedback.note(&format!(
         "{}: georeferenced only by {by}, which tinsmith does not use: the output is in pixel \
          (column, row) coordinates; for world coordinates warp it onto a grid first, e.g. \
          `{warp} {} warped.tif`",
         info.path.display(),
         info.path.display()
-    );
+    ));
 }
 
 /// Fails when `output` is the file `input` or one GDAL reads with it (a VRT's source, an

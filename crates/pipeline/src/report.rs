@@ -4,8 +4,11 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::args::MeshArgs;
+use tinsmith_core::{Order, VertexHeights};
+
+use crate::jobs::MeshJob;
 use crate::number::readable;
+use crate::Feedback;
 
 /// What every mesh report says: the input, the options, the counts before and after, the
 /// bound and the independently measured error, and where the mesh went.
@@ -25,17 +28,17 @@ pub struct MeshSummary<'a> {
     max_error: Option<f64>,
     max_triangles: Option<usize>,
     max_vertices: Option<usize>,
-    error_model: String,
-    selection: String,
-    order: String,
-    retriangulate: String,
+    error_model: &'static str,
+    selection: &'static str,
+    order: &'static str,
+    retriangulate: &'static str,
     /// As asked (`auto` picks the strips or the RTIN; `start_vertices` says how many).
-    initial_mesh: String,
+    initial_mesh: &'static str,
     max_edge_length: Option<u32>,
     dp_max_ring: u16,
     flip_rounds: usize,
     extend_rounds: usize,
-    vertex_heights: String,
+    vertex_heights: &'static str,
     contour_interval: Option<f64>,
     contour_offset: Option<f64>,
     contour_levels: &'a [f64],
@@ -79,45 +82,45 @@ pub struct Outcome {
 }
 
 impl<'a> MeshSummary<'a> {
-    /// The summary of a run of `args` that wrote `output`.
-    pub fn new(args: &'a MeshArgs, output: &'a Path, outcome: Outcome) -> MeshSummary<'a> {
+    /// The summary of a run of `job` that wrote `output`.
+    pub fn new(job: &'a MeshJob, output: &'a Path, outcome: Outcome) -> MeshSummary<'a> {
         let (triangles_before, vertices_before) = outcome.before;
         let (triangles_after, vertices_after) = outcome.after;
         MeshSummary {
-            input: &args.input,
-            band: args.band,
+            input: &job.input,
+            band: job.band,
             isolated_samples: outcome.valid_samples.saturating_sub(vertices_before),
             band_count: outcome.band_count,
             width: outcome.size.0,
             height: outcome.size.1,
             valid_samples: outcome.valid_samples,
-            max_error: args.max_error,
-            max_triangles: args.max_triangles,
-            max_vertices: args.max_vertices,
-            error_model: value_name(args.error_model),
-            selection: value_name(args.selection),
+            max_error: job.max_error,
+            max_triangles: job.max_triangles,
+            max_vertices: job.max_vertices,
+            error_model: job.error_model.name(),
+            selection: job.selection.name(),
             // A count target always removes in greedy order (see `with_max_triangles`).
-            order: if args.max_triangles.is_some() || args.max_vertices.is_some() {
-                value_name(crate::args::OrderArg::Greedy)
+            order: if job.has_count_target() {
+                Order::Greedy.name()
             } else {
-                value_name(args.order)
+                job.order.name()
             },
-            retriangulate: value_name(args.retriangulate),
-            initial_mesh: value_name(args.initial_mesh),
-            max_edge_length: args.max_edge_length,
-            dp_max_ring: args.dp_max_ring,
-            flip_rounds: args.flip_rounds,
-            extend_rounds: args.extend_rounds,
+            retriangulate: job.retriangulate.name(),
+            initial_mesh: job.initial_mesh.name(),
+            max_edge_length: job.max_edge_length,
+            dp_max_ring: job.dp_max_ring,
+            flip_rounds: job.flip_rounds,
+            extend_rounds: job.extend_rounds,
             // As they came out: raised only where decimation raises them.
             vertex_heights: if outcome.vertex_heights_raised {
-                value_name(crate::args::VertexHeightsArg::Raised)
+                VertexHeights::Raised.name()
             } else {
-                value_name(crate::args::VertexHeightsArg::Samples)
+                VertexHeights::Samples.name()
             },
-            contour_interval: args.contour_interval,
-            contour_offset: args.contour_offset,
-            contour_levels: &args.contour_levels,
-            pixel_coords: args.pixel_coords,
+            contour_interval: job.contour_interval,
+            contour_offset: job.contour_offset,
+            contour_levels: &job.contour_levels,
+            pixel_coords: job.pixel_coords,
             triangles_before,
             triangles_after,
             vertices_before,
@@ -132,8 +135,8 @@ impl<'a> MeshSummary<'a> {
 
     /// The one-line summary on stderr: triangles before and after, measured error and bound,
     /// with `how` (e.g. the tiling) after the percentage.
-    pub fn print(&self, how: &str) {
-        note!(
+    pub fn print(&self, how: &str, feedback: &dyn Feedback) {
+        feedback.note(&format!(
             "{}: {} -> {} triangles ({:.1}% decimated){how}, measured max error {}{}",
             self.output.display(),
             self.triangles_before,
@@ -144,7 +147,7 @@ impl<'a> MeshSummary<'a> {
                 Some(e) => format!(" <= {}", readable(e)),
                 None => " (no bound asked)".into(),
             }
-        );
+        ));
         let short = [
             ("--max-triangles", self.max_triangles, self.triangles_after),
             ("--max-vertices", self.max_vertices, self.vertices_after),
@@ -166,27 +169,27 @@ impl<'a> MeshSummary<'a> {
                         "the domain's outline needs them (its corners are never removed)".into()
                     }
                 };
-                note!(
+                feedback.note(&format!(
                     "{}: note: {reached} is above {flag} {target}: {why}",
                     self.output.display()
-                );
+                ));
             }
         }
         if self.band_count > 1 {
-            note!(
+            feedback.note(&format!(
                 "{}: note: meshed band {} of {} (--band picks another)",
                 self.input.display(),
                 self.band,
                 self.band_count
-            );
+            ));
         }
         if self.isolated_samples > 0 {
-            note!(
+            feedback.note(&format!(
                 "{}: note: {} valid samples are in no 2x2 block of valid samples, so no \
                  triangle can hold them; they are not in the mesh",
                 self.input.display(),
                 self.isolated_samples
-            );
+            ));
         }
     }
 }
@@ -203,23 +206,27 @@ pub struct Seconds {
     pub total: f64,
 }
 
-/// Notes on stderr (unless `quiet`) when heights as large as `heights` leave decimation
+/// Notes when heights as large as `heights` leave decimation
 /// noticeably less than `bound`: it keeps `2^-40` of the largest |height| as a margin for
 /// the rounding of its arithmetic (see `tinsmith_core::effective_limit`), 0.9 at 1e12.
 /// The bound is kept either way; the mesh just keeps more triangles than the bound needs.
-pub fn note_rounding_margin(input: &Path, bound: f64, heights: Option<(f64, f64)>, quiet: bool) {
+pub fn note_rounding_margin(
+    input: &Path,
+    bound: f64,
+    heights: Option<(f64, f64)>,
+    feedback: &dyn Feedback,
+) {
     let Some((lo, hi)) = heights else { return };
     let max_abs = lo.abs().max(hi.abs());
     let limit = tinsmith_core::effective_limit(bound, max_abs);
     // Beyond MAX_ABS_HEIGHT the run is refused, which says enough.
-    if quiet
-        || !(bound.is_finite() && bound > 0.0)
+    if !(bound.is_finite() && bound > 0.0)
         || bound - limit <= 0.01 * bound
         || max_abs > tinsmith_core::MAX_ABS_HEIGHT
     {
         return;
     }
-    note!(
+    feedback.note(&format!(
         "{}: heights up to {} leave decimation about {:.3e} of the bound {} (the rest is \
          a margin for rounding, 2^-40 of the largest |height|): more triangles are kept \
          than the bound needs; subtracting a constant offset from the heights would give \
@@ -228,12 +235,5 @@ pub fn note_rounding_margin(input: &Path, bound: f64, heights: Option<(f64, f64)
         readable(max_abs),
         limit,
         readable(bound)
-    );
-}
-
-/// The flag value clap shows for `v`.
-fn value_name(v: impl clap::ValueEnum) -> String {
-    v.to_possible_value()
-        .map(|p| p.get_name().to_owned())
-        .unwrap_or_default()
+    ));
 }

@@ -8,7 +8,7 @@
 
 use std::fs::File;
 use std::io::{BufReader, ErrorKind, Read, Seek, Write};
-use std::net::{Ipv4Addr, TcpListener, TcpStream};
+use std::net::{Ipv4Addr, SocketAddr, TcpListener, TcpStream};
 use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
 
-use crate::args::ServeArgs;
+use crate::Feedback;
 
 /// The longest request head read.
 const MAX_HEAD: usize = 16 * 1024;
@@ -30,64 +30,95 @@ const MAX_CONNECTIONS: usize = 256;
 /// few kB); larger ones by their header.
 const GZIP_CHECK_BYTES: u64 = 16 << 20;
 
-pub fn run(args: &ServeArgs) -> Result<bool> {
-    if !args.dir.exists() {
-        bail!("{}: no such directory", args.dir.display());
+/// A local HTTP server for a directory (a terrain pyramid), bound to 127.0.0.1 and not
+/// yet serving: [`Server::addr`] says where, [`Server::run`] serves.
+#[derive(Debug)]
+pub struct Server {
+    dir: PathBuf,
+    listener: TcpListener,
+}
+
+/// What [`serve`] serves and where.
+#[derive(Debug, Clone)]
+pub struct ServeOptions {
+    /// The directory served (made by `tinsmith tiles`).
+    pub dir: PathBuf,
+    /// Port on 127.0.0.1; 0 picks a free one.
+    pub port: u16,
+    /// Stop after this many requests (for tests); `None` serves until killed.
+    pub max_requests: Option<u64>,
+}
+
+/// Binds a server for `options.dir` on 127.0.0.1; fails, naming it, when the directory is
+/// missing or the port taken. Notes when the directory holds no `layer.json` (CesiumJS
+/// would not load it as terrain).
+pub fn serve(options: &ServeOptions, feedback: &dyn Feedback) -> Result<Server> {
+    let dir = &options.dir;
+    if !dir.exists() {
+        bail!("{}: no such directory", dir.display());
     }
-    anyhow::ensure!(args.dir.is_dir(), "{}: not a directory", args.dir.display());
+    anyhow::ensure!(dir.is_dir(), "{}: not a directory", dir.display());
     let has_layer = |dir: &Path| dir.join("layer.json").is_file();
-    let pyramid_below = std::fs::read_dir(&args.dir).is_ok_and(|entries| {
+    let pyramid_below = std::fs::read_dir(dir).is_ok_and(|entries| {
         entries
             .flatten()
             .any(|e| e.path().is_dir() && has_layer(&e.path()))
     });
-    if !has_layer(&args.dir) && !pyramid_below {
-        note!(
+    if !has_layer(dir) && !pyramid_below {
+        feedback.note(&format!(
             "{}: note: no layer.json here, so CesiumJS will not load it as a terrain \
              pyramid (serve the directory `tinsmith tiles -o` made)",
-            args.dir.display()
-        );
+            dir.display()
+        ));
     }
-    let listener = TcpListener::bind((Ipv4Addr::LOCALHOST, args.port))
-        .with_context(|| format!("cannot listen on 127.0.0.1:{}", args.port))?;
-    let addr = listener.local_addr()?;
-    // A closed stdout only loses the announcement; the server still serves.
-    let mut stdout = std::io::stdout();
-    let _ = writeln!(stdout, "serving {} at http://{addr}/", args.dir.display());
-    let _ = stdout.flush();
-    let open = Arc::new(AtomicUsize::new(0));
-    let mut handlers = Vec::new();
-    for (served, stream) in listener.incoming().enumerate() {
-        let Ok(stream) = stream else { continue };
-        handlers.retain(|h: &std::thread::JoinHandle<()>| !h.is_finished());
-        // Over the cap (or when no thread can be started) the connection is closed
-        // unanswered: it only concerns its client.
-        if open.load(Ordering::Acquire) < MAX_CONNECTIONS {
-            open.fetch_add(1, Ordering::AcqRel);
-            let root = args.dir.clone();
-            let count = Arc::clone(&open);
-            let spawned = std::thread::Builder::new().spawn(move || {
-                let _ = handle(stream, &root);
-                count.fetch_sub(1, Ordering::AcqRel);
-            });
-            match spawned {
-                Ok(handler) => handlers.push(handler),
-                Err(_) => {
-                    open.fetch_sub(1, Ordering::AcqRel);
+    let listener = TcpListener::bind((Ipv4Addr::LOCALHOST, options.port))
+        .with_context(|| format!("cannot listen on 127.0.0.1:{}", options.port))?;
+    Ok(Server {
+        dir: dir.clone(),
+        listener,
+    })
+}
+
+impl Server {
+    /// The address it listens on.
+    pub fn addr(&self) -> Result<SocketAddr> {
+        Ok(self.listener.local_addr()?)
+    }
+
+    /// Serves, a thread per connection (at most [`MAX_CONNECTIONS`] at once), until
+    /// `max_requests` requests have come (forever when `None`).
+    pub fn run(self, max_requests: Option<u64>) -> Result<()> {
+        let open = Arc::new(AtomicUsize::new(0));
+        let mut handlers = Vec::new();
+        for (served, stream) in self.listener.incoming().enumerate() {
+            let Ok(stream) = stream else { continue };
+            handlers.retain(|h: &std::thread::JoinHandle<()>| !h.is_finished());
+            // Over the cap (or when no thread can be started) the connection is closed
+            // unanswered: it only concerns its client.
+            if open.load(Ordering::Acquire) < MAX_CONNECTIONS {
+                open.fetch_add(1, Ordering::AcqRel);
+                let root = self.dir.clone();
+                let count = Arc::clone(&open);
+                let spawned = std::thread::Builder::new().spawn(move || {
+                    let _ = handle(stream, &root);
+                    count.fetch_sub(1, Ordering::AcqRel);
+                });
+                match spawned {
+                    Ok(handler) => handlers.push(handler),
+                    Err(_) => {
+                        open.fetch_sub(1, Ordering::AcqRel);
+                    }
                 }
             }
+            if max_requests.is_some_and(|max| served as u64 + 1 >= max) {
+                break;
+            }
         }
-        if args
-            .max_requests
-            .is_some_and(|max| served as u64 + 1 >= max)
-        {
-            break;
+        for h in handlers {
+            let _ = h.join();
         }
+        Ok(())
     }
-    for h in handlers {
-        let _ = h.join();
-    }
-    Ok(true)
 }
 
 /// A response's status line and headers, before the body.

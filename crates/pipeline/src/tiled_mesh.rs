@@ -1,13 +1,11 @@
 //! `tinsmith mesh` on rasters larger than one tile (or with `--per-tile`): the tiled
-//! engine of `tinsmith-tile`, with a progress bar and the same report as the untiled path
+//! engine of `tinsmith-tile`, with tile progress and the same report as the untiled path
 //! plus the tile fields.
 
-use std::io::IsTerminal;
 use std::path::Path;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use anyhow::{bail, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use tinsmith_export::MeshFormat;
 use tinsmith_tile::{
@@ -15,48 +13,49 @@ use tinsmith_tile::{
     TileProgress, TilesReport, WeldedWriter,
 };
 
-use crate::args::{MeshArgs, TileFormatArg};
 use crate::georef::Georef;
+use crate::jobs::{MeshJob, TileFormat};
 use crate::output::NamingFile;
 use crate::report::{MeshSummary, Outcome, Seconds};
+use crate::Feedback;
 
 /// The output file when the untiled engine should run: no `--per-tile`, and the raster
 /// fits in one tile or a triangle or vertex count is the target (which needs the whole
 /// raster at once). `None` when the tiled engine should run.
-pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
-    let Some(output) = args.output.as_deref() else {
+pub fn untiled_output(job: &MeshJob) -> Result<Option<&Path>> {
+    let Some(output) = job.output.as_deref() else {
         return Ok(None);
     };
-    if args.per_tile.is_some() {
+    if job.per_tile.is_some() {
         return Ok(None);
     }
     // Checks the untiled path makes first, so that errors come in the same order.
-    let format = crate::export::format(args)?;
-    crate::output::check_writable_target(output, &args.input)?;
-    let reader = tinsmith_raster::WindowReader::open(&args.input, args.band)?;
-    if !args.pixel_coords {
+    let format = crate::format_plan::format(job)?;
+    crate::output::check_writable_target(output, &job.input)?;
+    let reader = tinsmith_raster::WindowReader::open(&job.input, job.band)?;
+    if !job.pixel_coords {
         // The CRS written: none for a raster without a geotransform (pixel coordinates).
         let info = reader.info();
         let crs_wkt = info
             .crs_wkt
             .as_deref()
             .filter(|_| info.transform().is_some());
-        crate::output::check_sidecar(output, &args.input, format, crs_wkt)?;
+        crate::output::check_sidecar(output, &job.input, format, crs_wkt)?;
     }
-    crate::georef::check_transform(reader.info(), args.pixel_coords)?;
-    crate::export::check_float32_positions(format, reader.info(), args)?;
-    let fits = reader.width() <= args.tile_size && reader.height() <= args.tile_size;
-    let count_target = args.max_triangles.is_some() || args.max_vertices.is_some();
+    crate::georef::check_transform(reader.info(), job.pixel_coords)?;
+    crate::format_plan::check_float32_positions(format, reader.info(), job)?;
+    let fits = reader.width() <= job.tile_size && reader.height() <= job.tile_size;
+    let count_target = job.max_triangles.is_some() || job.max_vertices.is_some();
     if count_target && !fits {
         // The start mesh has four times the triangles asked for, at most two per sample.
-        let by_vertices = args
+        let by_vertices = job
             .max_vertices
             .map_or(u64::MAX, |v| (v as u64).saturating_mul(2));
-        let target = (args.max_triangles.map_or(u64::MAX, |t| t as u64)).min(by_vertices);
+        let target = (job.max_triangles.map_or(u64::MAX, |t| t as u64)).min(by_vertices);
         let samples = u64::from(reader.width()) * u64::from(reader.height());
         let start_triangles = target.saturating_mul(4).min(samples.saturating_mul(2));
         crate::memory::check_whole_raster_fits(
-            &args.input,
+            &job.input,
             (reader.width(), reader.height()),
             crate::memory::Need {
                 bytes_per_sample: 50,
@@ -70,7 +69,7 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
         // 82 bytes per sample measured untiled on ETOPO5 at ε = 1 (session 2), more at
         // smaller bounds.
         crate::memory::check_whole_raster_fits(
-            &args.input,
+            &job.input,
             (reader.width(), reader.height()),
             crate::memory::Need {
                 bytes_per_sample: 120,
@@ -92,7 +91,7 @@ struct TiledMeshReport<'a> {
     summary: MeshSummary<'a>,
     /// The format and float32 fields, for `-o`.
     #[serde(flatten)]
-    output_format: Option<crate::export::PlanReport>,
+    output_format: Option<crate::format_plan::PlanReport>,
     seconds: Seconds,
     tiles: Tiles,
 }
@@ -116,64 +115,64 @@ struct Tiles {
 
 /// Meshes the raster tile by tile into one welded mesh (`-o`) or one file per tile
 /// (`--per-tile`); every tile is verified before it is written.
-pub fn run(args: &MeshArgs) -> Result<bool> {
+pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let total = Instant::now();
-    let input = args.input.display();
-    if args.max_triangles.is_some() || args.max_vertices.is_some() {
+    let input = job.input.display();
+    if job.max_triangles.is_some() || job.max_vertices.is_some() {
         bail!(
             "{input}: --max-triangles and --max-vertices need the whole raster at once, and \
              --per-tile meshes it tile by tile; give --max-error"
         );
     }
-    let Some(max_error) = args.max_error else {
+    let Some(max_error) = job.max_error else {
         bail!("{input}: tiles need --max-error");
     };
     // With -o, `untiled_output` has checked the output path, its sidecar and the
     // geotransform; --per-tile has not been through it.
-    let welded_format = match &args.output {
-        Some(_) => Some(crate::export::format(args)?),
+    let welded_format = match &job.output {
+        Some(_) => Some(crate::format_plan::format(job)?),
         None => {
-            crate::georef::check_input_transform(&args.input, args.band, args.pixel_coords)?;
+            crate::georef::check_input_transform(&job.input, job.band, job.pixel_coords)?;
             None
         }
     };
-    let welded_output = args.output.as_deref().zip(welded_format);
-    let reserved = crate::mesh::reserve_report(args, welded_output)?;
+    let welded_output = job.output.as_deref().zip(welded_format);
+    let reserved = crate::mesh::reserve_report(job, welded_output)?;
 
     let t = Instant::now();
-    let info = crate::progress::scan_raster(&args.input, args.band, args.quiet)?;
-    crate::output::note_gcps_unused(&info, args.pixel_coords, args.quiet);
+    let info = crate::progress::scan_raster(&job.input, job.band, feedback)?;
+    crate::output::note_gcps_unused(&info, job.pixel_coords, feedback);
     let source = RasterSource::new(&info)?;
     let scan_seconds = t.elapsed().as_secs_f64();
-    let bar = progress_bar(args.quiet);
-    let plan = TilePlan::new(info.width, info.height, args.tile_size).naming_file(&args.input)?;
-    bar.set_length(plan.len() as u64);
-    bar.set_message("tiles");
-    bar.reset_eta();
+    let plan = TilePlan::new(info.width, info.height, job.tile_size).naming_file(&job.input)?;
+    feedback.tiles_start("tiles");
+    feedback.tiles_done(0, plan.len() as u64);
 
     // Float32 formats leave the decimator the bound less their height rounding.
     let export_plan = match welded_format {
-        Some(format) => Some(crate::export::Plan::new(format, &info, None, args)?),
+        Some(format) => Some(crate::format_plan::FormatPlan::new(
+            format, &info, None, job, feedback,
+        )?),
         None => None,
     };
     let bound = export_plan.map_or(max_error, |p| p.decimation_bound);
     let heights = info.min.zip(info.max);
-    crate::report::note_rounding_margin(&args.input, bound, heights, args.quiet);
-    let decimation = args
+    crate::report::note_rounding_margin(&job.input, bound, heights, feedback);
+    let decimation = job
         .decimation_options(bound, heights)
-        .naming_file(&args.input)?;
+        .naming_file(&job.input)?;
     let vertex_heights_raised =
         decimation.raises_vertex_heights(info.max_abs_value().unwrap_or(0.0));
     let options = TileOptions::new(decimation)
-        .with_tile_size(args.tile_size)
-        .with_threads(args.threads.map_or(0, |n| n as usize));
-    let placement = Placement::new(info.transform(), args.pixel_coords);
-    let crs = if args.pixel_coords {
+        .with_tile_size(job.tile_size)
+        .with_threads(job.threads.map_or(0, |n| n as usize));
+    let placement = Placement::new(info.transform(), job.pixel_coords);
+    let crs = if job.pixel_coords {
         None
     } else {
         info.crs_wkt.as_deref()
     };
-    let mut progress = |p: TileProgress| bar.set_position(p.done as u64);
+    let mut progress = |p: TileProgress| feedback.tiles_done(p.done as u64, p.total as u64);
     // What every arm does with the engine's report: no triangle at all is an error, and
     // what is left is writing.
     let meshed = |report: TilesReport| -> Result<TilesReport> {
@@ -181,29 +180,29 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             bail!(
                 "{input}: band {} has no 2x2 block of valid samples, so there is nothing to \
                  triangulate",
-                args.band
+                job.band
             );
         }
-        bar.set_message("writing");
+        feedback.tiles_label("writing");
         Ok(report)
     };
 
-    let (report, output, write_seconds) = match (&args.output, welded_format, &args.per_tile) {
+    let (report, output, write_seconds) = match (&job.output, welded_format, &job.per_tile) {
         (Some(output), Some(format), _) if !streams(format) => {
             let mut collector = MeshCollector::new();
             let report = meshed(
                 mesh_tiles(&source, &options, &mut collector, &mut progress)
-                    .naming_file(&args.input)?,
+                    .naming_file(&job.input)?,
             )?;
             let t = Instant::now();
             let (vertices, triangles) = collector.into_parts();
-            let georef = Georef::new(info.transform(), args.pixel_coords);
+            let georef = Georef::new(info.transform(), job.pixel_coords);
             let (vertices, triangles) = georef.file_mesh(
                 vertices.iter().map(|&[x, y, z]| (x as u32, y as u32, z)),
                 triangles,
             );
             let plan = export_plan.expect("planned for -o");
-            crate::export::write(&plan, args, &info, vertices, &triangles)?;
+            crate::format_plan::write(&plan, job, &info, vertices, &triangles, feedback)?;
             let write = report.seconds_sink + t.elapsed().as_secs_f64();
             (report, output.as_path(), write)
         }
@@ -211,24 +210,24 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             let mut writer = WeldedWriter::create(output, format, crs, placement)?;
             let report = meshed(
                 mesh_tiles(&source, &options, &mut writer, &mut progress)
-                    .naming_file(&args.input)?,
+                    .naming_file(&job.input)?,
             )?;
             let t = Instant::now();
             writer.finish()?;
             let crs_written = crs.is_some_and(|w| !w.trim().is_empty());
-            crate::output::note_prj_left_beside(output, format, crs_written, args.quiet);
+            crate::output::note_prj_left_beside(output, format, crs_written, feedback);
             let write = report.seconds_sink + t.elapsed().as_secs_f64();
             (report, output.as_path(), write)
         }
         (_, _, Some(dir)) => {
-            let format = match args.tile_format.unwrap_or(TileFormatArg::Ply) {
-                TileFormatArg::Ply => MeshFormat::Ply,
-                TileFormatArg::Obj => MeshFormat::Obj,
+            let format = match job.tile_format.unwrap_or(TileFormat::Ply) {
+                TileFormat::Ply => MeshFormat::Ply,
+                TileFormat::Obj => MeshFormat::Obj,
             };
             let mut writer = PerTileWriter::create(dir, format, crs, placement)?;
             let report = meshed(
                 mesh_tiles(&source, &options, &mut writer, &mut progress)
-                    .naming_file(&args.input)?,
+                    .naming_file(&job.input)?,
             )?;
             let t = Instant::now();
             writer.finish()?;
@@ -237,7 +236,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         }
         _ => bail!("{input}: give -o OUT or --per-tile DIR"),
     };
-    bar.finish_and_clear();
+    feedback.tiles_end();
 
     let r: &TilesReport = &report;
     let outcome = Outcome {
@@ -251,7 +250,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
         vertex_heights_raised,
     };
     let json = TiledMeshReport {
-        summary: MeshSummary::new(args, output, outcome),
+        summary: MeshSummary::new(job, output, outcome),
         output_format: export_plan.map(|p| p.report()),
         seconds: Seconds {
             read: scan_seconds + r.seconds_read,
@@ -267,45 +266,27 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             columns: r.plan.columns(),
             rows: r.plan.rows(),
             threads: r.threads,
-            welded: args.per_tile.is_none(),
+            welded: job.per_tile.is_none(),
             scan_seconds,
             tiles_seconds: r.seconds_total,
         },
     };
-    if !args.quiet {
-        json.summary.print(&format!(
-            " in {} tiles of {}",
-            json.tiles.count, json.tiles.size
-        ));
-        if let (Some(plan), Some(output)) = (export_plan, &args.output) {
-            plan.note_origin(output);
-        }
+    json.summary.print(
+        &format!(" in {} tiles of {}", json.tiles.count, json.tiles.size),
+        feedback,
+    );
+    if let (Some(plan), Some(output)) = (export_plan, &job.output) {
+        plan.note_origin(output, feedback);
     }
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&json)?)?;
     }
     tinsmith_export::mark_finished();
-    Ok(true)
+    Ok(())
 }
 
 /// Whether the tiled engine streams `format` to the file tile by tile; the other formats
 /// are welded in memory (the mesh, not the raster) and written at the end.
 fn streams(format: MeshFormat) -> bool {
     matches!(format, MeshFormat::Ply | MeshFormat::Obj)
-}
-
-/// Tiles done / total with the ETA on stderr; hidden when quiet or when stderr is not a
-/// terminal.
-pub fn progress_bar(quiet: bool) -> ProgressBar {
-    if quiet || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(0);
-    if let Ok(style) = ProgressStyle::with_template(
-        "{msg:>8} [{bar:32}] {pos}/{len} tiles, {elapsed_precise} elapsed, ETA {eta}",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.enable_steady_tick(Duration::from_millis(200));
-    bar
 }

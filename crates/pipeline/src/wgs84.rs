@@ -8,12 +8,13 @@ use anyhow::{bail, Context, Result};
 use tinsmith_export::CrsRef;
 use tinsmith_raster::RasterInfo;
 
+use crate::Feedback;
+
 /// The CRS a file written from `raster` records: none with `--pixel-coords` or without a
 /// geotransform, else the raster's. With `wgs84` (GeoJSON without `--geojson-source-crs`,
 /// for `mesh` and `contour` alike) a raster with a CRS has `points` (file coordinates)
 /// reprojected in place to WGS84 longitude, latitude (RFC 7946), heights unchanged, and
-/// the file records EPSG 4326; without a CRS the points stay as they are, with a note on
-/// stderr unless `quiet`.
+/// the file records EPSG 4326; without a CRS the points stay as they are, with a note.
 pub fn file_crs<'r>(
     info: &'r RasterInfo,
     pixel_coords: bool,
@@ -21,7 +22,7 @@ pub fn file_crs<'r>(
     points: &mut [[f64; 3]],
     pieces: Pieces<'_>,
     path: &Path,
-    quiet: bool,
+    feedback: &dyn Feedback,
 ) -> Result<CrsRef<'r>> {
     let crs = match pixel_coords || info.transform().is_none() {
         true => CrsRef::default(),
@@ -58,12 +59,10 @@ pub fn file_crs<'r>(
             Ok(CrsRef::new(None, Some(4326)))
         }
         None => {
-            if !quiet {
-                note!(
-                    "{}: no CRS, so the coordinates are written as they are, with \"crs\": null",
-                    path.display()
-                );
-            }
+            feedback.note(&format!(
+                "{}: no CRS, so the coordinates are written as they are, with \"crs\": null",
+                path.display()
+            ));
             Ok(crs)
         }
     }

@@ -1,0 +1,45 @@
+//! Each command: its flags into a job, the pipeline run with feedback on stderr, and
+//! what it prints on stdout.
+
+use anyhow::Result;
+
+use crate::args::{ContourArgs, MeshArgs, ServeArgs, TilesArgs};
+use crate::progress::Stderr;
+
+/// `tinsmith mesh`; `Ok(true)` once the verified mesh is written.
+pub fn mesh(args: &MeshArgs) -> Result<bool> {
+    tinsmith_pipeline::mesh(&args.job(), &Stderr::new(args.quiet))?;
+    Ok(true)
+}
+
+/// `tinsmith contour`; `Ok(true)` once the lines are written.
+pub fn contour(args: &ContourArgs) -> Result<bool> {
+    tinsmith_pipeline::contour(&args.job(), &Stderr::new(args.quiet))?;
+    Ok(true)
+}
+
+/// `tinsmith tiles`; `Ok(true)` once the pyramid is in place.
+pub fn tiles(args: &TilesArgs) -> Result<bool> {
+    let options = args.options(tinsmith_pipeline::available_bytes());
+    let feedback = Stderr::new(args.quiet);
+    let report = args.report.as_deref();
+    tinsmith_pipeline::tiles(&args.input, &args.output, report, &options, &feedback)?;
+    Ok(true)
+}
+
+/// `tinsmith serve`: announces the address on stdout, then serves.
+pub fn serve(args: &ServeArgs) -> Result<bool> {
+    use std::io::Write as _;
+    let server = tinsmith_pipeline::serve(&args.options(), &Stderr::new(false))?;
+    // A closed stdout only loses the announcement; the server still serves.
+    let mut stdout = std::io::stdout();
+    let _ = writeln!(
+        stdout,
+        "serving {} at http://{}/",
+        args.dir.display(),
+        server.addr()?
+    );
+    let _ = stdout.flush();
+    server.run(args.max_requests)?;
+    Ok(true)
+}

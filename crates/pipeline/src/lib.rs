@@ -1,0 +1,59 @@
+//! The tinsmith commands as library calls: a raster in, a verified TIN, contour lines or a
+//! terrain pyramid out. Every run takes a plain job ([`MeshJob`], [`ContourJob`],
+//! [`VerifyJob`]) and a [`Feedback`] for its notes and progress; the `tinsmith` binary
+//! only parses flags into jobs, draws the feedback and maps errors to exit codes.
+//!
+//! What every run guarantees:
+//! - a mesh is written only after the independent verifier (`tinsmith-verify`) has
+//!   measured it within the bound at every valid sample, with its heights as the file
+//!   will hold them: float32 formats (STL, glTF) get a tighter decimation bound
+//!   ([`FormatPlan`]) so that the file, not only the mesh in memory, keeps the bound;
+//! - bad input fails before long work where it can, with a message naming the file;
+//! - outputs are written through temporary files renamed into place, so a failed run
+//!   leaves the old outputs untouched;
+//! - the same job gives byte-identical files.
+//!
+//! ```no_run
+//! use tinsmith_pipeline::{mesh, MeshJob, Silent};
+//!
+//! let mut job = MeshJob::new("dem.tif");
+//! job.output = Some("dem.ply".into());
+//! job.max_error = Some(0.5);
+//! mesh(&job, &Silent)?;
+//! # Ok::<(), anyhow::Error>(())
+//! ```
+#![deny(missing_docs)]
+#![deny(rustdoc::broken_intra_doc_links)]
+
+mod contour;
+mod feedback;
+mod format_plan;
+mod georef;
+mod jobs;
+mod memory;
+mod mesh;
+mod mesh_file;
+mod number;
+mod output;
+mod progress;
+mod report;
+mod serve;
+mod tiled_mesh;
+mod tiles;
+mod verify;
+mod wgs84;
+
+pub use contour::contour;
+pub use feedback::{Feedback, Silent};
+pub use format_plan::{parse_format, FormatPlan};
+pub use jobs::{ContourJob, ExportChoices, MeshJob, TileFormat, VerifyJob, DEFAULT_TILE_SIZE};
+pub use memory::available_bytes;
+pub use mesh::mesh;
+pub use number::readable;
+pub use progress::scan_raster;
+pub use serve::{serve, ServeOptions};
+pub use tiles::tiles;
+pub use verify::{verify, Verified};
+
+/// The results: `anyhow` errors whose chain names the file and the problem.
+pub type Result<T> = anyhow::Result<T>;

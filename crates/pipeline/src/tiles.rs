@@ -1,0 +1,62 @@
+//! `tinsmith tiles`: a quantized-mesh terrain pyramid, with its report reserved before
+//! the work and per-level notes.
+
+use std::path::Path;
+
+use tinsmith_tile::{build_terrain, TerrainOptions, TerrainReport};
+
+use crate::output::NamingFile;
+use crate::{Feedback, Result};
+
+/// Builds the pyramid of `input` into the directory `output` (moved into place whole when
+/// done) and, with `report`, writes the per-level report there; the report's path is
+/// checked and its room taken before any tile is made. Notes one line per level, then a
+/// summary.
+pub fn tiles(
+    input: &Path,
+    output: &Path,
+    report: Option<&Path>,
+    options: &TerrainOptions,
+    feedback: &dyn Feedback,
+) -> Result<TerrainReport> {
+    if let Some(report) = report {
+        crate::output::check_not_inside(output, report, "the pyramid directory")?;
+        crate::output::check_writable_target(report, input)?;
+    }
+    let reserved = report
+        .map(crate::output::ReservedReport::reserve)
+        .transpose()?;
+    let built = build_terrain(input, output, options, &mut |level| {
+        let flat = match level.flat_tiles {
+            0 => String::new(),
+            n => format!(" ({n} flat: a root tile without data, for --metadata)"),
+        };
+        feedback.note(&format!(
+            "level {:>2}: {} tiles{flat}, {} bytes, bound {:.3} m, measured {:.3} m, {:.2} s",
+            level.level,
+            level.tiles,
+            level.bytes,
+            level.achieved_bound,
+            level.measured_max_error,
+            level.seconds
+        ));
+    })
+    .naming_file(input)?;
+    if let Some(reserved) = reserved {
+        reserved.write(&serde_json::to_vec_pretty(&built)?)?;
+    }
+    tinsmith_export::mark_finished();
+    let tiles: u64 = built.levels.iter().map(|l| l.tiles).sum();
+    feedback.note(&format!(
+        "{tiles} tiles, levels {}..={}, in {}{}",
+        built.min_zoom,
+        built.max_zoom,
+        output.display(),
+        if options.gzip {
+            " (gzipped: serve with Content-Encoding: gzip, e.g. `tinsmith serve`)"
+        } else {
+            ""
+        }
+    ));
+    Ok(built)
+}

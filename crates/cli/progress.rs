@@ -1,56 +1,18 @@
-//! The pipeline's feedback on stderr: notes, a one-line progress display and a tile
-//! bar, the last two shown only when stderr is a terminal.
+//! The pipeline's feedback on stderr: notes unless `--quiet`, and progress (a status line
+//! or a tile bar, drawn by indicatif) only when stderr is a terminal, so pipes and CI
+//! logs stay clean.
 
 use std::cell::RefCell;
-use std::io::{IsTerminal, Write};
-use std::time::{Duration, Instant};
+use std::io::IsTerminal;
+use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use tinsmith_pipeline::Feedback;
 
-/// Rewrites one stderr line at most five times a second; silent when quiet or when stderr
-/// is not a terminal (pipes and CI logs stay clean).
-struct Progress {
-    enabled: bool,
-    last: Option<Instant>,
-    shown: bool,
-}
-
-impl Progress {
-    fn new(quiet: bool) -> Progress {
-        Progress {
-            enabled: !quiet && std::io::stderr().is_terminal(),
-            last: None,
-            shown: false,
-        }
-    }
-
-    fn show(&mut self, line: &str) {
-        if !self.enabled
-            || self
-                .last
-                .is_some_and(|t| t.elapsed() < Duration::from_millis(200))
-        {
-            return;
-        }
-        self.last = Some(Instant::now());
-        self.shown = true;
-        let _ = write!(std::io::stderr(), "\r\x1b[2K{line}");
-    }
-
-    fn clear(&mut self) {
-        if self.shown {
-            let _ = write!(std::io::stderr(), "\r\x1b[2K");
-            self.shown = false;
-        }
-    }
-}
-
-/// The pipeline's notes and progress on stderr: notes unless quiet; the progress line and
-/// the tile bar only on a terminal.
+/// Notes and progress of one run on stderr.
 pub struct Stderr {
     quiet: bool,
-    line: RefCell<Progress>,
+    /// The status line or the tile bar being drawn.
     bar: RefCell<Option<ProgressBar>>,
 }
 
@@ -59,8 +21,26 @@ impl Stderr {
     pub fn new(quiet: bool) -> Stderr {
         Stderr {
             quiet,
-            line: RefCell::new(Progress::new(quiet)),
             bar: RefCell::new(None),
+        }
+    }
+
+    /// A bar drawn with `template`; hidden when quiet or when stderr is not a terminal.
+    fn start(&self, template: &str) -> ProgressBar {
+        if self.quiet || !std::io::stderr().is_terminal() {
+            return ProgressBar::hidden();
+        }
+        let bar = ProgressBar::new(0);
+        if let Ok(style) = ProgressStyle::with_template(template) {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        bar.enable_steady_tick(Duration::from_millis(200));
+        bar
+    }
+
+    fn end(&self) {
+        if let Some(bar) = self.bar.borrow_mut().take() {
+            bar.finish_and_clear();
         }
     }
 }
@@ -73,17 +53,20 @@ impl Feedback for Stderr {
     }
 
     fn status(&self, line: &str) {
-        self.line.borrow_mut().show(line);
+        let mut bar = self.bar.borrow_mut();
+        bar.get_or_insert_with(|| self.start("{msg}"))
+            .set_message(line.to_owned());
     }
 
     fn clear_status(&self) {
-        self.line.borrow_mut().clear();
+        self.end();
     }
 
     fn tiles_start(&self, label: &str) {
-        let bar = tile_bar(self.quiet);
+        self.end();
+        let bar = self
+            .start("{msg:>8} [{bar:32}] {pos}/{len} tiles, {elapsed_precise} elapsed, ETA {eta}");
         bar.set_message(label.to_owned());
-        bar.reset_eta();
         *self.bar.borrow_mut() = Some(bar);
     }
 
@@ -101,24 +84,6 @@ impl Feedback for Stderr {
     }
 
     fn tiles_end(&self) {
-        if let Some(bar) = self.bar.borrow_mut().take() {
-            bar.finish_and_clear();
-        }
+        self.end();
     }
-}
-
-/// Tiles done / total with the ETA on stderr; hidden when quiet or when stderr is not a
-/// terminal.
-fn tile_bar(quiet: bool) -> ProgressBar {
-    if quiet || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(0);
-    if let Ok(style) = ProgressStyle::with_template(
-        "{msg:>8} [{bar:32}] {pos}/{len} tiles, {elapsed_precise} elapsed, ETA {eta}",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.enable_steady_tick(Duration::from_millis(200));
-    bar
 }

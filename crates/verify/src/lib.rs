@@ -53,8 +53,8 @@ mod mesh;
 mod options;
 mod predicates;
 mod problems;
-mod raster;
 mod report;
+mod scan_convert;
 mod verify;
 
 pub use error::{Result, VerifyError};

@@ -4,7 +4,7 @@ use crate::coverage::Coverage;
 use crate::edges::check_edges;
 use crate::predicates::{interpolate, orient};
 use crate::problems::{Kind, ProblemLog};
-use crate::raster::rasterize;
+use crate::scan_convert::rasterize;
 use crate::{ErrorLocation, GridRef, MeshRef, Report, Result, VerifyError, VerifyOptions};
 
 /// Checks `mesh` against `grid`: structure, coverage of the domain, and the true vertical

@@ -520,7 +520,7 @@ fn float32_formats_keep_the_bound_when_heights_do_not_fit_float32() {
 
 #[test]
 fn float32_formats_print_their_origin_tiled_or_not() {
-    // README: the origin is printed (and in the report); tiled runs used to print nothing.
+    // docs/guarantee.md (float32 formats): the origin is printed (and in the report); tiled runs used to print nothing.
     let d = Dir::new();
     let dem = fixture(DEM);
     for tile_size in ["4096", "33"] {

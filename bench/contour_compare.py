@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Contours from tinsmith's TIN versus gdal_contour on the full grid (issue 7, paper section 5).
+"""Contours from tinsmith's TIN versus gdal_contour on the full grid (paper section 5).
 
 For each DEM: the same explicit levels (offset + k * interval over the raster's range) go
 to `gdal_contour -fl ...` (Debian gdal-bin, marching squares on the full grid) and to

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Measure option combinations of `tinsmith mesh` to pick the defaults (issue 3).
+"""Measure option combinations of `tinsmith mesh` to pick the defaults.
 
 For each DEM and epsilon, runs each configuration (best of --repeat runs), and prints
 triangles and decimation seconds (initial mesh + decimation, from --report) per

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Benchmark of the tiled engine (issue 4): wall time, samples/s, peak RSS and the ratios.
+"""Benchmark of the tiled engine: wall time, samples/s, peak RSS and the ratios.
 
 Builds Float32 DEMs from real data (ETOPO5, resampled with GDAL's gdalwarp, cubic) in a
 work directory outside the repository (never committed), runs `tinsmith mesh` on them

@@ -1,6 +1,7 @@
 //! A real client: CesiumJS in headless Chromium loads a pyramid from `tinsmith serve`
 //! (`CesiumTerrainProvider.fromUrl`, `sampleTerrainMostDetailed`). A missing CesiumJS or
-//! Chromium install, or a Chromium that cannot start, fails.
+//! Chromium install, or a Chromium that cannot start, fails. `#[ignore]`d so that `cargo
+//! test` passes with only GDAL installed; `make test` runs it (`--include-ignored`).
 
 use std::path::Path;
 use std::process::Command;
@@ -11,6 +12,7 @@ use crate::terrain::gdal_samples;
 use crate::util::{fixture, serve, stderr, Dir};
 
 #[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let cesium = repo.join(".tools/node_modules/cesium/Build/Cesium");

@@ -1,7 +1,7 @@
 //! `tinsmith contour` on real rasters: GDAL's `ogrinfo` reads the GeoJSON and FlatGeobuf
 //! output with the right feature count and CRS; GeoJSON is WGS84 unless
 //! `--geojson-source-crs`, as GDAL transforms it; a mesh file gives the same lines as
-//! decimating in place; bad input fails cleanly (issue 7).
+//! decimating in place; bad input fails cleanly.
 
 use std::process::Command;
 

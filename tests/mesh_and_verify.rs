@@ -290,7 +290,7 @@ fn quiet_mesh_prints_nothing_and_report_has_every_phase() {
         r["triangles_after"].as_f64().unwrap(),
     );
     assert!((pct - 100.0 * (1.0 - after / before)).abs() < 1e-9);
-    // OBJ gets the raster's CRS in a .prj sidecar (issue 5).
+    // OBJ gets the raster's CRS in a .prj sidecar.
     assert_eq!(d.files(), vec!["m.obj", "m.prj", "r.json"]);
 }
 

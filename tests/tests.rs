@@ -4,6 +4,7 @@ mod util;
 
 mod bad_input;
 mod cesium;
+mod cli_reference;
 mod contour;
 mod foreign;
 mod formats;

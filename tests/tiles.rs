@@ -1,4 +1,4 @@
-//! Issue 4: the tiled engine from the command line. Small `--tile-size` values force many
+//! The tiled engine from the command line. Small `--tile-size` values force many
 //! tiles on the committed fixtures; the welded file is checked by `tinsmith verify` (which
 //! reads the whole raster untiled), for cracks by edge-use counts computed here from the
 //! file and the raster's cells, and for byte-identical output across thread counts.

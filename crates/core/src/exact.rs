@@ -1,5 +1,5 @@
 //! The exact error model: a triangle's error is measured over the original samples it
-//! covers, with no accumulation (beyond the paper; issue 3).
+//! covers, with no accumulation (beyond the paper).
 
 use crate::grid::MIN_EQUAL_RUN;
 use crate::predicates::{orient, plane_gradient, Point};

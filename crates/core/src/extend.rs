@@ -1,4 +1,4 @@
-//! Removal through extended holes (beyond the paper; issue 3). Once the sweeps have
+//! Removal through extended holes (beyond the paper). Once the sweeps have
 //! converged, every vertex that is left failed with the hole its star leaves. Its hole is
 //! then extended across a ring edge: the triangle on the far side of the edge joins the
 //! star (the edge is flipped into a spoke, where the quadrilateral is strictly convex), and

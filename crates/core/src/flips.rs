@@ -1,5 +1,5 @@
-//! Edge flips that lower triangle errors, each followed by another sweep (beyond the paper;
-//! issue 3). Vertex removal keeps whatever triangulation its holes left; flipping an edge
+//! Edge flips that lower triangle errors, each followed by another sweep (beyond the paper).
+//! Vertex removal keeps whatever triangulation its holes left; flipping an edge
 //! into the other diagonal of its quadrilateral where both new triangles fit better
 //! changes the stars of the four corners, and some of them can then go.
 

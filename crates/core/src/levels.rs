@@ -1,4 +1,4 @@
-//! Shaping the TIN for contour lines (beyond the paper; issue 7): a contour line gets one
+//! Shaping the TIN for contour lines (beyond the paper): a contour line gets one
 //! segment in every triangle its level passes through, so among TINs within the bound,
 //! those whose triangles span fewer levels give lines with fewer segments.
 //!

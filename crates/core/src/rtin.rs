@@ -1,6 +1,6 @@
 //! A coarse initial mesh: a right-triangulated irregular network (RTIN, the longest-edge
 //! bisection hierarchy of a power-of-two square) refined only where a triangle's exact
-//! error exceeds the limit or it would cover a nodata cell (beyond the paper; issue 3).
+//! error exceeds the limit or it would cover a nodata cell (beyond the paper).
 //!
 //! Vertex removal from the full grid costs time per sample even where the surface is
 //! smooth. Starting from the coarsest RTIN whose every triangle is within the limit skips
@@ -130,7 +130,7 @@ pub(crate) fn rtin_for_count(
 }
 
 /// The probed fraction of finest squares that split, below which [`rtin_triangles`] refines
-/// top-down. Measured (session 4, one thread, Big Tujunga, a 2048² ETOPO5 resample and a
+/// top-down. Measured (one thread, Big Tujunga, a 2048² ETOPO5 resample and a
 /// CT slice at bounds 0.5 to 30): top-down took 0.4-0.8 x bottom-up's time where the probe
 /// gave 0-0.24, the same at 0.27, and 1.06-1.5 x at 0.49-1.
 const TOP_DOWN_BELOW: f64 = 0.3;

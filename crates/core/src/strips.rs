@@ -1,6 +1,6 @@
 //! A cheap initial mesh: every row (or every column) simplified as a 1-D polyline within
 //! the limit, and each pair of adjacent simplified lines zipped into triangles (beyond the
-//! paper; issue 3).
+//! paper).
 //!
 //! A triangle between two adjacent lines holds samples only on those two lines, and on a
 //! line only along its own edge there (a diagonal between adjacent lines passes through

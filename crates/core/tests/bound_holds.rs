@@ -579,7 +579,7 @@ fn count_targets_reach_the_count_on_a_power_of_two_grid() {
 fn count_targets_with_nodata_come_close_to_the_full_grid_start() {
     // Nodata and a grid that fills only part of its power-of-two square force RTIN splits
     // whatever the bound; they must not pass for room to decimate in, or the start's
-    // coarse triangles set the error (before session 4's fix: 1.28 x the full grid's
+    // coarse triangles set the error (before that was fixed: 1.28 x the full grid's
     // error at 100 vertices here, 7 x on becmodel at 300).
     let spec = tinsmith_testkit::with_nodata_disc(
         tinsmith_testkit::terrain(215, 258, 4.0, 9),

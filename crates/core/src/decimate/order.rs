@@ -101,7 +101,7 @@ pub(super) fn sweep(
 /// 155 s of decimation, 1.7 s with the wait). Waiting lets each sweep remove about every
 /// other vertex there, so stars double per sweep instead. Holes this large are rare on real
 /// DEMs: six of them at bounds 0.5 to 30 keep the same triangle counts to within 0.01 %,
-/// except Fort Worth at 30 (61 triangles, now 68; docs/results.md, session 19).
+/// except Fort Worth at 30 (61 triangles, now 68; docs/results.md, "Large holes").
 const LARGE_HOLE_BOX: i64 = 128 * 128;
 
 /// The area (in samples) of the bounding box of `ring`'s sample positions.

@@ -35,8 +35,8 @@ const RAISE_IN_SLACKS: f64 = 65536.0;
 ///
 /// The raise only has to lift a sample exactly the bound above its triangle's plane (ties
 /// on integer heights) clear of the slack, which the rounding of any verifier stays far
-/// below; it gains the same from 1/64 of the bound down to 2^-20 of it (session 17,
-/// docs/results.md). Kept small, it is invisible: a flat lake stays at its level to a
+/// below; it gains the same from 1/64 of the bound down to 2^-20 of it (measured on
+/// becmodel, Big Tujunga and a CT slice: docs/results.md). Kept small, it is invisible: a flat lake stays at its level to a
 /// fraction of a millimetre, and a bound far beyond the relief does not lift the mesh.
 /// It grows with `max_error`, so the raise for a bound also bounds a run's at any smaller
 /// one (the float32 formats' rounding margin relies on that).

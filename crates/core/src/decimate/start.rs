@@ -8,7 +8,7 @@ use crate::{DecimationOptions, Grid, InitialMesh};
 /// The start [`InitialMesh::Auto`] stands for given the other options: with contour
 /// levels, the RTIN. The strips' 1-D pass drops samples without regard to the levels,
 /// and the level-shaped decimation that follows keeps more segments from them (contour
-/// bench, session 14, at ε = interval / 10: Big Tujunga −44 % segments against
+/// bench at ε = interval / 10: Big Tujunga −44 % segments against
 /// gdal_contour from the strips, −51 % from the RTIN; becmodel −54 % against −61 %).
 pub(super) fn resolved_start(options: &DecimationOptions) -> InitialMesh {
     match options.initial_mesh {
@@ -52,8 +52,7 @@ pub(super) fn coarse_start(
 }
 
 /// A count target's RTIN start has at least this many times the triangles asked for, so
-/// that the greedy removal, not the RTIN, picks the last ones to go. Measured (session 4,
-/// ETOPO5 to 1 M triangles, Big Tujunga to 100 k): at 4 the error matches or beats the
+/// that the greedy removal, not the RTIN, picks the last ones to go. Measured (ETOPO5 to 1 M triangles, Big Tujunga to 100 k): at 4 the error matches or beats the
 /// full-grid start (124.5 vs 128; 7 vs 7) in a quarter to half of its time; 2 is twice as
 /// fast again but 9–14 % worse; 1 doubles the error.
 pub(super) const COUNT_START_FACTOR: usize = 4;

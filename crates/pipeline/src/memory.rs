@@ -8,7 +8,7 @@ use std::path::Path;
 use anyhow::{bail, Result};
 
 /// What a whole-raster run holds, per raster sample and in all (measured on ETOPO5,
-/// 9.3 M samples, session 4; rounded up).
+/// 9.3 M samples; rounded up).
 #[derive(Debug, Clone, Copy)]
 pub struct Need {
     /// Bytes per sample: 50 for a count target (raster as `f64`, the RTIN's and the
@@ -182,7 +182,7 @@ pub fn file_bytes(path: &Path) -> u64 {
 
 /// The bytes the mesh file at `path` takes once read, with the verifier's per-triangle
 /// arrays: its size times a factor per format. Measured
-/// with `verify` on one ETOPO5 mesh (5.9 M triangles, session 15) written in every
+/// with `verify` on one ETOPO5 mesh (5.9 M triangles) written in every
 /// format: the mesh took 385 MB read from PLY, OBJ, STL, glTF, GeoJSON or LandXML alike
 /// (417 MB from FlatGeobuf), while the files weigh 18 (glTF) to 282 (GeoJSON) bytes a
 /// triangle.

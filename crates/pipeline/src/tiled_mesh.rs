@@ -66,7 +66,7 @@ pub fn untiled_output(job: &MeshJob) -> Result<Option<&Path>> {
             "give --max-error instead (decimated tile by tile, in bounded memory)",
         )?;
     } else if fits {
-        // 82 bytes per sample measured untiled on ETOPO5 at ε = 1 (session 2), more at
+        // 82 bytes per sample measured untiled on ETOPO5 at ε = 1, more at
         // smaller bounds.
         crate::memory::check_whole_raster_fits(
             &job.input,

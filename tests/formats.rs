@@ -5,8 +5,7 @@
 //! The oracles are installed by `make deps` (`.venv/`, `.tools/`). The tests that need
 //! them are `#[ignore]`d, so that `cargo test` passes with only GDAL installed; `make test`
 //! runs them (`--include-ignored`). A missing oracle fails the test with the command that
-//! installs it; set `TINSMITH_SKIP_ORACLES=1` to skip those checks on purpose (CI never
-//! does).
+//! installs it.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -25,33 +24,27 @@ fn repo() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The Python with trimesh, or `None` when skipping oracles was asked for.
-fn python() -> Option<PathBuf> {
+/// The Python with trimesh; fails the test when it is missing.
+fn python() -> PathBuf {
     let path = std::env::var_os("TINSMITH_PYTHON")
         .map(PathBuf::from)
         .unwrap_or_else(|| repo().join(".venv/bin/python3"));
-    oracle_present(path.exists(), &path.display().to_string()).then_some(path)
+    require_oracle(path.exists(), &path.display().to_string());
+    path
 }
 
-/// Whether the glTF validator is installed (see [`python`]).
-fn gltf_validator() -> bool {
+/// Fails the test when the glTF validator is missing.
+fn require_gltf_validator() {
     let modules = std::env::var_os("TINSMITH_NODE_MODULES")
         .map(PathBuf::from)
         .unwrap_or_else(|| repo().join(".tools/node_modules"));
     let present = modules.join("gltf-validator").exists();
-    oracle_present(present, "gltf-validator in .tools/node_modules")
+    require_oracle(present, "gltf-validator in .tools/node_modules");
 }
 
-/// Fails when an oracle is missing, unless `TINSMITH_SKIP_ORACLES=1`.
-fn oracle_present(present: bool, what: &str) -> bool {
-    if present {
-        return true;
-    }
-    if std::env::var("TINSMITH_SKIP_ORACLES").as_deref() == Ok("1") {
-        eprintln!("skipping the {what} checks (TINSMITH_SKIP_ORACLES=1)");
-        return false;
-    }
-    panic!("oracle missing: {what}; run `make deps` (or set TINSMITH_SKIP_ORACLES=1)");
+/// Fails when an oracle is missing, with the command that installs it.
+fn require_oracle(present: bool, what: &str) {
+    assert!(present, "oracle missing: {what}; run `make deps`");
 }
 
 /// Runs a program, asserting success; returns stdout.
@@ -245,7 +238,7 @@ fn every_tin_format_reads_back_and_verifies() {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn trimesh_reads_ply_obj_stl_and_glb_with_the_same_triangles() {
-    let Some(python) = python() else { return };
+    let python = python();
     let d = Dir::new();
     let dem = fixture(DEM);
     // Vertices at their samples: STL and glTF decimate to the bound less their float32
@@ -304,7 +297,7 @@ fn stl_base_makes_a_watertight_solid_over_holes_and_components() {
     let report = mesh(&d, &dem, "solid.stl", E, &["--base", "-10"]);
     // The reader drops the walls and the bottom: the top verifies.
     verify(&d, &dem, "solid.stl", E, &[]);
-    let Some(python) = python() else { return };
+    let python = python();
     let read = trimesh(&python, &d.path("solid.stl"));
     assert_eq!(
         read.json["watertight"], true,
@@ -319,9 +312,7 @@ fn stl_base_makes_a_watertight_solid_over_holes_and_components() {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn gltf_validator_finds_no_errors() {
-    if !gltf_validator() {
-        return;
-    }
+    require_gltf_validator();
     let d = Dir::new();
     let small = fixture(DEM);
     // The sample DEM keeps > 65535 vertices: 32-bit indices.
@@ -351,7 +342,7 @@ fn gltf_validator_finds_no_errors() {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn ogrinfo_reads_flatgeobuf_triangles_equal_to_the_ply() {
-    let Some(python) = python() else { return };
+    let python = python();
     let d = Dir::new();
     let dem = fixture(DEM);
     let report = mesh(&d, &dem, "m.ply", E, &[]);
@@ -377,7 +368,7 @@ fn ogrinfo_reads_flatgeobuf_triangles_equal_to_the_ply() {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn ogrinfo_reads_geojson_in_wgs84_and_in_the_source_crs() {
-    let Some(python) = python() else { return };
+    let python = python();
     let d = Dir::new();
     let dem = fixture(DEM);
     let report = mesh(&d, &dem, "m.ply", E, &[]);
@@ -430,7 +421,7 @@ fn ogrinfo_reads_geojson_in_wgs84_and_in_the_source_crs() {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn landxml_parses_as_xml_with_northing_easting_points() {
-    let Some(python) = python() else { return };
+    let python = python();
     let d = Dir::new();
     let dem = fixture(DEM);
     let report = mesh(&d, &dem, "m.ply", E, &[]);

@@ -215,7 +215,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
     } else {
         tinsmith_export::write_lines(&args.output, format, &lines, crs)?;
     }
-    tinsmith_export::mark_finished();
+    tinsmith_output::mark_finished();
 
     if !args.quiet {
         note!(

@@ -49,7 +49,7 @@ pub fn run(args: &TilesArgs) -> Result<bool> {
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&report)?)?;
     }
-    tinsmith_export::mark_finished();
+    tinsmith_output::mark_finished();
     if args.quiet {
         return Ok(true);
     }

@@ -284,7 +284,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&json)?)?;
     }
-    tinsmith_export::mark_finished();
+    tinsmith_output::mark_finished();
     Ok(true)
 }
 

@@ -166,3 +166,44 @@ pub fn check_not_inside(dir: &Path, report: &Path, what: &str) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn no_files() -> Vec<PathBuf> {
+        Vec::new()
+    }
+
+    #[test]
+    fn messages_name_the_target() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let input = dir.path().join("in.tif");
+        std::fs::write(&input, b"").expect("write");
+        let err = check_writable_target(Path::new("out/"), &input, no_files).expect_err("slash");
+        assert_eq!(
+            err.to_string(),
+            "out/: ends with '/', which names a directory, not an output file"
+        );
+        let err = check_writable_target(&input, &input, no_files).expect_err("input");
+        assert_eq!(
+            err.to_string(),
+            format!(
+                "{0}: is the input raster {0}; writing there would destroy it",
+                input.display()
+            )
+        );
+        let err = check_writable_target(dir.path(), &input, no_files).expect_err("dir");
+        assert!(matches!(err, Error::IsDirectory { .. }), "{err:?}");
+        let report = dir.path().join("r.json");
+        let err = check_distinct(&report, &report, "the output").expect_err("same");
+        assert_eq!(
+            err.to_string(),
+            format!(
+                "{0}: is also the output {0}; one would overwrite the other",
+                report.display()
+            )
+        );
+        assert!(check_writable_target(&report, &input, no_files).is_ok());
+    }
+}

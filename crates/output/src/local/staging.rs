@@ -136,3 +136,44 @@ fn occupied_reason(dir: &Path) -> Option<&'static str> {
         None
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_staged_directory_appears_whole_and_its_made_parents_go_on_error() {
+        let root = tempfile::tempdir().expect("temp dir");
+        let target = root.path().join("a/b/out");
+        let staged = StagedDir::new(&target, true).expect("staged");
+        std::fs::write(staged.path().join("f"), b"x").expect("write");
+        assert!(!target.exists());
+        staged.commit().expect("renamed");
+        assert!(target.join("f").is_file());
+
+        // Dropped unfinished: the directory and the parents made for it go.
+        let other = root.path().join("c/d/out");
+        let staged = StagedDir::new(&other, true).expect("staged");
+        drop(staged);
+        assert!(!root.path().join("c").exists());
+    }
+
+    #[test]
+    fn a_staged_directory_refuses_what_it_must_not_replace() {
+        let root = tempfile::tempdir().expect("temp dir");
+        let full = root.path().join("full");
+        std::fs::create_dir(&full).expect("mkdir");
+        std::fs::write(full.join("x"), b"").expect("write");
+        let err = StagedDir::new(&full, true).expect_err("occupied");
+        assert!(matches!(err, Error::Occupied { .. }), "{err:?}");
+        let missing = root.path().join("no/out");
+        let err = StagedDir::new(&missing, false).expect_err("no parent");
+        assert!(matches!(err, Error::MissingDirectory { .. }), "{err:?}");
+        assert!(!root.path().join("no").exists());
+        let names: Vec<_> = std::fs::read_dir(root.path())
+            .expect("read")
+            .map(|e| e.expect("entry").file_name())
+            .collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("full")]);
+    }
+}

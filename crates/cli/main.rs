@@ -66,7 +66,7 @@ fn main() -> ExitCode {
         Command::Tiles(a) => commands::tiles(&a),
         Command::Serve(a) => commands::serve(&a),
     };
-    if tinsmith_export::interrupted() {
+    if tinsmith_output::interrupted() {
         // The signal handler is removing the unfinished output (the error, if any, comes
         // from that) and exits the process itself.
         loop {
@@ -90,9 +90,9 @@ fn main() -> ExitCode {
 }
 
 /// Notes (unless `quiet`) the temporary outputs of killed runs that writing this run's
-/// outputs removed (see `tinsmith_export::take_removed_stale`).
+/// outputs removed (see `tinsmith_output::take_removed_stale`).
 fn note_removed_stale(quiet: bool) {
-    let removed = tinsmith_export::take_removed_stale();
+    let removed = tinsmith_output::take_removed_stale();
     if quiet || removed.is_empty() {
         return;
     }
@@ -188,12 +188,12 @@ fn on_signal_remove_pending_output() {
             let Some(signal) = signals.forever().next() else {
                 return;
             };
-            if tinsmith_export::finished() {
+            if tinsmith_output::finished() {
                 // Every output is complete and in place; only memory was being freed.
                 // SAFETY: as below.
                 unsafe { libc::_exit(0) }
             }
-            if tinsmith_export::remove_pending() > 0 {
+            if tinsmith_output::remove_pending() > 0 {
                 note!("\ntinsmith: interrupted; unfinished output removed");
             } else {
                 note!("\ntinsmith: interrupted");

@@ -224,6 +224,32 @@ impl Problem {
     }
 }
 
+/// The errors of staging and renaming a file (see `tinsmith_output`) as this crate's:
+/// [`Error::Io`] and [`Error::MissingDirectory`] with the same messages.
+impl From<tinsmith_output::Error> for Error {
+    fn from(error: tinsmith_output::Error) -> Self {
+        match error {
+            tinsmith_output::Error::Io {
+                path,
+                action,
+                source,
+            } => Error::Io {
+                path,
+                action,
+                source,
+            },
+            tinsmith_output::Error::MissingDirectory { path, dir } => {
+                Error::MissingDirectory { path, dir }
+            }
+            other => Error::Io {
+                path: other.path().to_path_buf(),
+                action: "write",
+                source: io::Error::other(other),
+            },
+        }
+    }
+}
+
 impl From<io::Error> for Problem {
     fn from(error: io::Error) -> Self {
         Problem::Io(error)

@@ -4,7 +4,8 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-use crate::atomic::write_atomically_with_sidecar;
+use tinsmith_output::write_atomically_with_sidecar;
+
 use crate::error::{Error, Problem, Result};
 use crate::format::MeshFormat;
 use crate::mesh::{Mesh, MeshRef};
@@ -105,6 +106,7 @@ pub fn write_mesh_with(
         },
         sidecar,
     )
+    .map_err(Error::from)
 }
 
 /// Checks that every vertex is finite relative to `origin` in float32.

@@ -4,13 +4,14 @@
 //!
 //! A mesh is given as plain slices ([`MeshRef`]): world `[x, y, z]` vertices, `[u32; 3]`
 //! triangles in the orientation to be written, and an optional CRS as WKT. This crate knows
-//! nothing about how the mesh was made; it depends on no other tinsmith crate.
+//! nothing about how the mesh was made; of the other tinsmith crates it depends only on
+//! `tinsmith-output`, which puts the bytes on disk.
 //!
 //! # Guarantees
 //! - **Atomic output.** [`write_mesh`] (and [`MeshStreamWriter`], which takes the mesh in
-//!   pieces) writes a temporary file next to the target and renames it into place; a file
-//!   it replaces keeps its permissions. After an error there is no partial file and no
-//!   temporary file; an existing file at the target keeps its content.
+//!   pieces) writes through `tinsmith_output`: a temporary file next to the target renamed
+//!   into place; a file it replaces keeps its permissions. After an error there is no
+//!   partial file and no temporary file; an existing file at the target keeps its content.
 //! - **Exact round trip in the double-precision formats.** [`read_mesh`] of a PLY, OBJ,
 //!   FlatGeobuf or LandXML file written by [`write_mesh`] (and a GeoJSON one, which prints
 //!   the shortest decimals) returns the same coordinates bit for bit (PLY stores `double`s,
@@ -57,7 +58,6 @@
 #![forbid(unsafe_code)]
 
 mod antimeridian;
-mod atomic;
 mod error;
 mod fgb;
 mod file;
@@ -70,19 +70,13 @@ mod mesh;
 mod obj;
 mod options;
 mod origin;
-mod pending;
 mod ply;
 mod quantized_mesh;
-mod stale;
 mod stl;
 mod stream;
 mod weld;
 
 pub use antimeridian::cut_at_antimeridian;
-pub use atomic::{
-    is_special_file, keep_permissions, output_parent, output_temp_dir, output_temp_file,
-    resolve_output, OutputTempDir,
-};
 pub use error::{Error, Result};
 pub use file::{prj_path, read_mesh, read_mesh_as, write_mesh, write_mesh_with};
 pub use format::MeshFormat;
@@ -90,16 +84,11 @@ pub use lines::{write_lines, write_multilines, CrsRef, LineFormat, LinePoint};
 pub use mesh::{Mesh, MeshRef};
 pub use options::WriteOptions;
 pub use origin::LocalOrigin;
-pub use pending::{
-    finished, interrupted, mark_finished, remove_pending, track_made_dirs, track_pending,
-    MadeDirsGuard, PendingGuard,
-};
 pub use quantized_mesh::{
     geodetic_to_ecef, gzip, oct_encode, surface_normal, EncodeError, GeoRectangle,
     QuantizedMeshTile, EXTENSION_METADATA, EXTENSION_NORMALS, HEADER_BYTES, MAX_16BIT_VERTICES,
     QUANTIZED_MAX, WGS84_A, WGS84_B,
 };
-pub use stale::{take_removed_stale, RemovedTemp, MIN_STALE_AGE};
 pub use stream::MeshStreamWriter;
 
 /// EPSG 4326 for EPSG 4979 (WGS84 with ellipsoidal heights, as ogr2ogr labels WGS84 files

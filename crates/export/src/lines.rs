@@ -6,8 +6,8 @@ use std::path::Path;
 
 use flatgeobuf::geozero::{ColumnValue, FeatureProcessor, GeomProcessor, PropertyProcessor};
 use flatgeobuf::{ColumnType, FgbWriter, FgbWriterOptions, GeometryType};
+use tinsmith_output::write_atomically;
 
-use crate::atomic::write_atomically;
 use crate::error::{Error, Result};
 use crate::{fgb, geojson};
 
@@ -202,6 +202,7 @@ pub fn write_multilines<P: LinePoint>(
         LineFormat::GeoJson => write_geojson(w, lines, crs),
         LineFormat::FlatGeobuf => write_fgb(w, lines, crs),
     })
+    .map_err(Error::from)
 }
 
 fn write_geojson<W: Write, P: LinePoint>(

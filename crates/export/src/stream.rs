@@ -4,7 +4,8 @@ use std::fs::File;
 use std::io::{self, BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
 
-use crate::atomic::write_atomically_with_sidecar;
+use tinsmith_output::write_atomically_with_sidecar;
+
 use crate::error::{Error, Result};
 use crate::format::MeshFormat;
 use crate::mesh::MeshRef;
@@ -90,7 +91,7 @@ impl MeshStreamWriter {
             });
         }
         // A device or pipe (`/dev/stdout`) has no directory of its own to spool in.
-        let spool_dir = if crate::is_special_file(path) {
+        let spool_dir = if tinsmith_output::is_special_file(path) {
             std::env::temp_dir()
         } else {
             dir.to_path_buf()
@@ -253,6 +254,7 @@ impl MeshStreamWriter {
             },
             sidecar,
         )
+        .map_err(Error::from)
     }
 
     /// The header [`crate::write_mesh`] writes for a mesh of the counts so far.
@@ -302,10 +304,7 @@ struct Spool {
 
 impl Spool {
     fn new(dir: &Path) -> io::Result<Spool> {
-        // Before the spools fill the disk, not at the end, when the output's temporary
-        // file is made: a killed run's leftover may be what would fill it.
-        crate::stale::sweep_once(dir);
-        let file = tempfile::tempfile_in(dir)?;
+        let file = tinsmith_output::unnamed_temp_file(dir)?;
         let writer = BufWriter::with_capacity(BUFFER_SIZE, file.try_clone()?);
         Ok(Spool { file, writer })
     }

@@ -216,7 +216,7 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
     } else {
         tinsmith_export::write_lines(&job.output, format, &lines, crs)?;
     }
-    tinsmith_export::mark_finished();
+    tinsmith_output::mark_finished();
 
     feedback.note(&format!(
         "{}: {} lines ({} closed), {} segments{} at {} levels from the {} ({} triangles) in {:.2} s",

@@ -171,7 +171,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&report)?)?;
     }
-    tinsmith_export::mark_finished();
+    tinsmith_output::mark_finished();
     Ok(())
 }
 
@@ -193,5 +193,5 @@ pub fn reserve_report(
         check_distinct(output, report, "the output")?;
         crate::output::check_distinct_from_sidecar(output, report, format, job.pixel_coords)?;
     }
-    ReservedReport::reserve(report).map(Some)
+    Ok(Some(ReservedReport::reserve(report)?))
 }

@@ -281,7 +281,7 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&json)?)?;
     }
-    tinsmith_export::mark_finished();
+    tinsmith_output::mark_finished();
     Ok(())
 }
 

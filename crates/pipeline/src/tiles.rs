@@ -45,7 +45,7 @@ pub fn tiles(
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&built)?)?;
     }
-    tinsmith_export::mark_finished();
+    tinsmith_output::mark_finished();
     let tiles: u64 = built.levels.iter().map(|l| l.tiles).sum();
     feedback.note(&format!(
         "{tiles} tiles, levels {}..={}, in {}{}",

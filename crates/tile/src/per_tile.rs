@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use tinsmith_export::{write_mesh, MeshFormat, MeshRef};
+use tinsmith_output::StagedDir;
 
 use crate::error::{Error, Result};
 use crate::placement::Placement;
@@ -21,9 +22,8 @@ use crate::sink::{FinishedTile, SinkError, TileSink};
 #[derive(Debug)]
 pub struct PerTileWriter {
     dir: PathBuf,
-    temp: tinsmith_export::OutputTempDir,
-    /// Keeps the temporary directory registered for removal on a signal.
-    _pending: tinsmith_export::PendingGuard,
+    /// The temporary directory the files go to, registered for removal on a signal.
+    temp: StagedDir,
     format: MeshFormat,
     crs_wkt: Option<String>,
     placement: Placement,
@@ -49,30 +49,27 @@ impl PerTileWriter {
             reason: reason.to_owned(),
             source,
         };
-        if let Some(reason) = occupied_reason(dir) {
-            return Err(output(reason, None));
-        }
-        let (parent, file_in_the_way) = tinsmith_export::output_parent(dir);
-        if let Some(file) = file_in_the_way {
-            return Err(output(
+        let temp = StagedDir::new(dir, false).map_err(|error| match error {
+            tinsmith_output::Error::Occupied { reason, .. } => output(reason, None),
+            tinsmith_output::Error::FileInTheWay { file, .. } => output(
                 &format!(
                     "{} is a file, so no directory can be made there",
                     file.display()
                 ),
                 None,
-            ));
-        }
-        if !parent.is_dir() {
-            return Err(output(
+            ),
+            tinsmith_output::Error::MissingDirectory { dir: parent, .. } => output(
                 &format!("parent directory {} does not exist", parent.display()),
                 None,
-            ));
-        }
-        let temp = tinsmith_export::output_temp_dir(parent)
-            .map_err(|e| output("cannot create a temporary directory beside it", Some(e)))?;
+            ),
+            tinsmith_output::Error::Io { source, .. } => output(
+                "cannot create a temporary directory beside it",
+                Some(source),
+            ),
+            other => output(&other.to_string(), None),
+        })?;
         Ok(PerTileWriter {
             dir: dir.to_path_buf(),
-            _pending: tinsmith_export::track_pending(temp.path()),
             temp,
             format,
             crs_wkt: crs_wkt.map(str::to_owned),
@@ -93,13 +90,11 @@ impl PerTileWriter {
     /// [`Error::Output`] when the rename fails (for example because the directory was
     /// created meanwhile and is not empty); the temporary directory is then removed.
     pub fn finish(self) -> Result<()> {
-        self.temp
-            .rename_into_place(&self.dir)
-            .map_err(|e| Error::Output {
-                path: self.dir.clone(),
-                reason: "cannot move the finished tiles into place".to_owned(),
-                source: Some(e),
-            })
+        self.temp.commit().map_err(|e| Error::Output {
+            path: self.dir.clone(),
+            reason: "cannot move the finished tiles into place".to_owned(),
+            source: Some(e),
+        })
     }
 }
 
@@ -117,7 +112,7 @@ impl TileSink for PerTileWriter {
             .temp
             .path()
             .join(PerTileWriter::file_name(tile.index(), self.format));
-        if tinsmith_export::interrupted() {
+        if tinsmith_output::interrupted() {
             // The temporary directory is being removed: add nothing to it.
             return Err(std::io::Error::from(std::io::ErrorKind::Interrupted).into());
         }
@@ -125,21 +120,5 @@ impl TileSink for PerTileWriter {
             MeshRef::new(&self.vertices, &self.triangles).with_crs_wkt(self.crs_wkt.as_deref());
         write_mesh(&path, self.format, mesh)?;
         Ok(())
-    }
-}
-
-/// Why `dir` cannot take a new output directory, if it exists as anything but an empty
-/// directory (a file, a link, a directory with entries): an output directory renamed
-/// into place must not replace it.
-pub(crate) fn occupied_reason(dir: &Path) -> Option<&'static str> {
-    let meta = std::fs::symlink_metadata(dir).ok()?;
-    if meta.is_symlink() {
-        Some("is a symbolic link (give the directory it points to, or a new path)")
-    } else if !meta.is_dir() {
-        Some("exists and is not a directory")
-    } else if std::fs::read_dir(dir).map_or(true, |mut e| e.next().is_some()) {
-        Some("exists and is not an empty directory")
-    } else {
-        None
     }
 }

@@ -6,7 +6,6 @@ mod budget;
 mod error;
 mod layer;
 mod rows;
-mod staging;
 mod stream;
 mod tile;
 mod tms;
@@ -17,6 +16,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use rayon::prelude::*;
+use tinsmith_output::StagedDir;
 use tinsmith_raster::{geographic_bounds, GeoBounds};
 
 pub use budget::LEVEL_ZERO_ERROR;
@@ -25,7 +25,6 @@ pub use error::{TerrainError, TerrainResult};
 pub use layer::METADATA_AVAILABILITY;
 use layer::{write_layer_json, Available};
 use rows::LevelRows;
-use staging::{write_atomic, Staging};
 use stream::{band_tile_rows, stream_levels, LevelSink, RowSource, Warp};
 use tile::{build_tile, TileOut};
 use tms::{bounds_array, step};
@@ -313,7 +312,7 @@ pub fn build_terrain(
     }
     // All or nothing: the pyramid is built in a temporary directory beside `out_dir` and
     // renamed into place at the end; a failure (or nothing to write) leaves no trace.
-    let mut staging = Staging::new(out_dir)?;
+    let staging = stage_pyramid(out_dir)?;
     let source = Warp {
         path: input,
         band: options.band,
@@ -355,7 +354,10 @@ pub fn build_terrain(
         max_zoom,
         &available,
     )?;
-    staging.finish(out_dir)?;
+    staging.commit().map_err(|source| TerrainError::Output {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
     Ok(TerrainReport {
         bounds: bounds_array(&bounds),
         min_zoom: options.min_zoom,
@@ -588,7 +590,7 @@ impl TileWriter<'_> {
     /// Writes a tile of level `z` into the staging directory and counts it.
     fn write(&mut self, z: u8, tile: &TileOut) -> TerrainResult<()> {
         let dir = self.out_dir.join(z.to_string()).join(tile.x.to_string());
-        if tinsmith_export::interrupted() {
+        if tinsmith_output::interrupted() {
             // The staging directory is being removed: add nothing to it.
             return Err(TerrainError::Output {
                 path: dir,
@@ -609,6 +611,40 @@ impl TileWriter<'_> {
         report.measured_max_error = report.measured_max_error.max(tile.max_error);
         Ok(())
     }
+}
+
+/// The temporary directory the pyramid is built in, beside `out_dir` (which must not
+/// exist, or be an empty directory), with the missing parents made for it.
+fn stage_pyramid(out_dir: &Path) -> TerrainResult<StagedDir> {
+    let refuse =
+        |reason: String| TerrainError::Options(format!("output {}: {reason}", out_dir.display()));
+    StagedDir::new(out_dir, true).map_err(|error| match error {
+        tinsmith_output::Error::Occupied { reason, .. } => refuse(format!(
+            "{reason}; give a new directory (the pyramid is written whole, never mixed \
+             with other files)"
+        )),
+        tinsmith_output::Error::FileInTheWay { file, .. } => refuse(format!(
+            "{} is a file, so no directory can be made there",
+            file.display()
+        )),
+        tinsmith_output::Error::Io { source, .. } => TerrainError::Output {
+            path: out_dir.to_path_buf(),
+            source,
+        },
+        other => TerrainError::Output {
+            path: out_dir.to_path_buf(),
+            source: std::io::Error::other(other),
+        },
+    })
+}
+
+/// Writes `bytes` to `path` (in the staging directory) through a temporary file renamed
+/// over it.
+fn write_atomic(path: &Path, bytes: &[u8]) -> TerrainResult<()> {
+    tinsmith_output::write_bytes_atomically(path, bytes).map_err(|source| TerrainError::Output {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 #[cfg(test)]

@@ -6,9 +6,8 @@ use std::path::Path;
 
 use tinsmith_raster::GeoBounds;
 
-use super::staging::write_atomic;
 use super::tms::bounds_array;
-use super::{TerrainOptions, TerrainResult};
+use super::{write_atomic, TerrainOptions, TerrainResult};
 
 /// Levels whose tiles carry the metadata extension: 0, N, 2N, ... (`metadataAvailability`).
 pub const METADATA_AVAILABILITY: u8 = 10;

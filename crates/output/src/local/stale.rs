@@ -2,8 +2,8 @@
 //! killer, a power cut), found and removed by the next run that writes in the same
 //! directory.
 //!
-//! Every `.tinsmith-*.tmp` file or directory a run creates ([`crate::output_temp_file`],
-//! [`crate::output_temp_dir`]) is locked (`flock`) by that run for as long as it exists,
+//! Every `.tinsmith-*.tmp` file or directory a run creates ([`crate::StagedFile`],
+//! [`crate::StagedDir`]) is locked (`flock`) by that run for as long as it exists,
 //! and the kernel drops the lock when the process ends, however it ends. So a temporary
 //! whose lock can be taken belongs to no live run. Before a run's first temporary in a
 //! directory, the others there are swept: those that can be locked and were last modified
@@ -15,7 +15,7 @@
 //! locks, which a read-only handle cannot take), nothing can be locked by the sweep, so
 //! nothing is removed there. Where a lock is local to one host but the directory is shared
 //! (NFS with `local_lock=flock`), a run on another host may take a live run's staging
-//! directory for stale: that run then fails ([`crate::OutputTempDir::rename_into_place`]
+//! directory for stale: that run then fails ([`crate::StagedDir::commit`]
 //! checks its directory is still the one it made) rather than publish a partial pyramid.
 
 use std::collections::HashSet;

@@ -5,6 +5,7 @@ use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
+use crate::pending::PendingGuard;
 
 /// Size of the write buffer.
 const BUFFER_SIZE: usize = 1 << 16;
@@ -14,7 +15,11 @@ const BUFFER_SIZE: usize = 1 << 16;
 /// The data goes to a temporary file (`.tinsmith-*.tmp`) in `path`'s directory, is flushed
 /// and synced, then renamed over `path`. If anything fails, the temporary file is removed
 /// and `path` is left as it was: absent, or holding its previous content.
-pub(crate) fn write_atomically<F>(path: &Path, write: F) -> Result<()>
+///
+/// # Errors
+/// [`Error::MissingDirectory`] when `path`'s directory does not exist; [`Error::Io`] when
+/// the temporary file cannot be made, `write` or the rename fails.
+pub fn write_atomically<F>(path: &Path, write: F) -> Result<()>
 where
     F: FnOnce(&mut BufWriter<&mut File>) -> io::Result<()>,
 {
@@ -28,7 +33,10 @@ where
 /// new sidecar is removed again (a previous sidecar at that path is then gone too; the
 /// main file keeps its previous content). Output to a device or pipe (`/dev/null`, a
 /// FIFO) gets no sidecar: there is no file for it to describe.
-pub(crate) fn write_atomically_with_sidecar<F>(
+///
+/// # Errors
+/// As [`write_atomically`].
+pub fn write_atomically_with_sidecar<F>(
     path: &Path,
     write: F,
     sidecar: Option<(&Path, &[u8])>,
@@ -50,32 +58,102 @@ where
     })
 }
 
+/// Writes `bytes` to `path` through a temporary file renamed over it (not synced: for
+/// the many files of a staged directory, which is itself renamed into place).
+///
+/// # Errors
+/// The I/O error of creating, writing or renaming the temporary file.
+pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let mut file = StagedFile::new(path)?;
+    file.file_mut().write_all(bytes)?;
+    file.commit()
+}
+
 /// A complete, synced temporary file waiting to be renamed over its target, or output
 /// already written in place to a device or pipe.
-pub(crate) struct Staged {
+struct Staged {
     /// `None` when the output went straight to a device or pipe.
-    temp: Option<tempfile::NamedTempFile>,
-    /// Keeps the temporary file registered for removal on a signal until it is renamed.
-    _pending: Option<crate::PendingGuard>,
-    /// The file the rename lands on: the path asked for, or what its symlink points to.
-    target: PathBuf,
+    file: Option<StagedFile>,
     /// The path asked for, for messages.
     path: PathBuf,
 }
 
 impl Staged {
     /// Renames the temporary file over the target.
-    pub(crate) fn commit(self) -> Result<()> {
-        let Some(temp) = self.temp else {
+    fn commit(self) -> Result<()> {
+        let Some(file) = self.file else {
             return Ok(());
         };
-        keep_permissions(temp.path(), &self.target);
-        temp.persist(&self.target).map_err(|error| Error::Io {
+        file.commit().map_err(|source| Error::Io {
             path: self.path,
             action: "move the finished temporary file into place",
-            source: error.error,
-        })?;
-        Ok(())
+            source,
+        })
+    }
+}
+
+/// A temporary file `.tinsmith-*.tmp` beside the file it is to replace, registered for
+/// removal on a signal (see [`crate::remove_pending`]) until [`StagedFile::commit`] renames
+/// it over its target; dropped without that, it is removed.
+#[derive(Debug)]
+pub struct StagedFile {
+    temp: tempfile::NamedTempFile,
+    /// Keeps the temporary file registered for removal on a signal until it is renamed.
+    _pending: PendingGuard,
+    /// The file the rename lands on.
+    target: PathBuf,
+}
+
+impl StagedFile {
+    /// Creates the temporary file in the directory of `target` (the file the rename is
+    /// to land on: a symbolic link is not followed here, see [`resolve_output`]).
+    ///
+    /// # Errors
+    /// The I/O error of creating the temporary file.
+    pub fn new(target: &Path) -> io::Result<StagedFile> {
+        let temp = output_temp_file(parent_dir(target))?;
+        Ok(StagedFile {
+            _pending: crate::track_pending(temp.path()),
+            temp,
+            target: target.to_path_buf(),
+        })
+    }
+
+    /// The temporary file.
+    pub fn file(&self) -> &File {
+        self.temp.as_file()
+    }
+
+    /// The temporary file, to write to.
+    pub fn file_mut(&mut self) -> &mut File {
+        self.temp.as_file_mut()
+    }
+
+    /// Renames the temporary file over its target, which keeps its permissions when it
+    /// is a file already (a private mesh stays private). On failure the temporary file is
+    /// removed and the target left as it was.
+    ///
+    /// # Errors
+    /// The rename's error.
+    pub fn commit(self) -> io::Result<()> {
+        keep_permissions(self.temp.path(), &self.target);
+        publish(Temp::File(self.temp), &self.target)
+    }
+}
+
+/// A locked temporary, file or directory, as [`publish`] takes it.
+pub(crate) enum Temp {
+    File(tempfile::NamedTempFile),
+    Dir(OutputTempDir),
+}
+
+/// Renames a staged temporary over `target`: the one step by which every output (a file,
+/// its sidecar, a whole directory) appears in place. The temporary stays locked until
+/// the rename is done (a sweep cannot take it between); on failure it is removed.
+pub(crate) fn publish(temp: Temp, target: &Path) -> io::Result<()> {
+    match temp {
+        Temp::File(temp) => temp.persist(target).map(drop).map_err(|error| error.error),
+        Temp::Dir(dir) => dir.rename_into_place(target),
     }
 }
 
@@ -83,7 +161,7 @@ impl Staged {
 /// is about to replace, so that replacing a file keeps its mode (a private 0600 mesh stays
 /// private); nothing when `target` does not exist yet. Best effort: a failure leaves the
 /// new file's default mode.
-pub fn keep_permissions(temp: &Path, target: &Path) {
+pub(crate) fn keep_permissions(temp: &Path, target: &Path) {
     if let Ok(meta) = std::fs::metadata(target) {
         if meta.is_file() {
             let _ = std::fs::set_permissions(temp, meta.permissions());
@@ -138,28 +216,41 @@ pub fn is_special_file(path: &Path) -> bool {
 /// output is readable as any other file the user writes (a web server serving tiles runs
 /// as another user). It is locked while open, and the first temporary in `dir` sweeps
 /// the stale ones killed runs left there (see [`crate::take_removed_stale`]).
-pub fn output_temp_file(dir: &Path) -> io::Result<tempfile::NamedTempFile> {
-    crate::stale::sweep_once(dir);
+pub(crate) fn output_temp_file(dir: &Path) -> io::Result<tempfile::NamedTempFile> {
+    super::stale::sweep_once(dir);
     let temp = temp_builder(0o666).tempfile_in(dir)?;
-    crate::stale::hold(temp.as_file());
+    super::stale::hold(temp.as_file());
     Ok(temp)
+}
+
+/// An unnamed temporary file in `dir` (`O_TMPFILE` on Linux; elsewhere unlinked right after
+/// creation), for data spooled on its way to an output there: it vanishes when its
+/// handles close, however the process ends. Like a named temporary, the first in `dir`
+/// sweeps the stale temporaries there, before the spool fills the disk (a killed run's
+/// leftover may be what would fill it).
+///
+/// # Errors
+/// The I/O error of creating the file.
+pub fn unnamed_temp_file(dir: &Path) -> io::Result<File> {
+    super::stale::sweep_once(dir);
+    tempfile::tempfile_in(dir)
 }
 
 /// A temporary directory `.tinsmith-*.tmp` in `parent`, to be renamed into place as an
 /// output directory: its mode is what `create_dir` would give, not tempfile's 0700.
 /// Locked and swept as [`output_temp_file`]'s files are.
-pub fn output_temp_dir(parent: &Path) -> io::Result<OutputTempDir> {
-    crate::stale::sweep_once(parent);
+pub(crate) fn output_temp_dir(parent: &Path) -> io::Result<OutputTempDir> {
+    super::stale::sweep_once(parent);
     let dir = temp_builder(0o777).tempdir_in(parent)?;
     let lock = File::open(dir.path())?;
-    crate::stale::hold(&lock);
+    super::stale::hold(&lock);
     Ok(OutputTempDir { dir, _lock: lock })
 }
 
 /// A temporary output directory (see [`output_temp_dir`]): removed with its contents when
 /// dropped, unless [`OutputTempDir::rename_into_place`] moved it.
 #[derive(Debug)]
-pub struct OutputTempDir {
+pub(crate) struct OutputTempDir {
     // Dropped first: the directory goes while the lock is still held.
     dir: tempfile::TempDir,
     _lock: File,
@@ -167,7 +258,7 @@ pub struct OutputTempDir {
 
 impl OutputTempDir {
     /// The directory's path.
-    pub fn path(&self) -> &Path {
+    pub(crate) fn path(&self) -> &Path {
         self.dir.path()
     }
 
@@ -176,7 +267,7 @@ impl OutputTempDir {
     ///
     /// # Errors
     /// The rename's error (`target` is a non-empty directory, on another file system...).
-    pub fn rename_into_place(self, target: &Path) -> io::Result<()> {
+    pub(crate) fn rename_into_place(self, target: &Path) -> io::Result<()> {
         use std::os::unix::fs::MetadataExt;
         let OutputTempDir { dir, _lock: lock } = self;
         let staged = dir.keep();
@@ -214,7 +305,8 @@ fn temp_builder(mode: u32) -> tempfile::Builder<'static, 'static> {
     builder
 }
 
-fn parent_dir(path: &Path) -> &Path {
+/// The directory `path` is in (`.` for a bare name).
+pub(crate) fn parent_dir(path: &Path) -> &Path {
     match path.parent() {
         Some(dir) if !dir.as_os_str().is_empty() => dir,
         _ => Path::new("."),
@@ -224,7 +316,7 @@ fn parent_dir(path: &Path) -> &Path {
 /// Writes the content of `path` to a synced temporary file beside its target (see
 /// [`resolve_output`]); dropping the result without [`Staged::commit`] removes the
 /// temporary file. A device or pipe (see [`is_special_file`]) is written in place.
-pub(crate) fn stage<F>(path: &Path, write: F) -> Result<Staged>
+fn stage<F>(path: &Path, write: F) -> Result<Staged>
 where
     F: FnOnce(&mut BufWriter<&mut File>) -> io::Result<()>,
 {
@@ -257,16 +349,13 @@ where
         write(&mut writer).map_err(io_error("write"))?;
         writer.flush().map_err(io_error("write"))?;
         return Ok(Staged {
-            temp: None,
-            _pending: None,
-            target,
+            file: None,
             path: path.to_path_buf(),
         });
     }
 
-    let mut temp = output_temp_file(dir)
+    let mut staged = StagedFile::new(&target)
         .map_err(io_error("create a temporary file in the output directory"))?;
-    let pending = crate::track_pending(temp.path());
     if crate::interrupted() {
         // The signal handler may have passed already: the temporary file goes now.
         return Err(io_error("write")(io::Error::from(
@@ -275,15 +364,13 @@ where
     }
 
     {
-        let mut writer = BufWriter::with_capacity(BUFFER_SIZE, temp.as_file_mut());
+        let mut writer = BufWriter::with_capacity(BUFFER_SIZE, staged.file_mut());
         write(&mut writer).map_err(io_error("write"))?;
         writer.flush().map_err(io_error("write"))?;
     }
-    temp.as_file().sync_all().map_err(io_error("write"))?;
+    staged.file().sync_all().map_err(io_error("write"))?;
     Ok(Staged {
-        temp: Some(temp),
-        _pending: Some(pending),
-        target,
+        file: Some(staged),
         path: path.to_path_buf(),
     })
 }

@@ -1,0 +1,46 @@
+//! Where and how a run's outputs land on disk: every mesh, sidecar, contour file, report,
+//! tiles pyramid and per-tile directory is staged beside its target and published whole.
+//! This crate knows nothing about formats; the format writers hand it bytes.
+//!
+//! # Guarantees
+//! - **Complete outputs or the old ones.** An output is written to a temporary
+//!   (`.tinsmith-*.tmp`, a file or a directory) next to its target and renamed into place
+//!   only when complete ([`write_atomically`], [`StagedFile`], [`StagedDir`]); a sidecar
+//!   (a mesh's `.prj`) is staged with its file and renamed just before it
+//!   ([`write_atomically_with_sidecar`]). A run that fails leaves the previous output at
+//!   the target untouched (or none); a file it replaces keeps its permissions; a symbolic
+//!   link at the target stays a link to the new content; a device or pipe is written in
+//!   place.
+//! - **No temporaries left behind.** A temporary is removed when its owner is dropped
+//!   (an error); on a signal, the handler empties the registry of pending temporaries
+//!   ([`remove_pending`]; the work still running sees [`interrupted`]); and one left by a
+//!   run that was killed outright (SIGKILL, the out-of-memory killer) is removed by the
+//!   next run that writes in the same directory ([`take_removed_stale`] says which).
+//! - **Early refusal.** [`check_writable_target`] and its kin refuse, before long work,
+//!   targets the run could not replace or must not (the input itself, a read-only file,
+//!   another output of the same run), and [`ReservedReport`] takes a report's room on disk
+//!   when the run starts.
+//!
+//! Outputs go to the local file system (the `local` module); the registry of pending
+//! temporaries ([`track_pending`], [`remove_pending`]) is process-wide.
+#![deny(missing_docs)]
+#![deny(rustdoc::broken_intra_doc_links)]
+#![deny(unsafe_code)]
+
+mod error;
+mod local;
+mod pending;
+
+pub use error::{Error, RenameError, Result};
+pub use local::atomic::{
+    is_special_file, output_parent, resolve_output, unnamed_temp_file, write_atomically,
+    write_atomically_with_sidecar, write_bytes_atomically, StagedFile,
+};
+pub use local::check::{check_distinct, check_not_input, check_not_inside, check_writable_target};
+pub use local::report::{ReservedReport, REPORT_RESERVE_BYTES};
+pub use local::staging::StagedDir;
+pub use local::stale::{take_removed_stale, RemovedTemp, MIN_STALE_AGE};
+pub use pending::{
+    finished, interrupted, mark_finished, remove_pending, track_made_dirs, track_pending,
+    MadeDirsGuard, PendingGuard,
+};

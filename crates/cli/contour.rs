@@ -31,12 +31,12 @@ use tinsmith_contour::{
 };
 use tinsmith_core::{decimate, DecimationOptions, Grid};
 use tinsmith_export::LineFormat;
+use tinsmith_georef::{Placement, Samples};
 use tinsmith_raster::{Raster, RasterInfo};
 use tinsmith_tile::{mesh_tiles, FinishedTile, RasterSource, SinkError, TileOptions, TileSink};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
 use crate::args::ContourArgs;
-use crate::georef::Georef;
 use crate::mesh_file::{expected_orientation, read_mesh_file, sample_positions};
 use crate::number::readable;
 use crate::output::NamingFile;
@@ -65,7 +65,8 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         check_distinct(mesh, &args.output, "the --mesh input")?;
     }
     let e = args.max_error.unwrap_or(0.0);
-    let size = crate::georef::check_input_transform(&args.input, args.band, args.pixel_coords)?;
+    let size =
+        crate::transform_check::check_input_transform(&args.input, args.band, args.pixel_coords)?;
     let tiled =
         args.mesh.is_none() && e > 0.0 && (size.0 > args.tile_size || size.1 > args.tile_size);
     // A TIN decimated here is shaped for the levels (fewer segments, same bound), so they
@@ -109,7 +110,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
             }
         };
         crate::memory::check_whole_raster_fits(&args.input, size, need, what, instead)?;
-        let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
+        let raster = tinsmith_raster::read_samples(&args.input, args.band)?;
         let (mesh, source, levels) = untiled_tin(args, e, &raster)?;
         // The lines are held whole before writing: refuse levels that would not fit.
         let segments = mesh.segment_count(&levels);
@@ -134,7 +135,7 @@ pub fn run(args: &ContourArgs) -> Result<bool> {
         };
         (contoured, raster.info, source, levels)
     };
-    let georef = Georef::new(info.transform(), args.pixel_coords);
+    let georef = Placement::new(info.transform(), args.pixel_coords);
     crate::output::note_gcps_unused(&info, args.pixel_coords, args.quiet);
     let polylines = contoured.lines;
 
@@ -316,9 +317,9 @@ fn untiled_tin(
     e: f64,
     raster: &Raster,
 ) -> Result<(ContourMesh, String, Vec<f64>)> {
-    let grid = &raster.grid;
+    let grid = &raster.samples;
     if let Some(path) = &args.mesh {
-        let georef = Georef::new(raster.info.transform(), args.pixel_coords);
+        let georef = Placement::new(raster.info.transform(), args.pixel_coords);
         let format = crate::mesh_file::mesh_format(path, args.mesh_format)?;
         let mesh = mesh_from_file(path, format, raster, georef, args.band)?;
         let levels = levels_for(args, mesh.height_range())?;
@@ -334,6 +335,7 @@ fn untiled_tin(
         return Ok((mesh, "full grid".to_owned(), levels));
     }
     let options = DecimationOptions::new(e).with_contour_levels(&levels);
+    let grid = &Grid::from_samples(grid.clone());
     let tin = decimate(grid, &options).naming_file(&args.input)?.tin;
     let vertices = tin
         .vertices()
@@ -511,10 +513,10 @@ fn mesh_from_file(
     path: &Path,
     format: tinsmith_export::MeshFormat,
     raster: &Raster,
-    georef: Georef,
+    georef: Placement,
     band: usize,
 ) -> Result<ContourMesh> {
-    let grid: &Grid = &raster.grid;
+    let grid: &Samples = &raster.samples;
     let file = read_mesh_file(path, format, raster, georef)?;
     let (lo, hi) = file
         .vertices
@@ -612,7 +614,7 @@ fn mesh_from_file(
                 } else {
                     ""
                 },
-                if matches!(georef, Georef::Pixel) {
+                if matches!(georef, Placement::Pixel) {
                     " (or was it written without --pixel-coords?)"
                 } else {
                     " (or was it written with --pixel-coords?)"

@@ -15,7 +15,6 @@ macro_rules! note {
 mod args;
 mod contour;
 mod export;
-mod georef;
 mod info;
 mod memory;
 mod mesh;
@@ -27,6 +26,7 @@ mod report;
 mod serve;
 mod terrain;
 mod tiled;
+mod transform_check;
 mod verify;
 mod wgs84;
 

@@ -5,12 +5,12 @@ use std::time::Instant;
 
 use anyhow::{bail, Result};
 use serde::Serialize;
-use tinsmith_core::decimate_with_progress;
+use tinsmith_core::{decimate_with_progress, Grid};
 use tinsmith_export::MeshFormat;
+use tinsmith_georef::Placement;
 use tinsmith_verify::{GridRef, VerifyOptions};
 
 use crate::args::MeshArgs;
-use crate::georef::Georef;
 use crate::output::NamingFile;
 use crate::output::{check_distinct, check_writable_target, ReservedReport};
 use crate::report::{MeshSummary, Outcome, Seconds};
@@ -69,10 +69,10 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let reserved = reserve_report(args, Some((output, format)))?;
 
     let t = Instant::now();
-    let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
+    let raster = tinsmith_raster::read_samples(&args.input, args.band)?;
     let read_seconds = t.elapsed().as_secs_f64();
     crate::output::note_gcps_unused(&raster.info, args.pixel_coords, args.quiet);
-    let grid = &raster.grid;
+    let grid = &Grid::from_samples(raster.samples);
     if grid.valid_cell_count() == 0 {
         bail!(
             "{}: band {} has no 2x2 block of valid samples, so there is nothing to triangulate",
@@ -103,7 +103,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let tin = &result.tin;
 
     // The promise is checked, independently, before anything is written.
-    let georef = Georef::new(raster.info.transform(), args.pixel_coords);
+    let georef = Placement::new(raster.info.transform(), args.pixel_coords);
     let t = Instant::now();
     let positions: Vec<[i64; 2]> = tin
         .vertices()

@@ -16,7 +16,6 @@ use tinsmith_tile::{
 };
 
 use crate::args::{MeshArgs, TileFormatArg};
-use crate::georef::Georef;
 use crate::output::NamingFile;
 use crate::report::{MeshSummary, Outcome, Seconds};
 
@@ -43,7 +42,7 @@ pub fn untiled_output(args: &MeshArgs) -> Result<Option<&Path>> {
             .filter(|_| info.transform().is_some());
         crate::output::check_sidecar(output, &args.input, format, crs_wkt)?;
     }
-    crate::georef::check_transform(reader.info(), args.pixel_coords)?;
+    crate::transform_check::check_transform(reader.info(), args.pixel_coords)?;
     crate::export::check_float32_positions(format, reader.info(), args)?;
     let fits = reader.width() <= args.tile_size && reader.height() <= args.tile_size;
     let count_target = args.max_triangles.is_some() || args.max_vertices.is_some();
@@ -133,7 +132,11 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
     let welded_format = match &args.output {
         Some(_) => Some(crate::export::format(args)?),
         None => {
-            crate::georef::check_input_transform(&args.input, args.band, args.pixel_coords)?;
+            crate::transform_check::check_input_transform(
+                &args.input,
+                args.band,
+                args.pixel_coords,
+            )?;
             None
         }
     };
@@ -197,7 +200,7 @@ pub fn run(args: &MeshArgs) -> Result<bool> {
             )?;
             let t = Instant::now();
             let (vertices, triangles) = collector.into_parts();
-            let georef = Georef::new(info.transform(), args.pixel_coords);
+            let georef = Placement::new(info.transform(), args.pixel_coords);
             let (vertices, triangles) = georef.file_mesh(
                 vertices.iter().map(|&[x, y, z]| (x as u32, y as u32, z)),
                 triangles,

@@ -1,10 +1,10 @@
 //! `tinsmith verify`: measure a mesh file's true error against its raster.
 
 use anyhow::{Context, Result};
+use tinsmith_georef::Placement;
 use tinsmith_verify::{GridRef, MeshRef, Report, VerifyOptions};
 
 use crate::args::VerifyArgs;
-use crate::georef::Georef;
 use crate::mesh_file::{
     expected_orientation, mesh_format, orient_polygon_triangles, read_mesh_file, sample_positions,
 };
@@ -23,16 +23,16 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
         "verify",
         "verification has no tiled mode; use a machine with more memory",
     )?;
-    let raster = tinsmith_raster::read_grid(&args.input, args.band)?;
-    crate::georef::check_transform(&raster.info, args.pixel_coords)?;
-    let georef = Georef::new(raster.info.transform(), args.pixel_coords);
+    let raster = tinsmith_raster::read_samples(&args.input, args.band)?;
+    crate::transform_check::check_transform(&raster.info, args.pixel_coords)?;
+    let georef = Placement::new(raster.info.transform(), args.pixel_coords);
     let mesh = read_mesh_file(&args.mesh, format, &raster, georef)?;
     let positions = sample_positions(&args.mesh, &mesh, format, &raster, georef)?;
     let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();
     let orientation = expected_orientation(&georef);
     let mut triangles = mesh.triangles;
     orient_polygon_triangles(format, &positions, &mut triangles, orientation);
-    let grid = &raster.grid;
+    let grid = &raster.samples;
     let mut options = VerifyOptions::new().with_orientation(orientation);
     if let Some(e) = args.max_error {
         options = options.with_max_error(e);

@@ -49,5 +49,26 @@ pub enum Error {
     InvalidMaxError(f64),
 }
 
+impl From<tinsmith_georef::SamplesError> for Error {
+    /// The same refusal, as [`Error::GridSize`] or [`Error::GridTooLarge`].
+    fn from(e: tinsmith_georef::SamplesError) -> Error {
+        use tinsmith_georef::SamplesError;
+        match e {
+            SamplesError::Size {
+                width,
+                height,
+                expected,
+                actual,
+            } => Error::GridSize {
+                width,
+                height,
+                expected,
+                actual,
+            },
+            SamplesError::TooLarge { width, height } => Error::GridTooLarge { width, height },
+        }
+    }
+}
+
 /// Result of the core's fallible functions.
 pub type Result<T> = std::result::Result<T, Error>;

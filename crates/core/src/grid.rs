@@ -2,19 +2,22 @@
 
 use std::sync::Arc;
 
-use crate::{Error, Result};
+use tinsmith_georef::Samples;
+
+use crate::Result;
 
 /// A `width` x `height` grid of samples in row-major order (row 0 first).
 ///
 /// Sample `(x, y)` (column, row) sits at integer position `(x, y)`. A sample is *valid* when
 /// it is finite; NaN and infinities mark nodata. A *cell* is the unit square with corners
 /// `(x, y)`..`(x + 1, y + 1)`; it belongs to the domain when its four corners are valid.
+///
+/// A grid is [`Samples`] plus what the decimator precomputes from them (the largest
+/// |value|, whether heights are integers, runs of equal samples, flat blocks).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Grid {
-    width: u32,
-    height: u32,
     /// Shared, so that a grid with raised heights is no copy of the samples.
-    values: Arc<Vec<f64>>,
+    samples: Arc<Samples>,
     /// Largest absolute valid value (0 without valid samples).
     max_abs: f64,
     /// See [`Grid::integral_heights`].
@@ -53,20 +56,16 @@ const INTEGRAL_PRODUCT_LIMIT: f64 = (1u64 << 50) as f64;
 
 impl Grid {
     /// Wraps row-major `values`; fails if `values.len() != width * height`, if either
-    /// dimension is zero, or if the grid has 2^32 samples or more.
+    /// dimension is zero ([`crate::Error::GridSize`]), or if the grid has 2^32 - 1 samples
+    /// or more ([`crate::Error::GridTooLarge`]).
     pub fn new(width: u32, height: u32, values: Vec<f64>) -> Result<Grid> {
-        let expected = width as usize * height as usize;
-        if width == 0 || height == 0 || values.len() != expected {
-            return Err(Error::GridSize {
-                width,
-                height,
-                expected,
-                actual: values.len(),
-            });
-        }
-        if expected as u64 >= u32::MAX as u64 {
-            return Err(Error::GridTooLarge { width, height });
-        }
+        Ok(Grid::from_samples(Samples::new(width, height, values)?))
+    }
+
+    /// The grid of `samples` (which [`Samples::new`] has already checked), with the
+    /// decimator's precomputed data built from them; the samples are kept, not copied.
+    pub fn from_samples(samples: Samples) -> Grid {
+        let (width, height, values) = (samples.width(), samples.height(), samples.values());
         let (max_abs, integers) = values
             .iter()
             .filter(|v| v.is_finite())
@@ -74,21 +73,19 @@ impl Grid {
                 (m.max(v.abs()), integers && v.fract() == 0.0)
             });
         let integral_heights = integers && Grid::integral_product_fits(width, height, max_abs);
-        let equal_runs = equal_runs(width as usize, &values);
+        let equal_runs = equal_runs(width as usize, values);
         let flat_blocks = match &equal_runs {
-            Some(runs) => flat_levels(width as usize, height as usize, &values, runs),
+            Some(runs) => flat_levels(width as usize, height as usize, values, runs),
             None => Vec::new(),
         };
-        Ok(Grid {
-            width,
-            height,
-            values: Arc::new(values),
+        Grid {
+            samples: Arc::new(samples),
             max_abs,
             integral_heights,
             equal_runs: equal_runs.map(Arc::new),
             flat_blocks: Arc::new(flat_blocks),
             raise: 0.0,
-        })
+        }
     }
 
     /// The grid with its vertices `raise` above their samples ([`Grid::vertex_height`]),
@@ -106,17 +103,18 @@ impl Grid {
     /// The height of a TIN vertex at sample `i` (row-major): the sample's value, or that
     /// raised on a grid [`Grid::with_raised_heights`] made.
     pub(crate) fn vertex_height(&self, i: usize) -> f64 {
-        let w = self.width as usize;
+        let w = self.width() as usize;
         self.vertex_height_at(i, i % w, i / w)
     }
 
     /// [`Grid::vertex_height`] of sample `i`, which is at column `x`, row `y`.
     pub(crate) fn vertex_height_at(&self, i: usize, x: usize, y: usize) -> f64 {
-        let inner = x > 0 && y > 0 && x + 1 < self.width as usize && y + 1 < self.height as usize;
+        let (width, height) = (self.width() as usize, self.height() as usize);
+        let inner = x > 0 && y > 0 && x + 1 < width && y + 1 < height;
         if self.raise != 0.0 && inner {
-            self.values[i] + self.raise
+            self.values()[i] + self.raise
         } else {
-            self.values[i]
+            self.values()[i]
         }
     }
 
@@ -172,51 +170,38 @@ impl Grid {
 
     /// Number of columns.
     pub fn width(&self) -> u32 {
-        self.width
+        self.samples.width()
     }
 
     /// Number of rows.
     pub fn height(&self) -> u32 {
-        self.height
+        self.samples.height()
     }
 
     /// All samples, row-major; nodata samples are non-finite.
     pub fn values(&self) -> &[f64] {
-        &self.values
+        self.samples.values()
     }
 
     /// The value at column `x`, row `y`, or `None` when it is nodata or out of range.
     pub fn get(&self, x: u32, y: u32) -> Option<f64> {
-        if x >= self.width || y >= self.height {
-            return None;
-        }
-        let v = self.values[y as usize * self.width as usize + x as usize];
-        v.is_finite().then_some(v)
+        self.samples.get(x, y)
     }
 
     /// Number of valid (finite) samples.
     pub fn valid_count(&self) -> usize {
-        self.values.iter().filter(|v| v.is_finite()).count()
+        self.samples.valid_count()
     }
 
     /// Number of cells whose four corners are valid: the domain's area in cell units.
     pub fn valid_cell_count(&self) -> usize {
-        let w = self.width as usize;
-        let mut n = 0;
-        for y in 0..self.height as usize - 1 {
-            for x in 0..w - 1 {
-                if self.cell_is_valid(x, y) {
-                    n += 1;
-                }
-            }
-        }
-        n
+        self.samples.valid_cell_count()
     }
 
     /// Number of samples that are a corner of at least one valid cell: the vertices of
     /// the full mesh.
     pub fn domain_sample_count(&self) -> usize {
-        let (w, h) = (self.width as usize, self.height as usize);
+        let (w, h) = (self.width() as usize, self.height() as usize);
         let cell = |x: usize, y: usize| x < w - 1 && y < h - 1 && self.cell_is_valid(x, y);
         let mut n = 0;
         for y in 0..h {
@@ -232,12 +217,7 @@ impl Grid {
     }
 
     pub(crate) fn cell_is_valid(&self, x: usize, y: usize) -> bool {
-        let w = self.width as usize;
-        let i = y * w + x;
-        self.values[i].is_finite()
-            && self.values[i + 1].is_finite()
-            && self.values[i + w].is_finite()
-            && self.values[i + w + 1].is_finite()
+        self.samples.cell_is_valid(x, y)
     }
 
     /// Largest absolute valid value (0 for a grid without valid samples): what

@@ -32,7 +32,6 @@ mod error_bound;
 mod exact;
 mod extend;
 mod flips;
-mod geo_transform;
 mod grid;
 mod hole;
 mod levels;
@@ -49,7 +48,6 @@ pub use decimate::{
 };
 pub use error::{Error, Result};
 pub use error_bound::ErrorBound;
-pub use geo_transform::GeoTransform;
 pub use grid::Grid;
 pub use mesh::VertexClass;
 pub use options::{

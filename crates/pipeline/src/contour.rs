@@ -34,7 +34,6 @@ use tinsmith_raster::{Raster, RasterInfo};
 use tinsmith_tile::{mesh_tiles, FinishedTile, RasterSource, SinkError, TileOptions, TileSink};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
-use crate::georef::Georef;
 use crate::jobs::ContourJob;
 use crate::mesh_file::{expected_orientation, read_mesh_file, sample_positions};
 use crate::number::readable;
@@ -42,6 +41,7 @@ use crate::output::NamingFile;
 use crate::output::{check_distinct, check_writable_target};
 use crate::wgs84::{file_crs, LineEnd, Pieces};
 use crate::Feedback;
+use tinsmith_georef::{Placement, Samples};
 
 /// Memory per line segment while contouring and writing: its point in the joiner, the
 /// polyline and the file coordinates (measured about 50 bytes on ETOPO5).
@@ -67,7 +67,8 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
         check_distinct(mesh, &job.output, "the --mesh input")?;
     }
     let e = job.max_error.unwrap_or(0.0);
-    let size = crate::georef::check_input_transform(&job.input, job.band, job.pixel_coords)?;
+    let size =
+        crate::transform_check::check_input_transform(&job.input, job.band, job.pixel_coords)?;
     let tiled = job.mesh.is_none() && e > 0.0 && (size.0 > job.tile_size || size.1 > job.tile_size);
     // A TIN decimated here is shaped for the levels (fewer segments, same bound), so they
     // come from the raster's height range first; a --mesh file's come from its own heights.
@@ -110,7 +111,7 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
             }
         };
         crate::memory::check_whole_raster_fits(&job.input, size, need, what, instead)?;
-        let raster = tinsmith_raster::read_grid(&job.input, job.band)?;
+        let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
         let (mesh, source, levels) = untiled_tin(job, e, &raster)?;
         // The lines are held whole before writing: refuse levels that would not fit.
         let segments = mesh.segment_count(&levels);
@@ -135,7 +136,7 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
         };
         (contoured, raster.info, source, levels)
     };
-    let georef = Georef::new(info.transform(), job.pixel_coords);
+    let georef = Placement::new(info.transform(), job.pixel_coords);
     crate::output::note_gcps_unused(&info, job.pixel_coords, feedback);
     let polylines = contoured.lines;
 
@@ -316,9 +317,9 @@ fn untiled_tin(
     e: f64,
     raster: &Raster,
 ) -> Result<(ContourMesh, String, Vec<f64>)> {
-    let grid = &raster.grid;
+    let grid = &raster.samples;
     if let Some(path) = &job.mesh {
-        let georef = Georef::new(raster.info.transform(), job.pixel_coords);
+        let georef = Placement::new(raster.info.transform(), job.pixel_coords);
         let format = crate::mesh_file::mesh_format(path, job.mesh_format)?;
         let mesh = mesh_from_file(path, format, raster, georef, job.band)?;
         let levels = levels_for(job, mesh.height_range())?;
@@ -334,6 +335,7 @@ fn untiled_tin(
         return Ok((mesh, "full grid".to_owned(), levels));
     }
     let options = DecimationOptions::new(e).with_contour_levels(&levels);
+    let grid = &Grid::from_samples(grid.clone());
     let tin = decimate(grid, &options).naming_file(&job.input)?.tin;
     let vertices = tin
         .vertices()
@@ -510,10 +512,10 @@ fn mesh_from_file(
     path: &Path,
     format: tinsmith_export::MeshFormat,
     raster: &Raster,
-    georef: Georef,
+    georef: Placement,
     band: usize,
 ) -> Result<ContourMesh> {
-    let grid: &Grid = &raster.grid;
+    let grid: &Samples = &raster.samples;
     let file = read_mesh_file(path, format, raster, georef)?;
     let (lo, hi) = file
         .vertices
@@ -611,7 +613,7 @@ fn mesh_from_file(
                 } else {
                     ""
                 },
-                if matches!(georef, Georef::Pixel) {
+                if matches!(georef, Placement::Pixel) {
                     " (or was it written without --pixel-coords?)"
                 } else {
                     " (or was it written with --pixel-coords?)"

@@ -10,7 +10,6 @@ use tinsmith_core::Grid;
 use tinsmith_export::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
 use tinsmith_raster::RasterInfo;
 
-use crate::georef::Georef;
 use crate::jobs::MeshJob;
 use crate::number::readable;
 use crate::output::NamingFile;
@@ -19,6 +18,7 @@ use crate::wgs84::{
     is_geographic, projected_crs, snap_to_antimeridian, Pieces,
 };
 use crate::Feedback;
+use tinsmith_georef::Placement;
 
 /// Largest rounding of a float32 position, in pixels, accepted before decimating: 90 % of
 /// the 1e-3 pixel within which the verifier maps file positions to samples. Half a float32
@@ -140,7 +140,7 @@ impl FormatPlan {
                 );
             }
         }
-        let georef = Georef::new(info.transform(), job.pixel_coords);
+        let georef = Placement::new(info.transform(), job.pixel_coords);
         note_degrees_in_a_3d_format(info, &georef, job, feedback)?;
         let (min, max) = extent(info, &georef);
         let origin = LocalOrigin::around(min, max);
@@ -230,14 +230,14 @@ pub fn check_float32_positions(format: MeshFormat, info: &RasterInfo, job: &Mesh
     if !format.is_float32() {
         return Ok(());
     }
-    let georef = Georef::new(info.transform(), job.pixel_coords);
+    let georef = Placement::new(info.transform(), job.pixel_coords);
     let (min, max) = extent(info, &georef);
     let origin = LocalOrigin::around(min, max);
     check_position_rounding(info, &georef, origin, min, max, out(job))
 }
 
 /// Min and max of the raster's file coordinates (sample centres) and valid heights.
-fn extent(info: &RasterInfo, georef: &Georef) -> ([f64; 3], [f64; 3]) {
+fn extent(info: &RasterInfo, georef: &Placement) -> ([f64; 3], [f64; 3]) {
     let (w, h) = (info.width.saturating_sub(1), info.height.saturating_sub(1));
     let mut min = [f64::INFINITY; 3];
     let mut max = [f64::NEG_INFINITY; 3];
@@ -259,7 +259,7 @@ fn extent(info: &RasterInfo, georef: &Georef) -> ([f64; 3], [f64; 3]) {
 /// offset, plus the `f64` roundings, in pixels through the inverse geotransform).
 fn check_position_rounding(
     info: &RasterInfo,
-    georef: &Georef,
+    georef: &Placement,
     origin: LocalOrigin,
     min: [f64; 3],
     max: [f64; 3],
@@ -274,8 +274,8 @@ fn check_position_rounding(
     }
     // Pixels per world unit: the inverse geotransform's largest row sum.
     let per_unit = match georef {
-        Georef::Pixel => 1.0,
-        Georef::World(t) => {
+        Placement::Pixel => 1.0,
+        Placement::World(t) => {
             let c = &t.0;
             let det = (c[1] * c[5] - c[2] * c[4]).abs();
             ((c[5].abs() + c[2].abs()).max(c[4].abs() + c[1].abs())) / det
@@ -354,11 +354,11 @@ pub fn write(
 /// raster, but drawn stretched by about 100,000 vertically.
 fn note_degrees_in_a_3d_format(
     info: &RasterInfo,
-    georef: &Georef,
+    georef: &Placement,
     job: &MeshJob,
     feedback: &dyn Feedback,
 ) -> Result<()> {
-    let Georef::World(_) = georef else {
+    let Placement::World(_) = georef else {
         return Ok(());
     };
     let geographic = match info.crs_wkt.as_deref() {
@@ -404,10 +404,10 @@ fn check_positions_map_back(
     info: &RasterInfo,
     job: &MeshJob,
 ) -> Result<()> {
-    let georef = Georef::new(info.transform(), job.pixel_coords);
+    let georef = Placement::new(info.transform(), job.pixel_coords);
     for (i, &v) in vertices.iter().enumerate() {
         let q = origin.quantize(v);
-        let tolerance = crate::georef::F32_SAMPLE_TOLERANCE;
+        let tolerance = tinsmith_georef::F32_SAMPLE_TOLERANCE;
         georef.sample_at([q[0], q[1]], tolerance).with_context(|| {
             format!(
                 "{}: vertex {i} would not map back to its sample in float32; nothing written",

@@ -28,7 +28,7 @@
 mod contour;
 mod feedback;
 mod format_plan;
-mod georef;
+
 mod jobs;
 mod memory;
 mod mesh;
@@ -40,6 +40,7 @@ mod report;
 mod serve;
 mod tiled_mesh;
 mod tiles;
+mod transform_check;
 mod verify;
 mod wgs84;
 

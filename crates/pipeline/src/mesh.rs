@@ -5,16 +5,16 @@ use std::time::Instant;
 
 use anyhow::{bail, Result};
 use serde::Serialize;
-use tinsmith_core::decimate_with_progress;
+use tinsmith_core::{decimate_with_progress, Grid};
 use tinsmith_export::MeshFormat;
 use tinsmith_verify::{GridRef, VerifyOptions};
 
-use crate::georef::Georef;
 use crate::jobs::MeshJob;
 use crate::output::NamingFile;
 use crate::output::{check_distinct, check_writable_target, ReservedReport};
 use crate::report::{MeshSummary, Outcome, Seconds};
 use crate::Feedback;
+use tinsmith_georef::Placement;
 
 /// The `--report` JSON.
 #[derive(Debug, Serialize)]
@@ -71,10 +71,10 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let reserved = reserve_report(job, Some((output, format)))?;
 
     let t = Instant::now();
-    let raster = tinsmith_raster::read_grid(&job.input, job.band)?;
+    let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
     let read_seconds = t.elapsed().as_secs_f64();
     crate::output::note_gcps_unused(&raster.info, job.pixel_coords, feedback);
-    let grid = &raster.grid;
+    let grid = &Grid::from_samples(raster.samples);
     if grid.valid_cell_count() == 0 {
         bail!(
             "{}: band {} has no 2x2 block of valid samples, so there is nothing to triangulate",
@@ -105,7 +105,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let tin = &result.tin;
 
     // The promise is checked, independently, before anything is written.
-    let georef = Georef::new(raster.info.transform(), job.pixel_coords);
+    let georef = Placement::new(raster.info.transform(), job.pixel_coords);
     let t = Instant::now();
     let positions: Vec<[i64; 2]> = tin
         .vertices()

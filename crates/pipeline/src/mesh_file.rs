@@ -7,10 +7,9 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use tinsmith_export::{Mesh, MeshFormat};
+use tinsmith_georef::Placement;
 use tinsmith_raster::Raster;
 use tinsmith_verify::Orientation;
-
-use crate::georef::Georef;
 
 /// Reads a mesh file written from `raster` in its file coordinates: RFC 7946 GeoJSON
 /// (WGS84 longitude, latitude) is transformed back to the raster's CRS.
@@ -21,7 +20,7 @@ pub fn read_mesh_file(
     path: &Path,
     format: MeshFormat,
     raster: &Raster,
-    georef: Georef,
+    georef: Placement,
 ) -> Result<Mesh> {
     let mut mesh = tinsmith_export::read_mesh_as(path, format)?;
     let polygons = is_polygon_format(format);
@@ -36,7 +35,7 @@ pub fn read_mesh_file(
     {
         mesh.epsg = Some(4326);
     }
-    if let (Some(4326), Georef::World(transform), Some(wkt)) =
+    if let (Some(4326), Placement::World(transform), Some(wkt)) =
         (mesh.epsg, georef, raster.info.crs_wkt.as_deref())
     {
         if transformed_from_wgs84(&mesh, raster, georef) {
@@ -67,7 +66,7 @@ pub fn sample_positions(
     mesh: &Mesh,
     format: MeshFormat,
     raster: &Raster,
-    georef: Georef,
+    georef: Placement,
 ) -> Result<Vec<[i64; 2]>> {
     let tolerance = position_tolerance(format, mesh, raster, georef);
     // Other tools rewrite RFC 7946 GeoJSON with 7 decimals (ogr2ogr's default), about
@@ -103,8 +102,13 @@ pub fn sample_positions(
 /// centre: the rounding of float32 positions for STL and glTF, of the transforms for a
 /// GeoJSON file in WGS84 read back into a projected raster's CRS, else of `f64`. A vertex
 /// further off is not taken for its sample: verify measures the mesh as written.
-pub fn position_tolerance(format: MeshFormat, mesh: &Mesh, raster: &Raster, georef: Georef) -> f64 {
-    use crate::georef::{F32_SAMPLE_TOLERANCE, F64_SAMPLE_TOLERANCE, WGS84_SAMPLE_TOLERANCE};
+pub fn position_tolerance(
+    format: MeshFormat,
+    mesh: &Mesh,
+    raster: &Raster,
+    georef: Placement,
+) -> f64 {
+    use tinsmith_georef::{F32_SAMPLE_TOLERANCE, F64_SAMPLE_TOLERANCE, WGS84_SAMPLE_TOLERANCE};
     if format.is_float32() {
         F32_SAMPLE_TOLERANCE
     } else if transformed_from_wgs84(mesh, raster, georef) {
@@ -117,9 +121,9 @@ pub fn position_tolerance(format: MeshFormat, mesh: &Mesh, raster: &Raster, geor
 /// Whether [`read_mesh_file`] transforms `mesh`'s vertices from WGS84 into the raster's
 /// CRS: a WGS84 mesh, world coordinates, and a raster with a CRS of its own other than
 /// EPSG:4326.
-fn transformed_from_wgs84(mesh: &Mesh, raster: &Raster, georef: Georef) -> bool {
+fn transformed_from_wgs84(mesh: &Mesh, raster: &Raster, georef: Placement) -> bool {
     mesh.epsg == Some(4326)
-        && matches!(georef, Georef::World(_))
+        && matches!(georef, Placement::World(_))
         && raster.info.epsg != Some(4326)
         && raster.info.crs_wkt.is_some()
 }
@@ -132,7 +136,7 @@ fn transformed_from_wgs84(mesh: &Mesh, raster: &Raster, georef: Georef) -> bool 
 /// stays within the raster (the east edge of a grid whose first and last columns are the
 /// same meridian), the counter-clockwise one spanning the fewest degrees; corners are then
 /// welded again by position.
-fn into_raster_frame(mesh: &mut Mesh, raster: &Raster, transform: tinsmith_core::GeoTransform) {
+fn into_raster_frame(mesh: &mut Mesh, raster: &Raster, transform: tinsmith_georef::GeoTransform) {
     let (w, h) = (f64::from(raster.info.width), f64::from(raster.info.height));
     let xs: Vec<f64> = [
         (-0.5, -0.5),
@@ -261,7 +265,7 @@ pub fn orient_polygon_triangles(
 
 /// Mesh files hold triangles counter-clockwise in file coordinates (normals up), which is
 /// clockwise in grid coordinates when the georeference flips orientation.
-pub fn expected_orientation(georef: &Georef) -> Orientation {
+pub fn expected_orientation(georef: &Placement) -> Orientation {
     if georef.flips_orientation() {
         Orientation::Clockwise
     } else {

@@ -9,15 +9,15 @@ use anyhow::{bail, Result};
 use serde::Serialize;
 use tinsmith_export::MeshFormat;
 use tinsmith_tile::{
-    mesh_tiles, MeshCollector, PerTileWriter, Placement, RasterSource, TileOptions, TilePlan,
-    TileProgress, TilesReport, WeldedWriter,
+    mesh_tiles, MeshCollector, PerTileWriter, RasterSource, TileOptions, TilePlan, TileProgress,
+    TilesReport, WeldedWriter,
 };
 
-use crate::georef::Georef;
 use crate::jobs::{MeshJob, TileFormat};
 use crate::output::NamingFile;
 use crate::report::{MeshSummary, Outcome, Seconds};
 use crate::Feedback;
+use tinsmith_georef::Placement;
 
 /// The output file when the untiled engine should run: no `--per-tile`, and the raster
 /// fits in one tile or a triangle or vertex count is the target (which needs the whole
@@ -42,7 +42,7 @@ pub fn untiled_output(job: &MeshJob) -> Result<Option<&Path>> {
             .filter(|_| info.transform().is_some());
         crate::output::check_sidecar(output, &job.input, format, crs_wkt)?;
     }
-    crate::georef::check_transform(reader.info(), job.pixel_coords)?;
+    crate::transform_check::check_transform(reader.info(), job.pixel_coords)?;
     crate::format_plan::check_float32_positions(format, reader.info(), job)?;
     let fits = reader.width() <= job.tile_size && reader.height() <= job.tile_size;
     let count_target = job.max_triangles.is_some() || job.max_vertices.is_some();
@@ -132,7 +132,7 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let welded_format = match &job.output {
         Some(_) => Some(crate::format_plan::format(job)?),
         None => {
-            crate::georef::check_input_transform(&job.input, job.band, job.pixel_coords)?;
+            crate::transform_check::check_input_transform(&job.input, job.band, job.pixel_coords)?;
             None
         }
     };
@@ -196,7 +196,7 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
             )?;
             let t = Instant::now();
             let (vertices, triangles) = collector.into_parts();
-            let georef = Georef::new(info.transform(), job.pixel_coords);
+            let georef = Placement::new(info.transform(), job.pixel_coords);
             let (vertices, triangles) = georef.file_mesh(
                 vertices.iter().map(|&[x, y, z]| (x as u32, y as u32, z)),
                 triangles,

@@ -3,11 +3,11 @@
 use anyhow::Context;
 use tinsmith_verify::{GridRef, MeshRef, Report, VerifyOptions};
 
-use crate::georef::Georef;
 use crate::mesh_file::{
     expected_orientation, mesh_format, orient_polygon_triangles, read_mesh_file, sample_positions,
 };
 use crate::{Result, VerifyJob};
+use tinsmith_georef::Placement;
 
 /// What [`verify`] measured, with what the caller needs to explain a failure.
 #[derive(Debug)]
@@ -36,16 +36,16 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
         "verify",
         "verification has no tiled mode; use a machine with more memory",
     )?;
-    let raster = tinsmith_raster::read_grid(&job.input, job.band)?;
-    crate::georef::check_transform(&raster.info, job.pixel_coords)?;
-    let georef = Georef::new(raster.info.transform(), job.pixel_coords);
+    let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
+    crate::transform_check::check_transform(&raster.info, job.pixel_coords)?;
+    let georef = Placement::new(raster.info.transform(), job.pixel_coords);
     let mesh = read_mesh_file(&job.mesh, format, &raster, georef)?;
     let positions = sample_positions(&job.mesh, &mesh, format, &raster, georef)?;
     let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();
     let orientation = expected_orientation(&georef);
     let mut triangles = mesh.triangles;
     orient_polygon_triangles(format, &positions, &mut triangles, orientation);
-    let grid = &raster.grid;
+    let grid = &raster.samples;
     let mut options = VerifyOptions::new().with_orientation(orientation);
     if let Some(e) = job.max_error {
         options = options.with_max_error(e);

@@ -183,7 +183,7 @@ pub fn check_wgs84_mesh_possible(info: &RasterInfo, path: &Path) -> Result<()> {
 
 /// The raster's CRS (WKT) and geotransform when it is georeferenced in a projected CRS
 /// (not EPSG:4326 or another geographic one): whose positions WGS84 GeoJSON reprojects.
-pub fn projected_crs(info: &RasterInfo) -> Result<Option<(&str, tinsmith_core::GeoTransform)>> {
+pub fn projected_crs(info: &RasterInfo) -> Result<Option<(&str, tinsmith_georef::GeoTransform)>> {
     let (Some(wkt), Some(transform)) = (info.crs_wkt.as_deref(), info.transform()) else {
         return Ok(None);
     };
@@ -211,7 +211,7 @@ fn pole_message(pole: &str) -> String {
 pub fn check_wgs84_maps_back(
     world: &[[f64; 3]],
     lon_lat: &[[f64; 3]],
-    (wkt, transform): (&str, tinsmith_core::GeoTransform),
+    (wkt, transform): (&str, tinsmith_georef::GeoTransform),
     path: &Path,
 ) -> Result<()> {
     let mut back = lon_lat.to_vec();

@@ -91,7 +91,7 @@ pub enum Error {
         /// GDAL's name of the band's data type.
         data_type: String,
     },
-    /// The raster has more samples than a [`tinsmith_core::Grid`] can hold.
+    /// The raster has more samples than one [`tinsmith_georef::Samples`] can hold.
     #[error(
         "{}: {width}x{height} samples is too large for one grid (at most 2^32-2 samples)",
         path.display()
@@ -188,16 +188,16 @@ pub enum Error {
         /// Its coordinates before the transformation.
         position: [f64; 3],
     },
-    /// The core refused the grid (a dimension of zero, or too many samples).
+    /// The samples read cannot form a grid (a dimension of zero, or too many samples).
     #[error("{}: band {band} cannot become a grid", path.display())]
     Grid {
         /// The file.
         path: PathBuf,
         /// The 1-based band.
         band: usize,
-        /// The core's reason.
+        /// Why ([`tinsmith_georef::Samples::new`]'s reason, worded as the core words it).
         #[source]
-        source: tinsmith_core::Error,
+        source: tinsmith_georef::SamplesError,
     },
 }
 

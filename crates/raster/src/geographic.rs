@@ -173,7 +173,7 @@ fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
             hint,
         });
     };
-    if tinsmith_core::GeoTransform(gt).is_singular() {
+    if tinsmith_georef::GeoTransform(gt).is_singular() {
         return Err(Error::NotGeoreferenced {
             path: path.to_path_buf(),
             missing: "a singular geotransform (a pixel size of 0: every sample at one place)",

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use tinsmith_core::{GeoTransform, Grid};
+use tinsmith_georef::{GeoTransform, Samples};
 
 /// Metadata of one band of a raster file, plus statistics over its samples.
 ///
@@ -70,7 +70,7 @@ pub struct RasterInfo {
 }
 
 impl RasterInfo {
-    /// The geotransform as the core's type, if the dataset has one.
+    /// The geotransform as [`GeoTransform`], if the dataset has one.
     pub fn transform(&self) -> Option<GeoTransform> {
         self.geo_transform.map(GeoTransform)
     }
@@ -87,13 +87,13 @@ impl RasterInfo {
     }
 }
 
-/// A band read into a [`Grid`] (nodata as NaN), with its [`RasterInfo`].
+/// A band read into [`Samples`] (nodata as NaN), with its [`RasterInfo`].
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct Raster {
-    /// The band's heights, row 0 first; nodata samples are NaN.
-    pub grid: Grid,
-    /// What was read, with statistics matching `grid`.
+    /// The band's heights, row 0 first; nodata samples are NaN, all others finite.
+    pub samples: Samples,
+    /// What was read, with statistics matching `samples`.
     pub info: RasterInfo,
 }
 

@@ -1,13 +1,14 @@
-//! Reads one band of any raster GDAL can open into a [`tinsmith_core::Grid`] of heights.
+//! Reads one band of any raster GDAL can open into [`tinsmith_georef::Samples`] of
+//! heights: plain data, from which the decimation core builds its grid.
 //!
-//! [`read_grid`] returns the grid (nodata as NaN) with a [`RasterInfo`]: driver, size, data
+//! [`read_samples`] returns the samples (nodata as NaN) with a [`RasterInfo`]: driver, size, data
 //! type, nodata value, CRS (WKT and EPSG code), geotransform and statistics of the samples.
 //! [`open_info`] gives the same [`RasterInfo`] without keeping the samples.
 //! [`to_wgs84`] and [`from_wgs84`] transform coordinates between a CRS and WGS84
 //! longitude, latitude (for RFC 7946 GeoJSON), so that no other crate links GDAL.
 //! [`open_info`] gives the same [`RasterInfo`] without keeping the samples. For rasters
 //! too large for one grid, [`WindowReader`] (or [`read_window`]) reads a rectangle at a
-//! time, decoded exactly as [`read_grid`] decodes the whole band, and
+//! time, decoded exactly as [`read_samples`] decodes the whole band, and
 //! [`RasterInfo::max_abs_value`] of [`open_info`] gives the raster-wide largest |height|.
 //!
 //! # What callers can rely on
@@ -17,7 +18,7 @@
 //!   (a `-3.4e38` declared in text matches the `f32` stored in the pixels) and floats within
 //!   GDAL's own tolerance, as `gdalinfo -stats` counts them; integer bands match a nodata
 //!   value only when it is an integer the type can hold (any other matches nothing).
-//!   Nodata samples are NaN in the grid; all other samples are finite.
+//!   Nodata samples are NaN in the samples; all other samples are finite.
 //! - **Heights.** Valid samples are mapped through the band's scale and offset when it has
 //!   them, so every height is in the band's real unit.
 //! - **Geotransform.** `None` when the dataset has none (GDAL reports an identity default
@@ -25,7 +26,7 @@
 //! - **Errors.** Every [`Error`] message starts with the path and names the problem: a
 //!   missing file, a file no GDAL raster driver can read, a band out of range, a
 //!   non-real-valued band, a raster too large for one grid, a failed read, or a band with
-//!   no valid sample ([`read_grid`] only). GDAL's explanation, when it gave one, is part of
+//!   no valid sample ([`read_samples`] only). GDAL's explanation, when it gave one, is part of
 //!   the message (without its repetition of the path), and GDAL's error is kept as the
 //!   [`std::error::Error::source`].
 //! - **Threads.** Each call opens its own GDAL dataset and closes it before returning, so
@@ -40,13 +41,13 @@
 //! use std::path::Path;
 //!
 //! # fn main() -> Result<(), tinsmith_raster::Error> {
-//! let raster = tinsmith_raster::read_grid(Path::new("tests/fixtures/landlab_hugo_site.asc"), 1)?;
+//! let raster = tinsmith_raster::read_samples(Path::new("tests/fixtures/landlab_hugo_site.asc"), 1)?;
 //! let info = &raster.info;
 //! println!(
 //!     "{}: {}x{} {} ({} valid samples, heights {:?}..{:?})",
 //!     info.driver, info.width, info.height, info.data_type, info.valid_samples, info.min, info.max
 //! );
-//! assert_eq!(raster.grid.valid_count() as u64, info.valid_samples);
+//! assert_eq!(raster.samples.valid_count() as u64, info.valid_samples);
 //! # Ok(())
 //! # }
 //! ```
@@ -74,6 +75,6 @@ pub use geographic::{
 };
 pub use info::{Raster, RasterInfo};
 pub use quiet::silence_gdal_errors;
-pub use read::{open_info, open_info_with_progress, read_grid};
+pub use read::{open_info, open_info_with_progress, read_samples};
 pub use reproject::{from_wgs84, is_geographic, is_wgs84_lon_lat, same_crs, to_wgs84};
 pub use window::{read_window, WindowReader};

@@ -6,7 +6,7 @@ use std::path::Path;
 use gdal::raster::{ColorInterpretation, RasterBand};
 use gdal::spatial_ref::SpatialRef;
 use gdal::{Dataset, DatasetOptions, GdalOpenFlags, Metadata};
-use tinsmith_core::Grid;
+use tinsmith_georef::Samples;
 
 use crate::decode::{SampleDecoder, SampleType, Stats};
 use crate::error::{gdal_reason, Error, Result};
@@ -19,7 +19,7 @@ const STRIP_SAMPLES: usize = 1 << 20;
 /// statistics of its samples (valid and nodata counts, min and max).
 ///
 /// Reads the whole band, one strip of rows at a time, but keeps no samples: this works for
-/// rasters too large for a [`Grid`]. A band without any valid sample is not an error here
+/// rasters too large for one [`Samples`]. A band without any valid sample is not an error here
 /// (`valid_samples == 0`, `min` and `max` are `None`).
 ///
 /// # Errors
@@ -53,7 +53,7 @@ pub fn open_info_with_progress(
     Ok(opened.finish(stats))
 }
 
-/// Reads band `band` (1-based) of the raster at `path` into a [`Grid`] of heights.
+/// Reads band `band` (1-based) of the raster at `path` into [`Samples`] of heights.
 ///
 /// Every sample type GDAL has for real numbers is accepted (Byte, Int8, UInt16, Int16,
 /// UInt32, Int32, UInt64, Int64, Float32, Float64; 64-bit integers beyond 2^53 lose
@@ -62,12 +62,12 @@ pub fn open_info_with_progress(
 /// rounded to `f32` first (so `-3.4e38` declared in text matches the stored `f32`), an integer
 /// band's is rounded to the nearest integer and matches nothing when the type cannot hold it.
 /// Valid samples are mapped through the band's scale and offset, if any. GDAL mask bands
-/// are not consulted. The returned [`RasterInfo`] has the statistics of the grid.
+/// are not consulted. The returned [`RasterInfo`] has the statistics of the samples.
 ///
 /// # Errors
 /// As [`open_info`], plus [`Error::TooLarge`] (checked before any sample is read) and
 /// [`Error::AllNodata`] when no sample is valid.
-pub fn read_grid(path: &Path, band: usize) -> Result<Raster> {
+pub fn read_samples(path: &Path, band: usize) -> Result<Raster> {
     let opened = OpenBand::open(path, band)?;
     let (width, height) = (opened.info.width, opened.info.height);
     let samples = width as u64 * height as u64;
@@ -92,13 +92,13 @@ pub fn read_grid(path: &Path, band: usize) -> Result<Raster> {
             band,
         });
     }
-    let grid = Grid::new(width, height, values).map_err(|source| Error::Grid {
+    let samples = Samples::new(width, height, values).map_err(|source| Error::Grid {
         path: path.to_path_buf(),
         band,
         source,
     })?;
     Ok(Raster {
-        grid,
+        samples,
         info: opened.finish(stats),
     })
 }

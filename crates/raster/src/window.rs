@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use tinsmith_core::Grid;
+use tinsmith_georef::Samples;
 
 use crate::error::{Error, Result};
 use crate::info::RasterInfo;
@@ -10,11 +10,11 @@ use crate::read::OpenBand;
 
 /// One band of a raster kept open for reading windows of it, one after another.
 ///
-/// The samples of a window are decoded exactly as [`crate::read_grid`] decodes the whole
-/// band (the same nodata rule in the band's own type, NaN and infinities as nodata, scale
-/// and offset applied), so a window of the grid `read_grid` returns and the grid
-/// [`WindowReader::read_window`] returns for the same rectangle are equal sample for
-/// sample.
+/// The samples of a window are decoded exactly as [`crate::read_samples`] decodes the
+/// whole band (the same nodata rule in the band's own type, NaN and infinities as nodata,
+/// scale and offset applied), so a window of the samples `read_samples` returns and the
+/// samples [`WindowReader::read_window`] returns for the same rectangle are equal sample
+/// for sample.
 ///
 /// # Threads
 /// A reader owns a GDAL dataset, which may be moved to another thread but not shared
@@ -74,7 +74,7 @@ impl WindowReader {
     }
 
     /// Reads the `width` x `height` samples whose top-left sample is column `x0`, row `y0`
-    /// into a [`Grid`] (row 0 of the grid is row `y0` of the raster; nodata as NaN).
+    /// into [`Samples`] (their row 0 is row `y0` of the raster; nodata as NaN).
     ///
     /// A window without any valid sample is not an error: every sample is NaN.
     ///
@@ -82,7 +82,7 @@ impl WindowReader {
     /// [`Error::WindowOutOfRange`] when the window is empty or not inside the raster,
     /// [`Error::TooLarge`] when it has 2^32 - 1 samples or more, [`Error::Read`] when GDAL
     /// fails.
-    pub fn read_window(&self, x0: u32, y0: u32, width: u32, height: u32) -> Result<Grid> {
+    pub fn read_window(&self, x0: u32, y0: u32, width: u32, height: u32) -> Result<Samples> {
         let info = &self.opened.info;
         let inside = |start: u32, len: u32, total: u32| {
             len > 0 && start.checked_add(len).is_some_and(|end| end <= total)
@@ -114,7 +114,7 @@ impl WindowReader {
             (width as usize, height as usize),
             &mut values,
         )?;
-        Grid::new(width, height, values).map_err(|source| Error::Grid {
+        Samples::new(width, height, values).map_err(|source| Error::Grid {
             path: info.path.clone(),
             band: info.band,
             source,
@@ -161,6 +161,6 @@ pub fn read_window(
     y0: u32,
     width: u32,
     height: u32,
-) -> Result<Grid> {
+) -> Result<Samples> {
     WindowReader::open(path, band)?.read_window(x0, y0, width, height)
 }

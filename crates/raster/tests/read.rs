@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use gdal::raster::{Buffer, GdalType, RasterCreationOptions};
 use gdal::{Dataset, DriverManager};
-use tinsmith_raster::{open_info, read_grid, Error, RasterInfo};
+use tinsmith_raster::{open_info, read_samples, Error, RasterInfo};
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -140,7 +140,7 @@ fn check_stats(info: &RasterInfo, valid: u64, nodata: u64, min: f64, max: f64) {
 #[test]
 fn hugo_site_esri_ascii_int_with_minus_9999() {
     let path = fixture("landlab_hugo_site.asc");
-    let raster = read_grid(&path, 1).expect("read hugo_site");
+    let raster = read_samples(&path, 1).expect("read hugo_site");
     let info = &raster.info;
     assert_eq!(info.driver, "AAIGrid");
     assert_eq!((info.width, info.height), (76, 55));
@@ -156,7 +156,7 @@ fn hugo_site_esri_ascii_int_with_minus_9999() {
     assert_eq!(info.epsg, None);
     check_stats(info, 76 * 55 - 2028, 2028, 1660.0, 1711.0);
 
-    let grid = &raster.grid;
+    let grid = &raster.samples;
     assert_eq!((grid.width(), grid.height()), (76, 55));
     assert_eq!(grid.valid_count(), 76 * 55 - 2028);
     assert_eq!(grid.values().iter().filter(|v| v.is_nan()).count(), 2028);
@@ -210,7 +210,7 @@ fn info_serialises_to_json_with_stable_field_names() {
 #[test]
 fn west_bijou_gully_float_esri_ascii_with_zero_nodata() {
     let path = fixture("landlab_west_bijou_gully.asc");
-    let raster = read_grid(&path, 1).expect("read west_bijou_gully");
+    let raster = read_samples(&path, 1).expect("read west_bijou_gully");
     let info = &raster.info;
     assert_eq!((info.width, info.height), (43, 89));
     assert_eq!(info.data_type, "Float32");
@@ -226,7 +226,7 @@ fn west_bijou_gully_float_esri_ascii_with_zero_nodata() {
     );
     check_stats(info, 43 * 89 - 2739, 2739, min, max);
     assert!(raster
-        .grid
+        .samples
         .values()
         .iter()
         .all(|v| v.is_nan() || *v > 1000.0));
@@ -235,7 +235,7 @@ fn west_bijou_gully_float_esri_ascii_with_zero_nodata() {
 #[test]
 fn tin_terrain_geotiff_float32_with_flt_max_nodata_and_epsg_3857() {
     let path = fixture("tintn_valid_raster_3857.tif");
-    let raster = read_grid(&path, 1).expect("read valid_raster");
+    let raster = read_samples(&path, 1).expect("read valid_raster");
     let info = &raster.info;
     assert_eq!(info.driver, "GTiff");
     assert_eq!((info.width, info.height), (100, 80));
@@ -255,7 +255,7 @@ fn tin_terrain_geotiff_float32_with_flt_max_nodata_and_epsg_3857() {
     // gdal_translate -of XYZ with 10 decimals, rounded to the band's Float32.
     assert_eq!(info.min, Some(f32_text("26.5792274475")));
     assert_eq!(info.max, Some(f32_text("44.0725631714")));
-    assert_eq!(raster.grid.valid_count(), 8000 - 970);
+    assert_eq!(raster.samples.valid_count(), 8000 - 970);
 }
 
 #[test]
@@ -295,14 +295,14 @@ fn int16_with_minus_32768_nodata() {
         ..Spec::new(10, 6, values)
     };
     let path = spec.tif(&dir.path().join("i16.tif"));
-    let raster = read_grid(&path, 1).expect("read");
+    let raster = read_samples(&path, 1).expect("read");
     assert_eq!(raster.info.data_type, "Int16");
     assert_eq!(raster.info.nodata, Some(-32768.0));
     check_stats(&raster.info, 57, 3, -190.0, 380.0);
-    assert_eq!(raster.grid.get(1, 0), Some(-190.0));
-    assert_eq!(raster.grid.get(7, 0), None);
-    assert_eq!(raster.grid.get(9, 5), None);
-    assert_eq!(raster.grid.get(8, 5), Some(380.0));
+    assert_eq!(raster.samples.get(1, 0), Some(-190.0));
+    assert_eq!(raster.samples.get(7, 0), None);
+    assert_eq!(raster.samples.get(9, 5), None);
+    assert_eq!(raster.samples.get(8, 5), Some(380.0));
 }
 
 #[test]
@@ -331,11 +331,11 @@ fn float32_with_minus_3_4e38_declared_as_f64_like_vinschgau() {
     let text = "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -3.4e38\n\
                 388.5 -3.4e38 400\n-3.4e38 500.25 3863\n";
     fs::write(&path, text).expect("write asc");
-    let raster = read_grid(&path, 1).expect("read");
+    let raster = read_samples(&path, 1).expect("read");
     assert_eq!(raster.info.data_type, "Float32");
     assert_eq!(raster.info.nodata.map(|v| v as f32), Some(nd));
     check_stats(&raster.info, 4, 2, 388.5, 3863.0);
-    assert_eq!(raster.grid.valid_count(), 4);
+    assert_eq!(raster.samples.valid_count(), 4);
 
     // GDAL's GTiff driver itself stores a Float32 band's nodata rounded to f32: also matched.
     let mut values: Vec<f32> = (0..48).map(|i| 388.0 + i as f32 * 72.5).collect();
@@ -350,8 +350,8 @@ fn float32_with_minus_3_4e38_declared_as_f64_like_vinschgau() {
     let info = open_info(&path, 1).expect("info");
     assert_eq!(info.nodata.map(|v| v as f32), Some(nd));
     check_stats(&info, 44, 4, 388.0, 388.0 + 47.0 * 72.5);
-    let raster = read_grid(&path, 1).expect("read");
-    assert_eq!(raster.grid.valid_count(), 44);
+    let raster = read_samples(&path, 1).expect("read");
+    assert_eq!(raster.samples.valid_count(), 44);
     assert_eq!(raster.info, info);
 }
 
@@ -443,10 +443,10 @@ fn signed_byte_reads_negative_heights() {
         ..Spec::new(3, 2, values)
     };
     let path = spec.tif(&dir.path().join("i8.tif"));
-    let raster = read_grid(&path, 1).expect("read");
+    let raster = read_samples(&path, 1).expect("read");
     assert_eq!(raster.info.data_type, "Int8");
     check_stats(&raster.info, 4, 2, -1.0, 127.0);
-    assert_eq!(raster.grid.get(1, 0), Some(-1.0));
+    assert_eq!(raster.samples.get(1, 0), Some(-1.0));
 }
 
 #[test]
@@ -457,12 +457,12 @@ fn float64_with_nan_and_no_declared_nodata() {
     values[3] = f64::INFINITY;
     values[19] = f64::NAN;
     let path = Spec::new(5, 4, values).tif(&dir.path().join("f64.tif"));
-    let raster = read_grid(&path, 1).expect("read");
+    let raster = read_samples(&path, 1).expect("read");
     assert_eq!(raster.info.data_type, "Float64");
     assert_eq!(raster.info.nodata, None);
     check_stats(&raster.info, 17, 3, -1.0, 3.5);
     assert!(
-        raster.grid.values()[3].is_nan(),
+        raster.samples.values()[3].is_nan(),
         "infinity becomes NaN in the grid"
     );
 }
@@ -505,11 +505,11 @@ fn alpha_band_zeros_are_nodata_whatever_its_type() {
         (int16.tif(&dir.path().join("i16.tif")), "alpha band 2"),
         (byte.tif(&dir.path().join("u8.tif")), "alpha band"),
     ] {
-        let raster = read_grid(&path, 1).expect("read");
+        let raster = read_samples(&path, 1).expect("read");
         assert_eq!(raster.info.mask.as_deref(), Some(kind), "{path:?}");
         check_stats(&raster.info, 4, 2, 10.0, 15.0);
-        assert!(raster.grid.get(1, 0).is_none() && raster.grid.get(1, 1).is_none());
-        assert_eq!(raster.grid.get(0, 1), Some(13.0));
+        assert!(raster.samples.get(1, 0).is_none() && raster.samples.get(1, 1).is_none());
+        assert_eq!(raster.samples.get(0, 1), Some(13.0));
         assert_eq!(&open_info(&path, 1).expect("info"), &raster.info);
     }
 }
@@ -534,10 +534,10 @@ fn per_dataset_mask_zeros_are_nodata() {
         let mut buf = Buffer::new((3, 2), vec![255u8, 255, 0, 255, 255, 255]);
         mask.write((0, 0), (3, 2), &mut buf).expect("write mask");
     }
-    let raster = read_grid(&path, 1).expect("read");
+    let raster = read_samples(&path, 1).expect("read");
     assert_eq!(raster.info.mask.as_deref(), Some("per-dataset mask"));
     check_stats(&raster.info, 5, 1, 1.0, 6.0);
-    assert!(raster.grid.get(2, 0).is_none());
+    assert!(raster.samples.get(2, 0).is_none());
 }
 
 #[test]
@@ -569,7 +569,7 @@ fn scale_and_offset_give_real_heights() {
 }
 
 #[test]
-fn all_nodata_is_an_error_for_read_grid_only() {
+fn all_nodata_is_an_error_for_read_samples_only() {
     let dir = tempdir();
     let spec = Spec {
         nodata: Some(-9999.0),
@@ -580,7 +580,7 @@ fn all_nodata_is_an_error_for_read_grid_only() {
     assert_eq!((info.valid_samples, info.nodata_samples), (0, 9));
     assert_eq!((info.min, info.max), (None, None));
 
-    let (err, text) = err_text(read_grid(&path, 1));
+    let (err, text) = err_text(read_samples(&path, 1));
     assert!(matches!(err, Error::AllNodata { band: 1, .. }), "{err:?}");
     assert_eq!(
         text,
@@ -600,14 +600,14 @@ fn band_selection_reads_the_chosen_band() {
         ..Spec::new(2, 2, vec![])
     };
     let path = spec.tif(&dir.path().join("three.tif"));
-    let second = read_grid(&path, 2).expect("band 2");
+    let second = read_samples(&path, 2).expect("band 2");
     assert_eq!((second.info.band, second.info.band_count), (2, 3));
     check_stats(&second.info, 3, 1, 10.0, 40.0);
-    assert_eq!(second.grid.get(1, 1), Some(40.0));
+    assert_eq!(second.samples.get(1, 1), Some(40.0));
     check_stats(&open_info(&path, 3).expect("band 3"), 4, 0, 7.0, 7.0);
 
     for band in [0, 4] {
-        let (err, text) = err_text(read_grid(&path, band));
+        let (err, text) = err_text(read_samples(&path, band));
         assert!(
             matches!(err, Error::BandOutOfRange { count: 3, .. }),
             "{err:?}"
@@ -654,7 +654,10 @@ fn geotransform_present_absent_and_rotated() {
     let path = spec.tif(&dir.path().join("rotated_gt.tif"));
     let info = open_info(&path, 1).expect("info");
     assert_eq!(info.geo_transform, Some(rotated));
-    assert_eq!(info.transform(), Some(tinsmith_core::GeoTransform(rotated)));
+    assert_eq!(
+        info.transform(),
+        Some(tinsmith_georef::GeoTransform(rotated))
+    );
 }
 
 #[test]
@@ -720,7 +723,7 @@ fn png_8_and_16_bit_greyscale_are_rasters() {
         ..Spec::new(8, 8, values)
     };
     let path = spec.png(&dir.path().join("grey8.png"));
-    let raster = read_grid(&path, 1).expect("8-bit PNG");
+    let raster = read_samples(&path, 1).expect("8-bit PNG");
     assert_eq!(raster.info.driver, "PNG");
     assert_eq!(raster.info.data_type, "Byte");
     assert_eq!(
@@ -736,11 +739,11 @@ fn png_8_and_16_bit_greyscale_are_rasters() {
         ..Spec::new(16, 4, values)
     };
     let path = spec.png(&dir.path().join("grey16.png"));
-    let raster = read_grid(&path, 1).expect("16-bit PNG");
+    let raster = read_samples(&path, 1).expect("16-bit PNG");
     assert_eq!(raster.info.data_type, "UInt16");
     assert_eq!((raster.info.width, raster.info.height), (16, 4));
     check_stats(&raster.info, 64, 0, 3.0, 63003.0);
-    assert_eq!(raster.grid.get(15, 3), Some(63003.0));
+    assert_eq!(raster.samples.get(15, 3), Some(63003.0));
 }
 
 #[test]
@@ -763,12 +766,12 @@ fn strips_cover_a_raster_taller_than_one_read() {
         ..Spec::new(w, h, values.clone())
     };
     let path = spec.tif(&dir.path().join("big.tif"));
-    let raster = read_grid(&path, 1).expect("read");
+    let raster = read_samples(&path, 1).expect("read");
     check_stats(&raster.info, (w * h) as u64 - nodata, nodata, 0.0, 4999.0);
     let last = (w * h - 1) as f64 % 5000.0;
-    assert_eq!(raster.grid.get(w as u32 - 1, h as u32 - 1), Some(last));
-    assert_eq!(raster.grid.get(0, 0), None);
-    assert_eq!(raster.grid.get(1, 0), Some(1.0));
+    assert_eq!(raster.samples.get(w as u32 - 1, h as u32 - 1), Some(last));
+    assert_eq!(raster.samples.get(0, 0), None);
+    assert_eq!(raster.samples.get(1, 0), Some(1.0));
 }
 
 // ---------------------------------------------------------------------------------------
@@ -778,7 +781,7 @@ fn strips_cover_a_raster_taller_than_one_read() {
 fn missing_file() {
     let dir = tempdir();
     let path = dir.path().join("absent.tif");
-    let (err, text) = err_text(read_grid(&path, 1));
+    let (err, text) = err_text(read_samples(&path, 1));
     assert!(matches!(err, Error::NotFound { .. }), "{err:?}");
     assert_eq!(text, format!("{}: no such file", path.display()));
     let path = dir.path().join("absent_dir/dem.asc");
@@ -791,7 +794,7 @@ fn missing_file() {
 fn assert_not_a_raster(path: &Path, reason_start: &str) {
     for result in [
         open_info(path, 1).map(|_| ()),
-        read_grid(path, 1).map(|_| ()),
+        read_samples(path, 1).map(|_| ()),
     ] {
         let (err, text) = err_text(result);
         assert!(
@@ -851,7 +854,7 @@ fn truncated_esri_ascii_fails_cleanly() {
     let path = dir.path().join("truncated.asc");
     fs::write(&path, &full[..full.len() / 2]).expect("write");
     // The header is intact, so the file opens; reading runs out of lines.
-    let (err, text) = err_text(read_grid(&path, 1));
+    let (err, text) = err_text(read_samples(&path, 1));
     assert!(matches!(err, Error::Read { band: 1, .. }), "{err:?}");
     let prefix = format!("{}: reading band 1 failed (", path.display());
     assert!(text.starts_with(&prefix), "{text}");
@@ -875,7 +878,7 @@ fn read_failure_names_file_and_band() {
     let path = dir.path().join("dangling.vrt");
     fs::write(&path, vrt(&src, "Float32", "", "")).expect("write vrt");
     fs::remove_file(&src).expect("remove source");
-    let (err, text) = err_text(read_grid(&path, 1));
+    let (err, text) = err_text(read_samples(&path, 1));
     assert!(matches!(err, Error::Read { band: 1, .. }), "{err:?}");
     let prefix = format!("{}: reading band 1 failed (", path.display());
     assert!(text.starts_with(&prefix), "{text}");
@@ -907,10 +910,10 @@ fn vrt_nodata_scale_and_offset_are_honoured() {
     let path = dir.path().join("scaled.vrt");
     let extra = "\n    <NoDataValue>-5</NoDataValue><Offset>1000</Offset><Scale>0.1</Scale>";
     fs::write(&path, vrt(&src, "Int16", "", extra)).expect("write vrt");
-    let raster = read_grid(&path, 1).expect("read");
+    let raster = read_samples(&path, 1).expect("read");
     assert_eq!(raster.info.nodata, Some(-5.0));
     assert_eq!(raster.info.valid_samples, 3);
-    let v = raster.grid.get(1, 0).expect("valid");
+    let v = raster.samples.get(1, 0).expect("valid");
     assert!((v - 1001.0).abs() < 1e-9, "{v}");
     assert!((raster.info.max.expect("max") - 1003.0).abs() < 1e-9);
 }

@@ -1,12 +1,12 @@
 //! Windowed reads decode exactly as whole-band reads: every window of the committed
-//! fixtures equals the same rectangle of `read_grid`'s grid, sample for sample (NaN for
-//! nodata), and bad windows are errors naming the file.
+//! fixtures equals the same rectangle of `read_samples`'s samples, sample for sample (NaN
+//! for nodata), and bad windows are errors naming the file.
 
 use std::path::{Path, PathBuf};
 
 use gdal::raster::{Buffer, RasterCreationOptions};
 use gdal::DriverManager;
-use tinsmith_raster::{open_info, read_grid, read_window, Error, WindowReader};
+use tinsmith_raster::{open_info, read_samples, read_window, Error, WindowReader};
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -36,8 +36,8 @@ fn windows_equal_the_whole_band_read() {
         "tintn_valid_raster_3857.tif",
     ] {
         let path = fixture(name);
-        let whole = read_grid(&path, 1).expect("read_grid");
-        let (width, height) = (whole.grid.width(), whole.grid.height());
+        let whole = read_samples(&path, 1).expect("read_samples");
+        let (width, height) = (whole.samples.width(), whole.samples.height());
         let reader = WindowReader::open(&path, 1).expect("open");
         assert_eq!((reader.width(), reader.height()), (width, height));
         assert_eq!(reader.info().valid_samples, 0, "no statistics on open");
@@ -52,7 +52,7 @@ fn windows_equal_the_whole_band_read() {
         for (x0, y0, w, h) in windows {
             let grid = reader.read_window(x0, y0, w, h).expect("window");
             assert_eq!((grid.width(), grid.height()), (w, h));
-            let expected = crop(whole.grid.values(), width, x0, y0, w, h);
+            let expected = crop(whole.samples.values(), width, x0, y0, w, h);
             assert_eq!(
                 bits(grid.values()),
                 bits(&expected),
@@ -62,7 +62,7 @@ fn windows_equal_the_whole_band_read() {
         let one = read_window(&path, 1, 1, 2, 3, 4).expect("read_window");
         assert_eq!(
             bits(one.values()),
-            bits(&crop(whole.grid.values(), width, 1, 2, 3, 4))
+            bits(&crop(whole.samples.values(), width, 1, 2, 3, 4))
         );
     }
 }

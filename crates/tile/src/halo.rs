@@ -2,6 +2,7 @@
 //! need the cells just outside it.
 
 use tinsmith_core::Grid;
+use tinsmith_georef::Samples;
 
 use crate::edge::EdgeProfile;
 use crate::plan::{TileIndex, TilePlan, TileWindow};
@@ -45,7 +46,7 @@ impl TileInput {
     pub(crate) fn cut(
         plan: &TilePlan,
         index: TileIndex,
-        halo: &Grid,
+        halo: &Samples,
         halo_window: TileWindow,
     ) -> TileInput {
         let window = plan.window(index);
@@ -90,7 +91,7 @@ impl TileInput {
 
 /// Raster-coordinate access to a halo read.
 struct HaloView<'a> {
-    grid: &'a Grid,
+    grid: &'a Samples,
     window: TileWindow,
     raster_width: u32,
     raster_height: u32,
@@ -167,12 +168,12 @@ mod tests {
         Grid::new(w, h, values.map(|(x, y)| f(x, y)).collect()).expect("grid")
     }
 
-    fn crop(g: &Grid, t: TileWindow) -> Grid {
+    fn crop(g: &Grid, t: TileWindow) -> Samples {
         let values = (t.y0..=t.y1())
             .flat_map(|y| (t.x0..=t.x1()).map(move |x| (x, y)))
             .map(|(x, y)| g.values()[(y * g.width() + x) as usize])
             .collect();
-        Grid::new(t.width, t.height, values).expect("crop")
+        Samples::new(t.width, t.height, values).expect("crop")
     }
 
     fn inputs(g: &Grid, size: u32) -> (TilePlan, Vec<TileInput>) {

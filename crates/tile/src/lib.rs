@@ -47,7 +47,6 @@ mod error;
 mod halo;
 mod order;
 mod per_tile;
-mod placement;
 mod plan;
 mod sink;
 mod source;
@@ -60,7 +59,6 @@ pub use edge::{edge_limit, edge_span, EdgeProfile};
 pub use engine::{mesh_tiles, TileOptions, TileProgress, TilesReport, DEFAULT_TILE_SIZE};
 pub use error::{Error, Result};
 pub use per_tile::PerTileWriter;
-pub use placement::Placement;
 pub use plan::{TileIndex, TilePlan, TileWindow};
 pub use sink::{FinishedTile, SinkError, TileSink};
 pub use source::{GridSource, RasterSource, ReadError, TileSource, WindowRead};
@@ -68,4 +66,5 @@ pub use terrain::{
     build_terrain, streaming_bytes, tile_rectangle, LevelReport, TerrainError, TerrainOptions,
     TerrainReport, TerrainResult, LEVEL_ZERO_ERROR, MAX_LEVEL, METADATA_AVAILABILITY, TILE_CELLS,
 };
+pub use tinsmith_georef::Placement;
 pub use welded::WeldedWriter;

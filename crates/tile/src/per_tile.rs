@@ -6,9 +6,9 @@ use tinsmith_export::{write_mesh, MeshFormat, MeshRef};
 use tinsmith_output::StagedDir;
 
 use crate::error::{Error, Result};
-use crate::placement::Placement;
 use crate::plan::TileIndex;
 use crate::sink::{FinishedTile, SinkError, TileSink};
+use tinsmith_georef::Placement;
 
 /// Writes each tile as its own mesh file, [`PerTileWriter::file_name`], into a directory.
 ///
@@ -102,7 +102,7 @@ impl TileSink for PerTileWriter {
     fn tile(&mut self, tile: &FinishedTile) -> std::result::Result<(), SinkError> {
         self.vertices.clear();
         self.vertices.extend(tile.vertices().iter().map(|v| {
-            let [x, y] = self.placement.position(v.x, v.y);
+            let [x, y] = self.placement.file_position(v.x, v.y);
             [x, y, v.z]
         }));
         self.triangles.clear();

@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use tinsmith_core::Grid;
+use tinsmith_georef::Samples;
 use tinsmith_raster::{RasterInfo, WindowReader};
 
 use crate::error::{Error, Result};
@@ -59,12 +60,12 @@ pub trait WindowRead {
         y0: u32,
         width: u32,
         height: u32,
-    ) -> std::result::Result<Grid, ReadError>;
+    ) -> std::result::Result<Samples, ReadError>;
 }
 
 /// One band of a raster file, read through GDAL, a window at a time.
 ///
-/// Samples are decoded as `tinsmith_raster::read_grid` decodes them (nodata compared in
+/// Samples are decoded as `tinsmith_raster::read_samples` decodes them (nodata compared in
 /// the band's own type, NaN and infinities as nodata, scale and offset applied).
 #[derive(Debug, Clone)]
 pub struct RasterSource {
@@ -148,7 +149,7 @@ impl WindowRead for WindowReader {
         y0: u32,
         width: u32,
         height: u32,
-    ) -> std::result::Result<Grid, ReadError> {
+    ) -> std::result::Result<Samples, ReadError> {
         Ok(WindowReader::read_window(self, x0, y0, width, height)?)
     }
 }
@@ -214,7 +215,7 @@ impl WindowRead for GridSource<'_> {
         y0: u32,
         width: u32,
         height: u32,
-    ) -> std::result::Result<Grid, ReadError> {
+    ) -> std::result::Result<Samples, ReadError> {
         let w = self.grid.width();
         if x0 + width > w || y0 + height > self.grid.height() {
             return Err(
@@ -229,6 +230,6 @@ impl WindowRead for GridSource<'_> {
                     .copied()
             })
             .collect();
-        Ok(Grid::new(width, height, values)?)
+        Ok(Samples::new(width, height, values)?)
     }
 }

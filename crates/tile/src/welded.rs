@@ -5,8 +5,8 @@ use std::path::Path;
 use tinsmith_export::{MeshFormat, MeshStreamWriter};
 
 use crate::error::Result;
-use crate::placement::Placement;
 use crate::sink::{FinishedTile, SinkError, TileSink};
+use tinsmith_georef::Placement;
 
 /// Writes the tiles of a run as one mesh file (PLY or OBJ), streamed: each tile's new
 /// vertices and its triangles are appended as the tile arrives, so memory does not grow
@@ -69,7 +69,7 @@ impl TileSink for WeldedWriter {
         tile.check_follows(self.stream.vertex_count())?;
         self.vertices.clear();
         self.vertices.extend(tile.new_vertices().map(|v| {
-            let [x, y] = self.placement.position(v.x, v.y);
+            let [x, y] = self.placement.file_position(v.x, v.y);
             [x, y, v.z]
         }));
         self.stream.write_vertices(&self.vertices)?;

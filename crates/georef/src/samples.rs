@@ -1,0 +1,165 @@
+//! A rectangle of raster samples as plain data: what ingestion hands out.
+
+/// A `width` x `height` block of samples: `values` in row-major order (row 0 first, then
+/// row 1, ...), so sample `(x, y)` (column, row) is `values[y * width + x]`.
+///
+/// NaN marks nodata; a raster reader hands out every other sample finite (any non-finite
+/// value is nodata to every consumer). [`Samples::new`] guarantees that both dimensions
+/// are at least 1, that there are exactly `width * height` values, and that there are
+/// fewer than 2^32 - 1 of them (so every sample has a `u32` index). Nothing else is
+/// computed or cached: building the decimator's grid from it is the core's business.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Samples {
+    width: u32,
+    height: u32,
+    values: Vec<f64>,
+}
+
+/// Why [`Samples::new`] refused its values; the messages name the grid the values were to
+/// form.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SamplesError {
+    /// The dimensions and the value count disagree, or a dimension is zero.
+    #[error("grid of {width}x{height} needs {expected} values, got {actual}")]
+    Size {
+        /// Columns.
+        width: u32,
+        /// Rows.
+        height: u32,
+        /// width * height.
+        expected: usize,
+        /// Values supplied.
+        actual: usize,
+    },
+    /// Too many samples to index with 32 bits (2^32 - 1 or more).
+    #[error("grid of {width}x{height} has more than 2^32-1 samples")]
+    TooLarge {
+        /// Columns.
+        width: u32,
+        /// Rows.
+        height: u32,
+    },
+}
+
+impl Samples {
+    /// Wraps row-major `values` (NaN = nodata); fails if `values.len() != width * height`,
+    /// if either dimension is zero ([`SamplesError::Size`]), or if there are 2^32 - 1
+    /// samples or more ([`SamplesError::TooLarge`]).
+    pub fn new(width: u32, height: u32, values: Vec<f64>) -> Result<Samples, SamplesError> {
+        let expected = width as usize * height as usize;
+        if width == 0 || height == 0 || values.len() != expected {
+            return Err(SamplesError::Size {
+                width,
+                height,
+                expected,
+                actual: values.len(),
+            });
+        }
+        if expected as u64 >= u32::MAX as u64 {
+            return Err(SamplesError::TooLarge { width, height });
+        }
+        Ok(Samples {
+            width,
+            height,
+            values,
+        })
+    }
+
+    /// Number of columns (at least 1).
+    #[inline]
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Number of rows (at least 1).
+    #[inline]
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// All `width * height` samples, row-major; nodata samples are NaN (non-finite).
+    #[inline]
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// The samples, row-major, given back without a copy.
+    pub fn into_values(self) -> Vec<f64> {
+        self.values
+    }
+
+    /// The value at column `x`, row `y`, or `None` when it is nodata or out of range.
+    #[inline]
+    pub fn get(&self, x: u32, y: u32) -> Option<f64> {
+        if x >= self.width || y >= self.height {
+            return None;
+        }
+        let v = self.values[y as usize * self.width as usize + x as usize];
+        v.is_finite().then_some(v)
+    }
+
+    /// Number of valid (finite) samples.
+    pub fn valid_count(&self) -> usize {
+        self.values.iter().filter(|v| v.is_finite()).count()
+    }
+
+    /// Number of cells whose four corners are valid: the area, in cells, that a TIN of
+    /// these samples can cover.
+    pub fn valid_cell_count(&self) -> usize {
+        let (w, h) = (self.width as usize, self.height as usize);
+        (0..h - 1)
+            .map(|y| (0..w - 1).filter(|&x| self.cell_is_valid(x, y)).count())
+            .sum()
+    }
+
+    /// Whether the cell with top-left sample `(x, y)` has four valid corners. Panics when
+    /// the cell is not inside the grid (`x + 1 < width`, `y + 1 < height`).
+    #[inline]
+    pub fn cell_is_valid(&self, x: usize, y: usize) -> bool {
+        let w = self.width as usize;
+        let i = y * w + x;
+        self.values[i].is_finite()
+            && self.values[i + 1].is_finite()
+            && self.values[i + w].is_finite()
+            && self.values[i + w + 1].is_finite()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_are_checked_as_the_core_checks_them() {
+        assert_eq!(
+            Samples::new(2, 3, vec![0.0; 5]).unwrap_err().to_string(),
+            "grid of 2x3 needs 6 values, got 5"
+        );
+        assert!(matches!(
+            Samples::new(0, 3, Vec::new()),
+            Err(SamplesError::Size { expected: 0, .. })
+        ));
+        assert_eq!(
+            SamplesError::TooLarge {
+                width: 65536,
+                height: 65536
+            }
+            .to_string(),
+            "grid of 65536x65536 has more than 2^32-1 samples"
+        );
+    }
+
+    #[test]
+    fn nodata_is_not_valid_and_breaks_cells() {
+        let nan = f64::NAN;
+        let s = Samples::new(3, 2, vec![1.0, 2.0, 3.0, 4.0, nan, 6.0]).unwrap();
+        assert_eq!(s.valid_count(), 5);
+        assert_eq!(s.valid_cell_count(), 0);
+        assert_eq!(s.get(2, 1), Some(6.0));
+        assert_eq!(s.get(1, 1), None);
+        assert_eq!(s.get(3, 0), None);
+        let s = Samples::new(3, 2, vec![1.0, 2.0, 3.0, 4.0, 5.0, nan]).unwrap();
+        assert_eq!(s.valid_cell_count(), 1);
+        assert!(s.cell_is_valid(0, 0) && !s.cell_is_valid(1, 0));
+    }
+}

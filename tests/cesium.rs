@@ -8,7 +8,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
-use crate::terrain::gdal_samples;
+use crate::tiles::gdal_samples;
 use crate::util::{fixture, serve, stderr, Dir};
 
 #[test]

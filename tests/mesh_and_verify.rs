@@ -465,7 +465,7 @@ fn max_edge_length_caps_every_edge_untiled_and_tiled() {
         let mut args = vec!["mesh", &dem, "-o", "m.ply", "--max-error", "20", "-q"];
         args.extend_from_slice(&extra);
         assert!(d.run(&args).status.success());
-        let mesh = tinsmith_export::read_mesh(&d.path("m.ply")).expect("mesh");
+        let mesh = tinsmith_formats::read_mesh(&d.path("m.ply")).expect("mesh");
         let longest = mesh
             .triangles
             .iter()

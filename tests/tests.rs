@@ -10,5 +10,5 @@ mod foreign;
 mod formats;
 mod mesh_and_verify;
 mod serve;
-mod terrain;
+mod tiled_mesh;
 mod tiles;

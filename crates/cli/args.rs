@@ -7,9 +7,9 @@ mod values;
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
-use tinsmith_export::MeshFormat;
+use tinsmith_formats::MeshFormat;
 use tinsmith_pipeline::{ServeOptions, VerifyJob};
-use tinsmith_tile::TerrainOptions;
+use tinsmith_terrain::TerrainOptions;
 
 pub use contour::ContourArgs;
 pub use mesh::MeshArgs;

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{ArgGroup, Args};
-use tinsmith_export::MeshFormat;
+use tinsmith_formats::MeshFormat;
 use tinsmith_pipeline::ContourJob;
 
 use super::{parse_finite, parse_interval, parse_max_error};

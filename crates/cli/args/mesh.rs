@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
-use tinsmith_export::MeshFormat;
+use tinsmith_formats::MeshFormat;
 use tinsmith_pipeline::{ExportChoices, MeshJob, TileFormat};
 
 use super::values::{

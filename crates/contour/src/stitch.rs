@@ -12,7 +12,7 @@ use crate::{levels::sorted_levels, ContourMesh, Error, Polyline, Result};
 /// neighbouring piece) rather than the mesh.
 ///
 /// Each piece is a [`ContourMesh`] with an id for each of its vertices; pieces meet where
-/// they share vertex ids, as the tiles of a welded mesh do (`tinsmith-tile` numbers a tile
+/// they share vertex ids, as the tiles of a welded mesh do (`tinsmith-tiling` numbers a tile
 /// edge's vertices once for both tiles). A line crossing from piece to piece is walked in
 /// each and its parts are joined through the edge, named by its two ids, where one part
 /// leaves and the next enters, in whatever order the pieces come.

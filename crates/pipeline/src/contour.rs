@@ -1,5 +1,5 @@
 //! `tinsmith contour`: contour lines of a raster's TIN (paper §5), written as GeoJSON or
-//! FlatGeobuf by [`tinsmith_export::write_lines`].
+//! FlatGeobuf by [`tinsmith_formats::write_lines`].
 //!
 //! The TIN is, in order of precedence: the mesh file given with `--mesh` (its vertices
 //! mapped back to grid samples as `tinsmith verify` does, its heights as written); the
@@ -29,9 +29,9 @@ use tinsmith_contour::{
     interval_levels, simplify_indices, sorted_levels, ContourMesh, ContourStitcher, Polyline,
 };
 use tinsmith_core::{decimate, DecimationOptions, Grid};
-use tinsmith_export::LineFormat;
+use tinsmith_formats::LineFormat;
 use tinsmith_raster::{Raster, RasterInfo};
-use tinsmith_tile::{mesh_tiles, FinishedTile, RasterSource, SinkError, TileOptions, TileSink};
+use tinsmith_tiling::{mesh_tiles, FinishedTile, RasterSource, SinkError, TileOptions, TileSink};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
 use crate::jobs::ContourJob;
@@ -200,7 +200,7 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
         // lines cut where they cross the antimeridian.
         let cut: Vec<(Vec<Vec<[f64; 2]>>, f64)> = lines
             .iter()
-            .map(|&(line, level)| (tinsmith_export::cut_at_antimeridian(line), level))
+            .map(|&(line, level)| (tinsmith_formats::cut_at_antimeridian(line), level))
             .filter(|(parts, _)| !parts.is_empty())
             .collect();
         let parts: Vec<Vec<&[[f64; 2]]>> = cut
@@ -213,9 +213,9 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
             .zip(&cut)
             .map(|(parts, &(_, level))| (parts.as_slice(), level))
             .collect();
-        tinsmith_export::write_multilines(&job.output, format, &lines, crs)?;
+        tinsmith_formats::write_multilines(&job.output, format, &lines, crs)?;
     } else {
-        tinsmith_export::write_lines(&job.output, format, &lines, crs)?;
+        tinsmith_formats::write_lines(&job.output, format, &lines, crs)?;
     }
     tinsmith_output::mark_finished();
 
@@ -396,7 +396,7 @@ fn tiled_lines(
         job,
     };
     feedback.tiles_start("tiles");
-    let mut progress = |p: tinsmith_tile::TileProgress| {
+    let mut progress = |p: tinsmith_tiling::TileProgress| {
         feedback.tiles_done(p.done as u64, p.total as u64);
     };
     let report = mesh_tiles(&source, &options, &mut sink, &mut progress);
@@ -510,7 +510,7 @@ fn nothing_to_contour(job: &ContourJob) -> anyhow::Error {
 /// raster's.
 fn mesh_from_file(
     path: &Path,
-    format: tinsmith_export::MeshFormat,
+    format: tinsmith_formats::MeshFormat,
     raster: &Raster,
     georef: Placement,
     band: usize,

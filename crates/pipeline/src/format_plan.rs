@@ -7,7 +7,7 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use tinsmith_core::Grid;
-use tinsmith_export::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
+use tinsmith_formats::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
 use tinsmith_raster::RasterInfo;
 
 use crate::jobs::MeshJob;
@@ -343,7 +343,7 @@ pub fn write(
     let mesh = MeshRef::new(&vertices, triangles)
         .with_crs_wkt(crs.wkt)
         .with_epsg(crs.epsg);
-    tinsmith_export::write_mesh_with(path, plan.format, mesh, &options)?;
+    tinsmith_formats::write_mesh_with(path, plan.format, mesh, &options)?;
     let crs_written = crs.wkt.is_some_and(|w| !w.trim().is_empty());
     crate::output::note_prj_left_beside(path, plan.format, crs_written, feedback);
     Ok(())

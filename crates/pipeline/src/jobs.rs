@@ -8,10 +8,10 @@ use tinsmith_core::{
     DecimationOptions, EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation,
     VertexHeights,
 };
-use tinsmith_export::MeshFormat;
+use tinsmith_formats::MeshFormat;
 
 /// Samples per tile side (shared row and column included) unless a job says otherwise.
-pub const DEFAULT_TILE_SIZE: u32 = tinsmith_tile::DEFAULT_TILE_SIZE;
+pub const DEFAULT_TILE_SIZE: u32 = tinsmith_tiling::DEFAULT_TILE_SIZE;
 
 /// A mesh run: read band `band` of `input`, decimate it within `max_error` (or to a
 /// count), verify the TIN independently and write it to `output` (one file) or

@@ -188,8 +188,8 @@ pub fn file_bytes(path: &Path) -> u64 {
 /// triangle.
 /// Each factor is the measured ratio rounded up, with room for files written more
 /// compactly than tinsmith writes them (OBJ).
-pub fn mesh_file_memory(path: &Path, format: tinsmith_export::MeshFormat) -> u64 {
-    use tinsmith_export::MeshFormat;
+pub fn mesh_file_memory(path: &Path, format: tinsmith_formats::MeshFormat) -> u64 {
+    use tinsmith_formats::MeshFormat;
     // Measured ratios: PLY 2.6, OBJ 1.36, STL 1.3, glTF 3.6, GeoJSON 0.23,
     // FlatGeobuf 0.32, LandXML 0.85.
     let (times, per) = match format {
@@ -244,7 +244,7 @@ mod tests {
     /// them, in every format.
     #[test]
     fn mesh_file_estimates_cover_the_measured_memory_per_triangle() {
-        use tinsmith_export::{MeshFormat, MeshRef};
+        use tinsmith_formats::{MeshFormat, MeshRef};
         // Over 65,536 vertices: glTF then stores 32-bit indices, as large meshes do.
         let n = 260u32;
         let vertices: Vec<[f64; 3]> = (0..n * n)
@@ -269,7 +269,7 @@ mod tests {
         for format in MeshFormat::ALL {
             let path = dir.path().join(format!("mesh.{}", format.extension()));
             let mesh = MeshRef::new(&vertices, &triangles);
-            tinsmith_export::write_mesh(&path, format, mesh).unwrap();
+            tinsmith_formats::write_mesh(&path, format, mesh).unwrap();
             let estimate = mesh_file_memory(&path, format);
             assert!(
                 estimate >= 65 * triangles.len() as u64,

@@ -6,7 +6,7 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 use serde::Serialize;
 use tinsmith_core::{decimate_with_progress, Grid};
-use tinsmith_export::MeshFormat;
+use tinsmith_formats::MeshFormat;
 use tinsmith_verify::{GridRef, VerifyOptions};
 
 use crate::jobs::MeshJob;

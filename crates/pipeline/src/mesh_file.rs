@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use tinsmith_export::{Mesh, MeshFormat};
+use tinsmith_formats::{Mesh, MeshFormat};
 use tinsmith_georef::Placement;
 use tinsmith_raster::Raster;
 use tinsmith_verify::Orientation;
@@ -22,7 +22,7 @@ pub fn read_mesh_file(
     raster: &Raster,
     georef: Placement,
 ) -> Result<Mesh> {
-    let mut mesh = tinsmith_export::read_mesh_as(path, format)?;
+    let mut mesh = tinsmith_formats::read_mesh_as(path, format)?;
     let polygons = is_polygon_format(format);
     // A GIS rewrite may keep WGS84 as WKT alone (a shapefile's GCS_WGS_1984).
     if polygons

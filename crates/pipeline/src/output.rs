@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
-use tinsmith_export::MeshFormat;
+use tinsmith_formats::MeshFormat;
 pub use tinsmith_output::{check_distinct, check_not_inside, ReservedReport};
 
 use crate::Feedback;
@@ -34,7 +34,7 @@ pub fn check_sidecar(
     if !format.uses_prj_sidecar() || tinsmith_output::is_special_file(output) {
         return Ok(());
     }
-    let ours = tinsmith_export::prj_path(output);
+    let ours = tinsmith_formats::prj_path(output);
     // GDAL's file list of the input names its `.prj` when it reads one (ESRI ASCII, EHdr);
     // a `.prj` merely named like a GeoTIFF input is not the input's (it is usually the
     // sidecar of an earlier mesh of it).
@@ -94,7 +94,7 @@ pub fn note_prj_left_beside(
     crs_written: bool,
     feedback: &dyn Feedback,
 ) {
-    let prj = tinsmith_export::prj_path(output);
+    let prj = tinsmith_formats::prj_path(output);
     if crs_written || !format.uses_prj_sidecar() || !prj.is_file() {
         return;
     }
@@ -154,7 +154,7 @@ pub fn check_distinct_from_sidecar(
 ) -> Result<()> {
     if format.uses_prj_sidecar() && !pixel_coords {
         check_distinct(
-            &tinsmith_export::prj_path(output),
+            &tinsmith_formats::prj_path(output),
             report,
             "the output's CRS sidecar",
         )?;

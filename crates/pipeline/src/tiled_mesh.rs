@@ -1,5 +1,5 @@
 //! `tinsmith mesh` on rasters larger than one tile (or with `--per-tile`): the tiled
-//! engine of `tinsmith-tile`, with tile progress and the same report as the untiled path
+//! engine of `tinsmith-tiling`, with tile progress and the same report as the untiled path
 //! plus the tile fields.
 
 use std::path::Path;
@@ -7,8 +7,8 @@ use std::time::Instant;
 
 use anyhow::{bail, Result};
 use serde::Serialize;
-use tinsmith_export::MeshFormat;
-use tinsmith_tile::{
+use tinsmith_formats::MeshFormat;
+use tinsmith_tiling::{
     mesh_tiles, MeshCollector, PerTileWriter, RasterSource, TileOptions, TilePlan, TileProgress,
     TilesReport, WeldedWriter,
 };

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use tinsmith_tile::{build_terrain, TerrainOptions, TerrainReport};
+use tinsmith_terrain::{build_terrain, TerrainOptions, TerrainReport};
 
 use crate::output::NamingFile;
 use crate::{Feedback, Result};

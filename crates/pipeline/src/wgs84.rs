@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use tinsmith_export::CrsRef;
+use tinsmith_formats::CrsRef;
 use tinsmith_raster::RasterInfo;
 
 use crate::Feedback;

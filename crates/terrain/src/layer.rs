@@ -1,0 +1,156 @@
+//! `layer.json` and the tiles' availability metadata (which tiles exist below each one).
+
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use tinsmith_raster::GeoBounds;
+
+use crate::pyramid::write_atomic;
+use crate::tms::bounds_array;
+use crate::{TerrainOptions, TerrainResult};
+
+/// Levels whose tiles carry the metadata extension: 0, N, 2N, ... (`metadataAvailability`).
+pub const METADATA_AVAILABILITY: u8 = 10;
+
+/// Which tiles exist, per level.
+pub(super) type Available = Vec<BTreeSet<(u32, u32)>>;
+
+/// `available` tiles of one level as `{startX, startY, endX, endY}` rectangles (runs of
+/// columns along each row, merged with identical runs of the rows above), restricted to
+/// columns `x_range` and rows `y_range`.
+pub(super) fn rectangles(
+    tiles: &BTreeSet<(u32, u32)>,
+    x_range: [u32; 2],
+    y_range: [u32; 2],
+) -> Vec<[u32; 4]> {
+    let mut by_row: std::collections::BTreeMap<u32, Vec<[u32; 2]>> = Default::default();
+    for &(x, y) in tiles {
+        if x < x_range[0] || x > x_range[1] || y < y_range[0] || y > y_range[1] {
+            continue;
+        }
+        let runs = by_row.entry(y).or_default();
+        match runs.last_mut() {
+            Some(run) if run[1] + 1 == x => run[1] = x,
+            _ => runs.push([x, x]),
+        }
+    }
+    // The set is ordered by x first, so each row's columns arrive in increasing order.
+    let mut out: Vec<[u32; 4]> = Vec::new();
+    let mut open: Vec<[u32; 4]> = Vec::new();
+    for (&y, runs) in &by_row {
+        let mut next_open = Vec::new();
+        for run in runs {
+            match open
+                .iter()
+                .position(|r| r[0] == run[0] && r[2] == run[1] && r[3] + 1 == y)
+            {
+                Some(k) => {
+                    let mut r = open.swap_remove(k);
+                    r[3] = y;
+                    next_open.push(r);
+                }
+                None => next_open.push([run[0], y, run[1], y]),
+            }
+        }
+        out.append(&mut open);
+        open = next_open;
+    }
+    out.append(&mut open);
+    out.sort_by_key(|r| (r[1], r[0]));
+    out
+}
+
+fn rectangles_json(rects: &[[u32; 4]]) -> String {
+    let mut s = String::from("[");
+    for (k, r) in rects.iter().enumerate() {
+        if k > 0 {
+            s.push(',');
+        }
+        let _ = write!(
+            s,
+            r#"{{"startX":{},"startY":{},"endX":{},"endY":{}}}"#,
+            r[0], r[1], r[2], r[3]
+        );
+    }
+    s.push(']');
+    s
+}
+
+/// The metadata extension of tile z/x/y: availability of levels z+1 ..= z+10 below it.
+pub(super) fn metadata_json(available: &Available, z: u8, x: u32, y: u32) -> String {
+    let mut levels = Vec::new();
+    for k in 1..=u32::from(METADATA_AVAILABILITY) {
+        let level = usize::from(z) + k as usize;
+        let Some(tiles) = available.get(level) else {
+            break;
+        };
+        let f = 1u32 << k;
+        let rects = rectangles(tiles, [x * f, (x + 1) * f - 1], [y * f, (y + 1) * f - 1]);
+        levels.push(rectangles_json(&rects));
+    }
+    // Trailing empty levels say nothing; CesiumJS needs no entry for them.
+    while levels.last().is_some_and(|l| l == "[]") {
+        levels.pop();
+    }
+    format!(r#"{{"available":[{}]}}"#, levels.join(","))
+}
+
+pub(super) fn write_layer_json(
+    input: &Path,
+    out_dir: &Path,
+    options: &TerrainOptions,
+    bounds: &GeoBounds,
+    max_zoom: u8,
+    available: &Available,
+) -> TerrainResult<()> {
+    let name = input
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "terrain".into());
+    let mut extensions = Vec::new();
+    if options.normals {
+        extensions.push(serde_json::json!("octvertexnormals"));
+    }
+    if options.metadata {
+        extensions.push(serde_json::json!("metadata"));
+    }
+    let all = [0, u32::MAX];
+    // The deepest level that has tiles (a tiny raster's finest levels may have none).
+    let max_zoom = available
+        .iter()
+        .rposition(|tiles| !tiles.is_empty())
+        .map_or(max_zoom, |z| z as u8);
+    let available: Vec<serde_json::Value> = available[..=usize::from(max_zoom)]
+        .iter()
+        .map(|tiles| {
+            rectangles(tiles, all, all)
+                .iter()
+                .map(|r| {
+                    serde_json::json!({"startX": r[0], "startY": r[1], "endX": r[2], "endY": r[3]})
+                })
+                .collect()
+        })
+        .collect();
+    let mut layer = serde_json::json!({
+        "tilejson": "2.1.0",
+        "name": name,
+        "description": "made by tinsmith",
+        "version": "1.0.0",
+        "format": "quantized-mesh-1.0",
+        "scheme": "tms",
+        "projection": "EPSG:4326",
+        "tiles": ["{z}/{x}/{y}.terrain?v={version}"],
+        "minzoom": options.min_zoom,
+        "maxzoom": max_zoom,
+        "bounds": bounds_array(bounds),
+        "extensions": extensions,
+        "available": available,
+        "attribution": "",
+    });
+    if options.metadata {
+        layer["metadataAvailability"] = serde_json::json!(METADATA_AVAILABILITY);
+    }
+    let text = serde_json::to_string_pretty(&layer).expect("JSON values serialize");
+    write_atomic(&out_dir.join("layer.json"), text.as_bytes())
+}

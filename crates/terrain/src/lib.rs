@@ -1,0 +1,32 @@
+//! Cesium quantized-mesh terrain: the tile encoder ([`QuantizedMeshTile`]) and whole
+//! pyramids ([`build_terrain`]): geographic TMS tiles (EPSG:4326, 2x1 root tiles, y = 0
+//! in the south), each decimated within `quality x e(level)` (Cesium's geometric error at
+//! the level) and checked by the independent verifier, with shared edges simplified once
+//! so that same-level neighbours keep identical edge vertices, and `layer.json` with the
+//! tiles' availability. The pyramid is staged and moved into place whole.
+#![deny(missing_docs)]
+#![deny(rustdoc::broken_intra_doc_links)]
+#![forbid(unsafe_code)]
+
+mod budget;
+mod error;
+mod layer;
+mod pyramid;
+mod quantized_mesh;
+mod rows;
+mod stream;
+mod tile;
+mod tms;
+
+pub use budget::LEVEL_ZERO_ERROR;
+pub use error::{TerrainError, TerrainResult};
+pub use layer::METADATA_AVAILABILITY;
+pub use pyramid::{
+    build_terrain, streaming_bytes, LevelReport, TerrainOptions, TerrainReport, MAX_LEVEL,
+};
+pub use quantized_mesh::{
+    geodetic_to_ecef, gzip, oct_encode, surface_normal, EncodeError, GeoRectangle,
+    QuantizedMeshTile, EXTENSION_METADATA, EXTENSION_NORMALS, HEADER_BYTES, MAX_16BIT_VERTICES,
+    QUANTIZED_MAX, WGS84_A, WGS84_B,
+};
+pub use tms::{tile_rectangle, TILE_CELLS};

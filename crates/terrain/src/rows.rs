@@ -1,0 +1,414 @@
+//! One level's lattice, a window of rows at a time: which tiles and lattice points the level
+//! covers, the rows currently held, what a tile reads from them (its grid, its edges with
+//! their halo, its normals), and the next coarser level's rows filtered from them.
+
+use std::ops::Range;
+
+use crate::quantized_mesh::surface_normal;
+use rayon::prelude::*;
+use tinsmith_raster::{GeoBounds, GeoLattice};
+
+use crate::tms::{step, tile_range, TILE_CELLS};
+use tinsmith_tiling::EdgeProfile;
+
+/// `TILE_CELLS` as a row or column count.
+const CELLS: usize = TILE_CELLS as usize;
+
+/// The binomial taps of the downsampling filter, by offset in finer lattice steps.
+const TAPS: [(i64, f64); 5] = [(-2, 1.0), (-1, 4.0), (0, 6.0), (1, 4.0), (2, 1.0)];
+
+/// The samples of one level on its lattice, over whole tiles: global lattice column
+/// `217 tx0 + i`, row `217 ty0 + j` (row 0 the southernmost), NaN where there is no data.
+///
+/// A level whose tiles go all the way round the globe ([`LevelRows::wraps`]) is periodic:
+/// its last column is its first one a turn east (and holds the same samples), and
+/// whatever reads past one side of it reads the other, so the tiles either side of the
+/// seam see the same edge, and coarser levels filter across it.
+///
+/// Rows arrive in increasing order ([`LevelRows::push`]) and leave from the bottom
+/// ([`LevelRows::drop_below`]); only rows `first..end()` are held. Every accessor takes
+/// level-wide coordinates and treats the level's own border (row or column outside
+/// `0..height`, `0..width`) exactly as the whole raster did, so a tile reads the same
+/// samples, edges and normals whatever else is held.
+pub(super) struct LevelRows {
+    pub(super) level: u8,
+    /// First tile column and TMS row covered.
+    pub(super) tx0: u32,
+    pub(super) ty0: u32,
+    /// Tiles covered.
+    pub(super) tiles_x: u32,
+    pub(super) tiles_y: u32,
+    /// Lattice columns and rows of the whole level.
+    pub(super) width: usize,
+    /// Whether the tiles go all the way round (`2^(level+1)` columns).
+    wraps: bool,
+    pub(super) height: usize,
+    /// The first row held.
+    first: usize,
+    /// Rows `first..end()`, row-major.
+    values: Vec<f32>,
+}
+
+impl LevelRows {
+    /// The level's lattice over the tiles `bounds` touches, holding no rows yet.
+    pub(super) fn new(bounds: &GeoBounds, level: u8) -> LevelRows {
+        let ([x0, x1], [y0, y1]) = tile_range(bounds, level);
+        let (tiles_x, tiles_y) = (x1 - x0 + 1, y1 - y0 + 1);
+        LevelRows {
+            level,
+            tx0: x0,
+            ty0: y0,
+            tiles_x,
+            tiles_y,
+            width: tiles_x as usize * CELLS + 1,
+            height: tiles_y as usize * CELLS + 1,
+            wraps: u64::from(tiles_x) == 2u64 << level,
+            first: 0,
+            values: Vec::new(),
+        }
+    }
+
+    /// Tile `x`, `y` of `level` alone, at height 0 everywhere (the ellipsoid), every row
+    /// held: a root tile CesiumJS expects that the raster does not reach (`--metadata`).
+    pub(super) fn flat_tile(level: u8, x: u32, y: u32) -> LevelRows {
+        let side = CELLS + 1;
+        LevelRows {
+            level,
+            tx0: x,
+            ty0: y,
+            tiles_x: 1,
+            tiles_y: 1,
+            width: side,
+            height: side,
+            wraps: false,
+            first: 0,
+            values: vec![0.0; side * side],
+        }
+    }
+
+    /// One past the last row held: the number of rows pushed so far.
+    pub(super) fn end(&self) -> usize {
+        self.first + self.values.len() / self.width
+    }
+
+    /// Whether every row of the level has been pushed.
+    pub(super) fn complete(&self) -> bool {
+        self.end() == self.height
+    }
+
+    /// The positions of lattice rows `rows`, columns `columns`, for the warp: computed
+    /// from global lattice indices, so a block's positions do not depend on its origin
+    /// beyond the float rounding of one multiplication.
+    pub(super) fn lattice(&self, rows: Range<usize>, columns: Range<usize>) -> GeoLattice {
+        let d = step(self.level);
+        let cells = f64::from(TILE_CELLS);
+        GeoLattice {
+            west: -180.0 + (f64::from(self.tx0) * cells + columns.start as f64) * d,
+            south: -90.0 + (f64::from(self.ty0) * cells + rows.start as f64) * d,
+            step: d,
+            width: columns.len() as u32,
+            height: rows.len() as u32,
+        }
+    }
+
+    /// Appends whole rows after the last one held.
+    ///
+    /// # Panics
+    /// When `rows` is not a whole number of rows or goes past the level's last row: the
+    /// stream makes exactly the rows of the level, in order.
+    pub(super) fn push(&mut self, rows: &[f32]) {
+        assert!(
+            rows.len().is_multiple_of(self.width)
+                && self.end() + rows.len() / self.width <= self.height,
+            "level {}: {} samples do not continue rows 0..{} of {} x {}",
+            self.level,
+            rows.len(),
+            self.end(),
+            self.width,
+            self.height
+        );
+        self.values.extend_from_slice(rows);
+        if self.wraps {
+            let start = self.values.len() - rows.len();
+            for row in self.values[start..].chunks_exact_mut(self.width) {
+                row[self.width - 1] = row[0];
+            }
+        }
+    }
+
+    /// Column `i` (which may lie outside the level), or `None` outside a level that does
+    /// not wrap; around a level that wraps, the column a whole turn away inside it.
+    fn column(&self, i: i64) -> Option<usize> {
+        if self.wraps {
+            Some(i.rem_euclid(self.width as i64 - 1) as usize)
+        } else {
+            (i >= 0 && i < self.width as i64).then_some(i as usize)
+        }
+    }
+
+    /// Drops the rows below `row` (all held rows if `row` is beyond them).
+    pub(super) fn drop_below(&mut self, row: usize) {
+        let row = row.min(self.end());
+        if row > self.first {
+            self.values.drain(..(row - self.first) * self.width);
+            self.first = row;
+        }
+    }
+
+    /// Row `j`, or `None` outside the level.
+    ///
+    /// # Panics
+    /// When `j` is in the level but not held: the stream keeps every row a reader needs.
+    fn row(&self, j: i64) -> Option<&[f32]> {
+        if j < 0 || j >= self.height as i64 {
+            return None;
+        }
+        let j = j as usize;
+        assert!(
+            j >= self.first && j < self.end(),
+            "level {}: row {j} is needed but rows {}..{} are held",
+            self.level,
+            self.first,
+            self.end()
+        );
+        let start = (j - self.first) * self.width;
+        Some(&self.values[start..start + self.width])
+    }
+
+    pub(super) fn at(&self, i: usize, j: usize) -> f64 {
+        let row = self.row(j as i64).expect("a sample inside the level");
+        f64::from(row[i])
+    }
+
+    /// The tile rows (local, from 0) whose rows and one-row halo are all held or past the
+    /// level's border: `0..ready_tile_rows()` minus those already handed out.
+    pub(super) fn ready_tile_rows(&self) -> u32 {
+        let end = self.end();
+        (0..self.tiles_y)
+            .take_while(|&t| ((t as usize + 1) * CELLS + 2).min(self.height) <= end)
+            .count() as u32
+    }
+
+    /// The first row that tile row `t` (local) reads: its southern edge less the halo;
+    /// the level's height once every tile row is done.
+    pub(super) fn first_row_of_tile_row(&self, t: u32) -> usize {
+        if t >= self.tiles_y {
+            self.height
+        } else {
+            (t as usize * CELLS).saturating_sub(1)
+        }
+    }
+
+    /// Sample (0, 0) of tile `x`, `y` (global tile indices) in level coordinates.
+    pub(super) fn tile_origin(&self, x: u32, y: u32) -> (usize, usize) {
+        (
+            (x - self.tx0) as usize * CELLS,
+            (y - self.ty0) as usize * CELLS,
+        )
+    }
+
+    /// The `(TILE_CELLS + 1)^2` samples of tile `x`, `y`, row-major from the south-west.
+    pub(super) fn tile_values(&self, x: u32, y: u32) -> Vec<f64> {
+        let (i0, j0) = self.tile_origin(x, y);
+        let mut values = Vec::with_capacity((CELLS + 1) * (CELLS + 1));
+        for j in j0..=j0 + CELLS {
+            let row = self.row(j as i64).expect("a tile row inside the level");
+            values.extend(row[i0..=i0 + CELLS].iter().map(|&v| f64::from(v)));
+        }
+        values
+    }
+
+    /// The range of valid heights of tile `x`, `y`, if it has any.
+    pub(super) fn tile_height_range(&self, x: u32, y: u32) -> Option<(f64, f64)> {
+        let (i0, j0) = self.tile_origin(x, y);
+        let mut range: Option<(f64, f64)> = None;
+        for j in j0..=j0 + CELLS {
+            let row = self.row(j as i64).expect("a tile row inside the level");
+            for v in &row[i0..=i0 + CELLS] {
+                if v.is_finite() {
+                    let v = f64::from(*v);
+                    range = Some(match range {
+                        Some((lo, hi)) => (lo.min(v), hi.max(v)),
+                        None => (v, v),
+                    });
+                }
+            }
+        }
+        range
+    }
+
+    /// Whether the cell with lower-left sample (i, j) lies in the level (round it, when
+    /// it wraps) and has four valid corners.
+    pub(super) fn cell_valid(&self, i: i64, j: i64) -> bool {
+        let Some(i) = self.column(i).filter(|&i| i + 1 < self.width) else {
+            return false;
+        };
+        if j < 0 || j + 1 >= self.height as i64 {
+            return false;
+        }
+        let j = j as usize;
+        [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)]
+            .iter()
+            .all(|&(a, b)| self.at(a, b).is_finite())
+    }
+
+    /// The edge from sample (i, j) along +x (`horizontal`) or +y, `TILE_CELLS` steps,
+    /// as both tiles beside it see it. Reads rows `j - 1 ..= j + 1` of a horizontal edge,
+    /// `j ..= j + TILE_CELLS` of a vertical one.
+    pub(super) fn edge(&self, i: usize, j: usize, horizontal: bool) -> EdgeProfile {
+        let n = CELLS;
+        let (i, j) = (i as i64, j as i64);
+        let point = |k: i64| if horizontal { (i + k, j) } else { (i, j + k) };
+        let values = (0..=n as i64)
+            .map(|k| {
+                let (a, b) = point(k);
+                self.at(a as usize, b as usize)
+            })
+            .collect();
+        let open = (0..n as i64)
+            .map(|k| {
+                let (a, b) = point(k);
+                // The cells on both sides of the step; a side outside the level is the
+                // level's outer border, where no tile has data.
+                let (side1, side2) = if horizontal {
+                    ((a, b - 1), (a, b))
+                } else {
+                    ((a - 1, b), (a, b))
+                };
+                let inside = |(x, y): (i64, i64)| {
+                    self.column(x).is_some_and(|x| x + 1 < self.width)
+                        && y >= 0
+                        && y + 1 < self.height as i64
+                };
+                [side1, side2]
+                    .iter()
+                    .all(|&c| !inside(c) || self.cell_valid(c.0, c.1))
+            })
+            .collect();
+        EdgeProfile::new(values, open)
+    }
+
+    /// Unit ECEF normal at sample (i, j) from central differences of the level's samples
+    /// (one-sided at nodata or the level's border): the same for every tile that has the
+    /// sample, so normals are continuous across tile edges. Reads rows `j - 1 ..= j + 1`.
+    /// On a pole's row, where every sample is the same point, the east-west difference is
+    /// left out: its spacing is zero, and it made normals up to 90 degrees off vertical.
+    pub(super) fn normal(&self, i: usize, j: usize, lon: f64, lat: f64) -> [f64; 3] {
+        let d = step(self.level).to_radians();
+        let z = self.at(i, j);
+        let sample = |a: i64, b: i64| -> Option<f64> {
+            let a = self.column(a)?;
+            if b < 0 || b >= self.height as i64 {
+                return None;
+            }
+            Some(self.at(a, b as usize)).filter(|v| v.is_finite())
+        };
+        let slope = |lo: Option<f64>, hi: Option<f64>, spacing: f64| match (lo, hi) {
+            (Some(a), Some(b)) => (b - a) / (2.0 * spacing),
+            (None, Some(b)) => (b - z) / spacing,
+            (Some(a), None) => (z - a) / spacing,
+            (None, None) => 0.0,
+        };
+        let (ii, jj) = (i as i64, j as i64);
+        let dx = crate::quantized_mesh::WGS84_A * d * lat.to_radians().cos().max(1e-6);
+        let dy = crate::quantized_mesh::WGS84_A * d;
+        let at_pole = lat.abs() >= 90.0 - 1e-9;
+        let ge = if at_pole {
+            0.0
+        } else {
+            slope(sample(ii - 1, jj), sample(ii + 1, jj), dx)
+        };
+        let gn = slope(sample(ii, jj - 1), sample(ii, jj + 1), dy);
+        let (e, n, u) = (-ge, -gn, 1.0);
+        let len = (e * e + n * n + u * u).sqrt();
+        let (e, n, u) = (e / len, n / len, u / len);
+        let (lon, lat) = (lon.to_radians(), lat.to_radians());
+        let east = [-lon.sin(), lon.cos(), 0.0];
+        let north = [-lat.sin() * lon.cos(), -lat.sin() * lon.sin(), lat.cos()];
+        let up = surface_normal(lon.to_degrees(), lat.to_degrees());
+        [0, 1, 2].map(|k| e * east[k] + n * north[k] + u * up[k])
+    }
+
+    /// This level's row (local) that `coarser`'s row 0 is centred on: coarser row `J` is
+    /// centred on row `2 J + offset` here (`offset` is 0 or -217).
+    fn offset_to(&self, coarser: &LevelRows) -> i64 {
+        let cells = TILE_CELLS as i64;
+        2 * i64::from(coarser.ty0) * cells - i64::from(self.ty0) * cells
+    }
+
+    /// One past the last row of `coarser` that can be made from the rows pushed here so
+    /// far: row `J` reads rows `2 J + offset - 2 ..= 2 J + offset + 2` of this level (those
+    /// outside it count as nodata).
+    pub(super) fn coarser_rows_ready(&self, coarser: &LevelRows) -> usize {
+        if self.complete() {
+            return coarser.height;
+        }
+        // 2 J + offset + 2 < end, so J <= (end - offset - 3) / 2.
+        let limit = self.end() as i64 - self.offset_to(coarser) - 3;
+        if limit < 0 {
+            return 0;
+        }
+        (limit as usize / 2 + 1).min(coarser.height)
+    }
+
+    /// The first row here that `coarser`'s next row (its `end()`) reads.
+    pub(super) fn first_row_for(&self, coarser: &LevelRows) -> usize {
+        if coarser.complete() {
+            return self.height;
+        }
+        let row = 2 * coarser.end() as i64 + self.offset_to(coarser) - 2;
+        row.max(0) as usize
+    }
+
+    /// Rows `rows` of the next coarser level: lattice point (X, Y) there is this level's
+    /// (2X, 2Y), low-pass filtered with the binomial [1 4 6 4 1] x [1 4 6 4 1] kernel over
+    /// the valid samples here; nodata only where all 25 are. Columns are matched round
+    /// the globe: a coarser level that wraps, or one that starts west of this one, reads
+    /// the samples a whole turn away where this level has them. The domain so grows by at most
+    /// one coarse sample per level, which keeps small inputs visible at coarse levels.
+    /// Rows are filtered in parallel; each sample's sum runs in the same order whatever
+    /// the rows held, so the result depends only on the level's samples.
+    ///
+    /// # Panics
+    /// When a row the filter reads is not held (see [`LevelRows::coarser_rows_ready`]).
+    pub(super) fn coarser_rows(&self, coarser: &LevelRows, rows: Range<usize>) -> Vec<f32> {
+        let cells = TILE_CELLS as i64;
+        let fx0 = i64::from(self.tx0) * cells;
+        let fy0 = i64::from(self.ty0) * cells;
+        let cx0 = i64::from(coarser.tx0) * cells;
+        let cy0 = i64::from(coarser.ty0) * cells;
+        let width = coarser.width;
+        // Lattice columns in a whole turn of this level.
+        let turn = (2i64 << self.level) * cells;
+        let mut out = vec![f32::NAN; width * rows.len()];
+        out.par_chunks_mut(width).enumerate().for_each(|(k, row)| {
+            let gy = 2 * (cy0 + (rows.start + k) as i64);
+            let fine_rows = TAPS.map(|(dy, _)| self.row(gy + dy - fy0));
+            let fine = |r: Option<&[f32]>, gx: i64| -> f32 {
+                let i = (gx - fx0).rem_euclid(turn);
+                match r {
+                    Some(r) if i < self.width as i64 => r[i as usize],
+                    _ => f32::NAN,
+                }
+            };
+            for (i, slot) in row.iter_mut().enumerate() {
+                let gx = 2 * (cx0 + i as i64);
+                let (mut sum, mut weight) = (0.0f64, 0.0f64);
+                for (r, (_, wy)) in fine_rows.iter().zip(TAPS) {
+                    for (dx, wx) in TAPS {
+                        let v = fine(*r, gx + dx);
+                        if v.is_finite() {
+                            sum += wx * wy * f64::from(v);
+                            weight += wx * wy;
+                        }
+                    }
+                }
+                if weight == 0.0 {
+                    continue;
+                }
+                *slot = (sum / weight) as f32;
+            }
+        });
+        out
+    }
+}

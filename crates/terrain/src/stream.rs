@@ -1,0 +1,476 @@
+//! The pyramid as a stream of rows: the finest level warped band by band, each coarser level
+//! filtered from the finer one's rows as soon as they exist, each level's tile rows handed
+//! out as soon as every row they read is held, and rows nobody needs any more dropped, so
+//! memory is a few bands of tile rows per level, whatever the raster's height.
+
+use std::ops::Range;
+use std::path::Path;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use tinsmith_raster::{warp_to_geographic, GeoBounds};
+
+use crate::rows::LevelRows;
+use crate::tms::TILE_CELLS;
+use crate::TerrainResult;
+
+/// Where the finest level's samples come from.
+pub(super) trait RowSource: Sync {
+    /// Rows `rows` of `level`'s lattice, all columns, row-major, row 0 the southernmost,
+    /// NaN where there is no data. A row must get the same samples in any band.
+    fn rows(&self, level: &LevelRows, rows: Range<usize>) -> TerrainResult<Vec<f32>>;
+}
+
+/// A band of the input, reprojected by GDAL ([`warp_to_geographic`]): a level that fits in
+/// one band in one piece, any other band in square blocks.
+///
+/// GDAL chooses its bilinear kernel per warp from the ratio of the output's size to the
+/// bounding box of the input window it reads: when the box looks larger than the output,
+/// as it does for a long thin strip of lon/lat rows tilted against a projected grid, it
+/// widens the kernel as if downsampling, and smooths. Blocks as wide as they are tall keep
+/// the whole warp's four-sample kernel on the test rasters
+/// (`crates/raster/tests/geographic.rs`); GDAL's heuristic still varies on large or
+/// 0..360 inputs, as it did between the chunks of a large whole warp (docs/results.md).
+/// The samples only have to be the same in both passes, which they are: the bands and
+/// blocks are fixed by the level alone.
+pub(super) struct Warp<'a> {
+    pub(super) path: &'a Path,
+    pub(super) band: usize,
+}
+
+impl RowSource for Warp<'_> {
+    fn rows(&self, level: &LevelRows, rows: Range<usize>) -> TerrainResult<Vec<f32>> {
+        let (width, height) = (level.width, rows.len());
+        if height == level.height {
+            return Ok(warp_to_geographic(
+                self.path,
+                self.band,
+                &level.lattice(rows, 0..width),
+            )?);
+        }
+        let mut out = vec![f32::NAN; width * height];
+        let block = height.max(1);
+        for c0 in (0..width).step_by(block) {
+            let w = block.min(width - c0);
+            let lattice = level.lattice(rows.clone(), c0..c0 + w);
+            let values = warp_to_geographic(self.path, self.band, &lattice)?;
+            for (r, row) in values.chunks_exact(w).enumerate() {
+                out[r * width + c0..][..w].copy_from_slice(row);
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// What the stream hands its rows to.
+pub(super) trait LevelSink {
+    /// Tile rows `tile_rows` (local, 0 the level's southernmost) of `level`: every
+    /// lattice row they read (their own and one beyond each side, see [`LevelRows`]) is
+    /// held. Called once per tile row, in increasing order within a level.
+    fn tile_rows(&mut self, level: &LevelRows, tile_rows: Range<u32>) -> TerrainResult<()>;
+
+    /// Every tile row of `level` has been handed out; `seconds` were spent making its rows.
+    fn level_done(&mut self, level: u8, seconds: f64) -> TerrainResult<()>;
+}
+
+/// Samples per warp band of the finest level (16 MiB of f32). Bands are whole tile rows,
+/// at least one; a level that fits comes in one band, as one warp.
+const BAND_SAMPLES: usize = 1 << 22;
+
+/// Tile rows per warp band of the finest level of `bounds`' pyramid at `max_zoom`.
+pub(super) fn band_tile_rows(bounds: &GeoBounds, max_zoom: u8) -> u32 {
+    let width = LevelRows::new(bounds, max_zoom).width;
+    let rows = BAND_SAMPLES / (width * TILE_CELLS as usize);
+    rows.clamp(1, u32::MAX as usize) as u32
+}
+
+/// The finest level's warp bands: `band_tile_rows` tile rows each, the first with the
+/// halo row above, so that each band completes its tile rows.
+fn bands(level: &LevelRows, band_tile_rows: u32) -> Vec<Range<usize>> {
+    let rows = band_tile_rows.max(1) as usize * TILE_CELLS as usize;
+    let mut out = Vec::new();
+    let mut start = 0;
+    while start < level.height {
+        let end = (out.len() * rows + rows + 2).min(level.height);
+        out.push(start..end);
+        start = end;
+    }
+    out
+}
+
+/// One level's place in the stream.
+struct Level {
+    rows: LevelRows,
+    /// The next tile row (local) to hand out.
+    next_tile_row: u32,
+    /// Seconds spent making the level's rows.
+    seconds: f64,
+    done: bool,
+}
+
+/// Streams levels `max_zoom` down to `min_zoom` of `bounds` from `source` into `sink`.
+///
+/// The finest level is read in bands of `band_tile_rows` tile rows, a group of one band per
+/// thread at a time, in parallel; the next group is warped while this group's rows go
+/// through the levels. After each band, from the finest level down, each
+/// level hands its complete tile rows to the sink, then makes every coarser row its rows
+/// allow, then drops the rows neither its tiles nor the coarser level need any more.
+///
+/// # Guarantees
+/// - Every level's rows equal those of the whole level made at once (the warp of the
+///   whole lattice, then [`LevelRows::coarser_rows`] of the whole finer level), for any
+///   band height, given a source whose samples do not depend on the band.
+/// - Tile rows reach the sink in a fixed order that depends on the levels and the band
+///   height only, never on the threads; levels finish finest first.
+/// - When a tile row of level z reaches the sink, every tile row of every finer level
+///   inside its footprint has already reached it: a coarser row needs finer rows beyond
+///   the footprint's tile rows, and a level hands out its tile rows before making coarser
+///   rows.
+/// - Held rows per level: at most a band plus one tile row and a few halo rows; besides,
+///   two groups of warped bands.
+///
+/// # Errors
+/// The first error of the source or the sink; the stream stops there.
+pub(super) fn stream_levels(
+    source: &dyn RowSource,
+    bounds: &GeoBounds,
+    zooms: (u8, u8),
+    band_tile_rows: u32,
+    pool: &rayon::ThreadPool,
+    sink: &mut dyn LevelSink,
+) -> TerrainResult<()> {
+    let (min_zoom, max_zoom) = zooms;
+    let mut levels: Vec<Level> = (min_zoom..=max_zoom)
+        .rev()
+        .map(|z| Level {
+            rows: LevelRows::new(bounds, z),
+            next_tile_row: 0,
+            seconds: 0.0,
+            done: false,
+        })
+        .collect();
+    let bands = bands(&levels[0].rows, band_tile_rows);
+    let groups: Vec<&[Range<usize>]> = bands.chunks(pool.current_num_threads().max(1)).collect();
+    // The finest level's geometry, for the warps running beside the tiles.
+    let finest = LevelRows::new(bounds, max_zoom);
+    let warp = |group: &[Range<usize>]| -> (Vec<TerrainResult<Vec<f32>>>, f64) {
+        let t = Instant::now();
+        let warped = pool.install(|| {
+            group
+                .par_iter()
+                .map(|rows| source.rows(&finest, rows.clone()))
+                .collect()
+        });
+        (warped, t.elapsed().as_secs_f64())
+    };
+    // The next group is warped on its own thread while this one's tiles are built; the
+    // samples do not depend on the timing.
+    std::thread::scope(|scope| -> TerrainResult<()> {
+        let mut next = groups
+            .first()
+            .map(|&group| scope.spawn(move || warp(group)));
+        for k in 0..groups.len() {
+            let (warped, seconds) = next
+                .take()
+                .expect("a warp per group")
+                .join()
+                .expect("the warp thread does not panic");
+            next = groups
+                .get(k + 1)
+                .map(|&group| scope.spawn(move || warp(group)));
+            levels[0].seconds += seconds;
+            for samples in warped {
+                levels[0].rows.push(&samples?);
+                cascade(&mut levels, pool, sink)?;
+            }
+        }
+        Ok(())
+    })?;
+    for level in &levels {
+        assert!(
+            level.done,
+            "level {} unfinished: rows to {}, tile rows to {}",
+            level.rows.level,
+            level.rows.end(),
+            level.next_tile_row
+        );
+    }
+    Ok(())
+}
+
+/// From the finest level down: hand out the complete tile rows, make the coarser rows that
+/// can be made, drop the rows no longer needed.
+fn cascade(
+    levels: &mut [Level],
+    pool: &rayon::ThreadPool,
+    sink: &mut dyn LevelSink,
+) -> TerrainResult<()> {
+    for k in 0..levels.len() {
+        let (finer, coarser) = levels.split_at_mut(k + 1);
+        let level = &mut finer[k];
+        let ready = level.rows.ready_tile_rows();
+        if ready > level.next_tile_row {
+            sink.tile_rows(&level.rows, level.next_tile_row..ready)?;
+            level.next_tile_row = ready;
+        }
+        if !level.done && level.next_tile_row == level.rows.tiles_y {
+            level.done = true;
+            sink.level_done(level.rows.level, level.seconds)?;
+        }
+        let mut keep = level.rows.first_row_of_tile_row(level.next_tile_row);
+        if let Some(coarse) = coarser.first_mut() {
+            let t = Instant::now();
+            let rows = coarse.rows.end()..level.rows.coarser_rows_ready(&coarse.rows);
+            if !rows.is_empty() {
+                let values = pool.install(|| level.rows.coarser_rows(&coarse.rows, rows));
+                coarse.rows.push(&values);
+            }
+            coarse.seconds += t.elapsed().as_secs_f64();
+            keep = keep.min(level.rows.first_row_for(&coarse.rows));
+        }
+        level.rows.drop_below(keep);
+    }
+    Ok(())
+}
+
+/// A made-up finest level for tests: smooth hills with a nodata disc, each sample a
+/// function of its global lattice indices only (so any band gives the same samples).
+#[cfg(test)]
+pub(super) struct Hills {
+    /// Centre (lon, lat) and radius of the nodata disc, degrees.
+    pub(super) hole: [f64; 3],
+}
+
+#[cfg(test)]
+impl RowSource for Hills {
+    fn rows(&self, level: &LevelRows, rows: Range<usize>) -> TerrainResult<Vec<f32>> {
+        let lattice = level.lattice(rows, 0..level.width);
+        let d = lattice.step;
+        let i0 = ((lattice.west + 180.0) / d).round();
+        let j0 = ((lattice.south + 90.0) / d).round();
+        let mut out = Vec::with_capacity(lattice.width as usize * lattice.height as usize);
+        for j in 0..lattice.height {
+            let lat = -90.0 + (j0 + f64::from(j)) * d;
+            for i in 0..lattice.width {
+                let lon = -180.0 + (i0 + f64::from(i)) * d;
+                let [cx, cy, r] = self.hole;
+                let v = if (lon - cx).hypot(lat - cy) < r {
+                    f32::NAN
+                } else {
+                    (300.0 * (lon * 40.0).sin() * (lat * 27.0).cos() + 80.0 * (lon * 200.0).cos())
+                        as f32
+                };
+                out.push(v);
+            }
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The next coarser level of a whole finer level, as the pipeline made it before it
+    /// streamed: a reference that shares no code with [`LevelRows::coarser_rows`].
+    fn whole_coarser(fine: &LevelRows, fine_values: &[f32], coarse: &LevelRows) -> Vec<f32> {
+        let c = i64::from(TILE_CELLS);
+        let (fx0, fy0) = (i64::from(fine.tx0) * c, i64::from(fine.ty0) * c);
+        let (cx0, cy0) = (i64::from(coarse.tx0) * c, i64::from(coarse.ty0) * c);
+        let at = |gx: i64, gy: i64| -> f32 {
+            let (i, j) = (gx - fx0, gy - fy0);
+            if i < 0 || j < 0 || i >= fine.width as i64 || j >= fine.height as i64 {
+                f32::NAN
+            } else {
+                fine_values[j as usize * fine.width + i as usize]
+            }
+        };
+        let taps = [(-2, 1.0), (-1, 4.0), (0, 6.0), (1, 4.0), (2, 1.0)];
+        let mut out = vec![f32::NAN; coarse.width * coarse.height];
+        for j in 0..coarse.height {
+            for i in 0..coarse.width {
+                let (gx, gy) = (2 * (cx0 + i as i64), 2 * (cy0 + j as i64));
+                let (mut sum, mut weight) = (0.0f64, 0.0f64);
+                for (dy, wy) in taps {
+                    for (dx, wx) in taps {
+                        let v = at(gx + dx, gy + dy);
+                        if v.is_finite() {
+                            sum += wx * wy * f64::from(v);
+                            weight += wx * wy;
+                        }
+                    }
+                }
+                if weight > 0.0 {
+                    out[j * coarse.width + i] = (sum / weight) as f32;
+                }
+            }
+        }
+        out
+    }
+
+    /// One level as the sink saw it.
+    struct Record {
+        /// Its samples, NaN until seen.
+        values: Vec<f32>,
+        /// First TMS row and tile rows.
+        ty0: u32,
+        tiles_y: u32,
+        /// Tile rows handed out so far.
+        handed: u32,
+    }
+
+    /// Copies every row the sink is handed into whole levels, reads each tile row's halo,
+    /// and checks the order promises of [`stream_levels`].
+    struct Recorder {
+        levels: Vec<Record>,
+        done: Vec<u8>,
+        max_zoom: u8,
+    }
+
+    impl LevelSink for Recorder {
+        fn tile_rows(&mut self, level: &LevelRows, tile_rows: Range<u32>) -> TerrainResult<()> {
+            let z = usize::from(level.level);
+            assert!(!self.done.contains(&level.level));
+            assert_eq!(
+                self.levels[z].handed, tile_rows.start,
+                "tile rows in order, once"
+            );
+            let n = TILE_CELLS as usize;
+            for t in tile_rows.clone() {
+                let j0 = t as usize * n;
+                for j in j0.saturating_sub(1)..=(j0 + n + 1).min(level.height - 1) {
+                    for i in 0..level.width {
+                        let v = level.at(i, j) as f32;
+                        let slot = &mut self.levels[z].values[j * level.width + i];
+                        assert!(slot.is_nan() || slot.to_bits() == v.to_bits());
+                        *slot = v;
+                    }
+                }
+                // Finer tile rows inside this one's footprint were all handed out.
+                let row = level.ty0 + t;
+                for (k, finer) in self.levels[z + 1..].iter().enumerate() {
+                    let f = 1u32 << (k + 1);
+                    let start = (row * f).max(finer.ty0);
+                    let end = ((row + 1) * f).min(finer.ty0 + finer.tiles_y);
+                    assert!(
+                        start >= end || end <= finer.ty0 + finer.handed,
+                        "level {}: rows {start}..{end} not all handed out before {}/{row}",
+                        z + k + 1,
+                        level.level
+                    );
+                }
+            }
+            self.levels[z].handed = tile_rows.end;
+            Ok(())
+        }
+
+        fn level_done(&mut self, level: u8, _seconds: f64) -> TerrainResult<()> {
+            // Finest first.
+            assert_eq!(self.max_zoom - self.done.len() as u8, level);
+            self.done.push(level);
+            Ok(())
+        }
+    }
+
+    fn same(a: &[f32], b: &[f32]) -> bool {
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()))
+    }
+
+    #[test]
+    fn streamed_levels_equal_whole_levels_for_any_band_height() {
+        // 3 x 4 tiles at level 5 (tiles of 5.625 degrees), a hole across tile edges; the
+        // coarser levels start on an even finer row (level 4) and on an odd one (3, 2).
+        let bounds = GeoBounds {
+            west: 10.3,
+            south: 35.0,
+            east: 21.0,
+            north: 52.0,
+            resolution: 0.02,
+        };
+        let source = Hills {
+            hole: [11.25, 45.0, 1.5],
+        };
+        let (min_zoom, max_zoom) = (2, 5);
+        // The whole levels, made at once.
+        let mut whole = Vec::new();
+        let finest = LevelRows::new(&bounds, max_zoom);
+        whole.push(source.rows(&finest, 0..finest.height).unwrap());
+        for z in (min_zoom..max_zoom).rev() {
+            let fine = LevelRows::new(&bounds, z + 1);
+            let coarse = LevelRows::new(&bounds, z);
+            let values = whole_coarser(&fine, whole.last().unwrap(), &coarse);
+            whole.push(values);
+        }
+        whole.reverse(); // coarsest first, index z - min_zoom
+        let finest_values = whole.last().unwrap();
+        assert!(
+            finest_values.iter().any(|v| v.is_nan()) && finest_values.iter().any(|v| v.is_finite())
+        );
+
+        for (band_rows, threads) in [(1, 1), (1, 3), (2, 2), (100, 2)] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut recorder = Recorder {
+                levels: (0..=max_zoom)
+                    .map(|z| {
+                        let l = LevelRows::new(&bounds, z);
+                        Record {
+                            values: vec![f32::NAN; l.width * l.height],
+                            ty0: l.ty0,
+                            tiles_y: l.tiles_y,
+                            handed: 0,
+                        }
+                    })
+                    .collect(),
+                done: Vec::new(),
+                max_zoom,
+            };
+            stream_levels(
+                &source,
+                &bounds,
+                (min_zoom, max_zoom),
+                band_rows,
+                &pool,
+                &mut recorder,
+            )
+            .unwrap();
+            assert_eq!(
+                recorder.done,
+                (min_zoom..=max_zoom).rev().collect::<Vec<_>>()
+            );
+            for z in min_zoom..=max_zoom {
+                let streamed = &recorder.levels[usize::from(z)].values;
+                let reference = &whole[usize::from(z - min_zoom)];
+                assert!(
+                    same(streamed, reference),
+                    "level {z}, bands of {band_rows} tile rows, {threads} threads"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn bands_complete_tile_rows() {
+        let bounds = GeoBounds {
+            west: 0.0,
+            south: 0.0,
+            east: 50.0,
+            north: 50.0,
+            resolution: 0.1,
+        };
+        let level = LevelRows::new(&bounds, 3);
+        assert_eq!(level.tiles_y, 3);
+        let n = TILE_CELLS as usize;
+        assert_eq!(
+            bands(&level, 1),
+            vec![0..n + 2, n + 2..2 * n + 2, 2 * n + 2..3 * n + 1]
+        );
+        assert_eq!(bands(&level, 2), vec![0..2 * n + 2, 2 * n + 2..3 * n + 1]);
+        assert_eq!(bands(&level, 5), vec![0..3 * n + 1]);
+    }
+}

@@ -1,0 +1,190 @@
+//! One tile: decimated with its edges locked, verified, and encoded as quantized-mesh.
+
+use crate::quantized_mesh::{gzip, QuantizedMeshTile, QUANTIZED_MAX};
+use tinsmith_core::{decimate_with_border, DecimationOptions, Grid, VertexHeights};
+use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
+
+use crate::budget::{quanta_per_step, LevelBudget};
+use crate::layer::{metadata_json, Available};
+use crate::rows::LevelRows;
+use crate::tms::{step, tile_column, tile_rectangle, TILE_CELLS, U_PER_CELL};
+use crate::{TerrainError, TerrainOptions, TerrainResult};
+use tinsmith_tiling::{edge_limit, edge_span, EdgeProfile};
+
+/// One tile done on a worker.
+pub(super) struct TileOut {
+    pub(super) x: u32,
+    pub(super) y: u32,
+    pub(super) bytes: Vec<u8>,
+    pub(super) vertices: usize,
+    pub(super) triangles: usize,
+    pub(super) max_error: f64,
+}
+
+pub(super) fn build_tile(
+    raster: &LevelRows,
+    x: u32,
+    y: u32,
+    budget: &LevelBudget,
+    options: &TerrainOptions,
+    metadata_available: Option<&Available>,
+) -> TerrainResult<Option<TileOut>> {
+    let z = raster.level;
+    // Where the tile is written (`x` may be a turn east, see `tile_range`).
+    let column = tile_column(z, x);
+    let n = TILE_CELLS as usize;
+    let (i0, j0) = raster.tile_origin(x, y);
+    let values = raster.tile_values(x, y);
+    let grid = Grid::new(TILE_CELLS + 1, TILE_CELLS + 1, values).expect("a 218 x 218 grid");
+    if grid.valid_cell_count() == 0 {
+        return Ok(None);
+    }
+
+    // Shared edges, each decided from the level raster alone: both neighbours agree.
+    let limit = edge_limit(budget.decimation, budget.max_abs);
+    let keep = |edge: EdgeProfile| {
+        if limit > 0.0 {
+            edge.simplify(limit, edge_span(budget.max_edge))
+        } else {
+            vec![true; n + 1]
+        }
+    };
+    let south = keep(raster.edge(i0, j0, true));
+    let north = keep(raster.edge(i0, j0 + n, true));
+    let west = keep(raster.edge(i0, j0, false));
+    let east = keep(raster.edge(i0 + n, j0, false));
+    let last = TILE_CELLS;
+    let keep_border = |gx: u32, gy: u32| {
+        if gy == 0 {
+            south[gx as usize]
+        } else if gy == last {
+            north[gx as usize]
+        } else if gx == 0 {
+            west[gy as usize]
+        } else if gx == last {
+            east[gy as usize]
+        } else {
+            true
+        }
+    };
+    // Vertices at their samples: flat ground (the sea at 0, a tile the raster does not
+    // reach) stays exactly at its height in the quantized tiles.
+    let mut decimation_options =
+        DecimationOptions::new(budget.decimation).with_vertex_heights(VertexHeights::Samples);
+    decimation_options.max_abs_value = Some(budget.max_abs);
+    decimation_options.max_edge_length = budget.max_edge;
+    let tin = decimate_with_border(&grid, &decimation_options, &keep_border, &mut |_| {})
+        .map_err(|source| TerrainError::Decimate {
+            z,
+            x: column,
+            y,
+            source,
+        })?
+        .tin;
+    if tin.triangles().is_empty() {
+        return Ok(None);
+    }
+
+    // Heights on the level's lattice: tile minimum rounded down to a multiple of the step.
+    let s = budget.step;
+    let (lo, hi) = tin
+        .vertices()
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v.z), hi.max(v.z))
+        });
+    let k_min = (lo / s).floor();
+    let min_height = k_min * s;
+    let per_step = quanta_per_step(k_min, (hi / s).round() - k_min);
+    let max_height = min_height + f64::from(QUANTIZED_MAX) * s / f64::from(per_step);
+    let quantized: Vec<[u16; 3]> = tin
+        .vertices()
+        .iter()
+        .map(|v| {
+            let h = ((v.z / s).round() - k_min) * f64::from(per_step);
+            [
+                (v.x * U_PER_CELL) as u16,
+                (v.y * U_PER_CELL) as u16,
+                h.clamp(0.0, f64::from(QUANTIZED_MAX)) as u16,
+            ]
+        })
+        .collect();
+
+    // The promise, checked on what the decoder will compute.
+    let positions: Vec<[i64; 2]> = tin
+        .vertices()
+        .iter()
+        .map(|v| [i64::from(v.x), i64::from(v.y)])
+        .collect();
+    let decoded: Vec<f64> = quantized
+        .iter()
+        .map(|q| min_height + f64::from(q[2] / per_step as u16) * s)
+        .collect();
+    let check = tinsmith_verify::verify(
+        GridRef::new(grid.width(), grid.height(), grid.values()),
+        MeshRef::new(&positions, &decoded, tin.triangles()),
+        &VerifyOptions::new().with_max_error(budget.verify),
+    )
+    .map_err(|e| TerrainError::Verify {
+        z,
+        x: column,
+        y,
+        problems: e.to_string(),
+    })?;
+    if !check.passed() {
+        return Err(TerrainError::Verify {
+            z,
+            x: column,
+            y,
+            problems: check.problems.join("; "),
+        });
+    }
+
+    let rect = tile_rectangle(z, x, y);
+    let normals: Option<Vec<[f64; 3]>> = options.normals.then(|| {
+        let d = step(z);
+        tin.vertices()
+            .iter()
+            .map(|v| {
+                let (gi, gj) = (i0 + v.x as usize, j0 + v.y as usize);
+                raster.normal(
+                    gi,
+                    gj,
+                    rect.west + f64::from(v.x) * d,
+                    rect.south + f64::from(v.y) * d,
+                )
+            })
+            .collect()
+    });
+    let metadata = metadata_available.map(|available| metadata_json(available, z, column, y));
+    let mut tile = QuantizedMeshTile::new(
+        rect,
+        min_height as f32,
+        max_height as f32,
+        &quantized,
+        tin.triangles(),
+    );
+    if let Some(normals) = &normals {
+        tile = tile.with_normals(normals);
+    }
+    if let Some(metadata) = &metadata {
+        tile = tile.with_metadata(metadata);
+    }
+    let mut bytes = tile.encode().map_err(|source| TerrainError::Encode {
+        z,
+        x: column,
+        y,
+        source,
+    })?;
+    if options.gzip {
+        bytes = gzip(&bytes);
+    }
+    Ok(Some(TileOut {
+        x: column,
+        y,
+        bytes,
+        vertices: quantized.len(),
+        triangles: tin.triangles().len(),
+        max_error: check.max_error,
+    }))
+}

@@ -37,8 +37,8 @@ use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 use crate::jobs::ContourJob;
 use crate::mesh_file::{expected_orientation, read_mesh_file, sample_positions};
 use crate::number::readable;
-use crate::output::NamingFile;
-use crate::output::{check_distinct, check_writable_target};
+use crate::output_paths::NamingFile;
+use crate::output_paths::{check_distinct, check_writable_target};
 use crate::wgs84::{file_crs, LineEnd, Pieces};
 use crate::Feedback;
 use tinsmith_georef::{Placement, Samples};
@@ -73,7 +73,7 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
     // A TIN decimated here is shaped for the levels (fewer segments, same bound), so they
     // come from the raster's height range first; a --mesh file's come from its own heights.
     let (contoured, info, source, levels) = if tiled {
-        let info = crate::progress::scan_raster(&job.input, job.band, feedback)?;
+        let info = crate::scan::scan_raster(&job.input, job.band, feedback)?;
         let levels = levels_for(job, info.min.zip(info.max))?;
         let (contoured, tiles) = tiled_lines(job, e, &info, &levels, feedback)?;
         let source = format!("TIN within {} ({tiles} tiles)", readable(e));
@@ -137,7 +137,7 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
         (contoured, raster.info, source, levels)
     };
     let georef = Placement::new(info.transform(), job.pixel_coords);
-    crate::output::note_gcps_unused(&info, job.pixel_coords, feedback);
+    crate::output_paths::note_gcps_unused(&info, job.pixel_coords, feedback);
     let polylines = contoured.lines;
 
     // Grid coordinates -> file coordinates, with the level as z for the reprojection, then

@@ -12,7 +12,7 @@ use tinsmith_raster::RasterInfo;
 
 use crate::jobs::MeshJob;
 use crate::number::readable;
-use crate::output::NamingFile;
+use crate::output_paths::NamingFile;
 use crate::wgs84::{
     check_no_fold_in_lon_lat, check_wgs84_maps_back, check_wgs84_mesh_possible, file_crs,
     is_geographic, projected_crs, snap_to_antimeridian, Pieces,
@@ -345,7 +345,7 @@ pub fn write(
         .with_epsg(crs.epsg);
     tinsmith_formats::write_mesh_with(path, plan.format, mesh, &options)?;
     let crs_written = crs.wkt.is_some_and(|w| !w.trim().is_empty());
-    crate::output::note_prj_left_beside(path, plan.format, crs_written, feedback);
+    crate::output_paths::note_prj_left_beside(path, plan.format, crs_written, feedback);
     Ok(())
 }
 

@@ -10,8 +10,8 @@ use tinsmith_formats::MeshFormat;
 use tinsmith_verify::{GridRef, VerifyOptions};
 
 use crate::jobs::MeshJob;
-use crate::output::NamingFile;
-use crate::output::{check_distinct, check_writable_target, ReservedReport};
+use crate::output_paths::NamingFile;
+use crate::output_paths::{check_distinct, check_writable_target, ReservedReport};
 use crate::report::{MeshSummary, Outcome, Seconds};
 use crate::Feedback;
 use tinsmith_georef::Placement;
@@ -73,7 +73,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let t = Instant::now();
     let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
     let read_seconds = t.elapsed().as_secs_f64();
-    crate::output::note_gcps_unused(&raster.info, job.pixel_coords, feedback);
+    crate::output_paths::note_gcps_unused(&raster.info, job.pixel_coords, feedback);
     let grid = &Grid::from_samples(raster.samples);
     if grid.valid_cell_count() == 0 {
         bail!(
@@ -186,12 +186,12 @@ pub fn reserve_report(
         return Ok(None);
     };
     if let Some(dir) = &job.per_tile {
-        crate::output::check_not_inside(dir, report, "the --per-tile directory")?;
+        crate::output_paths::check_not_inside(dir, report, "the --per-tile directory")?;
     }
     check_writable_target(report, &job.input)?;
     if let Some((output, format)) = output {
         check_distinct(output, report, "the output")?;
-        crate::output::check_distinct_from_sidecar(output, report, format, job.pixel_coords)?;
+        crate::output_paths::check_distinct_from_sidecar(output, report, format, job.pixel_coords)?;
     }
     Ok(Some(ReservedReport::reserve(report)?))
 }

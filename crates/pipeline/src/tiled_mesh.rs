@@ -14,7 +14,7 @@ use tinsmith_tiling::{
 };
 
 use crate::jobs::{MeshJob, TileFormat};
-use crate::output::NamingFile;
+use crate::output_paths::NamingFile;
 use crate::report::{MeshSummary, Outcome, Seconds};
 use crate::Feedback;
 use tinsmith_georef::Placement;
@@ -31,7 +31,7 @@ pub fn untiled_output(job: &MeshJob) -> Result<Option<&Path>> {
     }
     // Checks the untiled path makes first, so that errors come in the same order.
     let format = crate::format_plan::format(job)?;
-    crate::output::check_writable_target(output, &job.input)?;
+    crate::output_paths::check_writable_target(output, &job.input)?;
     let reader = tinsmith_raster::WindowReader::open(&job.input, job.band)?;
     if !job.pixel_coords {
         // The CRS written: none for a raster without a geotransform (pixel coordinates).
@@ -40,7 +40,7 @@ pub fn untiled_output(job: &MeshJob) -> Result<Option<&Path>> {
             .crs_wkt
             .as_deref()
             .filter(|_| info.transform().is_some());
-        crate::output::check_sidecar(output, &job.input, format, crs_wkt)?;
+        crate::output_paths::check_sidecar(output, &job.input, format, crs_wkt)?;
     }
     crate::transform_check::check_transform(reader.info(), job.pixel_coords)?;
     crate::format_plan::check_float32_positions(format, reader.info(), job)?;
@@ -140,8 +140,8 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let reserved = crate::mesh::reserve_report(job, welded_output)?;
 
     let t = Instant::now();
-    let info = crate::progress::scan_raster(&job.input, job.band, feedback)?;
-    crate::output::note_gcps_unused(&info, job.pixel_coords, feedback);
+    let info = crate::scan::scan_raster(&job.input, job.band, feedback)?;
+    crate::output_paths::note_gcps_unused(&info, job.pixel_coords, feedback);
     let source = RasterSource::new(&info)?;
     let scan_seconds = t.elapsed().as_secs_f64();
     let plan = TilePlan::new(info.width, info.height, job.tile_size).naming_file(&job.input)?;
@@ -215,7 +215,7 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
             let t = Instant::now();
             writer.finish()?;
             let crs_written = crs.is_some_and(|w| !w.trim().is_empty());
-            crate::output::note_prj_left_beside(output, format, crs_written, feedback);
+            crate::output_paths::note_prj_left_beside(output, format, crs_written, feedback);
             let write = report.seconds_sink + t.elapsed().as_secs_f64();
             (report, output.as_path(), write)
         }

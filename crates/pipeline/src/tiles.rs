@@ -5,7 +5,7 @@ use std::path::Path;
 
 use tinsmith_terrain::{build_terrain, TerrainOptions, TerrainReport};
 
-use crate::output::NamingFile;
+use crate::output_paths::NamingFile;
 use crate::{Feedback, Result};
 
 /// Builds the pyramid of `input` into the directory `output` (moved into place whole when
@@ -20,11 +20,11 @@ pub fn tiles(
     feedback: &dyn Feedback,
 ) -> Result<TerrainReport> {
     if let Some(report) = report {
-        crate::output::check_not_inside(output, report, "the pyramid directory")?;
-        crate::output::check_writable_target(report, input)?;
+        crate::output_paths::check_not_inside(output, report, "the pyramid directory")?;
+        crate::output_paths::check_writable_target(report, input)?;
     }
     let reserved = report
-        .map(crate::output::ReservedReport::reserve)
+        .map(crate::output_paths::ReservedReport::reserve)
         .transpose()?;
     let built = build_terrain(input, output, options, &mut |level| {
         let flat = match level.flat_tiles {

@@ -28,7 +28,6 @@
 mod contour;
 mod feedback;
 mod format_plan;
-
 mod jobs;
 mod memory;
 mod mesh;

@@ -7,7 +7,7 @@ use anyhow::{bail, Result};
 use serde::Serialize;
 use tinsmith_core::{decimate_with_progress, Grid};
 use tinsmith_formats::MeshFormat;
-use tinsmith_verify::{GridRef, VerifyOptions};
+use tinsmith_tiling::check_tin;
 
 use crate::jobs::MeshJob;
 use crate::output_paths::NamingFile;
@@ -107,22 +107,8 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     // The promise is checked, independently, before anything is written.
     let georef = Placement::new(raster.info.transform(), job.pixel_coords);
     let t = Instant::now();
-    let positions: Vec<[i64; 2]> = tin
-        .vertices()
-        .iter()
-        .map(|v| [v.x as i64, v.y as i64])
-        .collect();
     // The heights as the file will hold them (float32 formats round them).
-    let heights: Vec<f64> = tin
-        .vertices()
-        .iter()
-        .map(|v| plan.file_height(v.z))
-        .collect();
-    let check = tinsmith_verify::verify(
-        GridRef::new(grid.width(), grid.height(), grid.values()),
-        tinsmith_verify::MeshRef::new(&positions, &heights, tin.triangles()),
-        &VerifyOptions::new().with_max_error(max_error),
-    )?;
+    let check = check_tin(grid, tin, |_, v| plan.file_height(v.z), max_error)?;
     let verify_seconds = t.elapsed().as_secs_f64();
     if !check.passed() {
         bail!(

@@ -2,7 +2,7 @@
 
 use crate::quantized_mesh::{gzip, QuantizedMeshTile, QUANTIZED_MAX};
 use tinsmith_core::{decimate_with_border, DecimationOptions, Grid, VertexHeights};
-use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
+use tinsmith_tiling::check_tin;
 
 use crate::budget::{quanta_per_step, LevelBudget};
 use crate::layer::{metadata_json, Available};
@@ -111,26 +111,14 @@ pub(super) fn build_tile(
         .collect();
 
     // The promise, checked on what the decoder will compute.
-    let positions: Vec<[i64; 2]> = tin
-        .vertices()
-        .iter()
-        .map(|v| [i64::from(v.x), i64::from(v.y)])
-        .collect();
-    let decoded: Vec<f64> = quantized
-        .iter()
-        .map(|q| min_height + f64::from(q[2] / per_step as u16) * s)
-        .collect();
-    let check = tinsmith_verify::verify(
-        GridRef::new(grid.width(), grid.height(), grid.values()),
-        MeshRef::new(&positions, &decoded, tin.triangles()),
-        &VerifyOptions::new().with_max_error(budget.verify),
-    )
-    .map_err(|e| TerrainError::Verify {
-        z,
-        x: column,
-        y,
-        problems: e.to_string(),
-    })?;
+    let decoded = |i: usize, _: &_| min_height + f64::from(quantized[i][2] / per_step as u16) * s;
+    let check =
+        check_tin(&grid, &tin, decoded, budget.verify).map_err(|e| TerrainError::Verify {
+            z,
+            x: column,
+            y,
+            problems: e.to_string(),
+        })?;
     if !check.passed() {
         return Err(TerrainError::Verify {
             z,

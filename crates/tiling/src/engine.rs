@@ -3,11 +3,11 @@
 
 use std::time::Instant;
 
+use crate::tin_check::check_tin;
 use tinsmith_core::{
     decimate_with_border, effective_limit, DecimationOptions, DecimationReport, ErrorModel, Grid,
     TinVertex, MAX_ABS_HEIGHT,
 };
-use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
 use crate::edge::{edge_limit, edge_span, EdgeProfile};
 use crate::error::{Error, Result};
@@ -357,22 +357,13 @@ impl TileJob {
         // The promise is checked, independently, before the tile goes anywhere.
         let t = Instant::now();
         let tin = &decimation.tin;
-        let positions: Vec<[i64; 2]> = tin
-            .vertices()
-            .iter()
-            .map(|v| [v.x as i64, v.y as i64])
-            .collect();
-        let heights: Vec<f64> = tin.vertices().iter().map(|v| v.z).collect();
-        let grid = &input.grid;
-        let check = tinsmith_verify::verify(
-            GridRef::new(grid.width(), grid.height(), grid.values()),
-            MeshRef::new(&positions, &heights, tin.triangles()),
-            &VerifyOptions::new().with_max_error(self.options.max_error),
-        )
-        .map_err(|source| Error::Verify {
-            tile: index,
-            source,
-        })?;
+        let check =
+            check_tin(&input.grid, tin, |_, v| v.z, self.options.max_error).map_err(|source| {
+                Error::Verify {
+                    tile: index,
+                    source,
+                }
+            })?;
         if !check.passed() {
             return Err(Error::VerifyFailed {
                 tile: index,

@@ -51,6 +51,7 @@ mod per_tile_writer;
 mod plan;
 mod sink;
 mod source;
+mod tin_check;
 mod vertex_ids;
 mod welded_writer;
 
@@ -64,4 +65,5 @@ pub use per_tile_writer::PerTileWriter;
 pub use plan::{TileIndex, TilePlan, TileWindow};
 pub use sink::{FinishedTile, SinkError, TileSink};
 pub use source::{GridSource, RasterSource, ReadError, TileSource, WindowRead};
+pub use tin_check::check_tin;
 pub use welded_writer::WeldedWriter;

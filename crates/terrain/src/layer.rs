@@ -1,7 +1,6 @@
 //! `layer.json` and the tiles' availability metadata (which tiles exist below each one).
 
 use std::collections::BTreeSet;
-use std::fmt::Write as _;
 use std::path::Path;
 
 use tinsmith_raster::GeoBounds;
@@ -61,24 +60,43 @@ pub(super) fn rectangles(
     out
 }
 
-fn rectangles_json(rects: &[[u32; 4]]) -> String {
-    let mut s = String::from("[");
-    for (k, r) in rects.iter().enumerate() {
-        if k > 0 {
-            s.push(',');
-        }
-        let _ = write!(
-            s,
-            r#"{{"startX":{},"startY":{},"endX":{},"endY":{}}}"#,
-            r[0], r[1], r[2], r[3]
-        );
-    }
-    s.push(']');
-    s
+/// A rectangle of available tiles, `{startX, startY, endX, endY}`, as `layer.json` and the
+/// metadata extension both write it.
+#[derive(serde::Serialize)]
+struct TileRange {
+    #[serde(rename = "startX")]
+    start_x: u32,
+    #[serde(rename = "startY")]
+    start_y: u32,
+    #[serde(rename = "endX")]
+    end_x: u32,
+    #[serde(rename = "endY")]
+    end_y: u32,
+}
+
+/// `available` tiles of one level, in the given columns and rows, as [`TileRange`]s.
+fn tile_ranges(
+    tiles: &BTreeSet<(u32, u32)>,
+    x_range: [u32; 2],
+    y_range: [u32; 2],
+) -> Vec<TileRange> {
+    rectangles(tiles, x_range, y_range)
+        .into_iter()
+        .map(|[start_x, start_y, end_x, end_y]| TileRange {
+            start_x,
+            start_y,
+            end_x,
+            end_y,
+        })
+        .collect()
 }
 
 /// The metadata extension of tile z/x/y: availability of levels z+1 ..= z+10 below it.
 pub(super) fn metadata_json(available: &Available, z: u8, x: u32, y: u32) -> String {
+    #[derive(serde::Serialize)]
+    struct Metadata {
+        available: Vec<Vec<TileRange>>,
+    }
     let mut levels = Vec::new();
     for k in 1..=u32::from(METADATA_AVAILABILITY) {
         let level = usize::from(z) + k as usize;
@@ -86,14 +104,18 @@ pub(super) fn metadata_json(available: &Available, z: u8, x: u32, y: u32) -> Str
             break;
         };
         let f = 1u32 << k;
-        let rects = rectangles(tiles, [x * f, (x + 1) * f - 1], [y * f, (y + 1) * f - 1]);
-        levels.push(rectangles_json(&rects));
+        levels.push(tile_ranges(
+            tiles,
+            [x * f, (x + 1) * f - 1],
+            [y * f, (y + 1) * f - 1],
+        ));
     }
     // Trailing empty levels say nothing; CesiumJS needs no entry for them.
-    while levels.last().is_some_and(|l| l == "[]") {
+    while levels.last().is_some_and(Vec::is_empty) {
         levels.pop();
     }
-    format!(r#"{{"available":[{}]}}"#, levels.join(","))
+    let metadata = Metadata { available: levels };
+    serde_json::to_string(&metadata).expect("tile ranges serialize")
 }
 
 pub(super) fn write_layer_json(
@@ -121,16 +143,9 @@ pub(super) fn write_layer_json(
         .iter()
         .rposition(|tiles| !tiles.is_empty())
         .map_or(max_zoom, |z| z as u8);
-    let available: Vec<serde_json::Value> = available[..=usize::from(max_zoom)]
+    let available: Vec<Vec<TileRange>> = available[..=usize::from(max_zoom)]
         .iter()
-        .map(|tiles| {
-            rectangles(tiles, all, all)
-                .iter()
-                .map(|r| {
-                    serde_json::json!({"startX": r[0], "startY": r[1], "endX": r[2], "endY": r[3]})
-                })
-                .collect()
-        })
+        .map(|tiles| tile_ranges(tiles, all, all))
         .collect();
     let mut layer = serde_json::json!({
         "tilejson": "2.1.0",

@@ -53,9 +53,6 @@
 //! # Ok(())
 //! # }
 //! ```
-#![deny(missing_docs)]
-#![deny(rustdoc::broken_intra_doc_links)]
-#![forbid(unsafe_code)]
 
 mod antimeridian;
 mod error;

@@ -29,9 +29,6 @@
 //! assert_eq!(placement.sample_at(p, F64_SAMPLE_TOLERANCE).unwrap(), [1, 1]);
 //! assert!(placement.flips_orientation());
 //! ```
-#![deny(missing_docs)]
-#![deny(rustdoc::broken_intra_doc_links)]
-#![forbid(unsafe_code)]
 
 mod geo_transform;
 mod placement;

@@ -90,6 +90,7 @@ fn kib_field(text: &str, name: &str) -> Option<u64> {
 
 /// Room under a resource limit of this process: the soft limit less what it uses now
 /// (`usage`, a field of `/proc/self/status`); `None` when unlimited.
+#[allow(unsafe_code)]
 fn rlimit_room(resource: libc::__rlimit_resource_t, usage: &str) -> Option<u64> {
     let mut limit = libc::rlimit {
         rlim_cur: 0,

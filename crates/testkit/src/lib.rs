@@ -2,8 +2,6 @@
 //!
 //! Grids are plain `(width, height, values)` row-major with NaN for nodata, so this crate
 //! depends on no other tinsmith crate and any crate may use it in its tests.
-#![deny(missing_docs)]
-#![forbid(unsafe_code)]
 
 use proptest::prelude::*;
 

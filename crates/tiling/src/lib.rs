@@ -37,9 +37,6 @@
 //! # Ok(())
 //! # }
 //! ```
-#![deny(missing_docs)]
-#![deny(rustdoc::broken_intra_doc_links)]
-#![forbid(unsafe_code)]
 
 mod collector;
 mod edge;

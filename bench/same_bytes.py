@@ -5,7 +5,9 @@
 
 Every case runs the binary once; each output file (recursively, for tile directories)
 is hashed with SHA-256, and stdout is hashed too (for `info` and `verify`). Report JSON
-files are hashed without their wall-clock times (`seconds`, `*_seconds`). With `--against`, the
+files are hashed without their wall-clock times (`seconds`, `*_seconds`), and in stdout and
+JSON the checkout's, the shared data's and the work directory's paths are replaced by
+placeholders, so runs from different checkouts compare. With `--against`, the
 hashes are compared with an earlier run's and every difference is listed; the exit code
 is 1 when any differs. Restructuring the code must leave every hash unchanged.
 """
@@ -34,7 +36,7 @@ def cases(shared):
         "pysheds_dem_fortworth_3arcsec.tif",
         "tintn_valid_raster_3857.tif",
     ]:
-        path = os.path.join(shared, "data", "dem", name)
+        path = os.path.join(os.path.realpath(shared), "data", "dem", name)
         if os.path.exists(path):
             dems.append((name.split(".")[0], path))
     out = []
@@ -99,7 +101,14 @@ def without_times(value):
     return value
 
 
-def hash_tree(root):
+def without_paths(data, paths):
+    """`data` with each of `paths` (placeholder -> path) replaced by its placeholder."""
+    for placeholder, path in paths.items():
+        data = data.replace(os.fsencode(path), placeholder.encode())
+    return data
+
+
+def hash_tree(root, paths):
     result = {}
     for dirpath, _, files in os.walk(root):
         for name in sorted(files):
@@ -107,6 +116,8 @@ def hash_tree(root):
             rel = os.path.relpath(path, root)
             with open(path, "rb") as f:
                 data = f.read()
+            if name.endswith(".json"):
+                data = without_paths(data, paths)
             if name.endswith(".json") and name.startswith("r"):
                 try:
                     report = json.loads(data)
@@ -120,10 +131,10 @@ def hash_tree(root):
 
 def run(binary, shared):
     results = {}
-    # A fixed directory: reports name their output paths.
-    work = os.path.join(tempfile.gettempdir(), "tinsmith-same-bytes")
-    shutil.rmtree(work, ignore_errors=True)
-    os.makedirs(work)
+    work = tempfile.mkdtemp(prefix="tinsmith-same-bytes-")
+    # Longest first: the work directory may lie inside the checkout.
+    paths = {"{work}": work, "{shared}": os.path.realpath(shared), "{repo}": REPO}
+    paths = dict(sorted(paths.items(), key=lambda kv: -len(kv[1])))
     try:
         for name, args in cases(shared):
             out = os.path.join(work, name)
@@ -132,8 +143,9 @@ def run(binary, shared):
             argv = [a.replace("{out}", out).replace("{sample_mesh}", mesh_for_verify)
                     for a in args]
             proc = subprocess.run([binary] + argv, capture_output=True)
-            entry = {"exit": proc.returncode, "stdout": digest(proc.stdout)}
-            entry["files"] = hash_tree(out)
+            stdout = without_paths(proc.stdout, paths)
+            entry = {"exit": proc.returncode, "stdout": digest(stdout)}
+            entry["files"] = hash_tree(out, paths)
             results[name] = entry
             status = "ok" if proc.returncode == 0 else f"exit {proc.returncode}"
             print(f"{name}: {status}, {len(entry['files'])} file(s)", file=sys.stderr)

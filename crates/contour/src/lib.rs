@@ -6,7 +6,7 @@
 //! A [`ContourMesh`] is a checked triangle mesh with heights (from any vertex list and
 //! triangle list, or [`ContourMesh::from_grid`] for the full-resolution grid); [`contour`]
 //! cuts it at each level by marching triangles and joins the segments into [`Polyline`]s.
-//! No I/O, no GDAL: coordinates are whatever the caller gives (the `tinsmith` CLI uses grid
+//! No I/O, no GDAL: coordinates are whatever the caller gives (the `tinsmith` pipeline uses grid
 //! positions and maps the result to world coordinates). [`ContourStitcher`] gives the same
 //! lines for a mesh that arrives in pieces (tiles), holding only the lines.
 //! [`simplify_indices`] is an opt-in Douglas–Peucker step for callers that trade exactness

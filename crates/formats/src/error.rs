@@ -1,4 +1,4 @@
-//! The error type of the exporter: one enum, every variant names the file it is about.
+//! The error type of the format readers and writers: one enum, every variant names the file it is about.
 
 use std::fmt;
 use std::io;

@@ -2,7 +2,7 @@
 //! decimator and the map from grid positions to the coordinates written in mesh files.
 //!
 //! This crate depends on no other tinsmith crate and links no GDAL, so a reader, the
-//! decimation core, the tile engine and the command line can all share these types
+//! decimation core, the tiled engine and the pipeline can all share these types
 //! without depending on one another.
 //!
 //! - [`Samples`]: a `width` x `height` block of heights in row-major order, NaN marking

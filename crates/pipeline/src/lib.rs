@@ -1,7 +1,9 @@
 //! The tinsmith commands as library calls: a raster in, a verified TIN, contour lines or a
-//! terrain pyramid out. Every run takes a plain job ([`MeshJob`], [`ContourJob`],
-//! [`VerifyJob`]) and a [`Feedback`] for its notes and progress; the `tinsmith` binary
-//! only parses flags into jobs, draws the feedback and maps errors to exit codes.
+//! terrain pyramid out. Every run takes plain values ([`MeshJob`], [`ContourJob`],
+//! [`VerifyJob`]; for [`tiles`], paths and `tinsmith_terrain::TerrainOptions`; for
+//! [`serve`], [`ServeOptions`]) and a [`Feedback`] for its notes and progress; the
+//! `tinsmith` binary parses flags into those values, draws the feedback, prints results
+//! and maps errors to exit codes.
 //!
 //! What every run guarantees:
 //! - a mesh is written only after the independent verifier (`tinsmith-verify`) has

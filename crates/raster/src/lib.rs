@@ -3,7 +3,6 @@
 //!
 //! [`read_samples`] returns the samples (nodata as NaN) with a [`RasterInfo`]: driver, size, data
 //! type, nodata value, CRS (WKT and EPSG code), geotransform and statistics of the samples.
-//! [`open_info`] gives the same [`RasterInfo`] without keeping the samples.
 //! [`to_wgs84`] and [`from_wgs84`] transform coordinates between a CRS and WGS84
 //! longitude, latitude (for RFC 7946 GeoJSON), so that no other crate links GDAL.
 //! [`open_info`] gives the same [`RasterInfo`] without keeping the samples. For rasters

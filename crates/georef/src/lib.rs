@@ -31,10 +31,12 @@
 //! ```
 
 mod geo_transform;
+mod number;
 mod placement;
 mod samples;
 
 pub use geo_transform::GeoTransform;
+pub use number::readable;
 pub use placement::{
     Placement, PositionError, F32_SAMPLE_TOLERANCE, F64_SAMPLE_TOLERANCE, WGS84_SAMPLE_TOLERANCE,
 };

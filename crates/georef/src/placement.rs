@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-use crate::GeoTransform;
+use crate::{readable, GeoTransform};
 
 /// How far (in pixels) a position in a double-precision file may be from a sample centre
 /// and still name it ([`Placement::sample_at`]): far above the rounding of `f64` positions
@@ -118,18 +118,6 @@ impl fmt::Display for PositionError {
 }
 
 impl std::error::Error for PositionError {}
-
-/// `x` as `Display` writes it (the shortest text that reads back as `x`), in scientific
-/// notation when it is at least 1e16 or below 1e-5 in magnitude (and not zero): how the
-/// command line writes numbers for people.
-fn readable(x: f64) -> String {
-    let magnitude = x.abs();
-    if magnitude != 0.0 && magnitude.is_finite() && !(1e-5..1e16).contains(&magnitude) {
-        format!("{x:e}")
-    } else {
-        format!("{x}")
-    }
-}
 
 impl Placement {
     /// World coordinates when there is a geotransform and pixel coordinates are not asked

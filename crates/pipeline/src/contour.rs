@@ -36,11 +36,11 @@ use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
 use crate::jobs::ContourJob;
 use crate::mesh_file::{expected_orientation, read_mesh_file, sample_positions};
-use crate::number::readable;
 use crate::output_paths::NamingFile;
 use crate::output_paths::{check_distinct, check_writable_target};
 use crate::wgs84::{file_crs, LineEnd, Pieces};
 use crate::Feedback;
+use tinsmith_georef::readable;
 use tinsmith_georef::{Placement, Samples};
 
 /// Memory per line segment while contouring and writing: its point in the joiner, the

@@ -11,13 +11,13 @@ use tinsmith_formats::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
 use tinsmith_raster::RasterInfo;
 
 use crate::jobs::MeshJob;
-use crate::number::readable;
 use crate::output_paths::NamingFile;
 use crate::wgs84::{
     check_no_fold_in_lon_lat, check_wgs84_maps_back, check_wgs84_mesh_possible, file_crs,
     is_geographic, projected_crs, snap_to_antimeridian, Pieces,
 };
 use crate::Feedback;
+use tinsmith_georef::readable;
 use tinsmith_georef::Placement;
 
 /// Largest rounding of a float32 position, in pixels, accepted before decimating: 90 % of

@@ -32,7 +32,6 @@ mod jobs;
 mod memory;
 mod mesh;
 mod mesh_file;
-mod number;
 mod output_paths;
 mod report;
 mod scan;
@@ -49,10 +48,10 @@ pub use format_plan::{parse_format, FormatPlan};
 pub use jobs::{ContourJob, ExportChoices, MeshJob, TileFormat, VerifyJob, DEFAULT_TILE_SIZE};
 pub use memory::available_bytes;
 pub use mesh::mesh;
-pub use number::readable;
 pub use scan::scan_raster;
 pub use serve::{serve, ServeOptions};
 pub use tiles::tiles;
+pub use tinsmith_georef::readable;
 pub use verify::{verify, Verified};
 
 /// The results: `anyhow` errors whose chain names the file and the problem.

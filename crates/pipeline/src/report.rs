@@ -7,8 +7,8 @@ use serde::Serialize;
 use tinsmith_core::{Order, VertexHeights};
 
 use crate::jobs::MeshJob;
-use crate::number::readable;
 use crate::Feedback;
+use tinsmith_georef::readable;
 
 /// What every mesh report says: the input, the options, the counts before and after, the
 /// bound and the independently measured error, and where the mesh went.

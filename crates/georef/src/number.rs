@@ -1,5 +1,5 @@
-//! Numbers for people: `f64`'s `Display` never switches to an exponent, so 1e297 would
-//! print as a 298-digit string.
+//! Numbers for people, as every tinsmith message writes them: `f64`'s `Display` never
+//! switches to an exponent, so 1e297 would print as a 298-digit string.
 
 /// `x` as `Display` writes it (the shortest text that reads back as `x`), in scientific
 /// notation when it is at least 1e16 or below 1e-5 in magnitude (and not zero).

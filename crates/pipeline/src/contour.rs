@@ -24,7 +24,8 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{bail, Context, Result};
+use crate::error::{bail, Context};
+use crate::Result;
 use tinsmith_contour::{
     interval_levels, simplify_indices, sorted_levels, ContourMesh, ContourStitcher, Polyline,
 };
@@ -425,7 +426,7 @@ struct StitchingSink<'a> {
     height_range: Option<(f64, f64)>,
     /// Why the run was stopped (lines that would not fit, or a contouring failure), for the
     /// caller to report as is.
-    stopped: Option<anyhow::Error>,
+    stopped: Option<crate::Error>,
     job: &'a ContourJob,
 }
 
@@ -476,9 +477,9 @@ impl StitchingSink<'_> {
 }
 
 impl TileSink for StitchingSink<'_> {
-    fn tile(&mut self, tile: &FinishedTile) -> Result<(), SinkError> {
+    fn tile(&mut self, tile: &FinishedTile) -> std::result::Result<(), SinkError> {
         self.contour_tile(tile).map_err(|e| {
-            let message = format!("{e:#}");
+            let message = e.chain_text();
             self.stopped = Some(e);
             message.into()
         })
@@ -486,12 +487,12 @@ impl TileSink for StitchingSink<'_> {
 }
 
 /// The error for a band without a valid 2x2 block of samples.
-fn nothing_to_contour(job: &ContourJob) -> anyhow::Error {
-    anyhow::anyhow!(
+fn nothing_to_contour(job: &ContourJob) -> crate::Error {
+    crate::Error::Refused(format!(
         "{}: band {} has no 2x2 block of valid samples, so there is nothing to contour",
         job.input.display(),
         job.band
-    )
+    ))
 }
 
 /// Reads a mesh file written from `raster` (as `tinsmith verify` reads it: GeoJSON in

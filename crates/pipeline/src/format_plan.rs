@@ -4,7 +4,8 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use crate::error::{bail, Context};
+use crate::Result;
 use serde::Serialize;
 use tinsmith_core::Grid;
 use tinsmith_formats::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};

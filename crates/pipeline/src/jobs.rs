@@ -152,7 +152,7 @@ impl MeshJob {
         &self,
         max_error: f64,
         heights: Option<(f64, f64)>,
-    ) -> anyhow::Result<DecimationOptions> {
+    ) -> crate::Result<DecimationOptions> {
         let mut options = DecimationOptions::new(max_error)
             .with_selection(self.selection)
             .with_error_model(self.error_model)
@@ -165,7 +165,7 @@ impl MeshJob {
         options.extend_rounds = self.extend_rounds;
         options.vertex_heights = self.vertex_heights;
         if self.has_count_target() && (self.flip_rounds > 0 || self.extend_rounds > 0) {
-            anyhow::bail!(
+            crate::error::bail!(
                 "{}: --flip-rounds and --extend-rounds work to an error bound, not with \
                  --max-triangles or --max-vertices",
                 self.input.display()

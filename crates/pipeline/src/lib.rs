@@ -22,10 +22,11 @@
 //! job.output = Some("dem.ply".into());
 //! job.max_error = Some(0.5);
 //! mesh(&job, &Silent)?;
-//! # Ok::<(), anyhow::Error>(())
+//! # Ok::<(), tinsmith_pipeline::Error>(())
 //! ```
 
 mod contour;
+mod error;
 mod feedback;
 mod format_plan;
 mod jobs;
@@ -43,6 +44,7 @@ mod verify;
 mod wgs84;
 
 pub use contour::contour;
+pub use error::{Error, Result};
 pub use feedback::{Feedback, Silent};
 pub use format_plan::{parse_format, FormatPlan};
 pub use jobs::{ContourJob, ExportChoices, MeshJob, TileFormat, VerifyJob, DEFAULT_TILE_SIZE};
@@ -53,6 +55,3 @@ pub use serve::{serve, ServeOptions};
 pub use tiles::tiles;
 pub use tinsmith_georef::readable;
 pub use verify::{verify, Verified};
-
-/// The results: `anyhow` errors whose chain names the file and the problem.
-pub type Result<T> = anyhow::Result<T>;

@@ -5,7 +5,8 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Result};
+use crate::error::bail;
+use crate::Result;
 
 /// What a whole-raster run holds, per raster sample and in all (measured on ETOPO5,
 /// 9.3 M samples; rounded up).

@@ -3,7 +3,8 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{bail, Result};
+use crate::error::bail;
+use crate::Result;
 use serde::Serialize;
 use tinsmith_core::{decimate_with_progress, Grid};
 use tinsmith_formats::MeshFormat;
@@ -37,7 +38,7 @@ struct MeshReport<'a> {
 /// independent verifier confirms the bound, with its heights as the file holds them.
 pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     if job.tile_format.is_some() && job.per_tile.is_none() {
-        anyhow::bail!(
+        crate::error::bail!(
             "--tile-format sets the format of the --per-tile files; without --per-tile the \
              format follows -o's extension (or --format)"
         );

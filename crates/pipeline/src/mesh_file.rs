@@ -5,7 +5,8 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use crate::error::Context;
+use crate::Result;
 use tinsmith_formats::{Mesh, MeshFormat};
 use tinsmith_georef::Placement;
 use tinsmith_raster::Raster;
@@ -79,7 +80,7 @@ pub fn sample_positions(
             let p = [v[0], v[1]];
             georef.sample_at(p, tolerance).map_err(|e| {
                 if !georef.near_miss(p, tolerance) {
-                    return anyhow::anyhow!("{}: vertex {i}: {e:#}", path.display());
+                    return crate::Error::Refused(format!("{}: vertex {i}: {e:#}", path.display()));
                 }
                 let ogr2ogr = match wgs84 {
                     true => {
@@ -88,11 +89,11 @@ pub fn sample_positions(
                     }
                     false => "",
                 };
-                anyhow::anyhow!(
+                crate::Error::Refused(format!(
                     "{}: vertex {i}: {e:#}: the file's positions were changed after it was \
                      written, and the mesh is measured as written{ogr2ogr}",
                     path.display()
-                )
+                ))
             })
         })
         .collect()

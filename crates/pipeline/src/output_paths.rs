@@ -4,7 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Result};
+use crate::error::bail;
+use crate::Result;
 use tinsmith_formats::MeshFormat;
 pub use tinsmith_output::{check_distinct, check_not_inside, ReservedReport};
 
@@ -169,12 +170,12 @@ pub trait NamingFile<T> {
     fn naming_file(self, path: &Path) -> Result<T>;
 }
 
-impl<T, E: Into<anyhow::Error>> NamingFile<T> for std::result::Result<T, E> {
+impl<T, E: Into<crate::Error>> NamingFile<T> for std::result::Result<T, E> {
     fn naming_file(self, path: &Path) -> Result<T> {
         self.map_err(|e| {
-            let e: anyhow::Error = e.into();
+            let e: crate::Error = e.into();
             let shown = path.display().to_string();
-            if format!("{e:#}").contains(&shown) {
+            if e.chain_text().contains(&shown) {
                 e
             } else {
                 e.context(shown)

@@ -14,7 +14,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use anyhow::{bail, Context, Result};
+use crate::error::{bail, Context};
+use crate::Result;
 
 use crate::Feedback;
 
@@ -57,7 +58,9 @@ pub fn serve(options: &ServeOptions, feedback: &dyn Feedback) -> Result<Server> 
     if !dir.exists() {
         bail!("{}: no such directory", dir.display());
     }
-    anyhow::ensure!(dir.is_dir(), "{}: not a directory", dir.display());
+    if !dir.is_dir() {
+        bail!("{}: not a directory", dir.display());
+    }
     let has_layer = |dir: &Path| dir.join("layer.json").is_file();
     let pyramid_below = std::fs::read_dir(dir).is_ok_and(|entries| {
         entries

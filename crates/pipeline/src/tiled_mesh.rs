@@ -5,7 +5,8 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{bail, Result};
+use crate::error::bail;
+use crate::Result;
 use serde::Serialize;
 use tinsmith_formats::MeshFormat;
 use tinsmith_tiling::{

@@ -3,7 +3,8 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Result};
+use crate::error::bail;
+use crate::Result;
 use tinsmith_georef::{Placement, F64_SAMPLE_TOLERANCE};
 
 /// Fails (before any long work) when world coordinates are to be written and the raster's

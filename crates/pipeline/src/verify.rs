@@ -1,6 +1,6 @@
 //! `tinsmith verify`: measure a mesh file's true error against its raster.
 
-use anyhow::Context;
+use crate::error::Context;
 use tinsmith_verify::{GridRef, MeshRef, Report, VerifyOptions};
 
 use crate::mesh_file::{
@@ -58,7 +58,7 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
     .with_context(|| format!("{}: cannot verify", job.mesh.display()))?;
     if report.domain_samples == 0 {
         // `mesh` refuses such a raster: a pass here would measure nothing.
-        anyhow::bail!(
+        crate::error::bail!(
             "{}: has no valid cell (a 2 x 2 block of valid samples), so no triangle can \
              cover any of its {} valid samples and there is nothing to measure",
             job.input.display(),

@@ -4,7 +4,8 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use crate::error::{bail, Context};
+use crate::Result;
 use tinsmith_formats::CrsRef;
 use tinsmith_raster::RasterInfo;
 

@@ -80,67 +80,125 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
         let source = format!("TIN within {} ({tiles} tiles)", readable(e));
         (contoured, info, source, levels)
     } else {
-        let (need, what, instead) = match &job.mesh {
-            Some(mesh) => (
-                crate::memory::Need {
-                    bytes_per_sample: 24,
-                    extra_bytes: crate::memory::mesh_file_memory(
-                        mesh,
-                        crate::mesh_file::mesh_format(mesh, job.mesh_format)?,
-                    ),
-                },
-                "contouring a --mesh",
-                "contour it with --max-error instead (decimated tile by tile, in bounded memory)",
-            ),
-            None => {
-                let (what, instead) = if e == 0.0 {
-                    (
-                        "contouring the full grid",
-                        "give --max-error > 0 (decimated tile by tile, in bounded memory)",
-                    )
-                } else {
-                    (
-                        "contouring in one tile (the raster fits --tile-size)",
-                        "give a smaller --tile-size",
-                    )
-                };
-                let need = crate::memory::Need {
-                    bytes_per_sample: 120,
-                    extra_bytes: 0,
-                };
-                (need, what, instead)
-            }
-        };
-        crate::memory::check_whole_raster_fits(&job.input, size, need, what, instead)?;
-        let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
-        let (mesh, source, levels) = untiled_tin(job, e, &raster)?;
-        // The lines are held whole before writing: refuse levels that would not fit.
-        let segments = mesh.segment_count(&levels);
-        crate::memory::check_fits(
-            segments.saturating_mul(BYTES_PER_SEGMENT),
-            |needed, available| {
-                lines_refusal(
-                    job,
-                    levels.len(),
-                    &format!("about {segments} times"),
-                    needed,
-                    available,
-                )
-            },
-        )?;
-        let lines = tinsmith_contour::contour(&mesh, &levels)
-            .with_context(|| format!("{}: contouring failed", job.input.display()))?;
-        let contoured = Contoured {
-            lines,
-            triangles: mesh.triangles().len(),
-            height_range: mesh.height_range(),
-        };
-        (contoured, raster.info, source, levels)
+        untiled_lines(job, e, size)?
     };
     let georef = Placement::new(info.transform(), job.pixel_coords);
     crate::output_paths::note_gcps_unused(&info, job.pixel_coords, feedback);
     let polylines = contoured.lines;
 
+    let (points, ends) = file_lines(job, &georef, polylines);
+    let written = write_file_lines(job, format, &info, points, &ends, feedback)?;
+    tinsmith_output::mark_finished();
+
+    feedback.note(&format!(
+        "{}: {} lines ({} closed), {} segments{} at {} levels from the {} ({} triangles) in {:.2} s",
+        job.output.display(),
+        written.lines,
+        written.closed,
+        written.segments,
+        job.simplify
+            .map(|d| format!(" (simplified within {})", readable(d)))
+            .unwrap_or_default(),
+        levels.len(),
+        source,
+        contoured.triangles,
+        started.elapsed().as_secs_f64()
+    ));
+    if written.lines == 0 {
+        if let Some((lo, hi)) = contoured.height_range {
+            let why = if levels.is_empty() {
+                "no level of the --interval lies within the TIN's heights"
+            } else if levels.iter().all(|&l| l < lo || l > hi) {
+                "the levels miss the TIN's heights"
+            } else {
+                "no level crosses the TIN (ground that only touches a level makes no \
+                 line, and lines too small to keep a point apart are dropped); its heights"
+            };
+            feedback.note(&format!(
+                "{}: no line: {why}, {} .. {}",
+                job.output.display(),
+                readable(lo),
+                readable(hi)
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The lines of a raster that fits one tile (or of a `--mesh` file, or of the full grid),
+/// with the raster's metadata, a word on which TIN they were drawn on, and the levels; the
+/// whole raster is held, so the run is refused first when it would not fit in memory.
+fn untiled_lines(
+    job: &ContourJob,
+    e: f64,
+    size: (u32, u32),
+) -> Result<(Contoured, RasterInfo, String, Vec<f64>)> {
+    let (need, what, instead) = match &job.mesh {
+        Some(mesh) => (
+            crate::memory::Need {
+                bytes_per_sample: 24,
+                extra_bytes: crate::memory::mesh_file_memory(
+                    mesh,
+                    crate::mesh_file::mesh_format(mesh, job.mesh_format)?,
+                ),
+            },
+            "contouring a --mesh",
+            "contour it with --max-error instead (decimated tile by tile, in bounded memory)",
+        ),
+        None => {
+            let (what, instead) = if e == 0.0 {
+                (
+                    "contouring the full grid",
+                    "give --max-error > 0 (decimated tile by tile, in bounded memory)",
+                )
+            } else {
+                (
+                    "contouring in one tile (the raster fits --tile-size)",
+                    "give a smaller --tile-size",
+                )
+            };
+            let need = crate::memory::Need {
+                bytes_per_sample: 120,
+                extra_bytes: 0,
+            };
+            (need, what, instead)
+        }
+    };
+    crate::memory::check_whole_raster_fits(&job.input, size, need, what, instead)?;
+    let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
+    let (mesh, source, levels) = untiled_tin(job, e, &raster)?;
+    // The lines are held whole before writing: refuse levels that would not fit.
+    let segments = mesh.segment_count(&levels);
+    crate::memory::check_fits(
+        segments.saturating_mul(BYTES_PER_SEGMENT),
+        |needed, available| {
+            lines_refusal(
+                job,
+                levels.len(),
+                &format!("about {segments} times"),
+                needed,
+                available,
+            )
+        },
+    )?;
+    let lines = tinsmith_contour::contour(&mesh, &levels)
+        .with_context(|| format!("{}: contouring failed", job.input.display()))?;
+    let contoured = Contoured {
+        lines,
+        triangles: mesh.triangles().len(),
+        height_range: mesh.height_range(),
+    };
+    Ok((contoured, raster.info, source, levels))
+}
+
+/// The lines in the file's coordinates (sample centres through the geotransform, or
+/// pixels), the level as z for a reprojection, simplified within `--simplify`; with each
+/// line's end in the points, its level and whether it is closed.
+fn file_lines(
+    job: &ContourJob,
+    georef: &Placement,
+    polylines: Vec<Polyline>,
+) -> (Vec<[f64; 3]>, Vec<LineEnd>) {
     // Grid coordinates -> file coordinates, with the level as z for the reprojection, then
     // --simplify. A north-up raster flips orientation; reverse so the high ground stays on
     // the left in file coordinates.
@@ -171,20 +229,42 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
         }
         ends.push((points.len(), level, closed));
     }
+    (points, ends)
+}
+
+/// How many lines, closed rings and segments [`write_file_lines`] wrote.
+struct Written {
+    lines: usize,
+    closed: usize,
+    segments: usize,
+}
+
+/// Writes the lines (`points` in file coordinates, `ends` as [`file_lines`] gives them):
+/// GeoJSON reprojected to WGS84 unless `--geojson-source-crs` (and cut at the
+/// antimeridian), repeated points dropped.
+fn write_file_lines(
+    job: &ContourJob,
+    format: LineFormat,
+    info: &RasterInfo,
+    points: Vec<[f64; 3]>,
+    ends: &[LineEnd],
+    feedback: &dyn Feedback,
+) -> Result<Written> {
+    let mut points = points;
     let wgs84 = format == LineFormat::GeoJson && !job.geojson_source_crs;
     let crs = file_crs(
-        &info,
+        info,
         job.pixel_coords,
         wgs84,
         &mut points,
-        Pieces::Lines(&ends),
+        Pieces::Lines(ends),
         &job.output,
         feedback,
     )?;
     if format == LineFormat::GeoJson && crs.epsg == Some(4326) {
         crate::wgs84::snap_to_antimeridian(&mut points);
     }
-    let (points, ends) = without_repeated_points(points, &ends);
+    let (points, ends) = without_repeated_points(points, ends);
     let closed = ends.iter().filter(|&&(_, _, closed)| closed).count();
     let mut start = 0;
     let lines: Vec<(&[[f64; 2]], f64)> = ends
@@ -218,41 +298,11 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
     } else {
         tinsmith_formats::write_lines(&job.output, format, &lines, crs)?;
     }
-    tinsmith_output::mark_finished();
-
-    feedback.note(&format!(
-        "{}: {} lines ({} closed), {} segments{} at {} levels from the {} ({} triangles) in {:.2} s",
-        job.output.display(),
-        lines.len(),
+    Ok(Written {
+        lines: lines.len(),
         closed,
         segments,
-        job.simplify
-            .map(|d| format!(" (simplified within {})", readable(d)))
-            .unwrap_or_default(),
-        levels.len(),
-        source,
-        contoured.triangles,
-        started.elapsed().as_secs_f64()
-    ));
-    if lines.is_empty() {
-        if let Some((lo, hi)) = contoured.height_range {
-            let why = if levels.is_empty() {
-                "no level of the --interval lies within the TIN's heights"
-            } else if levels.iter().all(|&l| l < lo || l > hi) {
-                "the levels miss the TIN's heights"
-            } else {
-                "no level crosses the TIN (ground that only touches a level makes no \
-                 line, and lines too small to keep a point apart are dropped); its heights"
-            };
-            feedback.note(&format!(
-                "{}: no line: {why}, {} .. {}",
-                job.output.display(),
-                readable(lo),
-                readable(hi)
-            ));
-        }
-    }
-    Ok(())
+    })
 }
 
 /// The lines (`ends`: each line's end in `points`, its level, whether it is a closed ring)

@@ -239,39 +239,20 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     };
     feedback.tiles_end();
 
-    let r: &TilesReport = &report;
-    let outcome = Outcome {
-        size: (info.width, info.height),
-        valid_samples: info.valid_samples,
-        band_count: info.band_count,
-        before: (r.initial_triangles, r.initial_vertices),
-        after: (r.final_triangles, r.final_vertices),
-        max_error_bound: r.max_bound,
-        measured_max_error: r.measured_max_error,
+    let wall = WallSeconds {
+        scan: scan_seconds,
+        write: write_seconds,
+        total: total.elapsed().as_secs_f64(),
+    };
+    let json = tiled_report(
+        job,
+        output,
+        &info,
+        &report,
+        export_plan,
         vertex_heights_raised,
-    };
-    let json = TiledMeshReport {
-        summary: MeshSummary::new(job, output, outcome),
-        output_format: export_plan.map(|p| p.report()),
-        seconds: Seconds {
-            read: scan_seconds + r.seconds_read,
-            initial_mesh: 0.0,
-            decimate: r.seconds_decimation,
-            verify: r.seconds_verify,
-            write: write_seconds,
-            total: total.elapsed().as_secs_f64(),
-        },
-        tiles: Tiles {
-            count: r.plan.len(),
-            size: r.plan.size(),
-            columns: r.plan.columns(),
-            rows: r.plan.rows(),
-            threads: r.threads,
-            welded: job.per_tile.is_none(),
-            scan_seconds,
-            tiles_seconds: r.seconds_total,
-        },
-    };
+        wall,
+    );
     json.summary.print(
         &format!(" in {} tiles of {}", json.tiles.count, json.tiles.size),
         feedback,
@@ -284,6 +265,58 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     }
     tinsmith_output::mark_finished();
     Ok(())
+}
+
+/// Wall-clock seconds of a tiled run: the statistics scan, the writing, the whole.
+#[derive(Debug, Clone, Copy)]
+struct WallSeconds {
+    scan: f64,
+    write: f64,
+    total: f64,
+}
+
+/// The `--report` JSON of a tiled run that wrote `output`, from the engine's report `r`.
+fn tiled_report<'a>(
+    job: &'a MeshJob,
+    output: &'a Path,
+    info: &tinsmith_raster::RasterInfo,
+    r: &TilesReport,
+    export_plan: Option<crate::FormatPlan>,
+    vertex_heights_raised: bool,
+    wall: WallSeconds,
+) -> TiledMeshReport<'a> {
+    let outcome = Outcome {
+        size: (info.width, info.height),
+        valid_samples: info.valid_samples,
+        band_count: info.band_count,
+        before: (r.initial_triangles, r.initial_vertices),
+        after: (r.final_triangles, r.final_vertices),
+        max_error_bound: r.max_bound,
+        measured_max_error: r.measured_max_error,
+        vertex_heights_raised,
+    };
+    TiledMeshReport {
+        summary: MeshSummary::new(job, output, outcome),
+        output_format: export_plan.map(|p| p.report()),
+        seconds: Seconds {
+            read: wall.scan + r.seconds_read,
+            initial_mesh: 0.0,
+            decimate: r.seconds_decimation,
+            verify: r.seconds_verify,
+            write: wall.write,
+            total: wall.total,
+        },
+        tiles: Tiles {
+            count: r.plan.len(),
+            size: r.plan.size(),
+            columns: r.plan.columns(),
+            rows: r.plan.rows(),
+            threads: r.threads,
+            welded: job.per_tile.is_none(),
+            scan_seconds: wall.scan,
+            tiles_seconds: r.seconds_total,
+        },
+    }
 }
 
 /// Whether the tiled engine streams `format` to the file tile by tile; the other formats

@@ -1,10 +1,9 @@
 //! `tinsmith info`: describe a raster band.
 
 use anyhow::Result;
-
-use crate::args::InfoArgs;
 use tinsmith_pipeline::readable;
 
+use crate::args::InfoArgs;
 use crate::progress::Stderr;
 
 /// Prints the band's metadata and value statistics; always `Ok(true)` on success.

@@ -24,25 +24,25 @@
 use std::path::Path;
 use std::time::Instant;
 
-use crate::error::{bail, Context};
-use crate::Result;
 use tinsmith_contour::{
     interval_levels, simplify_indices, sorted_levels, ContourMesh, ContourStitcher, Polyline,
 };
 use tinsmith_core::{decimate, DecimationOptions, Grid};
 use tinsmith_formats::LineFormat;
+use tinsmith_georef::readable;
+use tinsmith_georef::{Placement, Samples};
 use tinsmith_raster::{Raster, RasterInfo};
 use tinsmith_tiling::{mesh_tiles, FinishedTile, RasterSource, SinkError, TileOptions, TileSink};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
+use crate::error::{bail, Context};
 use crate::jobs::ContourJob;
 use crate::mesh_file::{expected_orientation, read_mesh_file, sample_positions};
 use crate::output_paths::NamingFile;
 use crate::output_paths::{check_distinct, check_writable_target};
 use crate::wgs84::{file_crs, LineEnd, Pieces};
 use crate::Feedback;
-use tinsmith_georef::readable;
-use tinsmith_georef::{Placement, Samples};
+use crate::Result;
 
 /// Memory per line segment while contouring and writing: its point in the joiner, the
 /// polyline and the file coordinates (measured about 50 bytes on ETOPO5).
@@ -166,7 +166,7 @@ fn untiled_lines(
     };
     crate::memory::check_whole_raster_fits(&job.input, size, need, what, instead)?;
     let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
-    let (mesh, source, levels) = untiled_tin(job, e, &raster)?;
+    let (mesh, source, levels, info) = untiled_tin(job, e, raster)?;
     // The lines are held whole before writing: refuse levels that would not fit.
     let segments = mesh.segment_count(&levels);
     crate::memory::check_fits(
@@ -188,7 +188,7 @@ fn untiled_lines(
         triangles: mesh.triangles().len(),
         height_range: mesh.height_range(),
     };
-    Ok((contoured, raster.info, source, levels))
+    Ok((contoured, info, source, levels))
 }
 
 /// The lines in the file's coordinates (sample centres through the geotransform, or
@@ -359,34 +359,34 @@ fn levels_for(job: &ContourJob, range: Option<(f64, f64)>) -> Result<Vec<f64>> {
     }
 }
 
-/// The TIN to contour from the whole raster in memory, with a word on where it came from
-/// and the levels: the `--mesh` file (levels over its heights), the full grid for `e = 0`,
-/// or the grid decimated within `e > 0` and shaped for the levels (over the raster's
-/// heights).
+/// The TIN to contour from the whole raster in memory, with a word on where it came from,
+/// the levels and the raster's metadata: the `--mesh` file (levels over its heights), the
+/// full grid for `e = 0`, or the grid decimated within `e > 0` and shaped for the levels
+/// (over the raster's heights). The grid takes the raster's samples over.
 fn untiled_tin(
     job: &ContourJob,
     e: f64,
-    raster: &Raster,
-) -> Result<(ContourMesh, String, Vec<f64>)> {
-    let grid = &raster.samples;
+    raster: Raster,
+) -> Result<(ContourMesh, String, Vec<f64>, RasterInfo)> {
     if let Some(path) = &job.mesh {
         let georef = Placement::new(raster.info.transform(), job.pixel_coords);
         let format = crate::mesh_file::mesh_format(path, job.mesh_format)?;
-        let mesh = mesh_from_file(path, format, raster, georef, job.band)?;
+        let mesh = mesh_from_file(path, format, &raster, georef, job.band)?;
         let levels = levels_for(job, mesh.height_range())?;
-        return Ok((mesh, "mesh file".to_owned(), levels));
+        return Ok((mesh, "mesh file".to_owned(), levels, raster.info));
     }
-    let levels = levels_for(job, raster.info.min.zip(raster.info.max))?;
-    if grid.valid_cell_count() == 0 {
+    let Raster { samples, info, .. } = raster;
+    let levels = levels_for(job, info.min.zip(info.max))?;
+    if samples.valid_cell_count() == 0 {
         return Err(nothing_to_contour(job));
     }
     if e == 0.0 {
-        let mesh = ContourMesh::from_grid(grid.width(), grid.height(), grid.values())
+        let mesh = ContourMesh::from_grid(samples.width(), samples.height(), samples.values())
             .naming_file(&job.input)?;
-        return Ok((mesh, "full grid".to_owned(), levels));
+        return Ok((mesh, "full grid".to_owned(), levels, info));
     }
     let options = DecimationOptions::new(e).with_contour_levels(&levels);
-    let grid = &Grid::from_samples(grid.clone());
+    let grid = &Grid::from_samples(samples);
     let tin = decimate(grid, &options).naming_file(&job.input)?.tin;
     let vertices = tin
         .vertices()
@@ -395,7 +395,7 @@ fn untiled_tin(
         .collect();
     let mesh = ContourMesh::new(vertices, tin.triangles().to_vec())
         .with_context(|| format!("{}: decimated TIN", job.input.display()))?;
-    Ok((mesh, format!("TIN within {}", readable(e)), levels))
+    Ok((mesh, format!("TIN within {}", readable(e)), levels, info))
 }
 
 /// Contour lines and what they were drawn on: the TIN's triangle count and height range.

@@ -4,13 +4,14 @@
 
 use std::path::Path;
 
-use crate::error::{bail, Context};
-use crate::Result;
 use serde::Serialize;
 use tinsmith_core::Grid;
 use tinsmith_formats::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
+use tinsmith_georef::readable;
+use tinsmith_georef::Placement;
 use tinsmith_raster::RasterInfo;
 
+use crate::error::{bail, Context};
 use crate::jobs::MeshJob;
 use crate::output_paths::NamingFile;
 use crate::wgs84::{
@@ -18,8 +19,7 @@ use crate::wgs84::{
     is_geographic, projected_crs, snap_to_antimeridian, Pieces,
 };
 use crate::Feedback;
-use tinsmith_georef::readable;
-use tinsmith_georef::Placement;
+use crate::Result;
 
 /// Largest rounding of a float32 position, in pixels, accepted before decimating: 90 % of
 /// the 1e-3 pixel within which the verifier maps file positions to samples. Half a float32

@@ -10,6 +10,8 @@ use tinsmith_core::{
 };
 use tinsmith_formats::MeshFormat;
 
+use crate::error::bail;
+
 /// Samples per tile side (shared row and column included) unless a job says otherwise.
 pub const DEFAULT_TILE_SIZE: u32 = tinsmith_tiling::DEFAULT_TILE_SIZE;
 
@@ -165,7 +167,7 @@ impl MeshJob {
         options.extend_rounds = self.extend_rounds;
         options.vertex_heights = self.vertex_heights;
         if self.has_count_target() && (self.flip_rounds > 0 || self.extend_rounds > 0) {
-            crate::error::bail!(
+            bail!(
                 "{}: --flip-rounds and --extend-rounds work to an error bound, not with \
                  --max-triangles or --max-vertices",
                 self.input.display()

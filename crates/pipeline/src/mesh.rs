@@ -3,19 +3,19 @@
 use std::path::Path;
 use std::time::Instant;
 
-use crate::error::bail;
-use crate::Result;
 use serde::Serialize;
 use tinsmith_core::{decimate_with_progress, Grid};
 use tinsmith_formats::MeshFormat;
+use tinsmith_georef::Placement;
 use tinsmith_tiling::check_tin;
 
+use crate::error::bail;
 use crate::jobs::MeshJob;
 use crate::output_paths::NamingFile;
 use crate::output_paths::{check_distinct, check_writable_target, ReservedReport};
 use crate::report::{MeshSummary, Outcome, Seconds};
 use crate::Feedback;
-use tinsmith_georef::Placement;
+use crate::Result;
 
 /// The `--report` JSON.
 #[derive(Debug, Serialize)]
@@ -38,7 +38,7 @@ struct MeshReport<'a> {
 /// independent verifier confirms the bound, with its heights as the file holds them.
 pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     if job.tile_format.is_some() && job.per_tile.is_none() {
-        crate::error::bail!(
+        bail!(
             "--tile-format sets the format of the --per-tile files; without --per-tile the \
              format follows -o's extension (or --format)"
         );

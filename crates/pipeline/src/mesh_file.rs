@@ -5,12 +5,13 @@
 
 use std::path::Path;
 
-use crate::error::Context;
-use crate::Result;
 use tinsmith_formats::{Mesh, MeshFormat};
 use tinsmith_georef::Placement;
 use tinsmith_raster::Raster;
 use tinsmith_verify::Orientation;
+
+use crate::error::Context;
+use crate::Result;
 
 /// Reads a mesh file written from `raster` in its file coordinates: RFC 7946 GeoJSON
 /// (WGS84 longitude, latitude) is transformed back to the raster's CRS.

@@ -4,12 +4,13 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::error::bail;
-use crate::Result;
 use tinsmith_formats::MeshFormat;
-pub use tinsmith_output::{check_distinct, check_not_inside, ReservedReport};
 
+use crate::error::bail;
 use crate::Feedback;
+use crate::Result;
+
+pub use tinsmith_output::{check_distinct, check_not_inside, ReservedReport};
 
 /// Fails early, before long work, when `path` cannot or must not take an output (see
 /// [`tinsmith_output::check_writable_target`]), among others when it is the `input` file

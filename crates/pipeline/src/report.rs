@@ -3,12 +3,11 @@
 use std::path::Path;
 
 use serde::Serialize;
-
 use tinsmith_core::{Order, VertexHeights};
+use tinsmith_georef::readable;
 
 use crate::jobs::MeshJob;
 use crate::Feedback;
-use tinsmith_georef::readable;
 
 /// What every mesh report says: the input, the options, the counts before and after, the
 /// bound and the independently measured error, and where the mesh went.

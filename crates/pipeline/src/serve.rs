@@ -15,9 +15,8 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use crate::error::{bail, Context};
-use crate::Result;
-
 use crate::Feedback;
+use crate::Result;
 
 /// The longest request head read.
 const MAX_HEAD: usize = 16 * 1024;

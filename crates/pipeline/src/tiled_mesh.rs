@@ -5,20 +5,20 @@
 use std::path::Path;
 use std::time::Instant;
 
-use crate::error::bail;
-use crate::Result;
 use serde::Serialize;
 use tinsmith_formats::MeshFormat;
+use tinsmith_georef::Placement;
 use tinsmith_tiling::{
     mesh_tiles, MeshCollector, PerTileWriter, RasterSource, TileOptions, TilePlan, TileProgress,
     TilesReport, WeldedWriter,
 };
 
+use crate::error::bail;
 use crate::jobs::{MeshJob, TileFormat};
 use crate::output_paths::NamingFile;
 use crate::report::{MeshSummary, Outcome, Seconds};
 use crate::Feedback;
-use tinsmith_georef::Placement;
+use crate::Result;
 
 /// The output file when the untiled engine should run: no `--per-tile`, and the raster
 /// fits in one tile or a triangle or vertex count is the target (which needs the whole

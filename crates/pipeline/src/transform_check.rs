@@ -3,9 +3,10 @@
 
 use std::path::Path;
 
+use tinsmith_georef::{Placement, F64_SAMPLE_TOLERANCE};
+
 use crate::error::bail;
 use crate::Result;
-use tinsmith_georef::{Placement, F64_SAMPLE_TOLERANCE};
 
 /// Fails (before any long work) when world coordinates are to be written and the raster's
 /// geotransform cannot give every sample its own: a non-finite coefficient, a singular map

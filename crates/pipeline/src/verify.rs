@@ -1,13 +1,13 @@
 //! `tinsmith verify`: measure a mesh file's true error against its raster.
 
-use crate::error::Context;
+use tinsmith_georef::Placement;
 use tinsmith_verify::{GridRef, MeshRef, Report, VerifyOptions};
 
+use crate::error::{bail, Context};
 use crate::mesh_file::{
     expected_orientation, mesh_format, orient_polygon_triangles, read_mesh_file, sample_positions,
 };
 use crate::{Result, VerifyJob};
-use tinsmith_georef::Placement;
 
 /// What [`verify`] measured, with what the caller needs to explain a failure.
 #[derive(Debug)]
@@ -58,7 +58,7 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
     .with_context(|| format!("{}: cannot verify", job.mesh.display()))?;
     if report.domain_samples == 0 {
         // `mesh` refuses such a raster: a pass here would measure nothing.
-        crate::error::bail!(
+        bail!(
             "{}: has no valid cell (a 2 x 2 block of valid samples), so no triangle can \
              cover any of its {} valid samples and there is nothing to measure",
             job.input.display(),

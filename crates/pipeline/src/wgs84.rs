@@ -4,12 +4,12 @@
 
 use std::path::Path;
 
-use crate::error::{bail, Context};
-use crate::Result;
 use tinsmith_formats::CrsRef;
 use tinsmith_raster::RasterInfo;
 
+use crate::error::{bail, Context};
 use crate::Feedback;
+use crate::Result;
 
 /// The CRS a file written from `raster` records: none with `--pixel-coords` or without a
 /// geotransform, else the raster's. With `wgs84` (GeoJSON without `--geojson-source-crs`,

@@ -82,11 +82,11 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
     } else {
         untiled_lines(job, e, size)?
     };
-    let georef = Placement::new(info.transform(), job.pixel_coords);
+    let placement = Placement::new(info.transform(), job.pixel_coords);
     crate::output_paths::note_gcps_unused(&info, job.pixel_coords, feedback);
     let polylines = contoured.lines;
 
-    let (points, ends) = file_lines(job, &georef, polylines);
+    let (points, ends) = file_lines(job, &placement, polylines);
     let written = write_file_lines(job, format, &info, points, &ends, feedback)?;
     tinsmith_output::mark_finished();
 
@@ -196,13 +196,13 @@ fn untiled_lines(
 /// line's end in the points, its level and whether it is closed.
 fn file_lines(
     job: &ContourJob,
-    georef: &Placement,
+    placement: &Placement,
     polylines: Vec<Polyline>,
 ) -> (Vec<[f64; 3]>, Vec<LineEnd>) {
     // Grid coordinates -> file coordinates, with the level as z for the reprojection, then
     // --simplify. A north-up raster flips orientation; reverse so the high ground stays on
     // the left in file coordinates.
-    let flip = georef.flips_orientation();
+    let flip = placement.flips_orientation();
     let mut points: Vec<[f64; 3]> =
         Vec::with_capacity(polylines.iter().map(|l| l.points().len()).sum());
     let mut ends = Vec::with_capacity(polylines.len());
@@ -214,7 +214,7 @@ fn file_lines(
         let closed = line.is_closed();
         let start = points.len();
         points.extend(line.points().iter().map(|&p| {
-            let [x, y] = georef.file_point(p);
+            let [x, y] = placement.file_point(p);
             [x, y, level]
         }));
         if let Some(tolerance) = job.simplify {
@@ -369,9 +369,9 @@ fn untiled_tin(
     raster: Raster,
 ) -> Result<(ContourMesh, String, Vec<f64>, RasterInfo)> {
     if let Some(path) = &job.mesh {
-        let georef = Placement::new(raster.info.transform(), job.pixel_coords);
+        let placement = Placement::new(raster.info.transform(), job.pixel_coords);
         let format = crate::mesh_file::mesh_format(path, job.mesh_format)?;
-        let mesh = mesh_from_file(path, format, &raster, georef, job.band)?;
+        let mesh = mesh_from_file(path, format, &raster, placement, job.band)?;
         let levels = levels_for(job, mesh.height_range())?;
         return Ok((mesh, "mesh file".to_owned(), levels, raster.info));
     }
@@ -563,11 +563,11 @@ fn mesh_from_file(
     path: &Path,
     format: tinsmith_formats::MeshFormat,
     raster: &Raster,
-    georef: Placement,
+    placement: Placement,
     band: usize,
 ) -> Result<ContourMesh> {
     let grid: &Samples = &raster.samples;
-    let file = read_mesh_file(path, format, raster, georef)?;
+    let file = read_mesh_file(path, format, raster, placement)?;
     let (lo, hi) = file
         .vertices
         .iter()
@@ -591,7 +591,7 @@ fn mesh_from_file(
     // Each file vertex's height: its sample's, or the file's where it is raised.
     let mut file_heights: Vec<f64> = Vec::with_capacity(file.vertices.len());
     let mut first_raise: Option<f64> = None;
-    let at = sample_positions(path, &file, format, raster, georef)?;
+    let at = sample_positions(path, &file, format, raster, placement)?;
     let is_inner = |x: i64, y: i64| {
         (1..grid.width() as i64 - 1).contains(&x) && (1..grid.height() as i64 - 1).contains(&y)
     };
@@ -664,7 +664,7 @@ fn mesh_from_file(
                 } else {
                     ""
                 },
-                if matches!(georef, Placement::Pixel) {
+                if matches!(placement, Placement::Pixel) {
                     " (or was it written without --pixel-coords?)"
                 } else {
                     " (or was it written with --pixel-coords?)"
@@ -703,7 +703,7 @@ fn mesh_from_file(
         .iter()
         .map(|t| t.map(|v| index[v as usize]))
         .collect();
-    let orientation = expected_orientation(&georef);
+    let orientation = expected_orientation(&placement);
     crate::mesh_file::orient_polygon_triangles(format, &positions, &mut triangles, orientation);
     let options = VerifyOptions::new().with_orientation(orientation);
     let report = tinsmith_verify::verify(

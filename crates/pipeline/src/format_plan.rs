@@ -141,9 +141,9 @@ impl FormatPlan {
                 );
             }
         }
-        let georef = Placement::new(info.transform(), job.pixel_coords);
-        note_degrees_in_a_3d_format(info, &georef, job, feedback)?;
-        let (min, max) = extent(info, &georef);
+        let placement = Placement::new(info.transform(), job.pixel_coords);
+        note_degrees_in_a_3d_format(info, &placement, job, feedback)?;
+        let (min, max) = extent(info, &placement);
         let origin = LocalOrigin::around(min, max);
         if let Some(base) = job.export.base {
             // The solid's floor is written as float32 like every other coordinate.
@@ -154,7 +154,7 @@ impl FormatPlan {
                 );
             }
         }
-        check_position_rounding(info, &georef, origin, min, max, out(job))?;
+        check_position_rounding(info, &placement, origin, min, max, out(job))?;
 
         // Raised vertex heights are not samples: bound their rounding from the range, up
         // to the highest sample raised (by at most the raise for the whole bound; the
@@ -231,19 +231,19 @@ pub fn check_float32_positions(format: MeshFormat, info: &RasterInfo, job: &Mesh
     if !format.is_float32() {
         return Ok(());
     }
-    let georef = Placement::new(info.transform(), job.pixel_coords);
-    let (min, max) = extent(info, &georef);
+    let placement = Placement::new(info.transform(), job.pixel_coords);
+    let (min, max) = extent(info, &placement);
     let origin = LocalOrigin::around(min, max);
-    check_position_rounding(info, &georef, origin, min, max, out(job))
+    check_position_rounding(info, &placement, origin, min, max, out(job))
 }
 
 /// Min and max of the raster's file coordinates (sample centres) and valid heights.
-fn extent(info: &RasterInfo, georef: &Placement) -> ([f64; 3], [f64; 3]) {
+fn extent(info: &RasterInfo, placement: &Placement) -> ([f64; 3], [f64; 3]) {
     let (w, h) = (info.width.saturating_sub(1), info.height.saturating_sub(1));
     let mut min = [f64::INFINITY; 3];
     let mut max = [f64::NEG_INFINITY; 3];
     for (x, y) in [(0, 0), (w, 0), (0, h), (w, h)] {
-        let p = georef.file_position(x, y);
+        let p = placement.file_position(x, y);
         for axis in 0..2 {
             min[axis] = min[axis].min(p[axis]);
             max[axis] = max[axis].max(p[axis]);
@@ -260,7 +260,7 @@ fn extent(info: &RasterInfo, georef: &Placement) -> ([f64; 3], [f64; 3]) {
 /// offset, plus the `f64` roundings, in pixels through the inverse geotransform).
 fn check_position_rounding(
     info: &RasterInfo,
-    georef: &Placement,
+    placement: &Placement,
     origin: LocalOrigin,
     min: [f64; 3],
     max: [f64; 3],
@@ -274,7 +274,7 @@ fn check_position_rounding(
         world = world.max(offset * 2f64.powi(-24) + magnitude * 2f64.powi(-51));
     }
     // Pixels per world unit: the inverse geotransform's largest row sum.
-    let per_unit = match georef {
+    let per_unit = match placement {
         Placement::Pixel => 1.0,
         Placement::World(t) => {
             let c = &t.0;
@@ -355,11 +355,11 @@ pub fn write(
 /// raster, but drawn stretched by about 100,000 vertically.
 fn note_degrees_in_a_3d_format(
     info: &RasterInfo,
-    georef: &Placement,
+    placement: &Placement,
     job: &MeshJob,
     feedback: &dyn Feedback,
 ) -> Result<()> {
-    let Placement::World(_) = georef else {
+    let Placement::World(_) = placement else {
         return Ok(());
     };
     let geographic = match info.crs_wkt.as_deref() {
@@ -405,16 +405,18 @@ fn check_positions_map_back(
     info: &RasterInfo,
     job: &MeshJob,
 ) -> Result<()> {
-    let georef = Placement::new(info.transform(), job.pixel_coords);
+    let placement = Placement::new(info.transform(), job.pixel_coords);
     for (i, &v) in vertices.iter().enumerate() {
         let q = origin.quantize(v);
         let tolerance = tinsmith_georef::F32_SAMPLE_TOLERANCE;
-        georef.sample_at([q[0], q[1]], tolerance).with_context(|| {
-            format!(
-                "{}: vertex {i} would not map back to its sample in float32; nothing written",
-                out(job).display()
-            )
-        })?;
+        placement
+            .sample_at([q[0], q[1]], tolerance)
+            .with_context(|| {
+                format!(
+                    "{}: vertex {i} would not map back to its sample in float32; nothing written",
+                    out(job).display()
+                )
+            })?;
     }
     Ok(())
 }

@@ -106,7 +106,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let tin = &result.tin;
 
     // The promise is checked, independently, before anything is written.
-    let georef = Placement::new(raster.info.transform(), job.pixel_coords);
+    let placement = Placement::new(raster.info.transform(), job.pixel_coords);
     let t = Instant::now();
     // The heights as the file will hold them (float32 formats round them).
     let check = check_tin(grid, tin, |_, v| plan.file_height(v.z), max_error)?;
@@ -120,7 +120,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     }
 
     let t = Instant::now();
-    let (vertices, triangles) = georef.file_mesh(
+    let (vertices, triangles) = placement.file_mesh(
         tin.vertices().iter().map(|v| (v.x, v.y, v.z)),
         tin.triangles().iter().copied(),
     );

@@ -22,7 +22,7 @@ pub fn read_mesh_file(
     path: &Path,
     format: MeshFormat,
     raster: &Raster,
-    georef: Placement,
+    placement: Placement,
 ) -> Result<Mesh> {
     let mut mesh = tinsmith_formats::read_mesh_as(path, format)?;
     let polygons = is_polygon_format(format);
@@ -38,9 +38,9 @@ pub fn read_mesh_file(
         mesh.epsg = Some(4326);
     }
     if let (Some(4326), Placement::World(transform), Some(wkt)) =
-        (mesh.epsg, georef, raster.info.crs_wkt.as_deref())
+        (mesh.epsg, placement, raster.info.crs_wkt.as_deref())
     {
-        if transformed_from_wgs84(&mesh, raster, georef) {
+        if transformed_from_wgs84(&mesh, raster, placement) {
             tinsmith_raster::from_wgs84(wkt, &mut mesh.vertices).with_context(|| {
                 format!(
                     "{}: cannot transform WGS84 back to the raster's CRS",
@@ -68,19 +68,19 @@ pub fn sample_positions(
     mesh: &Mesh,
     format: MeshFormat,
     raster: &Raster,
-    georef: Placement,
+    placement: Placement,
 ) -> Result<Vec<[i64; 2]>> {
-    let tolerance = position_tolerance(format, mesh, raster, georef);
+    let tolerance = position_tolerance(format, mesh, raster, placement);
     // Other tools rewrite RFC 7946 GeoJSON with 7 decimals (ogr2ogr's default), about
     // 1 cm: too coarse for the mesh's vertices to name their samples on fine rasters.
-    let wgs84 = transformed_from_wgs84(mesh, raster, georef);
+    let wgs84 = transformed_from_wgs84(mesh, raster, placement);
     mesh.vertices
         .iter()
         .enumerate()
         .map(|(i, v)| {
             let p = [v[0], v[1]];
-            georef.sample_at(p, tolerance).map_err(|e| {
-                if !georef.near_miss(p, tolerance) {
+            placement.sample_at(p, tolerance).map_err(|e| {
+                if !placement.near_miss(p, tolerance) {
                     return crate::Error::Refused(format!("{}: vertex {i}: {e:#}", path.display()));
                 }
                 let ogr2ogr = match wgs84 {
@@ -108,12 +108,12 @@ pub fn position_tolerance(
     format: MeshFormat,
     mesh: &Mesh,
     raster: &Raster,
-    georef: Placement,
+    placement: Placement,
 ) -> f64 {
     use tinsmith_georef::{F32_SAMPLE_TOLERANCE, F64_SAMPLE_TOLERANCE, WGS84_SAMPLE_TOLERANCE};
     if format.is_float32() {
         F32_SAMPLE_TOLERANCE
-    } else if transformed_from_wgs84(mesh, raster, georef) {
+    } else if transformed_from_wgs84(mesh, raster, placement) {
         WGS84_SAMPLE_TOLERANCE
     } else {
         F64_SAMPLE_TOLERANCE
@@ -123,9 +123,9 @@ pub fn position_tolerance(
 /// Whether [`read_mesh_file`] transforms `mesh`'s vertices from WGS84 into the raster's
 /// CRS: a WGS84 mesh, world coordinates, and a raster with a CRS of its own other than
 /// EPSG:4326.
-fn transformed_from_wgs84(mesh: &Mesh, raster: &Raster, georef: Placement) -> bool {
+fn transformed_from_wgs84(mesh: &Mesh, raster: &Raster, placement: Placement) -> bool {
     mesh.epsg == Some(4326)
-        && matches!(georef, Placement::World(_))
+        && matches!(placement, Placement::World(_))
         && raster.info.epsg != Some(4326)
         && raster.info.crs_wkt.is_some()
 }
@@ -267,8 +267,8 @@ pub fn orient_polygon_triangles(
 
 /// Mesh files hold triangles counter-clockwise in file coordinates (normals up), which is
 /// clockwise in grid coordinates when the georeference flips orientation.
-pub fn expected_orientation(georef: &Placement) -> Orientation {
-    if georef.flips_orientation() {
+pub fn expected_orientation(placement: &Placement) -> Orientation {
+    if placement.flips_orientation() {
         Orientation::Clockwise
     } else {
         Orientation::CounterClockwise

@@ -46,7 +46,7 @@ pub fn untiled_output(job: &MeshJob) -> Result<Option<&Path>> {
     crate::transform_check::check_transform(reader.info(), job.pixel_coords)?;
     crate::format_plan::check_float32_positions(format, reader.info(), job)?;
     let fits = reader.width() <= job.tile_size && reader.height() <= job.tile_size;
-    let count_target = job.max_triangles.is_some() || job.max_vertices.is_some();
+    let count_target = job.has_count_target();
     if count_target && !fits {
         // The start mesh has four times the triangles asked for, at most two per sample.
         let by_vertices = job
@@ -119,7 +119,7 @@ struct Tiles {
 pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let total = Instant::now();
     let input = job.input.display();
-    if job.max_triangles.is_some() || job.max_vertices.is_some() {
+    if job.has_count_target() {
         bail!(
             "{input}: --max-triangles and --max-vertices need the whole raster at once, and \
              --per-tile meshes it tile by tile; give --max-error"
@@ -197,8 +197,7 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
             )?;
             let t = Instant::now();
             let (vertices, triangles) = collector.into_parts();
-            let georef = Placement::new(info.transform(), job.pixel_coords);
-            let (vertices, triangles) = georef.file_mesh(
+            let (vertices, triangles) = placement.file_mesh(
                 vertices.iter().map(|&[x, y, z]| (x as u32, y as u32, z)),
                 triangles,
             );

@@ -38,11 +38,11 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
     )?;
     let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
     crate::transform_check::check_transform(&raster.info, job.pixel_coords)?;
-    let georef = Placement::new(raster.info.transform(), job.pixel_coords);
-    let mesh = read_mesh_file(&job.mesh, format, &raster, georef)?;
-    let positions = sample_positions(&job.mesh, &mesh, format, &raster, georef)?;
+    let placement = Placement::new(raster.info.transform(), job.pixel_coords);
+    let mesh = read_mesh_file(&job.mesh, format, &raster, placement)?;
+    let positions = sample_positions(&job.mesh, &mesh, format, &raster, placement)?;
     let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();
-    let orientation = expected_orientation(&georef);
+    let orientation = expected_orientation(&placement);
     let mut triangles = mesh.triangles;
     orient_polygon_triangles(format, &positions, &mut triangles, orientation);
     let grid = &raster.samples;

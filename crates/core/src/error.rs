@@ -4,26 +4,10 @@
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// The grid's dimensions and its value count disagree, or a dimension is zero.
-    #[error("grid of {width}x{height} needs {expected} values, got {actual}")]
-    GridSize {
-        /// Columns.
-        width: u32,
-        /// Rows.
-        height: u32,
-        /// width * height.
-        expected: usize,
-        /// Values supplied.
-        actual: usize,
-    },
-    /// The grid is too large to index with 32-bit vertex handles.
-    #[error("grid of {width}x{height} has more than 2^32-1 samples")]
-    GridTooLarge {
-        /// Columns.
-        width: u32,
-        /// Rows.
-        height: u32,
-    },
+    /// The grid's dimensions and its value count disagree, a dimension is zero, or the
+    /// grid is too large to index with 32-bit vertex handles.
+    #[error(transparent)]
+    Grid(#[from] tinsmith_georef::SamplesError),
     /// A border sample that [`crate::decimate_with_border`] was told to remove cannot be.
     #[error("border sample ({x}, {y}) cannot be removed: {problem}")]
     BorderSample {
@@ -47,27 +31,6 @@ pub enum Error {
     /// The maximum error is negative, NaN or infinite.
     #[error("maximum error must be a finite number >= 0, got {0}")]
     InvalidMaxError(f64),
-}
-
-impl From<tinsmith_georef::SamplesError> for Error {
-    /// The same refusal, as [`Error::GridSize`] or [`Error::GridTooLarge`].
-    fn from(e: tinsmith_georef::SamplesError) -> Error {
-        use tinsmith_georef::SamplesError;
-        match e {
-            SamplesError::Size {
-                width,
-                height,
-                expected,
-                actual,
-            } => Error::GridSize {
-                width,
-                height,
-                expected,
-                actual,
-            },
-            SamplesError::TooLarge { width, height } => Error::GridTooLarge { width, height },
-        }
-    }
 }
 
 /// Result of the core's fallible functions.

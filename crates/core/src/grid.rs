@@ -56,8 +56,7 @@ const INTEGRAL_PRODUCT_LIMIT: f64 = (1u64 << 50) as f64;
 
 impl Grid {
     /// Wraps row-major `values`; fails if `values.len() != width * height`, if either
-    /// dimension is zero ([`crate::Error::GridSize`]), or if the grid has 2^32 - 1 samples
-    /// or more ([`crate::Error::GridTooLarge`]).
+    /// dimension is zero, or if the grid has 2^32 - 1 samples or more ([`crate::Error::Grid`]).
     pub fn new(width: u32, height: u32, values: Vec<f64>) -> Result<Grid> {
         Ok(Grid::from_samples(Samples::new(width, height, values)?))
     }

@@ -231,9 +231,10 @@ impl Placement {
     /// than a hundredth of a pixel: a sample's position rounded or moved, which
     /// [`Placement::sample_at`] names as such.
     pub fn near_miss(self, p: [f64; 2], tolerance: f64) -> bool {
-        let tolerance = tolerance.max(self.f64_rounding(p));
-        self.nearest_sample(p)
-            .is_some_and(|(_, _, off)| off > tolerance && off <= NEAR_MISS_PX)
+        matches!(
+            self.sample_at(p, tolerance),
+            Err(PositionError::NearMiss { .. })
+        )
     }
 
     /// A bound, in pixels, on how far `f64` rounding can put the file position `p` of a

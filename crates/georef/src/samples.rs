@@ -83,11 +83,6 @@ impl Samples {
         &self.values
     }
 
-    /// The samples, row-major, given back without a copy.
-    pub fn into_values(self) -> Vec<f64> {
-        self.values
-    }
-
     /// The value at column `x`, row `y`, or `None` when it is nodata or out of range.
     #[inline]
     pub fn get(&self, x: u32, y: u32) -> Option<f64> {

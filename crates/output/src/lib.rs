@@ -5,7 +5,7 @@
 //! # Guarantees
 //! - **Complete outputs or the old ones.** An output is written to a temporary
 //!   (`.tinsmith-*.tmp`, a file or a directory) next to its target and renamed into place
-//!   only when complete ([`write_atomically`], [`StagedFile`], [`StagedDir`]); a sidecar
+//!   only when complete ([`write_atomically`], [`write_bytes_atomically`], [`StagedDir`]); a sidecar
 //!   (a mesh's `.prj`) is staged with its file and renamed just before it
 //!   ([`write_atomically_with_sidecar`]). A run that fails leaves the previous output at
 //!   the target untouched (or none); a file it replaces keeps its permissions; a symbolic
@@ -22,7 +22,7 @@
 //!   when the run starts.
 //!
 //! Outputs go to the local file system (the `local` module); the registry of pending
-//! temporaries ([`track_pending`], [`remove_pending`]) is process-wide.
+//! temporaries (emptied by [`remove_pending`]) is process-wide.
 
 mod error;
 mod local;
@@ -30,14 +30,13 @@ mod pending;
 
 pub use error::{Error, RenameError, Result};
 pub use local::atomic::{
-    is_special_file, output_parent, resolve_output, unnamed_temp_file, write_atomically,
-    write_atomically_with_sidecar, write_bytes_atomically, StagedFile,
+    is_special_file, unnamed_temp_file, write_atomically, write_atomically_with_sidecar,
+    write_bytes_atomically,
 };
-pub use local::check::{check_distinct, check_not_input, check_not_inside, check_writable_target};
+pub use local::check::{check_distinct, check_not_inside, check_writable_target};
 pub use local::report::{ReservedReport, REPORT_RESERVE_BYTES};
 pub use local::staging::StagedDir;
-pub use local::stale::{take_removed_stale, RemovedTemp, MIN_STALE_AGE};
-pub use pending::{
-    finished, interrupted, mark_finished, remove_pending, track_made_dirs, track_pending,
-    MadeDirsGuard, PendingGuard,
-};
+pub use local::stale::{take_removed_stale, RemovedTemp};
+pub use pending::{finished, interrupted, mark_finished, remove_pending};
+
+pub(crate) use pending::{track_made_dirs, track_pending};

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use tinsmith_formats::{Mesh, MeshFormat};
-use tinsmith_georef::Placement;
+use tinsmith_georef::{Placement, PositionError};
 use tinsmith_raster::Raster;
 use tinsmith_verify::Orientation;
 
@@ -80,7 +80,7 @@ pub fn sample_positions(
         .map(|(i, v)| {
             let p = [v[0], v[1]];
             placement.sample_at(p, tolerance).map_err(|e| {
-                if !placement.near_miss(p, tolerance) {
+                if !matches!(e, PositionError::NearMiss { .. }) {
                     return crate::Error::Refused(format!("{}: vertex {i}: {e:#}", path.display()));
                 }
                 let ogr2ogr = match wgs84 {

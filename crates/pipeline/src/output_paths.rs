@@ -14,7 +14,7 @@ pub use tinsmith_output::{check_distinct, check_not_inside, ReservedReport};
 
 /// Fails early, before long work, when `path` cannot or must not take an output (see
 /// [`tinsmith_output::check_writable_target`]), among others when it is the `input` file
-/// or one the input is read from (see [`tinsmith_output::check_not_input`]).
+/// or one the input is read from (the input itself or any file GDAL reads with it).
 pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
     Ok(tinsmith_output::check_writable_target(path, input, || {
         input_files(input)

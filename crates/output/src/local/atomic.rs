@@ -58,15 +58,17 @@ where
     })
 }
 
-/// Writes `bytes` to `path` through a temporary file renamed over it (not synced: for
-/// the many files of a staged directory, which is itself renamed into place).
+/// Writes `bytes` to `path` through a temporary file renamed over it: for the many files
+/// of a [`crate::StagedDir`], which is itself renamed into place and removed whole on
+/// error or signal, so the file is neither synced nor registered as pending, and its
+/// target is new (no permissions to keep).
 ///
 /// # Errors
 /// The I/O error of creating, writing or renaming the temporary file.
 pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let mut file = StagedFile::new(path)?;
-    file.file_mut().write_all(bytes)?;
-    file.commit()
+    let mut temp = output_temp_file(parent_dir(path))?;
+    temp.write_all(bytes)?;
+    temp.persist(path).map(drop).map_err(|e| e.error)
 }
 
 /// A complete, synced temporary file waiting to be renamed over its target, or output

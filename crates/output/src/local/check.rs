@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 
 /// Fails early, before long work, when `path` ends with '/', is a looping symbolic link,
 /// has a name too long for its file system, is the `input` file or one the input is read
-/// from (see [`check_not_input`]), is a directory, is a read-only file or one the
+/// from (see `check_not_input`), is a directory, is a read-only file or one the
 /// directory's sticky bit keeps this user from replacing, or its directory is missing.
 ///
 /// # Errors

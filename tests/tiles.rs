@@ -1055,7 +1055,7 @@ fn a_level_far_finer_than_memory_allows_is_refused_up_front() {
         .expect("gdal_translate (Debian gdal-bin) must be on PATH");
     assert!(o.status.success(), "{}", stderr(&o));
     let o = dir.run(&["tiles", "huge.vrt", "-o", "deep", "-q"]);
-    assert_fails_naming(&o, &["huge.vrt", "level 16", "in memory", "--max-zoom"]);
+    assert_fails_naming(&o, &["huge.vrt", "level 16", "in memory", "coarser copy"]);
     let left: Vec<_> = std::fs::read_dir(dir.path("."))
         .unwrap()
         .map(|e| e.unwrap().file_name())
@@ -1252,4 +1252,57 @@ fn normals_at_a_pole_point_up_on_flat_ground() {
         }
     }
     assert!(at_pole > 10, "{at_pole} vertices on the pole");
+}
+
+/// The `.terrain` files of levels `levels` under `root`.
+fn level_files(root: &Path, levels: std::ops::RangeInclusive<u32>) -> BTreeMap<PathBuf, Vec<u8>> {
+    terrain_files(root)
+        .into_iter()
+        .filter(|(path, _)| {
+            let z: u32 = path
+                .iter()
+                .next()
+                .unwrap()
+                .to_str()
+                .unwrap()
+                .parse()
+                .unwrap();
+            levels.contains(&z)
+        })
+        .collect()
+}
+
+#[test]
+fn a_tile_does_not_depend_on_the_zoom_range_or_the_threads() {
+    // The Albers DEM's own level is 11: levels up to it are filtered from it whatever
+    // --max-zoom is, and levels beyond are each sampled from the raster alone.
+    let dir = Dir::new();
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    pyramid(&dir, &input, "own", &["-q", "--normals"]);
+    pyramid(
+        &dir,
+        &input,
+        "coarse",
+        &["-q", "--normals", "--max-zoom", "8", "--threads", "1"],
+    );
+    pyramid(
+        &dir,
+        &input,
+        "deep",
+        &["-q", "--normals", "--max-zoom", "13"],
+    );
+    pyramid(
+        &dir,
+        &input,
+        "middle",
+        &["-q", "--normals", "--min-zoom", "6", "--max-zoom", "12"],
+    );
+    let own = level_files(&dir.path("own"), 0..=11);
+    assert_eq!(own.keys().filter(|p| p.starts_with("11")).count(), 18);
+    assert!(level_files(&dir.path("coarse"), 0..=8) == level_files(&dir.path("own"), 0..=8));
+    assert!(level_files(&dir.path("deep"), 0..=11) == own);
+    assert!(level_files(&dir.path("middle"), 6..=11) == level_files(&dir.path("own"), 6..=11));
+    assert!(level_files(&dir.path("middle"), 12..=12) == level_files(&dir.path("deep"), 12..=12));
+    assert!(level_files(&dir.path("middle"), 0..=5).is_empty());
+    assert!(!level_files(&dir.path("deep"), 13..=13).is_empty());
 }

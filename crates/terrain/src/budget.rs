@@ -1,5 +1,8 @@
-//! Each level's error budget: its bound from `--quality`, and the height quantum its tiles
-//! store heights in.
+//! Each level's error budget: its bound from `--quality`, the height quantum its tiles
+//! store heights in, and what a tile may spend on decimation once rounding is paid for.
+//!
+//! Everything here depends on the level, `--quality` and the tile's (or shared edge's)
+//! own samples only, never on other tiles: a tile is a function of its own data.
 
 use crate::quantized_mesh::QUANTIZED_MAX;
 use crate::tms::max_edge_length;
@@ -12,21 +15,83 @@ pub const LEVEL_ZERO_ERROR: f64 = 77_067.339_771_939_23;
 /// The smallest height quantum (2^-8 m), so that tile minima stay exact in float32.
 const MIN_HEIGHT_STEP: f64 = 1.0 / 256.0;
 
-/// The level's bound and its height quantum.
+/// The height quantum is the largest power of two up to `bound / STEP_SHARE` (and up to
+/// [`MAX_HEIGHT_STEP`]): rounding a height to it costs at most `bound / 32` of the bound,
+/// and a tile can span 32766 quanta, at least `bound x 2^11` metres (a rise of about 7.9 x
+/// `--quality` times the tile's width, which no terrain has) or 32766 m.
+const STEP_SHARE: f64 = 16.0;
+
+/// The largest height quantum (1 m): 32766 of them span any range of heights on Earth, from
+/// the deepest trench to the highest summit, so coarse levels keep metre heights.
+const MAX_HEIGHT_STEP: f64 = 1.0;
+
+/// The smallest magnitude the rounding slacks assume: heights on Earth stay below it, so
+/// a tile of lowland and one of mountains get the same slack.
+const MIN_SLACK_SCALE: f64 = 16_384.0;
+
+/// The level's bound and height quantum.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct LevelBudget {
     /// The bound asked for, `quality x e(level)`.
     pub(super) bound: f64,
-    /// The height quantum.
+    /// The height quantum: every stored height is a multiple of it.
     pub(super) step: f64,
     /// Longest edge, in lattice spacings (see [`max_edge_length`]).
     pub(super) max_edge: Option<u32>,
-    /// What decimation may use: the bound less the quantization error (half a step).
-    pub(super) decimation: f64,
-    /// What the verifier checks: the bound, or half a step (and a margin) when larger.
-    pub(super) verify: f64,
-    /// The finest level's largest |height| (every level's rounding slack).
-    pub(super) max_abs: f64,
+}
+
+impl LevelBudget {
+    /// The budget of `level` at `quality`.
+    pub(super) fn new(level: u8, quality: f64) -> LevelBudget {
+        let bound = quality * LEVEL_ZERO_ERROR / (1u64 << level) as f64;
+        let mut step = MIN_HEIGHT_STEP;
+        while step * 2.0 <= bound / STEP_SHARE && step < MAX_HEIGHT_STEP {
+            step *= 2.0;
+        }
+        LevelBudget {
+            bound,
+            step,
+            max_edge: max_edge_length(level, bound),
+        }
+    }
+
+    /// The float-arithmetic margin for heights up to `scale` in magnitude (2^-30 of
+    /// bound plus scale).
+    fn margin(&self, scale: f64) -> f64 {
+        (self.bound + scale) / (1u64 << 30) as f64
+    }
+
+    /// What decimation may use for data up to `scale` in magnitude: the bound less the
+    /// quantization error (half a step) and the margin; 0 when nothing is left.
+    pub(super) fn decimation(&self, scale: f64) -> f64 {
+        (self.bound - self.step / 2.0 - self.margin(scale)).max(0.0)
+    }
+
+    /// What the verifier checks: the bound, or half a step and the margin when larger.
+    pub(super) fn verify(&self, scale: f64) -> f64 {
+        self.bound.max(self.step / 2.0 + self.margin(scale))
+    }
+
+    /// The most quanta a tile's heights may span: 32766, so a minimum rounded down to the
+    /// lattice still leaves room.
+    pub(super) fn capacity(&self) -> f64 {
+        f64::from(QUANTIZED_MAX - 1) * self.step
+    }
+}
+
+/// The magnitude the rounding slacks of `values` assume: the next power of two above their
+/// largest finite |value|, at least [`MIN_SLACK_SCALE`]. Two tiles computing it from the
+/// same samples (a shared edge) get the same.
+pub(super) fn slack_scale(values: impl IntoIterator<Item = f64>) -> f64 {
+    let largest = values
+        .into_iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut scale = MIN_SLACK_SCALE;
+    while scale < largest {
+        scale *= 2.0;
+    }
+    scale
 }
 
 /// How many 16-bit height quanta a tile gives each height step: the largest power of two
@@ -34,9 +99,8 @@ pub(super) struct LevelBudget {
 /// steps above 0) within 32767 quanta, and its maximum height exact in float32
 /// (`k_min * quanta + 32767` below 2^24 in magnitude). The header's maximum, the top of
 /// the 16-bit range, is then within twice the tile's own height range (plus a step) instead
-/// of 32767 steps up, which the level's widest tile sets; CesiumJS builds each tile's
-/// bounding box from it. Heights stay multiples of the step, exactly, as neighbours
-/// decode them.
+/// of 32767 steps up; CesiumJS builds each tile's bounding box from it. Heights stay
+/// multiples of the step, exactly, as neighbours decode them.
 pub(super) fn quanta_per_step(k_min: f64, top: f64) -> u32 {
     let mut quanta = 1u32;
     while quanta < 1 << 14
@@ -48,26 +112,27 @@ pub(super) fn quanta_per_step(k_min: f64, top: f64) -> u32 {
     quanta
 }
 
-/// The level's bound and height quantum, from its widest tile and the finest level's
-/// largest |height|.
-pub(super) fn level_budget(level: u8, widest: f64, quality: f64, max_abs: f64) -> LevelBudget {
-    // The height quantum: the smallest power of two that fits every tile's range in
-    // 32766 steps (so a minimum rounded down to the lattice still leaves room).
-    let mut height_step = MIN_HEIGHT_STEP;
-    while height_step * f64::from(QUANTIZED_MAX - 1) < widest {
-        height_step *= 2.0;
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_step_is_a_power_of_two_within_a_sixteenth_of_the_bound_and_a_metre() {
+        for level in 0..=24 {
+            for quality in [0.05, 0.3, 1.0, 4.0] {
+                let b = LevelBudget::new(level, quality);
+                assert_eq!(b.step.log2().fract(), 0.0);
+                assert!(b.step == MIN_HEIGHT_STEP || b.step <= b.bound / STEP_SHARE);
+                assert!(b.step * 2.0 > b.bound / STEP_SHARE || b.step == MAX_HEIGHT_STEP);
+                assert!(b.decimation(0.0) < b.bound && b.verify(0.0) >= b.bound);
+            }
+        }
     }
-    let bound = quality * LEVEL_ZERO_ERROR / (1u64 << level) as f64;
-    let half_step = height_step / 2.0;
-    // The quantization error is at most half a step; keep a relative margin of 2^-30 for
-    // the float arithmetic of interpolation.
-    let margin = (bound + max_abs) / (1u64 << 30) as f64;
-    LevelBudget {
-        bound,
-        step: height_step,
-        max_edge: max_edge_length(level, bound),
-        decimation: (bound - half_step - margin).max(0.0),
-        verify: bound.max(half_step + margin),
-        max_abs,
+
+    #[test]
+    fn slack_scales_are_powers_of_two_from_16384() {
+        assert_eq!(slack_scale([1.0, -300.0, f64::NAN]), 16_384.0);
+        assert_eq!(slack_scale([-20_000.0]), 32_768.0);
+        assert_eq!(slack_scale([]), 16_384.0);
     }
 }

@@ -12,17 +12,26 @@ pub enum TerrainError {
     /// The options make no sense (the message says which).
     #[error("{0}")]
     Options(String),
-    /// Heights (largest magnitude, widest range of a tile) beyond what quantized-mesh
-    /// tiles, whose height ranges are stored in `f32`, can hold.
+    /// A tile's heights span more than its level's 16-bit height quanta can hold, or lie
+    /// too far from 0 for its float32 minimum to be exact.
     #[error(
-        "heights up to {max_abs:e} in magnitude (tiles spanning up to {widest:e}) are beyond what \
-         quantized-mesh tiles can hold (their height range is stored in f32)"
+        "tile {z}/{x}/{y}: heights from {low} to {high} m span more than the {capacity} m that \
+         16-bit heights hold at this level's height step (or lie too far from 0 for it); is a \
+         nodata value missing from the input, or is --quality too small?"
     )]
-    HeightsBeyondF32 {
-        /// The largest magnitude of a valid height.
-        max_abs: f64,
-        /// The widest range of valid heights of a tile.
-        widest: f64,
+    TileHeights {
+        /// Level.
+        z: u8,
+        /// Column.
+        x: u32,
+        /// TMS row.
+        y: u32,
+        /// The tile's lowest vertex height.
+        low: f64,
+        /// Its highest.
+        high: f64,
+        /// The span the level's height quantum allows.
+        capacity: f64,
     },
     /// The thread pool could not start.
     #[error("cannot start {threads} worker threads")]

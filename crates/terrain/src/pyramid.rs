@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use tinsmith_output::StagedDir;
 use tinsmith_raster::{geographic_bounds, GeoBounds};
 
-use crate::budget::{level_budget, LevelBudget};
+use crate::budget::LevelBudget;
 use crate::layer::{write_layer_json, Available};
 use crate::rows::LevelRows;
 use crate::stream::{band_tile_rows, stream_levels, LevelSink, RowSource, Warp};
@@ -235,7 +235,7 @@ pub fn build_terrain(
     let fits = |level: u8| {
         options
             .memory_limit
-            .is_none_or(|limit| streaming_bytes(&bounds, level, threads) <= limit)
+            .is_none_or(|limit| streaming_bytes(&bounds, level.max(own_level), threads) <= limit)
     };
     let not_overzoomed = |level: u8| {
         level <= own_level.saturating_add(OVERZOOM_LEVELS) || tiles_at(level) <= OVERZOOM_TILES
@@ -247,8 +247,9 @@ pub fn build_terrain(
     {
         Some(level) => format!("choose --max-zoom {level} or lower"),
         None => format!(
-            "no level from --min-zoom {} up would run here",
-            options.min_zoom
+            "no --max-zoom helps, since every level is filtered from the raster's own; make a \
+             coarser copy of the input (gdalwarp -tr) for a pyramid this wide, or build it in \
+             shards (--shard)"
         ),
     };
     if !not_overzoomed(max_zoom) {
@@ -263,22 +264,24 @@ pub fn build_terrain(
         )));
     }
     if let Some(limit) = options.memory_limit {
-        let need = streaming_bytes(&bounds, max_zoom, threads);
-        if need > limit && streaming_bytes(&bounds, max_zoom, 1) <= limit {
+        // Levels up to the raster's own are filtered from it, so it is always streamed.
+        let streamed = max_zoom.max(own_level);
+        let need = streaming_bytes(&bounds, streamed, threads);
+        if need > limit && streaming_bytes(&bounds, streamed, 1) <= limit {
             return Err(TerrainError::Options(format!(
                 "{threads} threads would need about {:.1} GB in memory (each warps a band of \
-                 level {max_zoom}) and {:.1} GB is available; use fewer --threads",
+                 level {streamed}) and {:.1} GB is available; use fewer --threads",
                 need as f64 / 1e9,
                 limit as f64 / 1e9
             )));
         }
         if need > limit {
             return Err(TerrainError::Options(format!(
-                "level {max_zoom} would need about {:.1} GB in memory (its tile rows span \
+                "level {streamed} would need about {:.1} GB in memory (its tile rows span \
                  {} tiles) and {:.1} GB is available (the raster's own resolution is level \
-                 {own_level}); {}",
+                 {own_level}, which every coarser level is filtered from); {}",
                 need as f64 / 1e9,
-                LevelRows::new(&bounds, max_zoom).tiles_x,
+                LevelRows::new(&bounds, streamed).tiles_x,
                 limit as f64 / 1e9,
                 suggestion()
             )));
@@ -306,12 +309,12 @@ pub fn build_terrain(
         path: input,
         band: options.band,
     };
-    let band_rows = band_tile_rows(&bounds, max_zoom);
     let (levels, available) = build_pyramid(
         &source,
         &bounds,
+        own_level,
         max_zoom,
-        band_rows,
+        None,
         staging.path(),
         options,
         progress,
@@ -355,19 +358,24 @@ pub fn build_terrain(
     })
 }
 
-/// The tiles of [`build_terrain`] from `source`, its finest level read in bands of
-/// `band_rows` tile rows: the level reports, coarsest first, and the tiles written.
+/// The tiles of [`build_terrain`] from `source`: levels finer than `anchor` each sampled
+/// from the source alone, finest first, then `anchor` and the levels filtered down from
+/// it (see [`stream_levels`]); levels beyond `max_zoom` are made but not written. Each
+/// level is read in bands of `band_rows` tile rows (default: [`band_tile_rows`]). Returns
+/// the level reports, coarsest first, and the tiles written.
+#[allow(clippy::too_many_arguments)]
 fn build_pyramid(
     source: &dyn RowSource,
     bounds: &GeoBounds,
+    anchor: u8,
     max_zoom: u8,
-    band_rows: u32,
+    band_rows: Option<u32>,
     out_dir: &Path,
     options: &TerrainOptions,
     progress: &mut dyn FnMut(&LevelReport),
 ) -> TerrainResult<(Vec<LevelReport>, Available)> {
     // The finest level has the most tiles: more workers than that would idle.
-    let finest = LevelRows::new(bounds, max_zoom);
+    let finest = LevelRows::new(bounds, max_zoom.max(anchor));
     let tiles = finest.tiles_x as usize * finest.tiles_y as usize;
     let workers = tinsmith_tiling::worker_count(options.threads, tiles);
     let pool = rayon::ThreadPoolBuilder::new()
@@ -377,75 +385,18 @@ fn build_pyramid(
             threads: workers,
             source,
         })?;
-    let zooms = (options.min_zoom, max_zoom);
-    let mut stats = LevelStats::new(max_zoom, &pool);
-    stream_levels(source, bounds, zooms, band_rows, &pool, &mut stats)?;
-    // Quantized-mesh stores a tile's height range in f32, and its heights as steps of it.
-    let widest = stats.widest.iter().fold(0.0f64, |w, &x| w.max(x));
-    if !(stats.max_abs < f64::from(f32::MAX) / 2.0 && widest < f64::from(f32::MAX) / 2.0) {
-        return Err(TerrainError::HeightsBeyondF32 {
-            max_abs: stats.max_abs,
-            widest,
-        });
+    let band = |level: u8| band_rows.unwrap_or_else(|| band_tile_rows(bounds, level));
+    let mut writer = TileWriter::new(max_zoom, out_dir, options, &pool, progress);
+    for z in (anchor + 1..=max_zoom).rev() {
+        stream_levels(source, bounds, (z, z), band(z), &pool, &mut writer)?;
     }
-    let mut writer = TileWriter::new(stats, out_dir, options, &pool, progress);
-    stream_levels(source, bounds, zooms, band_rows, &pool, &mut writer)?;
+    if options.min_zoom <= anchor {
+        let zooms = (options.min_zoom, anchor);
+        stream_levels(source, bounds, zooms, band(anchor), &pool, &mut writer)?;
+    }
     let mut levels = writer.finished;
     levels.reverse();
     Ok((levels, writer.available))
-}
-
-/// The first pass: what every tile of a level must agree on, from the whole level.
-struct LevelStats<'p> {
-    max_zoom: u8,
-    /// The largest |height| of the finest level.
-    max_abs: f64,
-    /// Per level: the widest range of valid heights of any of its tiles.
-    widest: Vec<f64>,
-    /// Per level: seconds spent.
-    seconds: Vec<f64>,
-    pool: &'p rayon::ThreadPool,
-}
-
-impl<'p> LevelStats<'p> {
-    fn new(max_zoom: u8, pool: &'p rayon::ThreadPool) -> Self {
-        let levels = usize::from(max_zoom) + 1;
-        LevelStats {
-            max_zoom,
-            max_abs: 0.0,
-            widest: vec![0.0; levels],
-            seconds: vec![0.0; levels],
-            pool,
-        }
-    }
-}
-
-impl LevelSink for LevelStats<'_> {
-    fn tile_rows(&mut self, level: &LevelRows, tile_rows: Range<u32>) -> TerrainResult<()> {
-        let t = Instant::now();
-        let tiles = tiles_of(level, tile_rows);
-        let ranges: Vec<(f64, f64)> = self.pool.install(|| {
-            tiles
-                .par_iter()
-                .filter_map(|&(x, y)| level.tile_height_range(x, y))
-                .collect()
-        });
-        let z = usize::from(level.level);
-        for (lo, hi) in ranges {
-            self.widest[z] = self.widest[z].max(hi - lo);
-            // Every sample of the finest level is in one of its tiles.
-            if level.level == self.max_zoom {
-                self.max_abs = self.max_abs.max(lo.abs()).max(hi.abs());
-            }
-        }
-        self.seconds[z] += t.elapsed().as_secs_f64();
-        Ok(())
-    }
-
-    fn level_done(&mut self, level: u8, seconds: f64) -> TerrainResult<()> {
-        self.seconds[usize::from(level)] += seconds;
-        Ok(())
-    }
 }
 
 /// The tiles of tile rows `tile_rows` (local) of a level, in TMS row then column order.
@@ -455,8 +406,9 @@ fn tiles_of(level: &LevelRows, tile_rows: Range<u32>) -> Vec<(u32, u32)> {
         .collect()
 }
 
-/// The second pass: builds, checks and writes the tiles, row by row of each level.
+/// Builds, checks and writes the tiles, row by row of each level.
 struct TileWriter<'a> {
+    max_zoom: u8,
     out_dir: &'a Path,
     options: &'a TerrainOptions,
     pool: &'a rayon::ThreadPool,
@@ -464,8 +416,6 @@ struct TileWriter<'a> {
     budgets: Vec<LevelBudget>,
     /// Per level, while it is being written.
     reports: Vec<LevelReport>,
-    /// Seconds of the first pass, per level.
-    stats_seconds: Vec<f64>,
     available: Available,
     /// Finished levels, finest first.
     finished: Vec<LevelReport>,
@@ -473,21 +423,14 @@ struct TileWriter<'a> {
 
 impl<'a> TileWriter<'a> {
     fn new(
-        stats: LevelStats<'_>,
+        max_zoom: u8,
         out_dir: &'a Path,
         options: &'a TerrainOptions,
         pool: &'a rayon::ThreadPool,
         progress: &'a mut dyn FnMut(&LevelReport),
     ) -> Self {
-        let budgets: Vec<LevelBudget> = (0..=stats.max_zoom)
-            .map(|z| {
-                level_budget(
-                    z,
-                    stats.widest[usize::from(z)],
-                    options.quality,
-                    stats.max_abs,
-                )
-            })
+        let budgets: Vec<LevelBudget> = (0..=max_zoom)
+            .map(|z| LevelBudget::new(z, options.quality))
             .collect();
         let reports = budgets
             .iter()
@@ -495,7 +438,7 @@ impl<'a> TileWriter<'a> {
             .map(|(budget, level)| LevelReport {
                 level,
                 bound: budget.bound,
-                achieved_bound: budget.verify,
+                achieved_bound: budget.bound,
                 height_step: budget.step,
                 measured_max_error: 0.0,
                 tiles: 0,
@@ -508,23 +451,32 @@ impl<'a> TileWriter<'a> {
             })
             .collect();
         TileWriter {
+            max_zoom,
             out_dir,
             options,
             pool,
             progress,
             budgets,
             reports,
-            stats_seconds: stats.seconds,
-            available: vec![BTreeSet::new(); usize::from(stats.max_zoom) + 1],
+            available: vec![BTreeSet::new(); usize::from(max_zoom) + 1],
             finished: Vec::new(),
         }
+    }
+
+    /// Whether `level` is written (levels between `max_zoom` and the anchor are only
+    /// filtered through).
+    fn writes(&self, level: u8) -> bool {
+        (self.options.min_zoom..=self.max_zoom).contains(&level)
     }
 }
 
 impl LevelSink for TileWriter<'_> {
     fn tile_rows(&mut self, level: &LevelRows, tile_rows: Range<u32>) -> TerrainResult<()> {
-        let t = Instant::now();
         let z = level.level;
+        if !self.writes(z) {
+            return Ok(());
+        }
+        let t = Instant::now();
         let tiles = tiles_of(level, tile_rows);
         let budget = &self.budgets[usize::from(z)];
         let options = self.options;
@@ -551,6 +503,9 @@ impl LevelSink for TileWriter<'_> {
     }
 
     fn level_done(&mut self, level: u8, seconds: f64) -> TerrainResult<()> {
+        if !self.writes(level) {
+            return Ok(());
+        }
         let z = usize::from(level);
         if level == 0 && self.options.metadata {
             // With metadataAvailability CesiumJS ignores `available` and requests both
@@ -568,7 +523,7 @@ impl LevelSink for TileWriter<'_> {
             }
         }
         let report = &mut self.reports[z];
-        report.seconds += seconds + self.stats_seconds[z];
+        report.seconds += seconds;
         (self.progress)(report);
         self.finished.push(report.clone());
         Ok(())
@@ -598,6 +553,7 @@ impl TileWriter<'_> {
         report.vertices += tile.vertices as u64;
         report.triangles += tile.triangles as u64;
         report.measured_max_error = report.measured_max_error.max(tile.max_error);
+        report.achieved_bound = report.achieved_bound.max(tile.verified_bound);
         Ok(())
     }
 }
@@ -750,7 +706,8 @@ mod tests {
                 &source,
                 &bounds,
                 12,
-                band_rows,
+                12,
+                Some(band_rows),
                 dir.path(),
                 &options,
                 &mut |level| finished.push(level.level),

@@ -218,25 +218,6 @@ impl LevelRows {
         values
     }
 
-    /// The range of valid heights of tile `x`, `y`, if it has any.
-    pub(super) fn tile_height_range(&self, x: u32, y: u32) -> Option<(f64, f64)> {
-        let (i0, j0) = self.tile_origin(x, y);
-        let mut range: Option<(f64, f64)> = None;
-        for j in j0..=j0 + CELLS {
-            let row = self.row(j as i64).expect("a tile row inside the level");
-            for v in &row[i0..=i0 + CELLS] {
-                if v.is_finite() {
-                    let v = f64::from(*v);
-                    range = Some(match range {
-                        Some((lo, hi)) => (lo.min(v), hi.max(v)),
-                        None => (v, v),
-                    });
-                }
-            }
-        }
-        range
-    }
-
     /// Whether the cell with lower-left sample (i, j) lies in the level (round it, when
     /// it wraps) and has four valid corners.
     pub(super) fn cell_valid(&self, i: i64, j: i64) -> bool {

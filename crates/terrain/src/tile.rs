@@ -4,7 +4,7 @@ use crate::quantized_mesh::{gzip, QuantizedMeshTile, QUANTIZED_MAX};
 use tinsmith_core::{decimate_with_border, DecimationOptions, Grid, VertexHeights};
 use tinsmith_tiling::check_tin;
 
-use crate::budget::{quanta_per_step, LevelBudget};
+use crate::budget::{quanta_per_step, slack_scale, LevelBudget};
 use crate::layer::{metadata_json, Available};
 use crate::rows::LevelRows;
 use crate::tms::{step, tile_column, tile_rectangle, TILE_CELLS, U_PER_CELL};
@@ -19,6 +19,8 @@ pub(super) struct TileOut {
     pub(super) vertices: usize,
     pub(super) triangles: usize,
     pub(super) max_error: f64,
+    /// The bound the tile was verified against (see [`LevelBudget::verify`]).
+    pub(super) verified_bound: f64,
 }
 
 pub(super) fn build_tile(
@@ -35,14 +37,17 @@ pub(super) fn build_tile(
     let n = TILE_CELLS as usize;
     let (i0, j0) = raster.tile_origin(x, y);
     let values = raster.tile_values(x, y);
+    let scale = slack_scale(values.iter().copied());
     let grid = Grid::new(TILE_CELLS + 1, TILE_CELLS + 1, values).expect("a 218 x 218 grid");
     if grid.valid_cell_count() == 0 {
         return Ok(None);
     }
 
-    // Shared edges, each decided from the level raster alone: both neighbours agree.
-    let limit = edge_limit(budget.decimation, budget.max_abs);
+    // Shared edges, each decided from the level raster alone (its samples and their
+    // magnitude): both neighbours agree.
     let keep = |edge: EdgeProfile| {
+        let scale = slack_scale(edge.values().iter().copied());
+        let limit = edge_limit(budget.decimation(scale), scale);
         if limit > 0.0 {
             edge.simplify(limit, edge_span(budget.max_edge))
         } else {
@@ -69,9 +74,9 @@ pub(super) fn build_tile(
     };
     // Vertices at their samples: flat ground (the sea at 0, a tile the raster does not
     // reach) stays exactly at its height in the quantized tiles.
-    let mut decimation_options =
-        DecimationOptions::new(budget.decimation).with_vertex_heights(VertexHeights::Samples);
-    decimation_options.max_abs_value = Some(budget.max_abs);
+    let mut decimation_options = DecimationOptions::new(budget.decimation(scale))
+        .with_vertex_heights(VertexHeights::Samples);
+    decimation_options.max_abs_value = Some(scale);
     decimation_options.max_edge_length = budget.max_edge;
     let tin = decimate_with_border(&grid, &decimation_options, &keep_border, &mut |_| {})
         .map_err(|source| TerrainError::Decimate {
@@ -94,8 +99,20 @@ pub(super) fn build_tile(
             (lo.min(v.z), hi.max(v.z))
         });
     let k_min = (lo / s).floor();
+    let top = (hi / s).round() - k_min;
+    if top > f64::from(QUANTIZED_MAX - 1) || k_min.abs() + f64::from(QUANTIZED_MAX) >= 16_777_216.0
+    {
+        return Err(TerrainError::TileHeights {
+            z,
+            x: column,
+            y,
+            low: lo,
+            high: hi,
+            capacity: budget.capacity(),
+        });
+    }
     let min_height = k_min * s;
-    let per_step = quanta_per_step(k_min, (hi / s).round() - k_min);
+    let per_step = quanta_per_step(k_min, top);
     let max_height = min_height + f64::from(QUANTIZED_MAX) * s / f64::from(per_step);
     let quantized: Vec<[u16; 3]> = tin
         .vertices()
@@ -112,13 +129,14 @@ pub(super) fn build_tile(
 
     // The promise, checked on what the decoder will compute.
     let decoded = |i: usize, _: &_| min_height + f64::from(quantized[i][2] / per_step as u16) * s;
-    let check =
-        check_tin(&grid, &tin, decoded, budget.verify).map_err(|e| TerrainError::Verify {
+    let check = check_tin(&grid, &tin, decoded, budget.verify(scale)).map_err(|e| {
+        TerrainError::Verify {
             z,
             x: column,
             y,
             problems: e.to_string(),
-        })?;
+        }
+    })?;
     if !check.passed() {
         return Err(TerrainError::Verify {
             z,
@@ -174,5 +192,6 @@ pub(super) fn build_tile(
         vertices: quantized.len(),
         triangles: tin.triangles().len(),
         max_error: check.max_error,
+        verified_bound: budget.verify(scale),
     }))
 }

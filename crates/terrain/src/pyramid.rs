@@ -246,11 +246,9 @@ pub fn build_terrain(
         .find(|&l| not_overzoomed(l) && fits(l))
     {
         Some(level) => format!("choose --max-zoom {level} or lower"),
-        None => format!(
-            "no --max-zoom helps, since every level is filtered from the raster's own; make a \
-             coarser copy of the input (gdalwarp -tr) for a pyramid this wide, or build it in \
-             shards (--shard)"
-        ),
+        None => "no --max-zoom helps, since every level is filtered from the raster's own; \
+                 make a coarser copy of the input (gdalwarp -tr) for a pyramid this wide"
+            .to_string(),
     };
     if !not_overzoomed(max_zoom) {
         return Err(TerrainError::Options(format!(

@@ -5,6 +5,7 @@
 //! so that same-level neighbours keep identical edge vertices, and `layer.json` with the
 //! tiles' availability. The pyramid is staged and moved into place whole.
 
+mod blocks;
 mod budget;
 mod error;
 mod layer;
@@ -14,6 +15,7 @@ mod rows;
 mod stream;
 mod tile;
 mod tms;
+mod writer;
 
 pub use budget::LEVEL_ZERO_ERROR;
 pub use error::{TerrainError, TerrainResult};

@@ -2,22 +2,18 @@
 //! tiles, y = 0 in the south), each decimated within `quality x e(level)`, with shared
 //! edges simplified once so that same-level neighbours keep identical edge vertices.
 
-use std::collections::BTreeSet;
-use std::ops::Range;
 use std::path::Path;
-use std::time::Instant;
 
-use rayon::prelude::*;
 use tinsmith_output::StagedDir;
 use tinsmith_raster::{geographic_bounds, GeoBounds};
 
+use crate::blocks::{block_window, blocks, domain, Cut, SplitSamples};
 use crate::budget::LevelBudget;
 use crate::layer::{write_layer_json, Available};
-use crate::rows::LevelRows;
-use crate::stream::{band_tile_rows, stream_levels, LevelSink, RowSource, Warp};
-use crate::tile::{build_tile, TileOut};
-use crate::tms::{bounds_array, step, TILE_CELLS};
-use crate::{TerrainError, TerrainResult, METADATA_AVAILABILITY};
+use crate::stream::{band_tile_rows, stream_levels, RowSource, Warp};
+use crate::tms::{bounds_array, step, tile_column, TileRect, TILE_CELLS};
+use crate::writer::{Scope, TileWriter, Written};
+use crate::{TerrainError, TerrainResult};
 
 /// The largest `--quality`: the level-0 bound is then 7.7e10 m, beyond any height; larger
 /// values only risk overflowing the bounds.
@@ -67,18 +63,43 @@ impl Default for TerrainOptions {
     }
 }
 
-/// About how many bytes streaming a pyramid over `bounds` down to `max_zoom` takes: the
-/// finest level's bands of whole tile rows (one per thread in the warp, a few held),
-/// 4 bytes a sample, with the coarser levels' rows (a third more), and the record of every
-/// tile written (for `layer.json`'s availability, about 48 bytes a tile). An estimate for
-/// refusing hopeless runs (a small raster at a far finer level than its own), not a bound.
+/// The raster's own level: the first whose lattice is at least as fine as the raster.
+fn own_level(bounds: &GeoBounds) -> u8 {
+    (0..MAX_LEVEL)
+        .find(|&l| step(l) <= bounds.resolution * (1.0 + 1e-9))
+        .unwrap_or(MAX_LEVEL)
+}
+
+/// About how many bytes building a pyramid over `bounds` down to `max_zoom` takes: the
+/// bands of whole tile rows of a block's window at the finest level streamed (one per
+/// thread in the warp, a few held), 4 bytes a sample, with the coarser levels' rows (a
+/// third more); the rows of the levels above the blocks; every block's samples at the
+/// split level; and the record of every tile written (for `layer.json`'s availability,
+/// about 48 bytes a tile). An estimate for refusing hopeless runs (a small raster at a far
+/// finer level than its own, a raster too wide), not a bound.
 pub fn streaming_bytes(bounds: &GeoBounds, max_zoom: u8, threads: usize) -> u64 {
-    let finest = LevelRows::new(bounds, max_zoom);
-    let band = (finest.width as u64 * u64::from(TILE_CELLS + 1)).max(1 << 22);
+    let cut = Cut::coarsest(own_level(bounds));
+    let finest = max_zoom.max(cut.anchor);
+    let cells = u64::from(TILE_CELLS + 1);
     let bands = threads.max(1) as u64 + 3;
-    let rows = band.saturating_mul(bands).saturating_mul(4);
-    let tiles = u64::from(finest.tiles_x) * u64::from(finest.tiles_y);
-    rows.saturating_add(tiles.saturating_mul(48))
+    let band_bytes = |tiles_wide: u64| {
+        (tiles_wide.saturating_mul(u64::from(TILE_CELLS)) * cells)
+            .max(1 << 22)
+            .saturating_mul(bands)
+            .saturating_mul(4)
+    };
+    let domain_wide = u64::from(domain(bounds, finest).width);
+    let window_wide = domain_wide.min((1u64 << (finest - cut.split).min(40)) + 2);
+    let blocks = band_bytes(window_wide);
+    let top = band_bytes(u64::from(domain(bounds, cut.split).width));
+    let split_samples = domain(bounds, cut.split)
+        .tiles()
+        .saturating_mul(cells * cells * 4);
+    let records = domain(bounds, finest).tiles().saturating_mul(48);
+    blocks
+        .max(top)
+        .saturating_add(split_samples)
+        .saturating_add(records)
         .saturating_mul(4)
         / 3
 }
@@ -125,6 +146,40 @@ pub struct LevelReport {
     /// tiles. Levels interleave in time, so the levels' seconds add up to about the wall
     /// time.
     pub seconds: f64,
+}
+
+impl LevelReport {
+    /// The report of a level with no tile yet.
+    pub(crate) fn empty(level: u8, quality: f64) -> LevelReport {
+        let budget = LevelBudget::new(level, quality);
+        LevelReport {
+            level,
+            bound: budget.bound,
+            achieved_bound: budget.bound,
+            height_step: budget.step,
+            measured_max_error: 0.0,
+            tiles: 0,
+            empty_tiles: 0,
+            flat_tiles: 0,
+            bytes: 0,
+            vertices: 0,
+            triangles: 0,
+            seconds: 0.0,
+        }
+    }
+
+    /// Adds `other`'s tiles and counts (the same level, another part of it) to these.
+    pub(crate) fn absorb(&mut self, other: &LevelReport) {
+        self.achieved_bound = self.achieved_bound.max(other.achieved_bound);
+        self.measured_max_error = self.measured_max_error.max(other.measured_max_error);
+        self.tiles += other.tiles;
+        self.empty_tiles += other.empty_tiles;
+        self.flat_tiles += other.flat_tiles;
+        self.bytes += other.bytes;
+        self.vertices += other.vertices;
+        self.triangles += other.triangles;
+        self.seconds += other.seconds;
+    }
 }
 
 /// What [`build_terrain`] produced.
@@ -194,9 +249,7 @@ pub fn build_terrain(
         )));
     }
     // The first level whose lattice is at least as fine as the raster.
-    let own_level = (0..MAX_LEVEL)
-        .find(|&l| step(l) <= bounds.resolution * (1.0 + 1e-9))
-        .unwrap_or(MAX_LEVEL);
+    let own_level = own_level(&bounds);
     let max_zoom = options.max_zoom.unwrap_or(own_level);
     if options.metadata && options.min_zoom > 0 {
         return Err(TerrainError::Options(format!(
@@ -224,10 +277,7 @@ pub fn build_terrain(
             options.min_zoom
         )));
     }
-    let tiles_at = |level: u8| {
-        let rows = LevelRows::new(&bounds, level);
-        u64::from(rows.tiles_x) * u64::from(rows.tiles_y)
-    };
+    let tiles_at = |level: u8| domain(&bounds, level).tiles();
     let threads = match options.threads {
         0 => rayon::current_num_threads(),
         n => n,
@@ -279,7 +329,7 @@ pub fn build_terrain(
                  {} tiles) and {:.1} GB is available (the raster's own resolution is level \
                  {own_level}, which every coarser level is filtered from); {}",
                 need as f64 / 1e9,
-                LevelRows::new(&bounds, streamed).tiles_x,
+                domain(&bounds, streamed).width,
                 limit as f64 / 1e9,
                 suggestion()
             )));
@@ -310,7 +360,7 @@ pub fn build_terrain(
     let (levels, available) = build_pyramid(
         &source,
         &bounds,
-        own_level,
+        Cut::coarsest(own_level),
         max_zoom,
         None,
         staging.path(),
@@ -356,16 +406,96 @@ pub fn build_terrain(
     })
 }
 
-/// The tiles of [`build_terrain`] from `source`: levels finer than `anchor` each sampled
-/// from the source alone, finest first, then `anchor` and the levels filtered down from
-/// it (see [`stream_levels`]); levels beyond `max_zoom` are made but not written. Each
-/// level is read in bands of `band_rows` tile rows (default: [`band_tile_rows`]). Returns
-/// the level reports, coarsest first, and the tiles written.
+/// Builds every tile of `blocks` (tiles of `cut.split`) and of the levels under them down
+/// to `max_zoom`, in TMS row then column order, writing them under `out_dir`; returns what
+/// was written and each block's samples at the split level (what the levels above are
+/// filtered from). `done` hears of each block as it finishes.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn build_blocks(
+    source: &dyn RowSource,
+    bounds: &GeoBounds,
+    cut: Cut,
+    max_zoom: u8,
+    blocks: &[TileRect],
+    band_rows: Option<u32>,
+    out_dir: &Path,
+    options: &TerrainOptions,
+    pool: &rayon::ThreadPool,
+    done: &mut dyn FnMut(usize),
+) -> TerrainResult<(Written, SplitSamples)> {
+    let mut written = Written::default();
+    let mut samples = SplitSamples::default();
+    for (k, &block) in blocks.iter().enumerate() {
+        let scope = Scope {
+            levels: (options.min_zoom.max(cut.split), max_zoom),
+            under: Some(block),
+        };
+        let mut writer = TileWriter::new(scope, max_zoom, Vec::new(), out_dir, options, pool);
+        let window = |z: u8| block_window(bounds, block, z);
+        let band = |z: u8| band_rows.unwrap_or_else(|| band_tile_rows(window(z)));
+        // Levels finer than the anchor first, each sampled alone; then the anchor and the
+        // levels filtered from it, down to the block's own.
+        for z in (cut.anchor + 1..=max_zoom).rev() {
+            stream_levels(source, &window, (z, z), band(z), pool, &mut writer)?;
+        }
+        let zooms = (cut.split, cut.anchor);
+        stream_levels(source, &window, zooms, band(cut.anchor), pool, &mut writer)?;
+        if let Some(values) = writer.block_samples.take() {
+            if values.iter().any(|v| v.is_finite()) {
+                let x = tile_column(cut.split, block.x0);
+                samples.tiles.insert((x, block.y0), values);
+            }
+        }
+        written.absorb(writer.finish());
+        done(k);
+    }
+    Ok((written, samples))
+}
+
+/// Builds the levels above the split, `min_zoom` up to `max_zoom` (if any are), filtered
+/// from the split level's `samples`, writing them under `out_dir`. `available` lists the
+/// tiles the blocks wrote (the metadata extension of levels 0, 10, 20 lists them).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn build_top(
+    samples: &SplitSamples,
+    bounds: &GeoBounds,
+    cut: Cut,
+    max_zoom: u8,
+    available: Available,
+    out_dir: &Path,
+    options: &TerrainOptions,
+    pool: &rayon::ThreadPool,
+) -> TerrainResult<Written> {
+    if cut.split == 0 || options.min_zoom >= cut.split || options.min_zoom > max_zoom {
+        return Ok(Written::default());
+    }
+    let scope = Scope {
+        levels: (options.min_zoom, max_zoom.min(cut.split - 1)),
+        under: None,
+    };
+    let mut writer = TileWriter::new(scope, max_zoom, available, out_dir, options, pool);
+    let rect = |z: u8| domain(bounds, z);
+    let band = band_tile_rows(rect(cut.split));
+    stream_levels(
+        samples,
+        &rect,
+        (options.min_zoom, cut.split),
+        band,
+        pool,
+        &mut writer,
+    )?;
+    Ok(writer.finish())
+}
+
+/// Every tile of the pyramid of `source` over `bounds` cut at `cut`, levels
+/// `options.min_zoom ..= max_zoom`, written under `out_dir`: the blocks, then the levels
+/// above them, then (with `--metadata`) the root tiles the raster does not reach, flat.
+/// Returns the level reports, coarsest first, and the tiles written.
 #[allow(clippy::too_many_arguments)]
 fn build_pyramid(
     source: &dyn RowSource,
     bounds: &GeoBounds,
-    anchor: u8,
+    cut: Cut,
     max_zoom: u8,
     band_rows: Option<u32>,
     out_dir: &Path,
@@ -373,9 +503,8 @@ fn build_pyramid(
     progress: &mut dyn FnMut(&LevelReport),
 ) -> TerrainResult<(Vec<LevelReport>, Available)> {
     // The finest level has the most tiles: more workers than that would idle.
-    let finest = LevelRows::new(bounds, max_zoom.max(anchor));
-    let tiles = finest.tiles_x as usize * finest.tiles_y as usize;
-    let workers = tinsmith_tiling::worker_count(options.threads, tiles);
+    let tiles = domain(bounds, max_zoom.max(cut.anchor)).tiles();
+    let workers = tinsmith_tiling::worker_count(options.threads, tiles as usize);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(workers)
         .build()
@@ -383,177 +512,52 @@ fn build_pyramid(
             threads: workers,
             source,
         })?;
-    let band = |level: u8| band_rows.unwrap_or_else(|| band_tile_rows(bounds, level));
-    let mut writer = TileWriter::new(max_zoom, out_dir, options, &pool, progress);
-    for z in (anchor + 1..=max_zoom).rev() {
-        stream_levels(source, bounds, (z, z), band(z), &pool, &mut writer)?;
-    }
-    if options.min_zoom <= anchor {
-        let zooms = (options.min_zoom, anchor);
-        stream_levels(source, bounds, zooms, band(anchor), &pool, &mut writer)?;
-    }
-    let mut levels = writer.finished;
-    levels.reverse();
-    Ok((levels, writer.available))
-}
-
-/// The tiles of tile rows `tile_rows` (local) of a level, in TMS row then column order.
-fn tiles_of(level: &LevelRows, tile_rows: Range<u32>) -> Vec<(u32, u32)> {
-    tile_rows
-        .flat_map(|j| (0..level.tiles_x).map(move |i| (level.tx0 + i, level.ty0 + j)))
-        .collect()
-}
-
-/// Builds, checks and writes the tiles, row by row of each level.
-struct TileWriter<'a> {
-    max_zoom: u8,
-    out_dir: &'a Path,
-    options: &'a TerrainOptions,
-    pool: &'a rayon::ThreadPool,
-    progress: &'a mut dyn FnMut(&LevelReport),
-    budgets: Vec<LevelBudget>,
-    /// Per level, while it is being written.
-    reports: Vec<LevelReport>,
-    available: Available,
-    /// Finished levels, finest first.
-    finished: Vec<LevelReport>,
-}
-
-impl<'a> TileWriter<'a> {
-    fn new(
-        max_zoom: u8,
-        out_dir: &'a Path,
-        options: &'a TerrainOptions,
-        pool: &'a rayon::ThreadPool,
-        progress: &'a mut dyn FnMut(&LevelReport),
-    ) -> Self {
-        let budgets: Vec<LevelBudget> = (0..=max_zoom)
-            .map(|z| LevelBudget::new(z, options.quality))
-            .collect();
-        let reports = budgets
-            .iter()
-            .zip(0..)
-            .map(|(budget, level)| LevelReport {
-                level,
-                bound: budget.bound,
-                achieved_bound: budget.bound,
-                height_step: budget.step,
-                measured_max_error: 0.0,
-                tiles: 0,
-                empty_tiles: 0,
-                flat_tiles: 0,
-                bytes: 0,
-                vertices: 0,
-                triangles: 0,
-                seconds: 0.0,
-            })
-            .collect();
-        TileWriter {
-            max_zoom,
-            out_dir,
-            options,
-            pool,
-            progress,
-            budgets,
-            reports,
-            available: vec![BTreeSet::new(); usize::from(max_zoom) + 1],
-            finished: Vec::new(),
-        }
-    }
-
-    /// Whether `level` is written (levels between `max_zoom` and the anchor are only
-    /// filtered through).
-    fn writes(&self, level: u8) -> bool {
-        (self.options.min_zoom..=self.max_zoom).contains(&level)
-    }
-}
-
-impl LevelSink for TileWriter<'_> {
-    fn tile_rows(&mut self, level: &LevelRows, tile_rows: Range<u32>) -> TerrainResult<()> {
-        let z = level.level;
-        if !self.writes(z) {
-            return Ok(());
-        }
-        let t = Instant::now();
-        let tiles = tiles_of(level, tile_rows);
-        let budget = &self.budgets[usize::from(z)];
-        let options = self.options;
-        // Finer levels inside these tiles' footprints are complete (see `stream_levels`).
-        let metadata_available = if options.metadata && z.is_multiple_of(METADATA_AVAILABILITY) {
-            Some(&self.available)
-        } else {
-            None
+    let all = blocks(bounds, cut);
+    let (mut written, samples) = build_blocks(
+        source,
+        bounds,
+        cut,
+        max_zoom,
+        &all,
+        band_rows,
+        out_dir,
+        options,
+        &pool,
+        &mut |_| {},
+    )?;
+    let available = written.available.clone();
+    written.absorb(build_top(
+        &samples, bounds, cut, max_zoom, available, out_dir, options, &pool,
+    )?);
+    if options.metadata && options.min_zoom == 0 {
+        // With metadataAvailability CesiumJS ignores `available` and requests both root
+        // tiles: one the raster does not reach is written flat (no subtree).
+        let scope = Scope {
+            levels: (0, 0),
+            under: None,
         };
-        let results: Vec<TerrainResult<Option<TileOut>>> = self.pool.install(|| {
-            tiles
-                .par_iter()
-                .map(|&(x, y)| build_tile(level, x, y, budget, options, metadata_available))
-                .collect()
-        });
-        for result in results {
-            match result? {
-                Some(tile) => self.write(z, &tile)?,
-                None => self.reports[usize::from(z)].empty_tiles += 1,
+        let available = written.available.clone();
+        let mut writer = TileWriter::new(scope, max_zoom, available, out_dir, options, &pool);
+        for x in 0..2 {
+            if !written.available[0].contains(&(x, 0)) {
+                writer.write_flat_root(x)?;
             }
         }
-        self.reports[usize::from(z)].seconds += t.elapsed().as_secs_f64();
-        Ok(())
+        written.absorb(writer.finish());
     }
-
-    fn level_done(&mut self, level: u8, seconds: f64) -> TerrainResult<()> {
-        if !self.writes(level) {
-            return Ok(());
-        }
-        let z = usize::from(level);
-        if level == 0 && self.options.metadata {
-            // With metadataAvailability CesiumJS ignores `available` and requests both
-            // root tiles: one the raster does not reach is written flat (no subtree).
-            for x in 0..2 {
-                if self.available[0].contains(&(x, 0)) {
-                    continue;
-                }
-                let flat = LevelRows::flat_tile(0, x, 0);
-                let budget = &self.budgets[0];
-                let tile = build_tile(&flat, x, 0, budget, self.options, Some(&self.available))?
-                    .expect("a flat tile has cells");
-                self.write(0, &tile)?;
-                self.reports[0].flat_tiles += 1;
-            }
-        }
-        let report = &mut self.reports[z];
-        report.seconds += seconds;
-        (self.progress)(report);
-        self.finished.push(report.clone());
-        Ok(())
+    let levels: Vec<LevelReport> = (options.min_zoom..=max_zoom)
+        .map(|z| {
+            written.reports[usize::from(z)]
+                .clone()
+                .unwrap_or_else(|| LevelReport::empty(z, options.quality))
+        })
+        .collect();
+    for level in levels.iter().rev() {
+        progress(level);
     }
-}
-
-impl TileWriter<'_> {
-    /// Writes a tile of level `z` into the staging directory and counts it.
-    fn write(&mut self, z: u8, tile: &TileOut) -> TerrainResult<()> {
-        let dir = self.out_dir.join(z.to_string()).join(tile.x.to_string());
-        if tinsmith_output::interrupted() {
-            // The staging directory is being removed: add nothing to it.
-            return Err(TerrainError::Output {
-                path: dir,
-                source: std::io::Error::from(std::io::ErrorKind::Interrupted),
-            });
-        }
-        std::fs::create_dir_all(&dir).map_err(|source| TerrainError::Output {
-            path: dir.clone(),
-            source,
-        })?;
-        write_atomic(&dir.join(format!("{}.terrain", tile.y)), &tile.bytes)?;
-        self.available[usize::from(z)].insert((tile.x, tile.y));
-        let report = &mut self.reports[usize::from(z)];
-        report.tiles += 1;
-        report.bytes += tile.bytes.len() as u64;
-        report.vertices += tile.vertices as u64;
-        report.triangles += tile.triangles as u64;
-        report.measured_max_error = report.measured_max_error.max(tile.max_error);
-        report.achieved_bound = report.achieved_bound.max(tile.verified_bound);
-        Ok(())
-    }
+    let mut available = written.available;
+    available.resize(usize::from(max_zoom) + 1, Default::default());
+    Ok((levels, available))
 }
 
 /// The temporary directory the pyramid is built in, beside `out_dir` (which must not
@@ -615,6 +619,7 @@ mod tests {
     use crate::quantized_mesh::QUANTIZED_MAX;
     use crate::tms::{max_edge_length, EARTH_RADIUS, U_PER_CELL};
     use crate::LEVEL_ZERO_ERROR;
+    use std::collections::BTreeSet;
     use std::path::PathBuf;
 
     #[test]
@@ -675,7 +680,7 @@ mod tests {
     }
 
     #[test]
-    fn pyramid_bytes_do_not_depend_on_the_band_height() {
+    fn pyramid_bytes_do_not_depend_on_the_band_height_or_the_cut() {
         // 4 x 3 tiles at level 12 with a hole; level 10 carries the metadata of 11 and 12,
         // so it must see their availability complete although the levels interleave.
         let bounds = GeoBounds {
@@ -697,13 +702,13 @@ mod tests {
             ..TerrainOptions::default()
         };
         let mut outputs = Vec::new();
-        for band_rows in [1, 100] {
+        for (split, band_rows) in [(8, 1), (8, 100), (10, 1), (12, 100), (11, 3)] {
             let dir = tempfile::tempdir().unwrap();
             let mut finished = Vec::new();
             let (mut levels, available) = build_pyramid(
                 &source,
                 &bounds,
-                12,
+                Cut { anchor: 12, split },
                 12,
                 Some(band_rows),
                 dir.path(),
@@ -725,10 +730,10 @@ mod tests {
         );
         let level_10 = &available[10];
         assert!(!level_10.is_empty() && !available[12].is_empty());
-        assert!(
-            outputs[0] == outputs[1],
-            "bands of 1 and 100 tile rows differ"
-        );
+        for (k, output) in outputs.iter().enumerate().skip(1) {
+            assert!(output.0 == outputs[0].0, "case {k}: other bytes");
+            assert!(output.2 == outputs[0].2, "case {k}: other tiles");
+        }
     }
 
     #[test]

@@ -6,9 +6,9 @@ use std::ops::Range;
 
 use crate::quantized_mesh::surface_normal;
 use rayon::prelude::*;
-use tinsmith_raster::{GeoBounds, GeoLattice};
+use tinsmith_raster::GeoLattice;
 
-use crate::tms::{step, tile_range, TILE_CELLS};
+use crate::tms::{step, TileRect, TILE_CELLS};
 use tinsmith_tiling::EdgeProfile;
 
 /// `TILE_CELLS` as a row or column count.
@@ -50,19 +50,18 @@ pub(super) struct LevelRows {
 }
 
 impl LevelRows {
-    /// The level's lattice over the tiles `bounds` touches, holding no rows yet.
-    pub(super) fn new(bounds: &GeoBounds, level: u8) -> LevelRows {
-        let ([x0, x1], [y0, y1]) = tile_range(bounds, level);
-        let (tiles_x, tiles_y) = (x1 - x0 + 1, y1 - y0 + 1);
+    /// The level's lattice over the tiles of `rect`, holding no rows yet. Whatever lies
+    /// outside `rect` counts as the level's border (no data).
+    pub(super) fn new(rect: TileRect) -> LevelRows {
         LevelRows {
-            level,
-            tx0: x0,
-            ty0: y0,
-            tiles_x,
-            tiles_y,
-            width: tiles_x as usize * CELLS + 1,
-            height: tiles_y as usize * CELLS + 1,
-            wraps: u64::from(tiles_x) == 2u64 << level,
+            level: rect.level,
+            tx0: rect.x0,
+            ty0: rect.y0,
+            tiles_x: rect.width,
+            tiles_y: rect.height,
+            width: rect.width as usize * CELLS + 1,
+            height: rect.height as usize * CELLS + 1,
+            wraps: rect.wraps(),
             first: 0,
             values: Vec::new(),
         }

@@ -8,10 +8,10 @@ use std::path::Path;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use tinsmith_raster::{warp_to_geographic, GeoBounds};
+use tinsmith_raster::warp_to_geographic;
 
 use crate::rows::LevelRows;
-use crate::tms::TILE_CELLS;
+use crate::tms::{TileRect, TILE_CELLS};
 use crate::TerrainResult;
 
 /// Where the finest level's samples come from.
@@ -77,9 +77,9 @@ pub(super) trait LevelSink {
 /// at least one; a level that fits comes in one band, as one warp.
 const BAND_SAMPLES: usize = 1 << 22;
 
-/// Tile rows per warp band of the finest level of `bounds`' pyramid at `max_zoom`.
-pub(super) fn band_tile_rows(bounds: &GeoBounds, max_zoom: u8) -> u32 {
-    let width = LevelRows::new(bounds, max_zoom).width;
+/// Tile rows per warp band of a level over `rect`.
+pub(super) fn band_tile_rows(rect: TileRect) -> u32 {
+    let width = LevelRows::new(rect).width;
     let rows = BAND_SAMPLES / (width * TILE_CELLS as usize);
     rows.clamp(1, u32::MAX as usize) as u32
 }
@@ -108,7 +108,10 @@ struct Level {
     done: bool,
 }
 
-/// Streams levels `max_zoom` down to `min_zoom` of `bounds` from `source` into `sink`.
+/// Streams levels `max_zoom` down to `min_zoom`, each over the tiles `rect_of(level)`, from
+/// `source` into `sink`. Each level's rectangle must cover the next coarser one's samples'
+/// sources wherever they matter (the coarser level reads the finer samples around twice its
+/// own indices; outside the finer rectangle it reads nodata).
 ///
 /// The finest level is read in bands of `band_tile_rows` tile rows, a group of one band per
 /// thread at a time, in parallel; the next group is warped while this group's rows go
@@ -133,7 +136,7 @@ struct Level {
 /// The first error of the source or the sink; the stream stops there.
 pub(super) fn stream_levels(
     source: &dyn RowSource,
-    bounds: &GeoBounds,
+    rect_of: &dyn Fn(u8) -> TileRect,
     zooms: (u8, u8),
     band_tile_rows: u32,
     pool: &rayon::ThreadPool,
@@ -143,7 +146,7 @@ pub(super) fn stream_levels(
     let mut levels: Vec<Level> = (min_zoom..=max_zoom)
         .rev()
         .map(|z| Level {
-            rows: LevelRows::new(bounds, z),
+            rows: LevelRows::new(rect_of(z)),
             next_tile_row: 0,
             seconds: 0.0,
             done: false,
@@ -152,7 +155,7 @@ pub(super) fn stream_levels(
     let bands = bands(&levels[0].rows, band_tile_rows);
     let groups: Vec<&[Range<usize>]> = bands.chunks(pool.current_num_threads().max(1)).collect();
     // The finest level's geometry, for the warps running beside the tiles.
-    let finest = LevelRows::new(bounds, max_zoom);
+    let finest = LevelRows::new(rect_of(max_zoom));
     let warp = |group: &[Range<usize>]| -> (Vec<TerrainResult<Vec<f32>>>, f64) {
         let t = Instant::now();
         let warped = pool.install(|| {
@@ -270,6 +273,7 @@ impl RowSource for Hills {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use tinsmith_raster::GeoBounds;
 
     /// The next coarser level of a whole finer level, as the pipeline made it before it
     /// streamed: a reference that shares no code with [`LevelRows::coarser_rows`].
@@ -396,11 +400,11 @@ mod tests {
         let (min_zoom, max_zoom) = (2, 5);
         // The whole levels, made at once.
         let mut whole = Vec::new();
-        let finest = LevelRows::new(&bounds, max_zoom);
+        let finest = LevelRows::new(TileRect::covering(&bounds, max_zoom));
         whole.push(source.rows(&finest, 0..finest.height).unwrap());
         for z in (min_zoom..max_zoom).rev() {
-            let fine = LevelRows::new(&bounds, z + 1);
-            let coarse = LevelRows::new(&bounds, z);
+            let fine = LevelRows::new(TileRect::covering(&bounds, z + 1));
+            let coarse = LevelRows::new(TileRect::covering(&bounds, z));
             let values = whole_coarser(&fine, whole.last().unwrap(), &coarse);
             whole.push(values);
         }
@@ -418,7 +422,7 @@ mod tests {
             let mut recorder = Recorder {
                 levels: (0..=max_zoom)
                     .map(|z| {
-                        let l = LevelRows::new(&bounds, z);
+                        let l = LevelRows::new(TileRect::covering(&bounds, z));
                         Record {
                             values: vec![f32::NAN; l.width * l.height],
                             ty0: l.ty0,
@@ -432,7 +436,7 @@ mod tests {
             };
             stream_levels(
                 &source,
-                &bounds,
+                &|z| TileRect::covering(&bounds, z),
                 (min_zoom, max_zoom),
                 band_rows,
                 &pool,
@@ -463,7 +467,7 @@ mod tests {
             north: 50.0,
             resolution: 0.1,
         };
-        let level = LevelRows::new(&bounds, 3);
+        let level = LevelRows::new(TileRect::covering(&bounds, 3));
         assert_eq!(level.tiles_y, 3);
         let n = TILE_CELLS as usize;
         assert_eq!(

@@ -91,3 +91,46 @@ pub(super) fn tile_range(bounds: &GeoBounds, level: u8) -> ([u32; 2], [u32; 2]) 
     ];
     (x, y)
 }
+
+/// A rectangle of whole tiles of one level: columns `x0 .. x0 + width` (which may run past
+/// the level's last column, a turn east, see [`tile_column`]) and TMS rows `y0 .. y0 +
+/// height`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct TileRect {
+    pub(super) level: u8,
+    pub(super) x0: u32,
+    pub(super) y0: u32,
+    pub(super) width: u32,
+    pub(super) height: u32,
+}
+
+impl TileRect {
+    /// The tiles of `level` that `bounds` touches (see [`tile_range`]).
+    pub(super) fn covering(bounds: &GeoBounds, level: u8) -> TileRect {
+        let ([x0, x1], [y0, y1]) = tile_range(bounds, level);
+        TileRect {
+            level,
+            x0,
+            y0,
+            width: x1 - x0 + 1,
+            height: y1 - y0 + 1,
+        }
+    }
+
+    /// Whether the rectangle goes all the way round the globe.
+    pub(super) fn wraps(&self) -> bool {
+        u64::from(self.width) == 2u64 << self.level
+    }
+
+    /// Tiles in the rectangle.
+    pub(super) fn tiles(&self) -> u64 {
+        u64::from(self.width) * u64::from(self.height)
+    }
+
+    /// Whether tile `x`, `y` (any turn) lies in the rectangle.
+    pub(super) fn contains(&self, x: u32, y: u32) -> bool {
+        let turn = 2i64 << self.level;
+        let dx = (i64::from(x) - i64::from(self.x0)).rem_euclid(turn);
+        dx < i64::from(self.width) && y >= self.y0 && y - self.y0 < self.height
+    }
+}

@@ -1,0 +1,201 @@
+//! A pyramid cut into blocks: every tile of the *split* level and the tiles under it are
+//! built from a window of the raster around that tile alone, and the levels above the
+//! split are filtered from the split level's samples, which the blocks hand over. A block
+//! is the unit a run (or a shard of a run) works on; the cut changes how the work is done,
+//! never the tiles.
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+use tinsmith_raster::GeoBounds;
+
+use crate::rows::LevelRows;
+use crate::stream::RowSource;
+use crate::tms::{tile_column, TileRect, TILE_CELLS};
+use crate::TerrainResult;
+
+/// The most levels from a block's tile down to the raster's own level: a block's window
+/// there is at most 16 x 16 tiles (and a ring of one), so its rows stay small.
+pub(super) const BLOCK_DEPTH: u8 = 4;
+
+/// Where the pyramid is cut.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Cut {
+    /// The raster's own level: it is sampled from the raster, and every coarser level is
+    /// filtered from it; finer levels are each sampled alone.
+    pub(super) anchor: u8,
+    /// The level whose tiles are the blocks (at most the anchor, at least
+    /// `anchor - BLOCK_DEPTH`).
+    pub(super) split: u8,
+}
+
+impl Cut {
+    /// The coarsest split the block depth allows: the fewest blocks.
+    pub(super) fn coarsest(anchor: u8) -> Cut {
+        Cut {
+            anchor,
+            split: anchor.saturating_sub(BLOCK_DEPTH),
+        }
+    }
+}
+
+/// The tiles of `level` a pyramid over `bounds` covers.
+pub(super) fn domain(bounds: &GeoBounds, level: u8) -> TileRect {
+    TileRect::covering(bounds, level)
+}
+
+/// The blocks of a cut: every tile of the split level's domain, in TMS row then column
+/// order, as 1 x 1 rectangles.
+pub(super) fn blocks(bounds: &GeoBounds, cut: Cut) -> Vec<TileRect> {
+    let d = domain(bounds, cut.split);
+    (d.y0..d.y0 + d.height)
+        .flat_map(|y| {
+            (d.x0..d.x0 + d.width).map(move |x| TileRect {
+                level: cut.split,
+                x0: x,
+                y0: y,
+                width: 1,
+                height: 1,
+            })
+        })
+        .collect()
+}
+
+/// The window a block is built from at `level` (at or below the block's): the tiles under
+/// it with a ring of one tile around them, within the level's domain (round the globe when
+/// the domain goes all the way round, a turn east when the ring would start west of
+/// column 0). Its samples near the block are those of the whole level: the ring holds
+/// every sample the block's tiles, their halos and the filter down to the block's level
+/// read (a ring of 217 samples at the anchor is filtered down to 1 after 7 levels, more
+/// than [`BLOCK_DEPTH`]).
+pub(super) fn block_window(bounds: &GeoBounds, block: TileRect, level: u8) -> TileRect {
+    let d = domain(bounds, level);
+    let f = level - block.level;
+    let turn = 2i64 << level;
+    let mut x0 = (i64::from(block.x0) << f) - 1;
+    let mut x1 = (i64::from(block.x0 + block.width) << f) + 1;
+    let y0 = ((i64::from(block.y0) << f) - 1).max(i64::from(d.y0));
+    let y1 = ((i64::from(block.y0 + block.height) << f) + 1).min(i64::from(d.y0 + d.height));
+    if d.wraps() {
+        if x1 - x0 >= turn {
+            return TileRect {
+                y0: y0 as u32,
+                height: (y1 - y0) as u32,
+                ..d
+            };
+        }
+        if x0 < 0 {
+            x0 += turn;
+            x1 += turn;
+        }
+    } else {
+        // The turn of the block's columns that meets the domain, then clipped to it.
+        let (d0, d1) = (i64::from(d.x0), i64::from(d.x0 + d.width));
+        let overlap = |k: i64| (x1 + k * turn).min(d1) - (x0 + k * turn).max(d0);
+        let k = [0, 1, -1]
+            .into_iter()
+            .max_by_key(|&k| (overlap(k), -k.abs()))
+            .expect("three turns");
+        x0 = (x0 + k * turn).max(d0);
+        x1 = (x1 + k * turn).min(d1);
+    }
+    TileRect {
+        level,
+        x0: x0 as u32,
+        y0: y0 as u32,
+        width: (x1 - x0) as u32,
+        height: (y1 - y0) as u32,
+    }
+}
+
+/// The samples of the split level's tiles, as the blocks handed them over, keyed by
+/// (column, TMS row); tiles without any are nodata.
+#[derive(Debug, Default)]
+pub(super) struct SplitSamples {
+    pub(super) tiles: BTreeMap<(u32, u32), Vec<f32>>,
+}
+
+impl RowSource for SplitSamples {
+    fn rows(&self, level: &LevelRows, rows: Range<usize>) -> TerrainResult<Vec<f32>> {
+        let n = TILE_CELLS as usize;
+        let side = n + 1;
+        let mut out = vec![f32::NAN; level.width * rows.len()];
+        for (k, j) in rows.enumerate() {
+            let tj = (j / n).min(level.tiles_y as usize - 1);
+            let oj = j - tj * n;
+            let y = level.ty0 + tj as u32;
+            for ti in 0..level.tiles_x as usize {
+                let x = tile_column(level.level, level.tx0 + ti as u32);
+                let Some(tile) = self.tiles.get(&(x, y)) else {
+                    continue;
+                };
+                let row = &tile[oj * side..(oj + 1) * side];
+                out[k * level.width + ti * n..][..side].copy_from_slice(row);
+            }
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bounds(west: f64, east: f64) -> GeoBounds {
+        GeoBounds {
+            west,
+            south: -10.0,
+            east,
+            north: 10.0,
+            resolution: 0.01,
+        }
+    }
+
+    #[test]
+    fn windows_ring_their_block_within_the_domain() {
+        let b = bounds(0.5, 20.0);
+        let block = TileRect {
+            level: 3,
+            x0: 8,
+            y0: 3,
+            width: 1,
+            height: 1,
+        };
+        let d = domain(&b, 5);
+        let w = block_window(&b, block, 5);
+        // Tiles 32..36 with a ring, clipped to the domain's columns and rows.
+        assert_eq!(w.x0, d.x0.max(31));
+        assert!(w.x0 + w.width <= d.x0 + d.width);
+        assert!(w.y0 >= d.y0 && w.y0 + w.height <= d.y0 + d.height);
+        for x in 32..36 {
+            for y in 12..16 {
+                if d.contains(x, y) {
+                    assert!(w.contains(x, y), "{x} {y}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_block_at_column_0_of_a_globe_rings_round_the_antimeridian() {
+        let b = GeoBounds {
+            west: -180.0,
+            south: -80.0,
+            east: 180.0,
+            north: 80.0,
+            resolution: 0.05,
+        };
+        let block = TileRect {
+            level: 2,
+            x0: 0,
+            y0: 1,
+            width: 1,
+            height: 1,
+        };
+        let w = block_window(&b, block, 4);
+        // Columns -1 ..= 4 a turn east (32 columns): 31 ..= 36.
+        assert_eq!((w.x0, w.width), (31, 6));
+        assert!(w.contains(31, 5) && w.contains(0, 5) && w.contains(4, 5));
+        assert_eq!(block_window(&b, block, 2).x0, 7);
+    }
+}

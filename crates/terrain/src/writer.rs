@@ -1,0 +1,231 @@
+//! The stream's sink that builds, checks and writes tiles: for one block (the tiles under
+//! one tile of the split level) or for the levels above the blocks.
+
+use std::collections::BTreeSet;
+use std::ops::{Range, RangeInclusive};
+use std::path::Path;
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use crate::budget::LevelBudget;
+use crate::layer::Available;
+use crate::rows::LevelRows;
+use crate::stream::LevelSink;
+use crate::tile::{build_tile, TileOut};
+use crate::tms::TileRect;
+use crate::{LevelReport, TerrainError, TerrainOptions, TerrainResult, METADATA_AVAILABILITY};
+
+/// Which tiles a writer writes.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Scope {
+    /// Levels written.
+    pub(super) levels: (u8, u8),
+    /// Only the tiles under this tile (a block), or every tile of the levels.
+    pub(super) under: Option<TileRect>,
+}
+
+impl Scope {
+    fn levels(&self) -> RangeInclusive<u8> {
+        self.levels.0..=self.levels.1
+    }
+
+    /// Whether tile `x`, `y` of level `z` (any turn) is written.
+    fn writes(&self, z: u8, x: u32, y: u32) -> bool {
+        if !self.levels().contains(&z) {
+            return false;
+        }
+        match self.under {
+            None => true,
+            Some(block) if z >= block.level => {
+                let f = z - block.level;
+                let below = TileRect {
+                    level: z,
+                    x0: block.x0 << f,
+                    y0: block.y0 << f,
+                    width: block.width << f,
+                    height: block.height << f,
+                };
+                below.contains(x, y)
+            }
+            Some(_) => false,
+        }
+    }
+}
+
+/// What a writer produced.
+#[derive(Debug, Default)]
+pub(super) struct Written {
+    /// Per level 0..=max_zoom (levels not written stay empty).
+    pub(super) reports: Vec<Option<LevelReport>>,
+    /// Tiles written, per level.
+    pub(super) available: Available,
+}
+
+impl Written {
+    /// Adds `other`'s tiles and counts to these.
+    pub(super) fn absorb(&mut self, other: Written) {
+        if self.reports.len() < other.reports.len() {
+            self.reports.resize(other.reports.len(), None);
+            self.available
+                .resize(other.available.len(), BTreeSet::new());
+        }
+        for (mine, theirs) in self.reports.iter_mut().zip(other.reports) {
+            match (mine.as_mut(), theirs) {
+                (_, None) => {}
+                (None, Some(t)) => *mine = Some(t),
+                (Some(m), Some(t)) => m.absorb(&t),
+            }
+        }
+        for (mine, theirs) in self.available.iter_mut().zip(other.available) {
+            mine.extend(theirs);
+        }
+    }
+}
+
+/// The sink: builds the tiles of `scope` from each level's rows, writes them under
+/// `out_dir`, and, for a block, keeps the block tile's samples (what the levels above are
+/// filtered from).
+pub(super) struct TileWriter<'a> {
+    scope: Scope,
+    out_dir: &'a Path,
+    options: &'a TerrainOptions,
+    pool: &'a rayon::ThreadPool,
+    budgets: Vec<LevelBudget>,
+    written: Written,
+    /// The samples of the block's own tile at its level, once seen.
+    pub(super) block_samples: Option<Vec<f32>>,
+}
+
+impl<'a> TileWriter<'a> {
+    /// A writer for `scope`, up to level `max_zoom`, that knows the tiles in `available`
+    /// already (levels below the scope, for the metadata extension).
+    pub(super) fn new(
+        scope: Scope,
+        max_zoom: u8,
+        available: Available,
+        out_dir: &'a Path,
+        options: &'a TerrainOptions,
+        pool: &'a rayon::ThreadPool,
+    ) -> Self {
+        let levels = usize::from(max_zoom) + 1;
+        let mut available = available;
+        available.resize(levels, BTreeSet::new());
+        TileWriter {
+            scope,
+            out_dir,
+            options,
+            pool,
+            budgets: (0..=max_zoom)
+                .map(|z| LevelBudget::new(z, options.quality))
+                .collect(),
+            written: Written {
+                reports: vec![None; levels],
+                available,
+            },
+            block_samples: None,
+        }
+    }
+
+    /// What was written.
+    pub(super) fn finish(self) -> Written {
+        self.written
+    }
+
+    /// The report of level `z`, started when first needed.
+    fn report(&mut self, z: u8) -> &mut LevelReport {
+        let quality = self.options.quality;
+        self.written.reports[usize::from(z)].get_or_insert_with(|| LevelReport::empty(z, quality))
+    }
+
+    /// Builds tile `x`, `y` of `flat` (a root the raster does not reach) and writes it.
+    pub(super) fn write_flat_root(&mut self, x: u32) -> TerrainResult<()> {
+        let flat = LevelRows::flat_tile(0, x, 0);
+        let available = self.options.metadata.then_some(&self.written.available);
+        let tile = build_tile(&flat, x, 0, &self.budgets[0], self.options, available)?
+            .expect("a flat tile has cells");
+        self.write(0, &tile)?;
+        self.report(0).flat_tiles += 1;
+        Ok(())
+    }
+
+    /// Writes a tile of level `z` under the output directory and counts it.
+    fn write(&mut self, z: u8, tile: &TileOut) -> TerrainResult<()> {
+        let dir = self.out_dir.join(z.to_string()).join(tile.x.to_string());
+        if tinsmith_output::interrupted() {
+            // The staging directory is being removed: add nothing to it.
+            return Err(TerrainError::Output {
+                path: dir,
+                source: std::io::Error::from(std::io::ErrorKind::Interrupted),
+            });
+        }
+        std::fs::create_dir_all(&dir).map_err(|source| TerrainError::Output {
+            path: dir.clone(),
+            source,
+        })?;
+        crate::pyramid::write_atomic(&dir.join(format!("{}.terrain", tile.y)), &tile.bytes)?;
+        self.written.available[usize::from(z)].insert((tile.x, tile.y));
+        let report = self.report(z);
+        report.tiles += 1;
+        report.bytes += tile.bytes.len() as u64;
+        report.vertices += tile.vertices as u64;
+        report.triangles += tile.triangles as u64;
+        report.measured_max_error = report.measured_max_error.max(tile.max_error);
+        report.achieved_bound = report.achieved_bound.max(tile.verified_bound);
+        Ok(())
+    }
+}
+
+/// The tiles of tile rows `tile_rows` (local) of a level, in TMS row then column order.
+fn tiles_of(level: &LevelRows, tile_rows: Range<u32>) -> Vec<(u32, u32)> {
+    tile_rows
+        .flat_map(|j| (0..level.tiles_x).map(move |i| (level.tx0 + i, level.ty0 + j)))
+        .collect()
+}
+
+impl LevelSink for TileWriter<'_> {
+    fn tile_rows(&mut self, level: &LevelRows, tile_rows: Range<u32>) -> TerrainResult<()> {
+        let z = level.level;
+        let t = Instant::now();
+        let mut tiles = tiles_of(level, tile_rows);
+        if let Some(block) = self.scope.under.filter(|b| b.level == z) {
+            if let Some(&(x, y)) = tiles.iter().find(|&&(x, y)| block.contains(x, y)) {
+                let values = level.tile_values(x, y);
+                self.block_samples = Some(values.iter().map(|&v| v as f32).collect());
+            }
+        }
+        tiles.retain(|&(x, y)| self.scope.writes(z, x, y));
+        if tiles.is_empty() {
+            return Ok(());
+        }
+        let budget = &self.budgets[usize::from(z)];
+        let options = self.options;
+        // Finer levels inside these tiles' footprints are complete (see `stream_levels`).
+        let metadata_available = if options.metadata && z.is_multiple_of(METADATA_AVAILABILITY) {
+            Some(&self.written.available)
+        } else {
+            None
+        };
+        let results: Vec<TerrainResult<Option<TileOut>>> = self.pool.install(|| {
+            tiles
+                .par_iter()
+                .map(|&(x, y)| build_tile(level, x, y, budget, options, metadata_available))
+                .collect()
+        });
+        for result in results {
+            match result? {
+                Some(tile) => self.write(z, &tile)?,
+                None => self.report(z).empty_tiles += 1,
+            }
+        }
+        self.report(z).seconds += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    fn level_done(&mut self, level: u8, seconds: f64) -> TerrainResult<()> {
+        if self.scope.levels().contains(&level) {
+            self.report(level).seconds += seconds;
+        }
+        Ok(())
+    }
+}

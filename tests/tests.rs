@@ -10,5 +10,6 @@ mod foreign;
 mod formats;
 mod mesh_and_verify;
 mod serve;
+mod shards;
 mod tiled_mesh;
 mod tiles;

@@ -47,13 +47,22 @@ pub enum Command {
 }
 
 #[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct TilesArgs {
+    #[command(subcommand)]
+    pub step: Option<TilesStep>,
     /// Any georeferenced raster GDAL can read, in any CRS (reprojected to EPSG:4326).
-    pub input: PathBuf,
+    #[arg(required = true)]
+    pub input: Option<PathBuf>,
     /// Output directory, new or empty: {z}/{x}/{y}.terrain and layer.json, moved into place
-    /// whole when done.
-    #[arg(short, long)]
-    pub output: PathBuf,
+    /// whole when done. With --shard, a directory every shard writes into.
+    #[arg(short, long, required = true)]
+    pub output: Option<PathBuf>,
+    /// Build only shard I of N (I from 0 to N-1), balanced by valid samples, into OUTPUT
+    /// shared by all shards, with a record of what it built; a re-run keeps the blocks
+    /// already done. Then `tinsmith tiles merge OUTPUT`.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<tinsmith_terrain::Shard>,
     /// Band to read (1-based).
     #[arg(long, default_value_t = 1)]
     pub band: usize,
@@ -76,6 +85,29 @@ pub struct TilesArgs {
     /// Content-Encoding: gzip).
     #[arg(long)]
     pub no_gzip: bool,
+    /// Worker threads, at most 1024 (default: all cores).
+    #[arg(long, default_value_t = 0, value_parser = threads_or_all)]
+    pub threads: usize,
+    /// Write the per-level report (bounds, measured error, tiles, bytes) as JSON.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// No per-level lines or summary on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// A step of a pyramid built in shards.
+#[derive(Debug, Subcommand)]
+pub enum TilesStep {
+    /// Finish a pyramid built with --shard: check that every shard of one plan is there,
+    /// build the levels above the shards' blocks, write layer.json last.
+    Merge(MergeArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The directory the shards wrote into.
+    pub dir: PathBuf,
     /// Worker threads, at most 1024 (default: all cores).
     #[arg(long, default_value_t = 0, value_parser = threads_or_all)]
     pub threads: usize,

@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 
-use crate::args::{ContourArgs, MeshArgs, ServeArgs, TilesArgs};
+use crate::args::{ContourArgs, MeshArgs, ServeArgs, TilesArgs, TilesStep};
 use crate::progress::Stderr;
 
 /// `tinsmith mesh`; `Ok(true)` once the verified mesh is written.
@@ -20,10 +20,26 @@ pub fn contour(args: &ContourArgs) -> Result<bool> {
 
 /// `tinsmith tiles`; `Ok(true)` once the pyramid is in place.
 pub fn tiles(args: &TilesArgs) -> Result<bool> {
+    if let Some(TilesStep::Merge(merge)) = &args.step {
+        let feedback = Stderr::new(merge.quiet);
+        let report = merge.report.as_deref();
+        tinsmith_pipeline::merge_tiles(&merge.dir, merge.threads, report, &feedback)?;
+        return Ok(true);
+    }
+    let (Some(input), Some(output)) = (&args.input, &args.output) else {
+        unreachable!("clap requires INPUT and --output without a subcommand");
+    };
     let options = args.options(tinsmith_pipeline::available_bytes());
     let feedback = Stderr::new(args.quiet);
     let report = args.report.as_deref();
-    tinsmith_pipeline::tiles(&args.input, &args.output, report, &options, &feedback)?;
+    match args.shard {
+        Some(shard) => {
+            tinsmith_pipeline::tiles_shard(input, output, report, &options, shard, &feedback)?;
+        }
+        None => {
+            tinsmith_pipeline::tiles(input, output, report, &options, &feedback)?;
+        }
+    }
     Ok(true)
 }
 

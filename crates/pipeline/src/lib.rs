@@ -52,6 +52,6 @@ pub use memory::available_bytes;
 pub use mesh::mesh;
 pub use scan::scan_raster;
 pub use serve::{serve, ServeOptions};
-pub use tiles::tiles;
+pub use tiles::{merge_tiles, tiles, tiles_shard};
 pub use tinsmith_georef::readable;
 pub use verify::{verify, Verified};

@@ -3,7 +3,10 @@
 
 use std::path::Path;
 
-use tinsmith_terrain::{build_terrain, TerrainOptions, TerrainReport};
+use tinsmith_terrain::{
+    build_shard, build_terrain, merge_shards, LevelReport, Shard, ShardReport, TerrainOptions,
+    TerrainReport,
+};
 
 use crate::output_paths::NamingFile;
 use crate::{Feedback, Result};
@@ -27,19 +30,7 @@ pub fn tiles(
         .map(crate::output_paths::ReservedReport::reserve)
         .transpose()?;
     let built = build_terrain(input, output, options, &mut |level| {
-        let flat = match level.flat_tiles {
-            0 => String::new(),
-            n => format!(" ({n} flat: a root tile without data, for --metadata)"),
-        };
-        feedback.note(&format!(
-            "level {:>2}: {} tiles{flat}, {} bytes, bound {:.3} m, measured {:.3} m, {:.2} s",
-            level.level,
-            level.tiles,
-            level.bytes,
-            level.achieved_bound,
-            level.measured_max_error,
-            level.seconds
-        ));
+        note_level(feedback, level)
     })
     .naming_file(input)?;
     if let Some(reserved) = reserved {
@@ -57,6 +48,93 @@ pub fn tiles(
         } else {
             ""
         }
+    ));
+    Ok(built)
+}
+
+/// One line about a finished level.
+fn note_level(feedback: &dyn Feedback, level: &LevelReport) {
+    let flat = match level.flat_tiles {
+        0 => String::new(),
+        n => format!(" ({n} flat: a root tile without data, for --metadata)"),
+    };
+    feedback.note(&format!(
+        "level {:>2}: {} tiles{flat}, {} bytes, bound {:.3} m, measured {:.3} m, {:.2} s",
+        level.level,
+        level.tiles,
+        level.bytes,
+        level.achieved_bound,
+        level.measured_max_error,
+        level.seconds
+    ));
+}
+
+/// Builds shard `shard` of the pyramid of `input` into the directory `output` that every
+/// shard shares (see [`tinsmith_terrain::build_shard`]) and, with `report`, writes what it
+/// built there. Notes each block, then a summary.
+pub fn tiles_shard(
+    input: &Path,
+    output: &Path,
+    report: Option<&Path>,
+    options: &TerrainOptions,
+    shard: Shard,
+    feedback: &dyn Feedback,
+) -> Result<ShardReport> {
+    if let Some(report) = report {
+        crate::output_paths::check_not_inside(output, report, "the pyramid directory")?;
+        crate::output_paths::check_writable_target(report, input)?;
+    }
+    let reserved = report
+        .map(crate::output_paths::ReservedReport::reserve)
+        .transpose()?;
+    let built = build_shard(input, output, options, shard, &mut |line| {
+        feedback.note(line)
+    })
+    .naming_file(input)?;
+    if let Some(reserved) = reserved {
+        reserved.write(&serde_json::to_vec_pretty(&built)?)?;
+    }
+    tinsmith_output::mark_finished();
+    feedback.note(&format!(
+        "shard {}: {} blocks ({} kept from an earlier run), {} tiles, {:.1} % of the plan's \
+         work, in {}; when every shard is done: tinsmith tiles merge {}",
+        built.shard,
+        built.blocks,
+        built.blocks_kept,
+        built.tiles,
+        100.0 * built.weight as f64 / built.total_weight.max(1) as f64,
+        output.display(),
+        output.display()
+    ));
+    Ok(built)
+}
+
+/// Finishes the sharded pyramid in `dir` (see [`tinsmith_terrain::merge_shards`]) and,
+/// with `report`, writes the per-level report there. Notes one line per level, then a
+/// summary.
+pub fn merge_tiles(
+    dir: &Path,
+    threads: usize,
+    report: Option<&Path>,
+    feedback: &dyn Feedback,
+) -> Result<TerrainReport> {
+    if let Some(report) = report {
+        crate::output_paths::check_not_inside(dir, report, "the pyramid directory")?;
+    }
+    let reserved = report
+        .map(crate::output_paths::ReservedReport::reserve)
+        .transpose()?;
+    let built = merge_shards(dir, threads, &mut |level| note_level(feedback, level))?;
+    if let Some(reserved) = reserved {
+        reserved.write(&serde_json::to_vec_pretty(&built)?)?;
+    }
+    tinsmith_output::mark_finished();
+    let tiles: u64 = built.levels.iter().map(|l| l.tiles).sum();
+    feedback.note(&format!(
+        "{tiles} tiles, levels {}..={}, in {} (layer.json written)",
+        built.min_zoom,
+        built.max_zoom,
+        dir.display()
     ));
     Ok(built)
 }

@@ -52,6 +52,7 @@
 //! ```
 
 mod cache;
+mod coverage;
 mod decode;
 mod error;
 mod files;
@@ -63,6 +64,7 @@ mod reproject;
 mod window;
 
 pub use cache::limit_block_cache;
+pub use coverage::{coverage, Coverage};
 pub use error::{Error, Result};
 pub use files::input_files;
 pub use geographic::{

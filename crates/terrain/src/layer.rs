@@ -119,17 +119,13 @@ pub(super) fn metadata_json(available: &Available, z: u8, x: u32, y: u32) -> Str
 }
 
 pub(super) fn write_layer_json(
-    input: &Path,
+    name: &str,
     out_dir: &Path,
     options: &TerrainOptions,
     bounds: &GeoBounds,
     max_zoom: u8,
     available: &Available,
 ) -> TerrainResult<()> {
-    let name = input
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "terrain".into());
     let mut extensions = Vec::new();
     if options.normals {
         extensions.push(serde_json::json!("octvertexnormals"));

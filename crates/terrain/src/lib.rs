@@ -9,9 +9,11 @@ mod blocks;
 mod budget;
 mod error;
 mod layer;
+mod plan;
 mod pyramid;
 mod quantized_mesh;
 mod rows;
+mod shards;
 mod stream;
 mod tile;
 mod tms;
@@ -20,6 +22,7 @@ mod writer;
 pub use budget::LEVEL_ZERO_ERROR;
 pub use error::{TerrainError, TerrainResult};
 pub use layer::METADATA_AVAILABILITY;
+pub use plan::Shard;
 pub use pyramid::{
     build_terrain, streaming_bytes, LevelReport, TerrainOptions, TerrainReport, MAX_LEVEL,
 };
@@ -28,4 +31,5 @@ pub use quantized_mesh::{
     QuantizedMeshTile, EXTENSION_METADATA, EXTENSION_NORMALS, HEADER_BYTES, MAX_16BIT_VERTICES,
     QUANTIZED_MAX, WGS84_A, WGS84_B,
 };
+pub use shards::{build_shard, merge_shards, ShardReport};
 pub use tms::{tile_rectangle, TILE_CELLS};

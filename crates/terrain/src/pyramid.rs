@@ -113,7 +113,7 @@ const OVERZOOM_LEVELS: u8 = 4;
 const OVERZOOM_TILES: u64 = 1_000_000;
 
 /// What one level produced.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LevelReport {
     /// The level.
     pub level: u8,
@@ -199,32 +199,109 @@ pub struct TerrainReport {
 /// Builds the pyramid of `input` into `out_dir`: `z/x/y.terrain` tiles and `layer.json`.
 ///
 /// # Guarantees
+/// - **A tile is a function of its own data.** The bytes of tile z/x/y depend only on the
+///   input, z/x/y and the options that shape tiles (band, quality, normals, metadata,
+///   gzip): not on `--min-zoom`, `--max-zoom` (except the metadata extension of levels
+///   0, 10 and 20, which lists the tiles below down to `--max-zoom`), the threads, or
+///   which other tiles a run (or a shard of one, [`build_shard`]) builds. Level L's
+///   lattice is defined once: the raster's own level is sampled from the raster (bilinear,
+///   each sample from its position alone), each coarser level is the finer one filtered
+///   (binomial 5 x 5) and halved, and each finer level is sampled alone.
 /// - **Bound.** At every valid sample of a tile's grid (its `(TILE_CELLS + 1)^2` lattice
-///   points, taken from the level's raster), the decoded tile (float32 min/max, 16-bit
-///   heights) is within `quality x e(level)` of the sample, or within half the level's
-///   height quantum when that is larger (reported as `achieved_bound`); checked for every
-///   tile by `tinsmith-verify` before the tile is written.
+///   points of its level), the decoded tile (float32 min/max, 16-bit heights) is within
+///   `quality x e(level)` of the sample, or within half the level's height quantum and
+///   a rounding margin when that is larger (reported as `achieved_bound`); checked for
+///   every tile by `tinsmith-verify` before the tile is written.
 /// - **Stitching.** Same-level neighbours have the same vertices along their shared edge,
 ///   at the same positions, with heights on the level's common lattice (multiples of
-///   `height_step`), so they decode to the same heights.
-/// - **Determinism.** The same input and options give the same bytes for any `threads`.
+///   `height_step`, fixed by the level's bound), so they decode to the same heights.
 /// - Tiles without a valid cell are not written and not listed in `available`.
-/// - **Memory.** Bounded by a few bands of tile rows per level (a band is at most 2^22
-///   samples of the finest level, or one tile row when a row is wider), plus one band per
-///   thread during the warp: it does not grow with the raster's height.
-///
-/// The finest level is warped from the input with GDAL (bilinear), band by band; each
-/// coarser level is the finer one smoothed and halved, row by row as the finer rows
-/// arrive. Each level's height quantum depends on its widest tile, and the rounding slack
-/// of every level on the finest level's largest |height|, both known only once the level
-/// has been seen whole, so the levels are streamed twice: once for these statistics, once
-/// for the tiles (the input is read twice, never held whole).
+/// - **Memory.** The pyramid is built block by block (a tile of the split level, at most
+///   four levels above the raster's own, and the tiles under it, from a window of the
+///   raster with a ring of one tile), a few bands of each block's tile rows at a time;
+///   then the levels above the blocks from the blocks' samples at the split level.
+/// - All or nothing: the pyramid is staged beside `out_dir` and renamed into place.
 pub fn build_terrain(
     input: &Path,
     out_dir: &Path,
     options: &TerrainOptions,
     progress: &mut dyn FnMut(&LevelReport),
 ) -> TerrainResult<TerrainReport> {
+    let Prepared {
+        bounds,
+        own_level,
+        max_zoom,
+    } = prepare(input, options)?;
+    // All or nothing: the pyramid is built in a temporary directory beside `out_dir` and
+    // renamed into place at the end; a failure (or nothing to write) leaves no trace.
+    let staging = stage_pyramid(out_dir)?;
+    let source = Warp {
+        path: input,
+        band: options.band,
+    };
+    let (levels, available) = build_pyramid(
+        &source,
+        &bounds,
+        Cut::coarsest(own_level),
+        max_zoom,
+        None,
+        staging.path(),
+        options,
+        progress,
+    )?;
+    // The coarser levels are made from the finest, each reaching a sample further out
+    // (see `LevelRows::coarser_rows`): without a triangle at the finest level they would
+    // only smear samples that hold none (a single valid sample, a single row) into
+    // terrain, where `mesh` and `contour` find nothing to triangulate.
+    let finest = levels.last().expect("min_zoom <= max_zoom");
+    if finest.tiles == finest.flat_tiles {
+        let hint = if options.max_zoom.is_some() {
+            " (at this --max-zoom the tile samples may be too far apart for the raster's \
+             extent: try a larger one)"
+        } else {
+            ""
+        };
+        return Err(TerrainError::Options(format!(
+            "{}: band {} has no tile with a 2x2 block of valid samples at level {max_zoom}, the \
+             finest (the coarser levels are made from it), so there is no terrain to write{hint}",
+            input.display(),
+            options.band,
+        )));
+    }
+    write_layer_json(
+        &layer_name(input),
+        staging.path(),
+        options,
+        &bounds,
+        max_zoom,
+        &available,
+    )?;
+    staging.commit().map_err(|source| TerrainError::Output {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    Ok(TerrainReport {
+        bounds: bounds_array(&bounds),
+        min_zoom: options.min_zoom,
+        max_zoom,
+        levels,
+    })
+}
+
+/// What every run of a pyramid works out from its input and options first.
+pub(super) struct Prepared {
+    /// The input's extent in EPSG:4326.
+    pub(super) bounds: GeoBounds,
+    /// The raster's own level (the anchor).
+    pub(super) own_level: u8,
+    /// The finest level written.
+    pub(super) max_zoom: u8,
+}
+
+/// Checks `options` against `input` and works out its bounds and levels; refuses, saying
+/// why, options that make no sense and runs that could not finish (too many tiles, too
+/// much memory, heights beyond float32).
+pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<Prepared> {
     if !(options.quality > 0.0 && options.quality <= MAX_QUALITY) {
         return Err(TerrainError::Options(format!(
             "--quality must be a positive number up to {MAX_QUALITY:e}, got {:?}",
@@ -350,106 +427,112 @@ pub fn build_terrain(
             }
         }
     }
-    // All or nothing: the pyramid is built in a temporary directory beside `out_dir` and
-    // renamed into place at the end; a failure (or nothing to write) leaves no trace.
-    let staging = stage_pyramid(out_dir)?;
-    let source = Warp {
-        path: input,
-        band: options.band,
-    };
-    let (levels, available) = build_pyramid(
-        &source,
-        &bounds,
-        Cut::coarsest(own_level),
+    Ok(Prepared {
+        bounds,
+        own_level,
         max_zoom,
-        None,
-        staging.path(),
-        options,
-        progress,
-    )?;
-    // The coarser levels are made from the finest, each reaching a sample further out
-    // (see `LevelRows::coarser_rows`): without a triangle at the finest level they would
-    // only smear samples that hold none (a single valid sample, a single row) into
-    // terrain, where `mesh` and `contour` find nothing to triangulate.
-    let finest = levels.last().expect("min_zoom <= max_zoom");
-    if finest.tiles == finest.flat_tiles {
-        let hint = if options.max_zoom.is_some() {
-            " (at this --max-zoom the tile samples may be too far apart for the raster's \
-             extent: try a larger one)"
-        } else {
-            ""
-        };
-        return Err(TerrainError::Options(format!(
-            "{}: band {} has no tile with a 2x2 block of valid samples at level {max_zoom}, the \
-             finest (the coarser levels are made from it), so there is no terrain to write{hint}",
-            input.display(),
-            options.band,
-        )));
-    }
-    write_layer_json(
-        input,
-        staging.path(),
-        options,
-        &bounds,
-        max_zoom,
-        &available,
-    )?;
-    staging.commit().map_err(|source| TerrainError::Output {
-        path: out_dir.to_path_buf(),
-        source,
-    })?;
-    Ok(TerrainReport {
-        bounds: bounds_array(&bounds),
-        min_zoom: options.min_zoom,
-        max_zoom,
-        levels,
     })
 }
 
-/// Builds every tile of `blocks` (tiles of `cut.split`) and of the levels under them down
-/// to `max_zoom`, in TMS row then column order, writing them under `out_dir`; returns what
-/// was written and each block's samples at the split level (what the levels above are
-/// filtered from). `done` hears of each block as it finishes.
+/// Builds every tile of `block` (a tile of `cut.split`) and of the levels under it down
+/// to `max_zoom`, writing them under `out_dir`; returns what was written and the block's
+/// samples at the split level when it has any valid one (what the levels above are
+/// filtered from).
 #[allow(clippy::too_many_arguments)]
-pub(super) fn build_blocks(
+pub(super) fn build_block(
     source: &dyn RowSource,
     bounds: &GeoBounds,
     cut: Cut,
     max_zoom: u8,
-    blocks: &[TileRect],
+    block: TileRect,
     band_rows: Option<u32>,
     out_dir: &Path,
     options: &TerrainOptions,
     pool: &rayon::ThreadPool,
-    done: &mut dyn FnMut(usize),
-) -> TerrainResult<(Written, SplitSamples)> {
-    let mut written = Written::default();
-    let mut samples = SplitSamples::default();
-    for (k, &block) in blocks.iter().enumerate() {
-        let scope = Scope {
-            levels: (options.min_zoom.max(cut.split), max_zoom),
-            under: Some(block),
-        };
-        let mut writer = TileWriter::new(scope, max_zoom, Vec::new(), out_dir, options, pool);
-        let window = |z: u8| block_window(bounds, block, z);
-        let band = |z: u8| band_rows.unwrap_or_else(|| band_tile_rows(window(z)));
-        // Levels finer than the anchor first, each sampled alone; then the anchor and the
-        // levels filtered from it, down to the block's own.
-        for z in (cut.anchor + 1..=max_zoom).rev() {
-            stream_levels(source, &window, (z, z), band(z), pool, &mut writer)?;
-        }
-        let zooms = (cut.split, cut.anchor);
-        stream_levels(source, &window, zooms, band(cut.anchor), pool, &mut writer)?;
-        if let Some(values) = writer.block_samples.take() {
-            if values.iter().any(|v| v.is_finite()) {
-                let x = tile_column(cut.split, block.x0);
-                samples.tiles.insert((x, block.y0), values);
-            }
-        }
-        written.absorb(writer.finish());
-        done(k);
+) -> TerrainResult<(Written, Option<Vec<f32>>)> {
+    let scope = Scope {
+        levels: (options.min_zoom.max(cut.split), max_zoom),
+        under: Some(block),
+    };
+    let mut writer = TileWriter::new(scope, max_zoom, Vec::new(), out_dir, options, pool);
+    let window = |z: u8| block_window(bounds, block, z);
+    let band = |z: u8| band_rows.unwrap_or_else(|| band_tile_rows(window(z)));
+    // Levels finer than the anchor first, each sampled alone; then the anchor and the
+    // levels filtered from it, down to the block's own.
+    for z in (cut.anchor + 1..=max_zoom).rev() {
+        stream_levels(source, &window, (z, z), band(z), pool, &mut writer)?;
     }
-    Ok((written, samples))
+    let zooms = (cut.split, cut.anchor);
+    stream_levels(source, &window, zooms, band(cut.anchor), pool, &mut writer)?;
+    let samples = writer
+        .block_samples
+        .take()
+        .filter(|values| values.iter().any(|v| v.is_finite()));
+    Ok((writer.finish(), samples))
+}
+
+/// The worker pool of a pyramid whose finest streamed level over `bounds` is `finest`.
+pub(super) fn worker_pool(
+    bounds: &GeoBounds,
+    finest: u8,
+    threads: usize,
+) -> TerrainResult<rayon::ThreadPool> {
+    // The finest level has the most tiles: more workers than that would idle.
+    let tiles = domain(bounds, finest).tiles();
+    let workers = tinsmith_tiling::worker_count(threads, tiles as usize);
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(workers)
+        .build()
+        .map_err(|source| TerrainError::Threads {
+            threads: workers,
+            source,
+        })
+}
+
+/// Writes, with `--metadata`, the root tiles the raster does not reach, flat (CesiumJS
+/// then ignores `available` and requests both root tiles), and adds them to `written`.
+pub(super) fn write_flat_roots(
+    written: &mut Written,
+    max_zoom: u8,
+    out_dir: &Path,
+    options: &TerrainOptions,
+    pool: &rayon::ThreadPool,
+) -> TerrainResult<()> {
+    if !(options.metadata && options.min_zoom == 0) {
+        return Ok(());
+    }
+    let scope = Scope {
+        levels: (0, 0),
+        under: None,
+    };
+    let available = written.available.clone();
+    let mut writer = TileWriter::new(scope, max_zoom, available, out_dir, options, pool);
+    for x in 0..2 {
+        if !written.available[0].contains(&(x, 0)) {
+            writer.write_flat_root(x)?;
+        }
+    }
+    written.absorb(writer.finish());
+    Ok(())
+}
+
+/// The level reports of `written`, `min_zoom ..= max_zoom`, coarsest first (a level
+/// without tiles reported empty).
+pub(super) fn level_reports(
+    written: &Written,
+    options: &TerrainOptions,
+    max_zoom: u8,
+) -> Vec<LevelReport> {
+    (options.min_zoom..=max_zoom)
+        .map(|z| {
+            written
+                .reports
+                .get(usize::from(z))
+                .cloned()
+                .flatten()
+                .unwrap_or_else(|| LevelReport::empty(z, options.quality))
+        })
+        .collect()
 }
 
 /// Builds the levels above the split, `min_zoom` up to `max_zoom` (if any are), filtered
@@ -502,62 +585,39 @@ fn build_pyramid(
     options: &TerrainOptions,
     progress: &mut dyn FnMut(&LevelReport),
 ) -> TerrainResult<(Vec<LevelReport>, Available)> {
-    // The finest level has the most tiles: more workers than that would idle.
-    let tiles = domain(bounds, max_zoom.max(cut.anchor)).tiles();
-    let workers = tinsmith_tiling::worker_count(options.threads, tiles as usize);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(workers)
-        .build()
-        .map_err(|source| TerrainError::Threads {
-            threads: workers,
-            source,
-        })?;
-    let all = blocks(bounds, cut);
-    let (mut written, samples) = build_blocks(
-        source,
-        bounds,
-        cut,
-        max_zoom,
-        &all,
-        band_rows,
-        out_dir,
-        options,
-        &pool,
-        &mut |_| {},
-    )?;
+    let pool = worker_pool(bounds, max_zoom.max(cut.anchor), options.threads)?;
+    let mut written = Written::default();
+    let mut samples = SplitSamples::default();
+    for block in blocks(bounds, cut) {
+        let (done, values) = build_block(
+            source, bounds, cut, max_zoom, block, band_rows, out_dir, options, &pool,
+        )?;
+        written.absorb(done);
+        if let Some(values) = values {
+            let x = tile_column(cut.split, block.x0);
+            samples.tiles.insert((x, block.y0), values);
+        }
+    }
     let available = written.available.clone();
     written.absorb(build_top(
         &samples, bounds, cut, max_zoom, available, out_dir, options, &pool,
     )?);
-    if options.metadata && options.min_zoom == 0 {
-        // With metadataAvailability CesiumJS ignores `available` and requests both root
-        // tiles: one the raster does not reach is written flat (no subtree).
-        let scope = Scope {
-            levels: (0, 0),
-            under: None,
-        };
-        let available = written.available.clone();
-        let mut writer = TileWriter::new(scope, max_zoom, available, out_dir, options, &pool);
-        for x in 0..2 {
-            if !written.available[0].contains(&(x, 0)) {
-                writer.write_flat_root(x)?;
-            }
-        }
-        written.absorb(writer.finish());
-    }
-    let levels: Vec<LevelReport> = (options.min_zoom..=max_zoom)
-        .map(|z| {
-            written.reports[usize::from(z)]
-                .clone()
-                .unwrap_or_else(|| LevelReport::empty(z, options.quality))
-        })
-        .collect();
+    write_flat_roots(&mut written, max_zoom, out_dir, options, &pool)?;
+    let levels = level_reports(&written, options, max_zoom);
     for level in levels.iter().rev() {
         progress(level);
     }
     let mut available = written.available;
     available.resize(usize::from(max_zoom) + 1, Default::default());
     Ok((levels, available))
+}
+
+/// The name `layer.json` gives a pyramid of `input`: its file stem.
+pub(super) fn layer_name(input: &Path) -> String {
+    input
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "terrain".into())
 }
 
 /// The temporary directory the pyramid is built in, beside `out_dir` (which must not

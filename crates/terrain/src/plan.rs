@@ -1,0 +1,304 @@
+//! What every shard of a pyramid agrees on before any work: the input's fingerprint, the
+//! options, where the pyramid is cut into blocks, and which blocks each shard builds
+//! (balanced by the valid samples they hold, not by their count).
+
+use std::ops::Range;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use tinsmith_raster::GeoBounds;
+
+use crate::blocks::{blocks, domain, Cut, BLOCK_DEPTH};
+use crate::tms::{tile_column, TileRect};
+use crate::{TerrainOptions, TerrainResult};
+
+/// Cells a side of the coarse read that fingerprints the input and weighs the blocks.
+const COVERAGE_SIDE: usize = 512;
+
+/// Blocks wanted per shard, so that whole blocks can balance the shards' work.
+const BLOCKS_PER_SHARD: u64 = 8;
+
+/// Shard `index` of `count` (0-based: `--shard 0/7` to `--shard 6/7`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    /// This shard, from 0.
+    pub index: u32,
+    /// How many shards the run has.
+    pub count: u32,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+
+    /// Parses `I/N` with `0 <= I < N`.
+    fn from_str(text: &str) -> Result<Shard, String> {
+        let bad = || format!("{text:?} is not a shard: give I/N, with I from 0 to N-1 (e.g. 0/8)");
+        let (i, n) = text.split_once('/').ok_or_else(bad)?;
+        let (index, count): (u32, u32) = (
+            i.trim().parse().map_err(|_| bad())?,
+            n.trim().parse().map_err(|_| bad())?,
+        );
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+/// The options that shape the tiles' bytes, as a plan records them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(super) struct TileOptions {
+    pub(super) band: usize,
+    pub(super) min_zoom: u8,
+    pub(super) max_zoom: u8,
+    pub(super) quality: f64,
+    pub(super) normals: bool,
+    pub(super) metadata: bool,
+    pub(super) gzip: bool,
+}
+
+impl TileOptions {
+    /// The options of a run (its `max_zoom` resolved).
+    pub(super) fn new(options: &TerrainOptions, max_zoom: u8) -> TileOptions {
+        TileOptions {
+            band: options.band,
+            min_zoom: options.min_zoom,
+            max_zoom,
+            quality: options.quality,
+            normals: options.normals,
+            metadata: options.metadata,
+            gzip: options.gzip,
+        }
+    }
+
+    /// Back to run options, with `threads`.
+    pub(super) fn to_options(&self, threads: usize) -> TerrainOptions {
+        TerrainOptions {
+            band: self.band,
+            min_zoom: self.min_zoom,
+            max_zoom: Some(self.max_zoom),
+            quality: self.quality,
+            normals: self.normals,
+            metadata: self.metadata,
+            gzip: self.gzip,
+            threads,
+            memory_limit: None,
+        }
+    }
+}
+
+/// A sharded pyramid's plan: the same on every machine for the same input, options and
+/// shard count.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(super) struct Plan {
+    /// The input as given (for messages) and its file stem (`layer.json`'s name).
+    pub(super) input: String,
+    pub(super) name: String,
+    /// SHA-256 of the input's size, georeferencing, band type and nodata, and of a
+    /// coarse read of its samples.
+    pub(super) fingerprint: String,
+    /// `[west, south, east, north, resolution]`, as [`GeoBounds`].
+    pub(super) bounds: [f64; 5],
+    pub(super) options: TileOptions,
+    pub(super) anchor: u8,
+    pub(super) split: u8,
+    pub(super) shards: u32,
+    /// Each block's weight (valid samples of the coarse read it holds, plus one), in block
+    /// order.
+    pub(super) weights: Vec<u64>,
+}
+
+impl Plan {
+    /// The plan for `shards` shards of the pyramid of `input` over `bounds` (anchored at
+    /// level `anchor`) with `options` (`max_zoom` resolved).
+    pub(super) fn new(
+        input: &Path,
+        bounds: &GeoBounds,
+        anchor: u8,
+        options: TileOptions,
+        shards: u32,
+    ) -> TerrainResult<Plan> {
+        let coverage = tinsmith_raster::coverage(input, options.band, COVERAGE_SIDE)?;
+        let info = tinsmith_raster::WindowReader::open(input, options.band)?
+            .info()
+            .clone();
+        let mut hash = Sha256::new();
+        let described = serde_json::json!({
+            "width": info.width, "height": info.height, "band": info.band,
+            "type": info.data_type, "nodata": info.nodata, "scale": info.scale,
+            "offset": info.offset, "crs": info.crs_wkt, "transform": info.geo_transform,
+        });
+        hash.update(described.to_string().as_bytes());
+        for v in &coverage.values {
+            hash.update(v.to_bits().to_le_bytes());
+        }
+        let fingerprint = hex(&hash.finalize());
+        // The coarsest split (fewest, largest blocks) that still gives every shard a few
+        // blocks to balance with.
+        let lowest = anchor.saturating_sub(BLOCK_DEPTH);
+        let split = (lowest..=anchor)
+            .find(|&s| domain(bounds, s).tiles() >= BLOCKS_PER_SHARD * u64::from(shards))
+            .unwrap_or(anchor);
+        let cut = Cut { anchor, split };
+        let all = blocks(bounds, cut);
+        let index = |x: u32, y: u32| {
+            all.iter()
+                .position(|b| tile_column(split, b.x0) == x && b.y0 == y)
+        };
+        let mut weights = vec![1u64; all.len()];
+        let size = 180.0 / (1u64 << split) as f64;
+        for (centre, value) in coverage.centres.iter().zip(&coverage.values) {
+            if !value.is_finite() || !centre[0].is_finite() || !centre[1].is_finite() {
+                continue;
+            }
+            let x = ((centre[0] + 180.0) / size)
+                .floor()
+                .rem_euclid(f64::from(2u32 << split));
+            let y = ((centre[1] + 90.0) / size).floor();
+            if y < 0.0 || y >= f64::from(1u32 << split) {
+                continue;
+            }
+            if let Some(k) = index(x as u32, y as u32) {
+                weights[k] += 1;
+            }
+        }
+        Ok(Plan {
+            input: input.display().to_string(),
+            name: input
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "terrain".into()),
+            fingerprint,
+            bounds: [
+                bounds.west,
+                bounds.south,
+                bounds.east,
+                bounds.north,
+                bounds.resolution,
+            ],
+            options,
+            anchor,
+            split,
+            shards,
+            weights,
+        })
+    }
+
+    pub(super) fn bounds(&self) -> GeoBounds {
+        let [west, south, east, north, resolution] = self.bounds;
+        GeoBounds {
+            west,
+            south,
+            east,
+            north,
+            resolution,
+        }
+    }
+
+    pub(super) fn cut(&self) -> Cut {
+        Cut {
+            anchor: self.anchor,
+            split: self.split,
+        }
+    }
+
+    /// Every block, in block order.
+    pub(super) fn blocks(&self) -> Vec<TileRect> {
+        blocks(&self.bounds(), self.cut())
+    }
+
+    /// The blocks of shard `index`: a run of consecutive blocks, each block going to the
+    /// shard whose share of the total weight holds the middle of the block's weight.
+    pub(super) fn shard_blocks(&self, index: u32) -> Range<usize> {
+        let total: u64 = self.weights.iter().sum();
+        let n = u128::from(self.shards);
+        let mut before = 0u64;
+        let owner: Vec<u32> = self
+            .weights
+            .iter()
+            .map(|&w| {
+                let middle = 2 * u128::from(before) + u128::from(w);
+                before += w;
+                ((middle * n) / (2 * u128::from(total))).min(n - 1) as u32
+            })
+            .collect();
+        let start = owner.partition_point(|&o| o < index);
+        let end = owner.partition_point(|&o| o <= index);
+        start..end
+    }
+
+    /// The hash of everything that decides a block's tiles (not the shard count): blocks
+    /// done under another shard count still serve.
+    pub(super) fn block_key(&self) -> String {
+        let text = serde_json::json!({
+            "fingerprint": self.fingerprint, "bounds": self.bounds,
+            "options": self.options, "anchor": self.anchor, "split": self.split,
+        });
+        hex(&Sha256::digest(text.to_string().as_bytes()))
+    }
+
+    /// The hash of the whole plan.
+    pub(super) fn id(&self) -> String {
+        let text = serde_json::to_string(self).expect("a plan serializes");
+        hex(&Sha256::digest(text.as_bytes()))
+    }
+}
+
+/// Lower-case hexadecimal.
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_parse_from_0() {
+        assert_eq!("3/7".parse::<Shard>(), Ok(Shard { index: 3, count: 7 }));
+        for bad in ["7/7", "1/0", "a/2", "3", "-1/2"] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+        }
+    }
+
+    fn plan(weights: Vec<u64>, shards: u32) -> Plan {
+        Plan {
+            input: String::new(),
+            name: String::new(),
+            fingerprint: String::new(),
+            bounds: [0.0; 5],
+            options: TileOptions::new(&TerrainOptions::default(), 3),
+            anchor: 3,
+            split: 1,
+            shards,
+            weights,
+        }
+    }
+
+    #[test]
+    fn shards_split_the_weight_into_consecutive_runs() {
+        let p = plan(vec![5, 1, 1, 1, 1, 1, 5, 5], 3);
+        let runs: Vec<_> = (0..3).map(|i| p.shard_blocks(i)).collect();
+        // Thirds of 20 end at 6.7 and 13.3: the blocks' middles are 2.5, 5.5, 6.5 | 7.5,
+        // 8.5, 9.5, 13 | 18.
+        assert_eq!(runs, [0..3, 3..7, 7..8]);
+        // Every block once, in order, whatever the count.
+        for n in [1, 2, 5, 8, 64] {
+            let p = plan(vec![3; 20], n);
+            let mut next = 0;
+            for i in 0..n {
+                let r = p.shard_blocks(i);
+                assert_eq!(r.start, next);
+                next = r.end;
+            }
+            assert_eq!(next, 20);
+        }
+    }
+}

@@ -1,0 +1,148 @@
+//! `tinsmith tiles --shard I/N` and `tinsmith tiles merge`: the union of the shards and the
+//! merge is the one-process pyramid byte for byte, whatever the shard count; a merge with
+//! shards missing or foreign refuses, naming them, and writes no `layer.json`.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use crate::util::{assert_fails_naming, fixture, stderr, Dir};
+
+/// Every file under `root` by relative path, without the shards' records.
+pub(crate) fn pyramid_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            let relative = path.strip_prefix(root).unwrap().to_path_buf();
+            if relative.starts_with("shards") {
+                continue;
+            }
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                out.insert(relative, std::fs::read(&path).unwrap());
+            }
+        }
+    }
+    out
+}
+
+fn run_ok(dir: &Dir, args: &[&str]) -> String {
+    let o = dir.run(args);
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    stderr(&o)
+}
+
+/// Builds `input`'s pyramid in one process (`one`) and in `n` shards then a merge
+/// (`sharded-n`), with `extra` options, and asserts they are the same files.
+fn check_shards(dir: &Dir, input: &str, extra: &[&str], counts: &[u32]) {
+    let mut args = vec!["tiles", input, "-o", "one", "-q"];
+    args.extend_from_slice(extra);
+    run_ok(dir, &args);
+    let one = pyramid_files(&dir.path("one"));
+    assert!(one.contains_key(Path::new("layer.json")) && one.len() > 5);
+    for &n in counts {
+        let out = format!("sharded-{n}");
+        // Shards in an order that is not their index order.
+        for i in (0..n).rev() {
+            let shard = format!("{i}/{n}");
+            let mut args = vec!["tiles", input, "-o", &out, "--shard", &shard, "-q"];
+            args.extend_from_slice(extra);
+            run_ok(dir, &args);
+        }
+        assert!(
+            !dir.path(&out).join("layer.json").exists(),
+            "no layer.json before the merge"
+        );
+        run_ok(dir, &["tiles", "merge", &out, "-q"]);
+        let sharded = pyramid_files(&dir.path(&out));
+        let differ: Vec<_> = one
+            .keys()
+            .chain(sharded.keys())
+            .filter(|k| one.get(*k) != sharded.get(*k))
+            .collect();
+        assert!(differ.is_empty(), "{n} shards differ in {differ:?}");
+    }
+}
+
+#[test]
+fn shards_and_their_merge_are_the_one_process_pyramid() {
+    let dir = Dir::new();
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    check_shards(&dir, &input, &["--normals", "--metadata"], &[1, 2, 7, 64]);
+}
+
+#[test]
+fn shards_of_a_globe_meet_across_the_antimeridian() {
+    let dir = Dir::new();
+    let input = fixture("etopo5_2deg_i16.tif");
+    check_shards(&dir, &input, &["--max-zoom", "3"], &[2, 7]);
+}
+
+#[test]
+fn a_merge_names_missing_and_foreign_shards_and_writes_no_layer_json() {
+    let dir = Dir::new();
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    run_ok(&dir, &["tiles", &input, "-o", "p", "--shard", "0/3", "-q"]);
+    run_ok(&dir, &["tiles", &input, "-o", "p", "--shard", "2/3", "-q"]);
+    let o = dir.run(&["tiles", "merge", "p"]);
+    assert_fails_naming(&o, &["1/3", "missing", "no layer.json"]);
+    assert!(!dir.path("p/layer.json").exists());
+    // A shard of another plan (another count) in the same directory.
+    run_ok(&dir, &["tiles", &input, "-o", "p", "--shard", "1/2", "-q"]);
+    let o = dir.run(&["tiles", "merge", "p"]);
+    assert_fails_naming(&o, &["1-of-2.json", "different plans"]);
+    assert!(!dir.path("p/layer.json").exists());
+    // Nothing to merge.
+    std::fs::create_dir(dir.path("empty")).unwrap();
+    let o = dir.run(&["tiles", "merge", "empty"]);
+    assert_fails_naming(&o, &["empty", "no shard records", "--shard"]);
+    // Bad shard specs.
+    for bad in ["3/3", "1", "a/b", "0/0"] {
+        let o = dir.run(&["tiles", &input, "-o", "q", "--shard", bad]);
+        assert_fails_naming(&o, &[bad, "I/N"]);
+    }
+}
+
+#[test]
+fn a_shard_run_again_keeps_the_blocks_it_finished() {
+    let dir = Dir::new();
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    run_ok(&dir, &["tiles", &input, "-o", "one", "-q"]);
+    run_ok(&dir, &["tiles", &input, "-o", "p", "--shard", "0/1", "-q"]);
+    // As if killed before its last blocks were recorded: their records are gone and one
+    // of their tiles is cut short.
+    let blocks = dir.path("p/shards/blocks");
+    let mut records: Vec<PathBuf> = std::fs::read_dir(&blocks)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "json"))
+        .collect();
+    records.sort();
+    let total = records.len();
+    assert!(total >= 4, "{total} blocks");
+    for record in &records[total - 2..] {
+        let text: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(record).unwrap()).unwrap();
+        if let Some(tile) = text["tiles"].as_array().unwrap().first() {
+            let t: Vec<u64> = tile
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_u64().unwrap())
+                .collect();
+            let path = dir.path(&format!("p/{}/{}/{}.terrain", t[0], t[1], t[2]));
+            std::fs::write(&path, b"cut short").unwrap();
+        }
+        std::fs::remove_file(record).unwrap();
+    }
+    std::fs::remove_file(dir.path("p/shards/0-of-1.json")).unwrap();
+    let log = run_ok(&dir, &["tiles", &input, "-o", "p", "--shard", "0/1"]);
+    assert!(
+        log.contains(&format!("({} kept from an earlier run)", total - 2)),
+        "{log}"
+    );
+    run_ok(&dir, &["tiles", "merge", "p", "-q"]);
+    assert!(pyramid_files(&dir.path("one")) == pyramid_files(&dir.path("p")));
+}

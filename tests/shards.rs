@@ -15,7 +15,7 @@ pub(crate) fn pyramid_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();
             let relative = path.strip_prefix(root).unwrap().to_path_buf();
-            if relative.starts_with("shards") {
+            if relative.starts_with("tinsmith") {
                 continue;
             }
             if path.is_dir() {
@@ -106,14 +106,14 @@ fn a_merge_names_missing_and_foreign_shards_and_writes_no_layer_json() {
 }
 
 #[test]
-fn a_shard_run_again_keeps_the_blocks_it_finished() {
+fn a_shard_run_again_keeps_the_tiles_it_finished() {
     let dir = Dir::new();
     let input = fixture("becmodel_dem_bc_albers_50m.tif");
     run_ok(&dir, &["tiles", &input, "-o", "one", "-q"]);
     run_ok(&dir, &["tiles", &input, "-o", "p", "--shard", "0/1", "-q"]);
     // As if killed before its last blocks were recorded: their records are gone and one
     // of their tiles is cut short.
-    let blocks = dir.path("p/shards/blocks");
+    let blocks = dir.path("p/tinsmith/blocks");
     let mut records: Vec<PathBuf> = std::fs::read_dir(&blocks)
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -122,27 +122,141 @@ fn a_shard_run_again_keeps_the_blocks_it_finished() {
     records.sort();
     let total = records.len();
     assert!(total >= 4, "{total} blocks");
-    for record in &records[total - 2..] {
+    let entries = |record: &PathBuf| -> Vec<serde_json::Value> {
         let text: serde_json::Value =
             serde_json::from_slice(&std::fs::read(record).unwrap()).unwrap();
-        if let Some(tile) = text["tiles"].as_array().unwrap().first() {
-            let t: Vec<u64> = tile
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|v| v.as_u64().unwrap())
-                .collect();
-            let path = dir.path(&format!("p/{}/{}/{}.terrain", t[0], t[1], t[2]));
+        text["tiles"].as_array().unwrap().clone()
+    };
+    let kept: usize = records[..total - 2].iter().map(|r| entries(r).len()).sum();
+    for record in &records[total - 2..] {
+        if let Some(tile) = entries(record).iter().find(|t| t["written"] == true) {
+            let path = dir.path(&format!(
+                "p/{}/{}/{}.terrain",
+                tile["z"], tile["x"], tile["y"]
+            ));
             std::fs::write(&path, b"cut short").unwrap();
         }
         std::fs::remove_file(record).unwrap();
     }
-    std::fs::remove_file(dir.path("p/shards/0-of-1.json")).unwrap();
+    std::fs::remove_file(dir.path("p/tinsmith/shards/0-of-1.json")).unwrap();
     let log = run_ok(&dir, &["tiles", &input, "-o", "p", "--shard", "0/1"]);
     assert!(
-        log.contains(&format!("({} kept from an earlier run)", total - 2)),
+        log.contains(&format!("({kept} kept from an earlier run)")),
         "{log}"
     );
     run_ok(&dir, &["tiles", "merge", "p", "-q"]);
     assert!(pyramid_files(&dir.path("one")) == pyramid_files(&dir.path("p")));
+}
+
+/// `input` with heights raised by `rise` m in the `size` x `size` window at `x0`, `y0`
+/// (a VRT over it).
+fn patched(dir: &Dir, input: &str, name: &str, window: [u32; 3], rise: f64) -> String {
+    let [x0, y0, size] = window;
+    let info = std::process::Command::new("gdalinfo")
+        .args(["-json", input])
+        .output()
+        .unwrap();
+    let info: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    let [w, h] = [0, 1].map(|k| info["size"][k].as_u64().unwrap());
+    let vrt = dir.path(name);
+    let status = std::process::Command::new("gdal_translate")
+        .args(["-q", "-of", "VRT", input])
+        .arg(&vrt)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let text = std::fs::read_to_string(&vrt).unwrap();
+    let source = format!(
+        "<ComplexSource><SourceFilename relativeToVRT=\"0\">{input}</SourceFilename>\
+         <SourceBand>1</SourceBand><SrcRect xOff=\"{x0}\" yOff=\"{y0}\" xSize=\"{size}\" \
+         ySize=\"{size}\"/><DstRect xOff=\"{x0}\" yOff=\"{y0}\" xSize=\"{size}\" \
+         ySize=\"{size}\"/><ScaleOffset>{rise}</ScaleOffset><ScaleRatio>1</ScaleRatio>\
+         </ComplexSource>"
+    );
+    assert!(x0 + size <= w as u32 && y0 + size <= h as u32);
+    let text = text.replacen("</VRTRasterBand>", &format!("{source}</VRTRasterBand>"), 1);
+    std::fs::write(&vrt, text).unwrap();
+    vrt.to_string_lossy().into_owned()
+}
+
+/// Each tile file's identity on disk (inode and modification time), by path.
+fn identities(root: &Path) -> BTreeMap<PathBuf, (u64, std::time::SystemTime)> {
+    use std::os::unix::fs::MetadataExt;
+    pyramid_files(root)
+        .into_keys()
+        .filter(|p| p.extension().is_some_and(|e| e == "terrain"))
+        .map(|p| {
+            let meta = std::fs::metadata(root.join(&p)).unwrap();
+            (p, (meta.ino(), meta.modified().unwrap()))
+        })
+        .collect()
+}
+
+#[test]
+fn an_update_rebuilds_only_the_tiles_a_changed_patch_reaches() {
+    let dir = Dir::new();
+    // The Albers DEM at 4 times its resolution (1720 x 2064 samples, own level 13).
+    let big = dir.path("big.tif");
+    let status = std::process::Command::new("gdal_translate")
+        .args(["-q", "-outsize", "400%", "400%", "-r", "bilinear"])
+        .arg(fixture("becmodel_dem_bc_albers_50m.tif"))
+        .arg(&big)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let big = big.to_string_lossy().into_owned();
+    let before = patched(&dir, &big, "dem.vrt", [1500, 1800, 100], 0.0);
+    run_ok(&dir, &["tiles", &before, "-o", "p", "--normals", "-q"]);
+    let old = identities(&dir.path("p"));
+    // The same file name changed in place, as a DEM is re-surveyed.
+    let after = patched(&dir, &big, "dem.vrt", [1500, 1800, 100], 40.0);
+    assert_eq!(before, after);
+    let log = run_ok(&dir, &["tiles", &after, "-o", "p", "--normals", "--update"]);
+    run_ok(&dir, &["tiles", &after, "-o", "fresh", "--normals", "-q"]);
+    let (updated, fresh) = (
+        pyramid_files(&dir.path("p")),
+        pyramid_files(&dir.path("fresh")),
+    );
+    let differ: Vec<_> = fresh
+        .keys()
+        .chain(updated.keys())
+        .filter(|k| fresh.get(*k) != updated.get(*k))
+        .collect();
+    assert!(
+        differ.is_empty(),
+        "the update differs from a fresh build in {differ:?}"
+    );
+    let new = identities(&dir.path("p"));
+    let rewritten: Vec<_> = new
+        .iter()
+        .filter(|(p, id)| old.get(*p) != Some(id))
+        .collect();
+    let total = new.len();
+    assert!(!rewritten.is_empty(), "the patch changed no tile");
+    assert!(
+        rewritten.len() * 4 < total,
+        "{} of {total} tiles rewritten",
+        rewritten.len()
+    );
+    // The patch is near the south-east corner: the finest level's tiles at the other
+    // corner are untouched.
+    let finest = new
+        .keys()
+        .map(|p| {
+            p.iter()
+                .next()
+                .unwrap()
+                .to_str()
+                .unwrap()
+                .parse::<u32>()
+                .unwrap()
+        })
+        .max()
+        .unwrap();
+    let far: Vec<_> = new
+        .keys()
+        .filter(|p| p.starts_with(finest.to_string()))
+        .collect();
+    assert!(far.iter().any(|p| old.get(*p) == new.get(*p)));
+    assert!(log.contains("kept"), "{log}");
 }

@@ -63,6 +63,11 @@ pub struct TilesArgs {
     /// already done. Then `tinsmith tiles merge OUTPUT`.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<tinsmith_terrain::Shard>,
+    /// Update the pyramid in OUTPUT in place from a changed INPUT: rebuild only the tiles
+    /// whose data changed since it was built (its records under OUTPUT/tinsmith/), remove
+    /// those that no longer have data, leave the rest untouched.
+    #[arg(long, conflicts_with = "shard")]
+    pub update: bool,
     /// Band to read (1-based).
     #[arg(long, default_value_t = 1)]
     pub band: usize,
@@ -196,6 +201,7 @@ impl TilesArgs {
             gzip: !self.no_gzip,
             threads: self.threads,
             memory_limit,
+            update: self.update,
         }
     }
 }

@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use tinsmith_terrain::{
-    build_shard, build_terrain, merge_shards, LevelReport, Shard, ShardReport, TerrainOptions,
-    TerrainReport,
+    build_shard, build_terrain, merge_shards, LevelReport, Progress, Shard, ShardReport,
+    TerrainOptions, TerrainReport,
 };
 
 use crate::output_paths::NamingFile;
@@ -29,17 +29,19 @@ pub fn tiles(
     let reserved = report
         .map(crate::output_paths::ReservedReport::reserve)
         .transpose()?;
-    let built = build_terrain(input, output, options, &mut |level| {
-        note_level(feedback, level)
-    })
-    .naming_file(input)?;
+    let built =
+        build_terrain(input, output, options, &mut |p| show(feedback, p)).naming_file(input)?;
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&built)?)?;
     }
     tinsmith_output::mark_finished();
     let tiles: u64 = built.levels.iter().map(|l| l.tiles).sum();
+    let kept = match built.tiles_kept {
+        0 => String::new(),
+        n => format!(" ({n} kept as they were: their data had not changed)"),
+    };
     feedback.note(&format!(
-        "{tiles} tiles, levels {}..={}, in {}{}",
+        "{tiles} tiles{kept}, levels {}..={}, in {}{}",
         built.min_zoom,
         built.max_zoom,
         output.display(),
@@ -50,6 +52,17 @@ pub fn tiles(
         }
     ));
     Ok(built)
+}
+
+/// Shows a build's progress: a status line of blocks, a note per finished level.
+fn show(feedback: &dyn Feedback, progress: Progress<'_>) {
+    match progress {
+        Progress::Block { done, total } if done < total => {
+            feedback.status(&format!("blocks: {done} of {total} built"))
+        }
+        Progress::Block { .. } => feedback.clear_status(),
+        Progress::Level(level) => note_level(feedback, level),
+    }
 }
 
 /// One line about a finished level.
@@ -87,21 +100,19 @@ pub fn tiles_shard(
     let reserved = report
         .map(crate::output_paths::ReservedReport::reserve)
         .transpose()?;
-    let built = build_shard(input, output, options, shard, &mut |line| {
-        feedback.note(line)
-    })
-    .naming_file(input)?;
+    let built = build_shard(input, output, options, shard, &mut |p| show(feedback, p))
+        .naming_file(input)?;
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&built)?)?;
     }
     tinsmith_output::mark_finished();
     feedback.note(&format!(
-        "shard {}: {} blocks ({} kept from an earlier run), {} tiles, {:.1} % of the plan's \
+        "shard {}: {} blocks, {} tiles ({} kept from an earlier run), {:.1} % of the plan's \
          work, in {}; when every shard is done: tinsmith tiles merge {}",
         built.shard,
         built.blocks,
-        built.blocks_kept,
         built.tiles,
+        built.tiles_kept,
         100.0 * built.weight as f64 / built.total_weight.max(1) as f64,
         output.display(),
         output.display()
@@ -124,7 +135,7 @@ pub fn merge_tiles(
     let reserved = report
         .map(crate::output_paths::ReservedReport::reserve)
         .transpose()?;
-    let built = merge_shards(dir, threads, &mut |level| note_level(feedback, level))?;
+    let built = merge_shards(dir, threads, &mut |p| show(feedback, p))?;
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&built)?)?;
     }

@@ -33,6 +33,12 @@ pub enum TerrainError {
         /// The span the level's height quantum allows.
         capacity: f64,
     },
+    /// The finest level has no tile with a valid cell: no terrain to write.
+    #[error("no tile with a 2x2 block of valid samples at level {level}, the finest")]
+    NoTerrain {
+        /// The finest level.
+        level: u8,
+    },
     /// The thread pool could not start.
     #[error("cannot start {threads} worker threads")]
     Threads {

@@ -1,13 +1,11 @@
 //! `layer.json` and the tiles' availability metadata (which tiles exist below each one).
 
 use std::collections::BTreeSet;
-use std::path::Path;
 
 use tinsmith_raster::GeoBounds;
 
-use crate::pyramid::write_atomic;
 use crate::tms::bounds_array;
-use crate::{TerrainOptions, TerrainResult};
+use crate::TerrainOptions;
 
 /// Levels whose tiles carry the metadata extension: 0, N, 2N, ... (`metadataAvailability`).
 pub const METADATA_AVAILABILITY: u8 = 10;
@@ -118,14 +116,14 @@ pub(super) fn metadata_json(available: &Available, z: u8, x: u32, y: u32) -> Str
     serde_json::to_string(&metadata).expect("tile ranges serialize")
 }
 
-pub(super) fn write_layer_json(
+/// The text of `layer.json` for a pyramid named `name`.
+pub(super) fn layer_json(
     name: &str,
-    out_dir: &Path,
     options: &TerrainOptions,
     bounds: &GeoBounds,
     max_zoom: u8,
     available: &Available,
-) -> TerrainResult<()> {
+) -> String {
     let mut extensions = Vec::new();
     if options.normals {
         extensions.push(serde_json::json!("octvertexnormals"));
@@ -162,6 +160,5 @@ pub(super) fn write_layer_json(
     if options.metadata {
         layer["metadataAvailability"] = serde_json::json!(METADATA_AVAILABILITY);
     }
-    let text = serde_json::to_string_pretty(&layer).expect("JSON values serialize");
-    write_atomic(&out_dir.join("layer.json"), text.as_bytes())
+    serde_json::to_string_pretty(&layer).expect("JSON values serialize")
 }

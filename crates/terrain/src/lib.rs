@@ -12,6 +12,7 @@ mod layer;
 mod plan;
 mod pyramid;
 mod quantized_mesh;
+mod records;
 mod rows;
 mod shards;
 mod stream;
@@ -24,7 +25,7 @@ pub use error::{TerrainError, TerrainResult};
 pub use layer::METADATA_AVAILABILITY;
 pub use plan::Shard;
 pub use pyramid::{
-    build_terrain, streaming_bytes, LevelReport, TerrainOptions, TerrainReport, MAX_LEVEL,
+    build_terrain, streaming_bytes, LevelReport, Progress, TerrainOptions, TerrainReport, MAX_LEVEL,
 };
 pub use quantized_mesh::{
     geodetic_to_ecef, gzip, oct_encode, surface_normal, EncodeError, GeoRectangle,

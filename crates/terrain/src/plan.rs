@@ -10,6 +10,7 @@ use sha2::{Digest, Sha256};
 use tinsmith_raster::GeoBounds;
 
 use crate::blocks::{blocks, domain, Cut, BLOCK_DEPTH};
+use crate::records::hex;
 use crate::tms::{tile_column, TileRect};
 use crate::{TerrainOptions, TerrainResult};
 
@@ -90,6 +91,7 @@ impl TileOptions {
             gzip: self.gzip,
             threads,
             memory_limit: None,
+            update: false,
         }
     }
 }
@@ -234,26 +236,11 @@ impl Plan {
         start..end
     }
 
-    /// The hash of everything that decides a block's tiles (not the shard count): blocks
-    /// done under another shard count still serve.
-    pub(super) fn block_key(&self) -> String {
-        let text = serde_json::json!({
-            "fingerprint": self.fingerprint, "bounds": self.bounds,
-            "options": self.options, "anchor": self.anchor, "split": self.split,
-        });
-        hex(&Sha256::digest(text.to_string().as_bytes()))
-    }
-
     /// The hash of the whole plan.
     pub(super) fn id(&self) -> String {
         let text = serde_json::to_string(self).expect("a plan serializes");
         hex(&Sha256::digest(text.as_bytes()))
     }
-}
-
-/// Lower-case hexadecimal.
-fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 #[cfg(test)]

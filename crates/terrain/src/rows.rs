@@ -217,6 +217,30 @@ impl LevelRows {
         values
     }
 
+    /// Feeds `hash` everything a tile `x`, `y` is built from: its samples and a ring of one
+    /// around them (edges and normals read it), each as its f32 bits, NaN as one value,
+    /// and a marker for a sample outside the level. Two tiles hashed the same are built
+    /// the same (with the same options and metadata).
+    pub(super) fn hash_tile_window(&self, x: u32, y: u32, hash: &mut impl sha2::Digest) {
+        const OUTSIDE: u32 = 0xffff_fffe;
+        let (i0, j0) = self.tile_origin(x, y);
+        let (i0, j0) = (i0 as i64, j0 as i64);
+        let mut bytes = Vec::with_capacity((CELLS + 3) * 4);
+        for j in j0 - 1..=j0 + CELLS as i64 + 1 {
+            bytes.clear();
+            let row = self.row(j);
+            for i in i0 - 1..=i0 + CELLS as i64 + 1 {
+                let bits = match (row, self.column(i)) {
+                    (Some(r), Some(c)) if r[c].is_nan() => f32::NAN.to_bits(),
+                    (Some(r), Some(c)) => r[c].to_bits(),
+                    _ => OUTSIDE,
+                };
+                bytes.extend_from_slice(&bits.to_le_bytes());
+            }
+            hash.update(&bytes);
+        }
+    }
+
     /// Whether the cell with lower-left sample (i, j) lies in the level (round it, when
     /// it wraps) and has four valid corners.
     pub(super) fn cell_valid(&self, i: i64, j: i64) -> bool {

@@ -7,13 +7,15 @@ use std::path::Path;
 use std::time::Instant;
 
 use rayon::prelude::*;
+use sha2::Digest;
 
 use crate::budget::LevelBudget;
-use crate::layer::Available;
+use crate::layer::{metadata_json, Available};
+use crate::records::{count, options_key, tile_sum, Entries, TileEntry};
 use crate::rows::LevelRows;
 use crate::stream::LevelSink;
 use crate::tile::{build_tile, TileOut};
-use crate::tms::TileRect;
+use crate::tms::{tile_column, TileRect};
 use crate::{LevelReport, TerrainError, TerrainOptions, TerrainResult, METADATA_AVAILABILITY};
 
 /// Which tiles a writer writes.
@@ -60,6 +62,11 @@ pub(super) struct Written {
     pub(super) reports: Vec<Option<LevelReport>>,
     /// Tiles written, per level.
     pub(super) available: Available,
+    /// Every tile considered, as its record keeps it.
+    pub(super) entries: Vec<TileEntry>,
+    /// Of them, tiles whose data had not changed since the run that recorded them: left
+    /// as they were, not built again.
+    pub(super) kept: u64,
 }
 
 impl Written {
@@ -80,6 +87,8 @@ impl Written {
         for (mine, theirs) in self.available.iter_mut().zip(other.available) {
             mine.extend(theirs);
         }
+        self.entries.extend(other.entries);
+        self.kept += other.kept;
     }
 }
 
@@ -88,6 +97,10 @@ impl Written {
 /// filtered from).
 pub(super) struct TileWriter<'a> {
     scope: Scope,
+    /// [`options_key`] of the run.
+    key: String,
+    /// Tiles a previous run recorded, by address.
+    known: &'a Entries,
     out_dir: &'a Path,
     options: &'a TerrainOptions,
     pool: &'a rayon::ThreadPool,
@@ -104,6 +117,7 @@ impl<'a> TileWriter<'a> {
         scope: Scope,
         max_zoom: u8,
         available: Available,
+        known: &'a Entries,
         out_dir: &'a Path,
         options: &'a TerrainOptions,
         pool: &'a rayon::ThreadPool,
@@ -113,6 +127,8 @@ impl<'a> TileWriter<'a> {
         available.resize(levels, BTreeSet::new());
         TileWriter {
             scope,
+            key: options_key(options),
+            known,
             out_dir,
             options,
             pool,
@@ -122,6 +138,8 @@ impl<'a> TileWriter<'a> {
             written: Written {
                 reports: vec![None; levels],
                 available,
+                entries: Vec::new(),
+                kept: 0,
             },
             block_samples: None,
         }
@@ -138,18 +156,96 @@ impl<'a> TileWriter<'a> {
         self.written.reports[usize::from(z)].get_or_insert_with(|| LevelReport::empty(z, quality))
     }
 
-    /// Builds tile `x`, `y` of `flat` (a root the raster does not reach) and writes it.
+    /// Builds root tile `x` flat (the raster does not reach it) and writes it, unless the
+    /// same is recorded as written already.
     pub(super) fn write_flat_root(&mut self, x: u32) -> TerrainResult<()> {
-        let flat = LevelRows::flat_tile(0, x, 0);
         let available = self.options.metadata.then_some(&self.written.available);
-        let tile = build_tile(&flat, x, 0, &self.budgets[0], self.options, available)?
-            .expect("a flat tile has cells");
-        self.write(0, &tile)?;
+        let metadata = available.map(|a| metadata_json(a, 0, x, 0));
+        let sum = tile_sum(&self.key, (0, x, 0), metadata.as_deref(), |h| {
+            h.update(b"flat")
+        });
+        let outcome = match self.known.get(&(0, x, 0)) {
+            Some(entry) if entry.sum == sum => Outcome::Kept(entry.clone()),
+            _ => {
+                let flat = LevelRows::flat_tile(0, x, 0);
+                let tile = build_tile(&flat, x, 0, &self.budgets[0], self.options, available)?;
+                Outcome::Built(0, x, 0, sum, tile)
+            }
+        };
+        self.apply(outcome)?;
         self.report(0).flat_tiles += 1;
         Ok(())
     }
 
-    /// Writes a tile of level `z` under the output directory and counts it.
+    /// Records a tile kept or built (writing it, or removing one a previous run wrote
+    /// where there is none now).
+    fn apply(&mut self, outcome: Outcome) -> TerrainResult<()> {
+        let entry = match outcome {
+            Outcome::Kept(entry) => {
+                self.written.kept += 1;
+                entry
+            }
+            Outcome::Built(z, x, y, sum, tile) => {
+                let entry = match &tile {
+                    Some(t) => TileEntry {
+                        z,
+                        x,
+                        y,
+                        sum,
+                        written: true,
+                        bytes: t.bytes.len() as u64,
+                        vertices: t.vertices as u64,
+                        triangles: t.triangles as u64,
+                        max_error: t.max_error,
+                        verified_bound: t.verified_bound,
+                    },
+                    None => TileEntry {
+                        z,
+                        x,
+                        y,
+                        sum,
+                        written: false,
+                        bytes: 0,
+                        vertices: 0,
+                        triangles: 0,
+                        max_error: 0.0,
+                        verified_bound: 0.0,
+                    },
+                };
+                match tile {
+                    Some(t) => self.write(z, &t)?,
+                    None if self.known.get(&(z, x, y)).is_some_and(|e| e.written) => {
+                        self.remove(z, x, y)?
+                    }
+                    None => {}
+                }
+                entry
+            }
+        };
+        if entry.written {
+            self.written.available[usize::from(entry.z)].insert((entry.x, entry.y));
+        }
+        count(self.report(entry.z), &entry);
+        self.written.entries.push(entry);
+        Ok(())
+    }
+
+    /// Removes tile `z/x/y` (no longer any data there).
+    fn remove(&self, z: u8, x: u32, y: u32) -> TerrainResult<()> {
+        let path = self
+            .out_dir
+            .join(z.to_string())
+            .join(x.to_string())
+            .join(format!("{y}.terrain"));
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                Err(TerrainError::Output { path, source: e })
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Writes a tile of level `z` under the output directory.
     fn write(&mut self, z: u8, tile: &TileOut) -> TerrainResult<()> {
         let dir = self.out_dir.join(z.to_string()).join(tile.x.to_string());
         if tinsmith_output::interrupted() {
@@ -163,17 +259,16 @@ impl<'a> TileWriter<'a> {
             path: dir.clone(),
             source,
         })?;
-        crate::pyramid::write_atomic(&dir.join(format!("{}.terrain", tile.y)), &tile.bytes)?;
-        self.written.available[usize::from(z)].insert((tile.x, tile.y));
-        let report = self.report(z);
-        report.tiles += 1;
-        report.bytes += tile.bytes.len() as u64;
-        report.vertices += tile.vertices as u64;
-        report.triangles += tile.triangles as u64;
-        report.measured_max_error = report.measured_max_error.max(tile.max_error);
-        report.achieved_bound = report.achieved_bound.max(tile.verified_bound);
-        Ok(())
+        crate::pyramid::write_atomic(&dir.join(format!("{}.terrain", tile.y)), &tile.bytes)
     }
+}
+
+/// A tile's fate in a run.
+enum Outcome {
+    /// Its data has not changed since it was recorded: left as it is.
+    Kept(TileEntry),
+    /// Built (level, column, row, fingerprint; `None`: no valid cell).
+    Built(u8, u32, u32, String, Option<TileOut>),
 }
 
 /// The tiles of tile rows `tile_rows` (local) of a level, in TMS row then column order.
@@ -199,24 +294,35 @@ impl LevelSink for TileWriter<'_> {
             return Ok(());
         }
         let budget = &self.budgets[usize::from(z)];
-        let options = self.options;
+        let (options, key, known) = (self.options, self.key.as_str(), self.known);
         // Finer levels inside these tiles' footprints are complete (see `stream_levels`).
         let metadata_available = if options.metadata && z.is_multiple_of(METADATA_AVAILABILITY) {
             Some(&self.written.available)
         } else {
             None
         };
-        let results: Vec<TerrainResult<Option<TileOut>>> = self.pool.install(|| {
+        let outcomes: Vec<TerrainResult<Outcome>> = self.pool.install(|| {
             tiles
                 .par_iter()
-                .map(|&(x, y)| build_tile(level, x, y, budget, options, metadata_available))
+                .map(|&(x, y)| {
+                    let column = tile_column(z, x);
+                    let metadata = metadata_available.map(|a| metadata_json(a, z, column, y));
+                    let sum = tile_sum(key, (z, column, y), metadata.as_deref(), |h| {
+                        level.hash_tile_window(x, y, h)
+                    });
+                    match known.get(&(z, column, y)) {
+                        Some(entry) if entry.sum == sum => Ok(Outcome::Kept(entry.clone())),
+                        _ => {
+                            let tile =
+                                build_tile(level, x, y, budget, options, metadata_available)?;
+                            Ok(Outcome::Built(z, column, y, sum, tile))
+                        }
+                    }
+                })
                 .collect()
         });
-        for result in results {
-            match result? {
-                Some(tile) => self.write(z, &tile)?,
-                None => self.report(z).empty_tiles += 1,
-            }
+        for outcome in outcomes {
+            self.apply(outcome?)?;
         }
         self.report(z).seconds += t.elapsed().as_secs_f64();
         Ok(())

@@ -1,0 +1,223 @@
+//! What a pyramid keeps about how each tile was made, under `tinsmith/` beside its tiles,
+//! so that a re-run (a shard interrupted, an input updated) rebuilds only the tiles whose
+//! data changed:
+//! - `tinsmith/blocks/{x}-{y}.json`: each tile of a block (a tile of the split level and
+//!   the tiles under it): the fingerprint of the data it was built from, whether it was
+//!   written, and its counts; `{x}-{y}.samples` holds the block's samples at the split
+//!   level (gzipped little-endian f32), what the levels above are filtered from.
+//! - `tinsmith/top.json`: the same for the levels above the blocks and the flat roots.
+//! - `tinsmith/shards/{i}-of-{n}.json`: a shard's plan and blocks (sharded runs).
+//!
+//! Records are written after the tiles they describe, so a record never claims a tile
+//! that is not in place.
+
+use std::collections::HashMap;
+use std::io::{Read, Write};
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use crate::plan::{Plan, Shard};
+use crate::pyramid::write_atomic;
+use crate::tms::TILE_CELLS;
+use crate::{LevelReport, TerrainError, TerrainOptions, TerrainResult};
+
+/// Where the records live, relative to the pyramid.
+pub(super) const RECORDS_DIR: &str = "tinsmith";
+
+/// One tile as a run left it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(super) struct TileEntry {
+    pub(super) z: u8,
+    pub(super) x: u32,
+    pub(super) y: u32,
+    /// Fingerprint of everything the tile was built from (hex).
+    pub(super) sum: String,
+    /// Whether it was written (a tile without a valid cell is not).
+    pub(super) written: bool,
+    pub(super) bytes: u64,
+    pub(super) vertices: u64,
+    pub(super) triangles: u64,
+    pub(super) max_error: f64,
+    pub(super) verified_bound: f64,
+}
+
+/// Tiles by (level, column, TMS row).
+pub(super) type Entries = HashMap<(u8, u32, u32), TileEntry>;
+
+/// The fingerprint of a tile: a hash of the options that shape tiles, its address, the
+/// data it reads (fed by `feed`) and its metadata extension.
+pub(super) fn tile_sum(
+    options_key: &str,
+    (z, x, y): (u8, u32, u32),
+    metadata: Option<&str>,
+    feed: impl FnOnce(&mut Sha256),
+) -> String {
+    let mut hash = Sha256::new();
+    hash.update(options_key.as_bytes());
+    hash.update([z]);
+    hash.update(x.to_le_bytes());
+    hash.update(y.to_le_bytes());
+    hash.update(metadata.unwrap_or("").as_bytes());
+    feed(&mut hash);
+    hex(&hash.finalize()[..16])
+}
+
+/// The key of the options that shape tiles' bytes (not the zoom range).
+pub(super) fn options_key(options: &TerrainOptions) -> String {
+    let text = serde_json::json!({
+        "band": options.band, "quality": options.quality, "normals": options.normals,
+        "metadata": options.metadata, "gzip": options.gzip, "format": 1,
+    });
+    hex(&Sha256::digest(text.to_string().as_bytes()))
+}
+
+/// Lower-case hexadecimal.
+pub(super) fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// What one block built.
+#[derive(Debug, Serialize, Deserialize)]
+pub(super) struct BlockRecord {
+    /// [`options_key`] of the run.
+    pub(super) options: String,
+    /// The block: column, TMS row (of the split level).
+    pub(super) block: [u32; 2],
+    pub(super) split: u8,
+    pub(super) tiles: Vec<TileEntry>,
+    /// Whether the block has samples at the split level (a `.samples` file).
+    pub(super) samples: bool,
+}
+
+/// What the levels above the blocks (and the flat roots) built.
+#[derive(Debug, Serialize, Deserialize)]
+pub(super) struct TopRecord {
+    pub(super) options: String,
+    pub(super) tiles: Vec<TileEntry>,
+}
+
+/// What a shard built.
+#[derive(Debug, Serialize, Deserialize)]
+pub(super) struct ShardRecord {
+    /// [`Plan::id`].
+    pub(super) plan_id: String,
+    pub(super) plan: Plan,
+    pub(super) shard: Shard,
+    /// Its blocks: column, TMS row.
+    pub(super) blocks: Vec<[u32; 2]>,
+}
+
+pub(super) fn block_name(split: u8, block: [u32; 2]) -> String {
+    format!("{RECORDS_DIR}/blocks/{split}-{}-{}", block[0], block[1])
+}
+
+pub(super) fn shard_name(shard: Shard) -> String {
+    format!(
+        "{RECORDS_DIR}/shards/{}-of-{}.json",
+        shard.index, shard.count
+    )
+}
+
+pub(super) fn top_name() -> String {
+    format!("{RECORDS_DIR}/top.json")
+}
+
+/// The bytes of `path`, or `None` when there is no such file.
+pub(super) fn read_optional(path: &Path) -> TerrainResult<Option<Vec<u8>>> {
+    match std::fs::read(path) {
+        Ok(bytes) => Ok(Some(bytes)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(source) => Err(TerrainError::Output {
+            path: path.to_path_buf(),
+            source,
+        }),
+    }
+}
+
+/// A JSON record at `dest/name`, or `None` when there is none.
+pub(super) fn read_record<T: serde::de::DeserializeOwned>(
+    dest: &Path,
+    name: &str,
+) -> TerrainResult<Option<T>> {
+    let path = dest.join(name);
+    let Some(bytes) = read_optional(&path)? else {
+        return Ok(None);
+    };
+    serde_json::from_slice(&bytes).map(Some).map_err(|e| {
+        TerrainError::Options(format!(
+            "{}: not a record tinsmith wrote ({e}); remove {} to start afresh",
+            path.display(),
+            dest.join(RECORDS_DIR).display()
+        ))
+    })
+}
+
+/// Writes `bytes` to `dest/name`, making the directories it needs.
+pub(super) fn put(dest: &Path, name: &str, bytes: &[u8]) -> TerrainResult<()> {
+    let path = dest.join(name);
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent).map_err(|source| TerrainError::Output {
+            path: parent.to_path_buf(),
+            source,
+        })?;
+    }
+    write_atomic(&path, bytes)
+}
+
+/// Writes a JSON record to `dest/name`.
+pub(super) fn put_record<T: Serialize>(dest: &Path, name: &str, record: &T) -> TerrainResult<()> {
+    put(
+        dest,
+        name,
+        &serde_json::to_vec(record).expect("a record serializes"),
+    )
+}
+
+/// A block's samples, gzipped.
+pub(super) fn gzip_samples(values: &[f32]) -> Vec<u8> {
+    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    for v in values {
+        e.write_all(&v.to_le_bytes()).expect("writing to memory");
+    }
+    e.finish().expect("writing to memory")
+}
+
+/// A block's samples from `path`.
+pub(super) fn read_samples(path: &Path) -> TerrainResult<Vec<f32>> {
+    let bytes = read_optional(path)?
+        .ok_or_else(|| TerrainError::Options(format!("{}: missing", path.display())))?;
+    let side = TILE_CELLS as usize + 1;
+    let mut raw = Vec::new();
+    let bad = |reason: String| {
+        TerrainError::Options(format!(
+            "{}: not a block's samples ({reason})",
+            path.display()
+        ))
+    };
+    flate2::read::GzDecoder::new(&bytes[..])
+        .read_to_end(&mut raw)
+        .map_err(|e| bad(e.to_string()))?;
+    if raw.len() != side * side * 4 {
+        return Err(bad(format!("{} bytes", raw.len())));
+    }
+    Ok(raw
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect())
+}
+
+/// Adds `entry`'s counts to `report` (its level's).
+pub(super) fn count(report: &mut LevelReport, entry: &TileEntry) {
+    if entry.written {
+        report.tiles += 1;
+        report.bytes += entry.bytes;
+        report.vertices += entry.vertices;
+        report.triangles += entry.triangles;
+        report.measured_max_error = report.measured_max_error.max(entry.max_error);
+        report.achieved_bound = report.achieved_bound.max(entry.verified_bound);
+    } else {
+        report.empty_tiles += 1;
+    }
+}

@@ -46,7 +46,9 @@ fn decode_pyramid(dir: &Path) -> BTreeMap<(u32, u32, u32), Tile> {
     let mut files: Vec<(PathBuf, (u32, u32, u32))> = Vec::new();
     for z in std::fs::read_dir(dir).unwrap() {
         let z = z.unwrap().path();
-        if !z.is_dir() {
+        // Levels only (not the records in tinsmith/).
+        let level = z.file_name().unwrap().to_str().unwrap().parse::<u32>();
+        if !z.is_dir() || level.is_err() {
             continue;
         }
         for x in std::fs::read_dir(&z).unwrap() {

@@ -46,6 +46,9 @@ pub enum Error {
     /// Building the terrain pyramid failed.
     #[error(transparent)]
     Terrain(#[from] tinsmith_terrain::TerrainError),
+    /// A pyramid's destination failed.
+    #[error(transparent)]
+    Store(#[from] tinsmith_store::StoreError),
     /// A file position is not on a sample of the raster.
     #[error(transparent)]
     Position(#[from] tinsmith_georef::PositionError),

@@ -8,6 +8,8 @@ use tinsmith_terrain::{
     TerrainOptions, TerrainReport,
 };
 
+use tinsmith_store::{DirectoryStore, TileStore};
+
 use crate::output_paths::NamingFile;
 use crate::{Feedback, Result};
 
@@ -100,7 +102,8 @@ pub fn tiles_shard(
     let reserved = report
         .map(crate::output_paths::ReservedReport::reserve)
         .transpose()?;
-    let built = build_shard(input, output, options, shard, &mut |p| show(feedback, p))
+    let store = pyramid_store(output)?;
+    let built = build_shard(input, &*store, options, shard, &mut |p| show(feedback, p))
         .naming_file(input)?;
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&built)?)?;
@@ -135,7 +138,8 @@ pub fn merge_tiles(
     let reserved = report
         .map(crate::output_paths::ReservedReport::reserve)
         .transpose()?;
-    let built = merge_shards(dir, threads, &mut |p| show(feedback, p))?;
+    let store = pyramid_store(dir)?;
+    let built = merge_shards(&*store, threads, &mut |p| show(feedback, p))?;
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&built)?)?;
     }
@@ -148,4 +152,9 @@ pub fn merge_tiles(
         dir.display()
     ));
     Ok(built)
+}
+
+/// The store a pyramid built in shards goes to: the directory `output` (made when missing).
+fn pyramid_store(output: &Path) -> Result<Box<dyn TileStore>> {
+    Ok(Box::new(DirectoryStore::open(output)?))
 }

@@ -52,6 +52,18 @@ impl DirectoryStore {
         tinsmith_output::write_bytes_atomically(&path, bytes).map_err(io)
     }
 
+    fn remove(&self, key: &str) -> StoreResult<()> {
+        let path = self.root.join(key);
+        match std::fs::remove_file(&path) {
+            Ok(()) => Ok(()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+            Err(source) => Err(StoreError::Io {
+                location: path.display().to_string(),
+                source,
+            }),
+        }
+    }
+
     fn read(&self, key: &str) -> StoreResult<Option<Vec<u8>>> {
         let path = self.root.join(key);
         match std::fs::read(&path) {
@@ -86,15 +98,12 @@ impl TileStore for DirectoryStore {
     }
 
     fn delete_tile(&self, z: u8, x: u32, y: u32) -> StoreResult<()> {
-        let path = self.root.join(tile_key(z, x, y));
-        match std::fs::remove_file(&path) {
-            Ok(()) => Ok(()),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-            Err(source) => Err(StoreError::Io {
-                location: path.display().to_string(),
-                source,
-            }),
-        }
+        self.remove(&tile_key(z, x, y))
+    }
+
+    fn delete_file(&self, name: &str) -> StoreResult<()> {
+        check_file_name(name)?;
+        self.remove(name)
     }
 
     fn put_file(&self, name: &str, bytes: &[u8]) -> StoreResult<()> {
@@ -177,6 +186,8 @@ mod tests {
         );
         store.delete_tile(3, 1, 2).unwrap();
         store.delete_tile(3, 1, 2).unwrap();
+        store.delete_file("shards/1-of-7.json").unwrap();
+        assert_eq!(store.list_files("shards/").unwrap(), ["shards/2-of-7.json"]);
         assert_eq!(store.get_tile(3, 1, 2).unwrap(), None);
         assert!(store.put_file("../x", b"").is_err());
         assert!(store.put_file("/x", b"").is_err());

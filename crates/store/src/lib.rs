@@ -55,6 +55,9 @@ pub trait TileStore: Send + Sync {
     /// The bytes of file `name`, or `None` when there is none.
     fn get_file(&self, name: &str) -> StoreResult<Option<Vec<u8>>>;
 
+    /// Removes file `name`; no error when there is none.
+    fn delete_file(&self, name: &str) -> StoreResult<()>;
+
     /// The names of the files whose name starts with `prefix`, sorted.
     fn list_files(&self, prefix: &str) -> StoreResult<Vec<String>>;
 }

@@ -12,11 +12,27 @@ pub enum TerrainError {
     /// The options make no sense (the message says which).
     #[error("{0}")]
     Options(String),
+    /// A tile's heights reach beyond what quantized-mesh tiles, whose height ranges are
+    /// stored in `f32`, can hold.
+    #[error(
+        "tile {z}/{x}/{y}: heights up to {max_abs:e} in magnitude are beyond what quantized-mesh \
+         tiles can hold (their height range is stored in f32)"
+    )]
+    HeightsBeyondF32 {
+        /// Level.
+        z: u8,
+        /// Column.
+        x: u32,
+        /// TMS row.
+        y: u32,
+        /// The largest magnitude of a valid height of the tile.
+        max_abs: f64,
+    },
     /// A tile's heights span more than its level's 16-bit height quanta can hold, or lie
     /// too far from 0 for its float32 minimum to be exact.
     #[error(
         "tile {z}/{x}/{y}: heights from {low} to {high} m span more than the {capacity} m that \
-         16-bit heights hold at this level's height step (or lie too far from 0 for it); is a \
+         16-bit quantized-mesh heights hold at this level's height step (or lie too far from 0 for it); is a \
          nodata value missing from the input, or is --quality too small?"
     )]
     TileHeights {
@@ -86,6 +102,9 @@ pub enum TerrainError {
         #[source]
         source: crate::quantized_mesh::EncodeError,
     },
+    /// The pyramid's destination failed (a directory, a container, an object store).
+    #[error(transparent)]
+    Store(#[from] tinsmith_store::StoreError),
     /// Writing the output failed.
     #[error("{}: cannot write", path.display())]
     Output {

@@ -11,13 +11,14 @@ use crate::blocks::{block_window, blocks, domain, Cut, SplitSamples};
 use crate::budget::LevelBudget;
 use crate::layer::{layer_json, Available};
 use crate::records::{
-    block_name, gzip_samples, options_key, put, put_record, read_optional, read_record, top_name,
-    BlockRecord, Entries, TopRecord, RECORDS_DIR,
+    block_name, gzip_samples, options_key, put_record, read_record, top_name, BlockRecord, Entries,
+    TopRecord, RECORDS_DIR,
 };
 use crate::stream::{band_tile_rows, stream_levels, RowSource, Warp};
 use crate::tms::{bounds_array, step, tile_column, TileRect, TILE_CELLS};
 use crate::writer::{Scope, TileWriter, Written};
 use crate::{TerrainError, TerrainResult};
+use tinsmith_store::{DirectoryStore, TileStore};
 
 /// The largest `--quality`: the level-0 bound is then 7.7e10 m, beyond any height; larger
 /// values only risk overflowing the bounds.
@@ -251,9 +252,9 @@ pub fn build_terrain(
     } else {
         Some(stage_pyramid(out_dir)?)
     };
-    let target = staging.as_ref().map_or(out_dir, |s| s.path());
+    let store = DirectoryStore::open(staging.as_ref().map_or(out_dir, |s| s.path()))?;
     let known = if options.update {
-        recorded_entries(out_dir)?
+        recorded_entries(&store)?
     } else {
         Entries::new()
     };
@@ -271,7 +272,7 @@ pub fn build_terrain(
         cut,
         max_zoom,
         &all,
-        target,
+        &store,
         options,
         &pool,
         &known,
@@ -284,7 +285,7 @@ pub fn build_terrain(
         &bounds,
         cut,
         max_zoom,
-        target,
+        &store,
         options,
         &pool,
         &known,
@@ -295,7 +296,7 @@ pub fn build_terrain(
         other => other,
     })?;
     if options.update {
-        remove_stale_records(out_dir, cut, &all)?;
+        remove_stale_records(&store, cut, &all)?;
     }
     if let Some(staging) = staging {
         staging.commit().map_err(|source| TerrainError::Output {
@@ -504,7 +505,7 @@ pub(super) fn build_block(
     max_zoom: u8,
     block: TileRect,
     band_rows: Option<u32>,
-    out_dir: &Path,
+    store: &dyn TileStore,
     options: &TerrainOptions,
     pool: &rayon::ThreadPool,
     known: &Entries,
@@ -513,7 +514,7 @@ pub(super) fn build_block(
         levels: (options.min_zoom.max(cut.split), max_zoom),
         under: Some(block),
     };
-    let mut writer = TileWriter::new(scope, max_zoom, Vec::new(), known, out_dir, options, pool);
+    let mut writer = TileWriter::new(scope, max_zoom, Vec::new(), known, store, options, pool);
     let window = |z: u8| block_window(bounds, block, z);
     let band = |z: u8| band_rows.unwrap_or_else(|| band_tile_rows(window(z)));
     // Levels finer than the anchor first, each sampled alone; then the anchor and the
@@ -553,7 +554,7 @@ pub(super) fn worker_pool(
 pub(super) fn write_flat_roots(
     written: &mut Written,
     max_zoom: u8,
-    out_dir: &Path,
+    store: &dyn TileStore,
     options: &TerrainOptions,
     pool: &rayon::ThreadPool,
     known: &Entries,
@@ -566,7 +567,7 @@ pub(super) fn write_flat_roots(
         under: None,
     };
     let available = written.available.clone();
-    let mut writer = TileWriter::new(scope, max_zoom, available, known, out_dir, options, pool);
+    let mut writer = TileWriter::new(scope, max_zoom, available, known, store, options, pool);
     for x in 0..2 {
         if !written.available[0].contains(&(x, 0)) {
             writer.write_flat_root(x)?;
@@ -605,7 +606,7 @@ pub(super) fn build_top(
     cut: Cut,
     max_zoom: u8,
     available: Available,
-    out_dir: &Path,
+    store: &dyn TileStore,
     options: &TerrainOptions,
     pool: &rayon::ThreadPool,
     known: &Entries,
@@ -617,7 +618,7 @@ pub(super) fn build_top(
         levels: (options.min_zoom, max_zoom.min(cut.split - 1)),
         under: None,
     };
-    let mut writer = TileWriter::new(scope, max_zoom, available, known, out_dir, options, pool);
+    let mut writer = TileWriter::new(scope, max_zoom, available, known, store, options, pool);
     let rect = |z: u8| domain(bounds, z);
     let band = band_tile_rows(rect(cut.split));
     stream_levels(
@@ -642,7 +643,7 @@ pub(super) fn build_recorded_blocks(
     cut: Cut,
     max_zoom: u8,
     blocks: &[TileRect],
-    out_dir: &Path,
+    store: &dyn TileStore,
     options: &TerrainOptions,
     pool: &rayon::ThreadPool,
     known: &Entries,
@@ -653,12 +654,12 @@ pub(super) fn build_recorded_blocks(
     let key = options_key(options);
     for (k, &block) in blocks.iter().enumerate() {
         let (built, values) = build_block(
-            source, bounds, cut, max_zoom, block, None, out_dir, options, pool, known,
+            source, bounds, cut, max_zoom, block, None, store, options, pool, known,
         )?;
         let id = [tile_column(cut.split, block.x0), block.y0];
         let name = block_name(cut.split, id);
         if let Some(values) = &values {
-            put(out_dir, &format!("{name}.samples"), &gzip_samples(values))?;
+            store.put_file(&format!("{name}.samples"), &gzip_samples(values))?;
         }
         let record = BlockRecord {
             options: key.clone(),
@@ -667,7 +668,7 @@ pub(super) fn build_recorded_blocks(
             tiles: built.entries.clone(),
             samples: values.is_some(),
         };
-        put_record(out_dir, &format!("{name}.json"), &record)?;
+        put_record(store, &format!("{name}.json"), &record)?;
         if let Some(values) = values {
             samples.tiles.insert((id[0], id[1]), values);
         }
@@ -693,7 +694,7 @@ pub(super) fn finish_pyramid(
     bounds: &GeoBounds,
     cut: Cut,
     max_zoom: u8,
-    out_dir: &Path,
+    store: &dyn TileStore,
     options: &TerrainOptions,
     pool: &rayon::ThreadPool,
     known: &Entries,
@@ -704,18 +705,18 @@ pub(super) fn finish_pyramid(
     written.available.resize(levels, Default::default());
     let available = written.available.clone();
     let mut top = build_top(
-        samples, bounds, cut, max_zoom, available, out_dir, options, pool, known,
+        samples, bounds, cut, max_zoom, available, store, options, pool, known,
     )?;
     let before = written.entries.len();
     written.absorb(std::mem::take(&mut top));
-    write_flat_roots(&mut written, max_zoom, out_dir, options, pool, known)?;
+    write_flat_roots(&mut written, max_zoom, store, options, pool, known)?;
     let reports = level_reports(&written, options, max_zoom);
     let finest = reports.last().expect("min_zoom <= max_zoom");
     if finest.tiles == finest.flat_tiles {
         return Err(TerrainError::NoTerrain { level: max_zoom });
     }
     put_record(
-        out_dir,
+        store,
         &top_name(),
         &TopRecord {
             options: options_key(options),
@@ -727,56 +728,37 @@ pub(super) fn finish_pyramid(
         written.entries.iter().map(|e| (e.z, e.x, e.y)).collect();
     for entry in known.values() {
         if entry.written && !now.contains(&(entry.z, entry.x, entry.y)) {
-            let path = out_dir
-                .join(entry.z.to_string())
-                .join(entry.x.to_string())
-                .join(format!("{}.terrain", entry.y));
-            let _ = std::fs::remove_file(path);
+            store.delete_tile(entry.z, entry.x, entry.y)?;
         }
     }
     for level in reports.iter().rev() {
         progress(Progress::Level(level));
     }
     let layer = layer_json(name, options, bounds, max_zoom, &written.available);
-    if read_optional(&out_dir.join("layer.json"))?.as_deref() != Some(layer.as_bytes()) {
-        write_atomic(&out_dir.join("layer.json"), layer.as_bytes())?;
+    if store.get_file("layer.json")?.as_deref() != Some(layer.as_bytes()) {
+        store.put_file("layer.json", layer.as_bytes())?;
     }
     Ok((reports, written.kept))
 }
 
-/// Every tile entry recorded under `dir` (blocks and top), by address: what an update
+/// Every tile entry recorded in `store` (blocks and top), by address: what an update
 /// compares against.
-pub(super) fn recorded_entries(dir: &Path) -> TerrainResult<Entries> {
+pub(super) fn recorded_entries(store: &dyn TileStore) -> TerrainResult<Entries> {
     let mut known = Entries::new();
-    let top: Option<TopRecord> = read_record(dir, &top_name())?;
+    let top: Option<TopRecord> = read_record(store, &top_name())?;
     let Some(top) = top else {
         return Err(TerrainError::Options(format!(
             "{}: --update needs a pyramid tinsmith built (with its records in {}/); build \
              it once without --update",
-            dir.display(),
+            store.location(),
             RECORDS_DIR
         )));
     };
-    let blocks_dir = dir.join(RECORDS_DIR).join("blocks");
-    let entries = std::fs::read_dir(&blocks_dir).map_err(|source| TerrainError::Output {
-        path: blocks_dir.clone(),
-        source,
-    })?;
-    for entry in entries {
-        let path = entry
-            .map_err(|source| TerrainError::Output {
-                path: blocks_dir.clone(),
-                source,
-            })?
-            .path();
-        if path.extension().is_none_or(|e| e != "json") {
+    for name in store.list_files(&format!("{RECORDS_DIR}/blocks/"))? {
+        if !name.ends_with(".json") {
             continue;
         }
-        let name = format!(
-            "{RECORDS_DIR}/blocks/{}",
-            path.file_name().expect("a file").to_string_lossy()
-        );
-        let record: BlockRecord = read_record(dir, &name)?.expect("listed just now");
+        let record: BlockRecord = read_record(store, &name)?.expect("listed just now");
         for tile in record.tiles {
             known.insert((tile.z, tile.x, tile.y), tile);
         }
@@ -787,24 +769,20 @@ pub(super) fn recorded_entries(dir: &Path) -> TerrainResult<Entries> {
     Ok(known)
 }
 
-/// Removes the block records under `dir` that are not of `blocks` at `cut` (an update
-/// cut the pyramid elsewhere).
-fn remove_stale_records(dir: &Path, cut: Cut, blocks: &[TileRect]) -> TerrainResult<()> {
+/// Removes the block records in `store` that are not of `blocks` at `cut` (an update cut
+/// the pyramid elsewhere).
+fn remove_stale_records(store: &dyn TileStore, cut: Cut, blocks: &[TileRect]) -> TerrainResult<()> {
     let wanted: std::collections::HashSet<String> = blocks
         .iter()
         .map(|b| block_name(cut.split, [tile_column(cut.split, b.x0), b.y0]))
         .collect();
-    let blocks_dir = dir.join(RECORDS_DIR).join("blocks");
-    let Ok(entries) = std::fs::read_dir(&blocks_dir) else {
-        return Ok(());
-    };
-    for entry in entries.flatten() {
-        let path = entry.path();
-        let Some(stem) = path.file_stem().map(|s| s.to_string_lossy().into_owned()) else {
-            continue;
-        };
-        if !wanted.contains(&format!("{RECORDS_DIR}/blocks/{stem}")) {
-            let _ = std::fs::remove_file(&path);
+    for name in store.list_files(&format!("{RECORDS_DIR}/blocks/"))? {
+        let stem = name
+            .strip_suffix(".json")
+            .or_else(|| name.strip_suffix(".samples"))
+            .unwrap_or(&name);
+        if !wanted.contains(stem) {
+            store.delete_file(&name)?;
         }
     }
     Ok(())
@@ -840,15 +818,6 @@ fn stage_pyramid(out_dir: &Path) -> TerrainResult<StagedDir> {
             path: out_dir.to_path_buf(),
             source: std::io::Error::other(other),
         },
-    })
-}
-
-/// Writes `bytes` to `path` (in the staging directory) through a temporary file renamed
-/// over it.
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> TerrainResult<()> {
-    tinsmith_output::write_bytes_atomically(path, bytes).map_err(|source| TerrainError::Output {
-        path: path.to_path_buf(),
-        source,
     })
 }
 
@@ -962,6 +931,7 @@ mod tests {
         let mut outputs = Vec::new();
         for (split, band_rows) in [(8, 1), (8, 100), (10, 1), (12, 100), (11, 3)] {
             let dir = tempfile::tempdir().unwrap();
+            let store = DirectoryStore::open(dir.path()).unwrap();
             let cut = Cut { anchor: 12, split };
             let pool = worker_pool(&bounds, 12, 2).unwrap();
             let known = Entries::new();
@@ -975,7 +945,7 @@ mod tests {
                     12,
                     block,
                     Some(band_rows),
-                    dir.path(),
+                    &store,
                     &options,
                     &pool,
                     &known,
@@ -995,7 +965,7 @@ mod tests {
                 &bounds,
                 cut,
                 12,
-                dir.path(),
+                &store,
                 &options,
                 &pool,
                 &known,

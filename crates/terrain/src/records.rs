@@ -13,15 +13,14 @@
 
 use std::collections::HashMap;
 use std::io::{Read, Write};
-use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use crate::plan::{Plan, Shard};
-use crate::pyramid::write_atomic;
 use crate::tms::TILE_CELLS;
 use crate::{LevelReport, TerrainError, TerrainOptions, TerrainResult};
+use tinsmith_store::TileStore;
 
 /// Where the records live, relative to the pyramid.
 pub(super) const RECORDS_DIR: &str = "tinsmith";
@@ -124,55 +123,32 @@ pub(super) fn top_name() -> String {
     format!("{RECORDS_DIR}/top.json")
 }
 
-/// The bytes of `path`, or `None` when there is no such file.
-pub(super) fn read_optional(path: &Path) -> TerrainResult<Option<Vec<u8>>> {
-    match std::fs::read(path) {
-        Ok(bytes) => Ok(Some(bytes)),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(source) => Err(TerrainError::Output {
-            path: path.to_path_buf(),
-            source,
-        }),
-    }
-}
-
-/// A JSON record at `dest/name`, or `None` when there is none.
+/// A JSON record `name` in `store`, or `None` when there is none.
 pub(super) fn read_record<T: serde::de::DeserializeOwned>(
-    dest: &Path,
+    store: &dyn TileStore,
     name: &str,
 ) -> TerrainResult<Option<T>> {
-    let path = dest.join(name);
-    let Some(bytes) = read_optional(&path)? else {
+    let Some(bytes) = store.get_file(name)? else {
         return Ok(None);
     };
     serde_json::from_slice(&bytes).map(Some).map_err(|e| {
         TerrainError::Options(format!(
-            "{}: not a record tinsmith wrote ({e}); remove {} to start afresh",
-            path.display(),
-            dest.join(RECORDS_DIR).display()
+            "{}/{name}: not a record tinsmith wrote ({e}); remove {}/{RECORDS_DIR} to start \
+             afresh",
+            store.location(),
+            store.location(),
         ))
     })
 }
 
-/// Writes `bytes` to `dest/name`, making the directories it needs.
-pub(super) fn put(dest: &Path, name: &str, bytes: &[u8]) -> TerrainResult<()> {
-    let path = dest.join(name);
-    if let Some(parent) = path.parent() {
-        std::fs::create_dir_all(parent).map_err(|source| TerrainError::Output {
-            path: parent.to_path_buf(),
-            source,
-        })?;
-    }
-    write_atomic(&path, bytes)
-}
-
-/// Writes a JSON record to `dest/name`.
-pub(super) fn put_record<T: Serialize>(dest: &Path, name: &str, record: &T) -> TerrainResult<()> {
-    put(
-        dest,
-        name,
-        &serde_json::to_vec(record).expect("a record serializes"),
-    )
+/// Writes a JSON record `name` into `store`.
+pub(super) fn put_record<T: Serialize>(
+    store: &dyn TileStore,
+    name: &str,
+    record: &T,
+) -> TerrainResult<()> {
+    let bytes = serde_json::to_vec(record).expect("a record serializes");
+    Ok(store.put_file(name, &bytes)?)
 }
 
 /// A block's samples, gzipped.
@@ -184,18 +160,17 @@ pub(super) fn gzip_samples(values: &[f32]) -> Vec<u8> {
     e.finish().expect("writing to memory")
 }
 
-/// A block's samples from `path`.
-pub(super) fn read_samples(path: &Path) -> TerrainResult<Vec<f32>> {
-    let bytes = read_optional(path)?
-        .ok_or_else(|| TerrainError::Options(format!("{}: missing", path.display())))?;
-    let side = TILE_CELLS as usize + 1;
-    let mut raw = Vec::new();
+/// A block's samples from file `name` of `store`.
+pub(super) fn read_samples(store: &dyn TileStore, name: &str) -> TerrainResult<Vec<f32>> {
     let bad = |reason: String| {
         TerrainError::Options(format!(
-            "{}: not a block's samples ({reason})",
-            path.display()
+            "{}/{name}: not a block's samples ({reason}); re-run the shard that built it",
+            store.location()
         ))
     };
+    let bytes = store.get_file(name)?.ok_or_else(|| bad("missing".into()))?;
+    let side = TILE_CELLS as usize + 1;
+    let mut raw = Vec::new();
     flate2::read::GzDecoder::new(&bytes[..])
         .read_to_end(&mut raw)
         .map_err(|e| bad(e.to_string()))?;

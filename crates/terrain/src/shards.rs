@@ -4,7 +4,9 @@
 //! and writes `layer.json` last, so a pyramid appears only when it is complete. The tiles
 //! are those of a one-process run, byte for byte (see [`crate::build_terrain`]).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
+
+use tinsmith_store::TileStore;
 
 use serde::Serialize;
 
@@ -43,7 +45,12 @@ pub struct ShardReport {
 }
 
 /// The recorded tiles of `block` under `dest`, when recorded with options `key`.
-fn known_tiles(dest: &Path, split: u8, block: [u32; 2], key: &str) -> TerrainResult<Entries> {
+fn known_tiles(
+    dest: &dyn TileStore,
+    split: u8,
+    block: [u32; 2],
+    key: &str,
+) -> TerrainResult<Entries> {
     let name = format!("{}.json", block_name(split, block));
     let record: Option<BlockRecord> = read_record(dest, &name)?;
     Ok(record
@@ -52,8 +59,7 @@ fn known_tiles(dest: &Path, split: u8, block: [u32; 2], key: &str) -> TerrainRes
         .unwrap_or_default())
 }
 
-/// Builds shard `shard` of the pyramid of `input` into the directory `dest` (shared by
-/// every shard; made when missing): the tiles of the shard's blocks, their records, then
+/// Builds shard `shard` of the pyramid of `input` into `dest` (shared by every shard): the tiles of the shard's blocks, their records, then
 /// the shard's record. Tiles an earlier run recorded with the same fingerprint (an
 /// interrupted run of this shard, or a run over an input since changed elsewhere) are kept
 /// as they are. `progress` hears of each block.
@@ -62,7 +68,7 @@ fn known_tiles(dest: &Path, split: u8, block: [u32; 2], key: &str) -> TerrainRes
 /// As [`crate::build_terrain`].
 pub fn build_shard(
     input: &Path,
-    dest: &Path,
+    dest: &dyn TileStore,
     options: &TerrainOptions,
     shard: Shard,
     progress: &mut dyn FnMut(Progress<'_>),
@@ -72,12 +78,6 @@ pub fn build_shard(
         own_level,
         max_zoom,
     } = prepare(input, options)?;
-    if dest.exists() && !dest.is_dir() {
-        return Err(TerrainError::Options(format!(
-            "output {}: is not a directory",
-            dest.display()
-        )));
-    }
     let plan = Plan::new(
         input,
         &bounds,
@@ -122,7 +122,7 @@ pub fn build_shard(
             .collect(),
     };
     let json = serde_json::to_vec_pretty(&record).expect("a record serializes");
-    crate::records::put(dest, &shard_name(shard), &json)?;
+    dest.put_file(&shard_name(shard), &json)?;
     let levels = crate::pyramid::level_reports(&written, options, max_zoom);
     Ok(ShardReport {
         shard,
@@ -135,42 +135,23 @@ pub fn build_shard(
     })
 }
 
-/// The shard records in `dest`, by file, in shard order.
-fn shard_records(dest: &Path) -> TerrainResult<Vec<(PathBuf, ShardRecord)>> {
-    let dir = dest.join(RECORDS_DIR).join("shards");
-    let none = || {
-        TerrainError::Options(format!(
-            "{}: no shard records ({RECORDS_DIR}/shards/I-of-N.json); run `tinsmith tiles \
-             INPUT -o {} --shard I/N` for every I first",
-            dest.display(),
-            dest.display()
-        ))
-    };
-    let entries = match std::fs::read_dir(&dir) {
-        Ok(entries) => entries,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(none()),
-        Err(source) => return Err(TerrainError::Output { path: dir, source }),
-    };
+/// The shard records in `dest`, by name, in shard order.
+fn shard_records(dest: &dyn TileStore) -> TerrainResult<Vec<(String, ShardRecord)>> {
     let mut out = Vec::new();
-    for entry in entries {
-        let path = entry
-            .map_err(|source| TerrainError::Output {
-                path: dir.clone(),
-                source,
-            })?
-            .path();
-        let Some(file) = path.file_name().map(|n| n.to_string_lossy().into_owned()) else {
-            continue;
-        };
-        if !(file.contains("-of-") && file.ends_with(".json")) {
+    for name in dest.list_files(&format!("{RECORDS_DIR}/shards/"))? {
+        if !(name.contains("-of-") && name.ends_with(".json")) {
             continue;
         }
-        let name = format!("{RECORDS_DIR}/shards/{file}");
         let record: ShardRecord = read_record(dest, &name)?.expect("listed just now");
-        out.push((path, record));
+        out.push((name, record));
     }
     if out.is_empty() {
-        return Err(none());
+        return Err(TerrainError::Options(format!(
+            "{}: no shard records ({RECORDS_DIR}/shards/I-of-N.json); run `tinsmith tiles \
+             INPUT -o {} --shard I/N` for every I first",
+            dest.location(),
+            dest.location()
+        )));
     }
     out.sort_by_key(|(_, r)| r.shard.index);
     Ok(out)
@@ -181,7 +162,7 @@ fn shard_records(dest: &Path) -> TerrainResult<Vec<(PathBuf, ShardRecord)>> {
 /// `layer.json` last. Refuses, naming them, shards of different plans, missing shards, or
 /// block records that do not match; then no `layer.json` is written.
 pub fn merge_shards(
-    dest: &Path,
+    dest: &dyn TileStore,
     threads: usize,
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> TerrainResult<TerrainReport> {
@@ -190,10 +171,11 @@ pub fn merge_shards(
     for (path, record) in &records {
         if record.plan_id != first.plan_id || record.plan_id != record.plan.id() {
             return Err(TerrainError::Options(format!(
-                "{} and {} belong to different plans (input {} vs {}, {} vs {} shards, or \
-                 other options): keep the shards of one run only",
-                first_path.display(),
-                path.display(),
+                "{} and {} in {} belong to different plans (input {} vs {}, {} vs {} shards, \
+                 or other options): keep the shards of one run only",
+                first_path,
+                path,
+                dest.location(),
                 first.plan.input,
                 record.plan.input,
                 first.plan.shards,
@@ -212,7 +194,7 @@ pub fn merge_shards(
     if !missing.is_empty() {
         return Err(TerrainError::Options(format!(
             "{}: shard{} {} of the plan missing (no {}); no layer.json written",
-            dest.display(),
+            dest.location(),
             if missing.len() > 1 { "s" } else { "" },
             missing
                 .iter()
@@ -240,8 +222,9 @@ pub fn merge_shards(
             .collect();
         if record.blocks != expected {
             return Err(TerrainError::Options(format!(
-                "{}: its blocks are not those its plan gives shard {}",
-                path.display(),
+                "{}/{}: its blocks are not those its plan gives shard {}",
+                dest.location(),
+                path,
                 record.shard
             )));
         }
@@ -252,7 +235,7 @@ pub fn merge_shards(
                 return Err(TerrainError::Options(format!(
                     "{}: block record {name}.json is missing or of other options; re-run \
                      shard {}",
-                    dest.display(),
+                    dest.location(),
                     record.shard
                 )));
             };
@@ -271,7 +254,7 @@ pub fn merge_shards(
             }
             written.absorb(one);
             if done.samples {
-                let values = read_samples(&dest.join(format!("{name}.samples")))?;
+                let values = read_samples(dest, &format!("{name}.samples"))?;
                 samples.tiles.insert((block[0], block[1]), values);
             }
         }

@@ -38,6 +38,18 @@ pub(super) fn build_tile(
     let (i0, j0) = raster.tile_origin(x, y);
     let values = raster.tile_values(x, y);
     let scale = slack_scale(values.iter().copied());
+    let largest = values
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    if largest >= f64::from(f32::MAX) / 2.0 {
+        return Err(TerrainError::HeightsBeyondF32 {
+            z,
+            x: column,
+            y,
+            max_abs: largest,
+        });
+    }
     let grid = Grid::new(TILE_CELLS + 1, TILE_CELLS + 1, values).expect("a 218 x 218 grid");
     if grid.valid_cell_count() == 0 {
         return Ok(None);

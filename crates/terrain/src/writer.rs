@@ -3,11 +3,11 @@
 
 use std::collections::BTreeSet;
 use std::ops::{Range, RangeInclusive};
-use std::path::Path;
 use std::time::Instant;
 
 use rayon::prelude::*;
 use sha2::Digest;
+use tinsmith_store::{TileEncoding, TileStore};
 
 use crate::budget::LevelBudget;
 use crate::layer::{metadata_json, Available};
@@ -92,8 +92,8 @@ impl Written {
     }
 }
 
-/// The sink: builds the tiles of `scope` from each level's rows, writes them under
-/// `out_dir`, and, for a block, keeps the block tile's samples (what the levels above are
+/// The sink: builds the tiles of `scope` from each level's rows, stores them in
+/// `store`, and, for a block, keeps the block tile's samples (what the levels above are
 /// filtered from).
 pub(super) struct TileWriter<'a> {
     scope: Scope,
@@ -101,7 +101,7 @@ pub(super) struct TileWriter<'a> {
     key: String,
     /// Tiles a previous run recorded, by address.
     known: &'a Entries,
-    out_dir: &'a Path,
+    store: &'a dyn TileStore,
     options: &'a TerrainOptions,
     pool: &'a rayon::ThreadPool,
     budgets: Vec<LevelBudget>,
@@ -118,7 +118,7 @@ impl<'a> TileWriter<'a> {
         max_zoom: u8,
         available: Available,
         known: &'a Entries,
-        out_dir: &'a Path,
+        store: &'a dyn TileStore,
         options: &'a TerrainOptions,
         pool: &'a rayon::ThreadPool,
     ) -> Self {
@@ -129,7 +129,7 @@ impl<'a> TileWriter<'a> {
             scope,
             key: options_key(options),
             known,
-            out_dir,
+            store,
             options,
             pool,
             budgets: (0..=max_zoom)
@@ -232,34 +232,26 @@ impl<'a> TileWriter<'a> {
 
     /// Removes tile `z/x/y` (no longer any data there).
     fn remove(&self, z: u8, x: u32, y: u32) -> TerrainResult<()> {
-        let path = self
-            .out_dir
-            .join(z.to_string())
-            .join(x.to_string())
-            .join(format!("{y}.terrain"));
-        match std::fs::remove_file(&path) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                Err(TerrainError::Output { path, source: e })
-            }
-            _ => Ok(()),
-        }
+        Ok(self.store.delete_tile(z, x, y)?)
     }
 
-    /// Writes a tile of level `z` under the output directory.
+    /// Stores a tile of level `z`.
     fn write(&mut self, z: u8, tile: &TileOut) -> TerrainResult<()> {
-        let dir = self.out_dir.join(z.to_string()).join(tile.x.to_string());
         if tinsmith_output::interrupted() {
-            // The staging directory is being removed: add nothing to it.
+            // The run is being torn down: add nothing.
             return Err(TerrainError::Output {
-                path: dir,
+                path: self.store.location().into(),
                 source: std::io::Error::from(std::io::ErrorKind::Interrupted),
             });
         }
-        std::fs::create_dir_all(&dir).map_err(|source| TerrainError::Output {
-            path: dir.clone(),
-            source,
-        })?;
-        crate::pyramid::write_atomic(&dir.join(format!("{}.terrain", tile.y)), &tile.bytes)
+        let encoding = if self.options.gzip {
+            TileEncoding::Gzip
+        } else {
+            TileEncoding::Identity
+        };
+        Ok(self
+            .store
+            .put_tile(z, tile.x, tile.y, &tile.bytes, encoding)?)
     }
 }
 

@@ -7,7 +7,9 @@ DEMO_DEM := data/becmodel_dem_bc_albers_50m.tif
 DEMO_ERROR := 5
 VENV := .venv
 TOOLS := .tools
-PY_ORACLES := trimesh==4.12.2 numpy==2.2.6
+# moto's standalone S3 server and boto3 (tests/object_storage.rs): a local S3 to write
+# to and read from, and an independent client to check what was stored.
+PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
 .PHONY: deps gdal oracles demo test bench-results bench-contour bench-compare bench-tiles
@@ -27,17 +29,26 @@ gdal:
 	@command -v cargo >/dev/null || { echo "Rust is missing: install it from https://rustup.rs"; exit 1; }
 
 ## The independent readers the format tests check our files with (tests/formats.rs):
-## trimesh in .venv (PyPI) and the Khronos glTF validator in .tools (npm). Idempotent.
-oracles: $(VENV)/.ok $(TOOLS)/node_modules/gltf-validator/package.json qm-oracles
+## trimesh, moto and boto3 in .venv (PyPI) and the Khronos glTF validator in .tools (npm).
+## Idempotent.
+oracles: py-oracles $(TOOLS)/node_modules/gltf-validator/package.json qm-oracles
 
-$(VENV)/.ok:
-	@# Debian's python3 needs python3-venv (ensurepip) to create a venv.
-	python3 -m venv $(VENV) 2>/dev/null || { rm -rf $(VENV); \
-	  $(SUDO) apt-get update -qq && \
-	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends python3-venv && \
-	  python3 -m venv $(VENV); }
-	$(VENV)/bin/pip install --quiet --disable-pip-version-check $(PY_ORACLES)
-	@touch $@
+## .venv/.ok records the PY_ORACLES installed: a venv made for another list is brought up
+## to this one. Debian's python3 needs python3-venv (ensurepip) to create a venv.
+.PHONY: py-oracles
+py-oracles:
+	@if [ "$$(cat $(VENV)/.ok 2>/dev/null)" != "$(PY_ORACLES)" ]; then \
+	  if [ ! -x $(VENV)/bin/pip ]; then \
+	    echo "creating $(VENV)"; \
+	    python3 -m venv $(VENV) 2>/dev/null || { rm -rf $(VENV); \
+	      $(SUDO) apt-get update -qq && \
+	      DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends python3-venv && \
+	      python3 -m venv $(VENV); } || exit 1; \
+	  fi; \
+	  echo "installing $(PY_ORACLES) into $(VENV)"; \
+	  $(VENV)/bin/pip install --quiet --disable-pip-version-check $(PY_ORACLES) && \
+	  echo "$(PY_ORACLES)" > $(VENV)/.ok; \
+	fi
 
 $(TOOLS)/node_modules/gltf-validator/package.json:
 	@command -v npm >/dev/null || { \

@@ -9,6 +9,7 @@ mod contour;
 mod foreign;
 mod formats;
 mod mesh_and_verify;
+mod object_storage;
 mod serve;
 mod shards;
 mod tiled_mesh;

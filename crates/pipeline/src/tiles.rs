@@ -4,11 +4,11 @@
 use std::path::Path;
 
 use tinsmith_terrain::{
-    build_shard, build_terrain, merge_shards, LevelReport, Progress, Shard, ShardReport,
-    TerrainOptions, TerrainReport,
+    build_shard, build_terrain, build_terrain_in, merge_shards, LevelReport, Progress, Shard,
+    ShardReport, TerrainOptions, TerrainReport,
 };
 
-use tinsmith_store::{DirectoryStore, TileStore};
+use tinsmith_store::{is_object_url, BucketStore, DirectoryStore, TileStore};
 
 use crate::output_paths::NamingFile;
 use crate::{Feedback, Result};
@@ -31,8 +31,16 @@ pub fn tiles(
     let reserved = report
         .map(crate::output_paths::ReservedReport::reserve)
         .transpose()?;
-    let built =
-        build_terrain(input, output, options, &mut |p| show(feedback, p)).naming_file(input)?;
+    let mut progress = |p: Progress<'_>| show(feedback, p);
+    let built = match output.to_str().filter(|o| is_object_url(o)) {
+        Some(url) => {
+            let store = BucketStore::open(url)?;
+            store.probe()?;
+            build_terrain_in(input, &store, options, &mut progress)
+        }
+        None => build_terrain(input, output, options, &mut progress),
+    }
+    .naming_file(input)?;
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&built)?)?;
     }
@@ -154,7 +162,15 @@ pub fn merge_tiles(
     Ok(built)
 }
 
-/// The store a pyramid built in shards goes to: the directory `output` (made when missing).
+/// The store a pyramid built in shards goes to: an object store for an `s3://` URL
+/// (checked reachable before any work), else the directory `output` (made when missing).
 fn pyramid_store(output: &Path) -> Result<Box<dyn TileStore>> {
-    Ok(Box::new(DirectoryStore::open(output)?))
+    match output.to_str().filter(|o| is_object_url(o)) {
+        Some(url) => {
+            let store = BucketStore::open(url)?;
+            store.probe()?;
+            Ok(Box::new(store))
+        }
+        None => Ok(Box::new(DirectoryStore::open(output)?)),
+    }
 }

@@ -12,9 +12,11 @@
 
 mod directory;
 mod error;
+mod object;
 
 pub use directory::DirectoryStore;
 pub use error::{StoreError, StoreResult};
+pub use object::{is_object_url, BucketStore};
 
 /// How a tile's bytes are encoded, so a store can label them for HTTP clients.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -25,7 +25,8 @@ pub use error::{TerrainError, TerrainResult};
 pub use layer::METADATA_AVAILABILITY;
 pub use plan::Shard;
 pub use pyramid::{
-    build_terrain, streaming_bytes, LevelReport, Progress, TerrainOptions, TerrainReport, MAX_LEVEL,
+    build_terrain, build_terrain_in, streaming_bytes, LevelReport, Progress, TerrainOptions,
+    TerrainReport, MAX_LEVEL,
 };
 pub use quantized_mesh::{
     geodetic_to_ecef, gzip, oct_encode, surface_normal, EncodeError, GeoRectangle,

@@ -239,11 +239,7 @@ pub fn build_terrain(
     options: &TerrainOptions,
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> TerrainResult<TerrainReport> {
-    let Prepared {
-        bounds,
-        own_level,
-        max_zoom,
-    } = prepare(input, options)?;
+    let prepared = prepare(input, options)?;
     // All or nothing: the pyramid is built in a temporary directory beside `out_dir` and
     // renamed into place at the end; a failure (or nothing to write) leaves no trace. An
     // update works in place, tile by tile.
@@ -258,6 +254,57 @@ pub fn build_terrain(
     } else {
         Entries::new()
     };
+    let report = build_into(input, prepared, &store, &known, options, progress)?;
+    if let Some(staging) = staging {
+        staging.commit().map_err(|source| TerrainError::Output {
+            path: out_dir.to_path_buf(),
+            source,
+        })?;
+    }
+    Ok(report)
+}
+
+/// Builds the pyramid of `input` into `store` (an object store, a container) directly:
+/// tiles and their records first, `layer.json` last, so that the pyramid appears only when
+/// it is complete. Tiles the store's records already hold with the same fingerprint (a
+/// run interrupted, or an input changed elsewhere) are kept as they are, and tiles that no
+/// longer have data are removed; so a re-run after a failure completes the pyramid, and
+/// `update` is implied.
+///
+/// # Guarantees
+/// As [`build_terrain`], except all-or-nothing: a failed run leaves the tiles it wrote
+/// (and any `layer.json` of an earlier complete run, untouched until the end).
+pub fn build_terrain_in(
+    input: &Path,
+    store: &dyn TileStore,
+    options: &TerrainOptions,
+    progress: &mut dyn FnMut(Progress<'_>),
+) -> TerrainResult<TerrainReport> {
+    let prepared = prepare(input, options)?;
+    let known = if store.get_file(&top_name())?.is_some() {
+        recorded_entries(store)?
+    } else {
+        Entries::new()
+    };
+    build_into(input, prepared, store, &known, options, progress)
+}
+
+/// The pyramid of `input` into `store`, keeping the tiles `known` with the same
+/// fingerprint, removing those that no longer have data and the records of blocks no
+/// longer in the run.
+fn build_into(
+    input: &Path,
+    prepared: Prepared,
+    store: &dyn TileStore,
+    known: &Entries,
+    options: &TerrainOptions,
+    progress: &mut dyn FnMut(Progress<'_>),
+) -> TerrainResult<TerrainReport> {
+    let Prepared {
+        bounds,
+        own_level,
+        max_zoom,
+    } = prepared;
     let source = Warp {
         path: input,
         band: options.band,
@@ -272,10 +319,10 @@ pub fn build_terrain(
         cut,
         max_zoom,
         &all,
-        &store,
+        store,
         options,
         &pool,
-        &known,
+        known,
         &mut |done| progress(Progress::Block { done, total }),
     )?;
     let (levels, tiles_kept) = finish_pyramid(
@@ -285,24 +332,18 @@ pub fn build_terrain(
         &bounds,
         cut,
         max_zoom,
-        &store,
+        store,
         options,
         &pool,
-        &known,
+        known,
         progress,
     )
     .map_err(|e| match e {
         TerrainError::NoTerrain { level } => no_terrain(input, options, level),
         other => other,
     })?;
-    if options.update {
-        remove_stale_records(&store, cut, &all)?;
-    }
-    if let Some(staging) = staging {
-        staging.commit().map_err(|source| TerrainError::Output {
-            path: out_dir.to_path_buf(),
-            source,
-        })?;
+    if !known.is_empty() {
+        remove_stale_records(store, cut, &all)?;
     }
     Ok(TerrainReport {
         bounds: bounds_array(&bounds),

@@ -1,5 +1,7 @@
 //! A real client: CesiumJS in headless Chromium loads a pyramid from `tinsmith serve`
-//! (`CesiumTerrainProvider.fromUrl`, `sampleTerrainMostDetailed`). A missing CesiumJS or
+//! (`CesiumTerrainProvider.fromUrl`, `sampleTerrainMostDetailed`), from the directory
+//! `tinsmith tiles` wrote and from the same pyramid in an MBTiles file (served by a second
+//! server, so the page loads it across origins, through CORS). A missing CesiumJS or
 //! Chromium install, or a Chromium that cannot start, fails. `#[ignore]`d so that `cargo
 //! test` passes with only GDAL installed; `make test` runs it (`--include-ignored`).
 
@@ -9,7 +11,7 @@ use std::process::Command;
 use serde_json::Value;
 
 use crate::tiles::gdal_samples;
-use crate::util::{fixture, serve, stderr, Dir};
+use crate::util::{fixture, pack_mbtiles, serve, stderr, Dir};
 
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
@@ -62,32 +64,45 @@ fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
     assert!(points.len() >= 3, "too few sample points with data");
     let points_file = dir.write("points.json", &serde_json::to_string(&points).unwrap());
 
-    let (_server, base) = serve(&dir, &["site"]);
-
-    let out = Command::new("node")
-        .arg(repo.join("tests/oracle/cesium_sample.cjs"))
-        .arg(format!("{base}index.html"))
-        .arg(format!("{base}terrain/"))
-        .arg(&points_file)
-        .output()
-        .expect("node runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let tiles = pack_mbtiles(
+        &dir.path("site/terrain"),
+        &dir.path("terrain.mbtiles"),
+        tinsmith_store::TileEncoding::Gzip,
     );
-    let result: Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
-    assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
+    assert!(tiles > 0);
+
+    let (_server, base) = serve(&dir, &["site"]);
+    let (_mbtiles_server, mbtiles_base) = serve(&dir, &["terrain.mbtiles"]);
     let bound = 77_067.34 / (1u64 << z) as f64;
-    for (k, want) in expected.iter().enumerate() {
-        assert_eq!(result["levels"][k].as_u64(), Some(z as u64), "{result}");
-        let got = result["heights"][k]
-            .as_f64()
-            .unwrap_or_else(|| panic!("point {k} has no height: {result}"));
+    let mut heights = Vec::new();
+    for terrain in [format!("{base}terrain/"), mbtiles_base] {
+        let out = Command::new("node")
+            .arg(repo.join("tests/oracle/cesium_sample.cjs"))
+            .arg(format!("{base}index.html"))
+            .arg(&terrain)
+            .arg(&points_file)
+            .output()
+            .expect("node runs");
         assert!(
-            (got - want).abs() <= bound + 1e-3,
-            "point {k}: CesiumJS {got}, DEM {want}, bound {bound}"
+            out.status.success(),
+            "{terrain}: {}",
+            String::from_utf8_lossy(&out.stderr)
         );
+        let result: Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
+        assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
+        for (k, want) in expected.iter().enumerate() {
+            assert_eq!(result["levels"][k].as_u64(), Some(z as u64), "{result}");
+            let got = result["heights"][k]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{terrain}: point {k} has no height: {result}"));
+            assert!(
+                (got - want).abs() <= bound + 1e-3,
+                "{terrain}: point {k}: CesiumJS {got}, DEM {want}, bound {bound}"
+            );
+        }
+        heights.push(result["heights"].clone());
     }
+    // The same tiles, so the same heights, to the bit.
+    assert_eq!(heights[0], heights[1]);
 }

@@ -4,7 +4,11 @@ use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::time::{Duration, Instant};
 
-use crate::util::{fixture, port_of, serve, stderr, Dir};
+use tinsmith_store::TileEncoding;
+
+use crate::util::{
+    assert_fails_naming, fixture, pack_mbtiles, port_of, pyramid_tiles, serve, stderr, Dir,
+};
 
 /// Sends one request and returns (status line, lower-cased headers, body).
 fn get(port: u16, method: &str, target: &str) -> (String, Vec<(String, String)>, Vec<u8>) {
@@ -164,4 +168,95 @@ fn only_real_gzip_is_sent_as_gzip_and_odd_requests_get_answers() {
     assert!(status.contains("204"), "{status}");
     assert_eq!(header(&headers, "content-length"), None);
     assert!(child.0.wait().unwrap().success());
+}
+
+#[test]
+fn an_mbtiles_file_is_served_as_its_directory_is() {
+    let dir = Dir::new();
+    let input = fixture("tintn_valid_raster_3857.tif");
+    for (name, encoding) in [("gz", TileEncoding::Gzip), ("raw", TileEncoding::Identity)] {
+        let mut args = vec!["tiles", &input, "-o", name, "--max-zoom", "12"];
+        if encoding == TileEncoding::Identity {
+            args.push("--no-gzip");
+        }
+        let o = dir.run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let tiles = pyramid_tiles(&dir.path(name));
+        assert!(tiles.len() > 10, "{} tiles", tiles.len());
+        if encoding == TileEncoding::Identity {
+            // A plain tile that begins with gzip's magic bytes (see above) stays plain.
+            let mut bytes = std::fs::read(&tiles[0].3).unwrap();
+            bytes[..4].copy_from_slice(&[0x1f, 0x8b, 0x08, 0x00]);
+            std::fs::write(&tiles[0].3, &bytes).unwrap();
+        }
+        let file = format!("{name}.mbtiles");
+        assert_eq!(
+            pack_mbtiles(&dir.path(name), &dir.path(&file), encoding),
+            tiles.len()
+        );
+
+        let (_dir_server, dir_base) = serve(&dir, &[name]);
+        let (_file_server, file_base) = serve(&dir, &[&file]);
+        let (dir_port, file_port) = (port_of(&dir_base), port_of(&file_base));
+        let mut requests: Vec<(&str, String)> = Vec::new();
+        for (z, x, y, _) in &tiles {
+            requests.push(("GET", format!("/{z}/{x}/{y}.terrain?v=1.0.0")));
+        }
+        let (z, x, y, _) = &tiles[tiles.len() / 2];
+        for target in [
+            "/layer.json",
+            "/./layer.json?v=2",
+            "/",
+            "/9/0/0.terrain",
+            "/12/01308/2906.terrain",
+            "/nope.json",
+            "/../Cargo.toml",
+        ] {
+            requests.push(("GET", target.to_string()));
+        }
+        for method in ["HEAD", "OPTIONS", "POST"] {
+            requests.push((method, format!("/{z}/{x}/{y}.terrain")));
+        }
+        for (method, target) in &requests {
+            let from_dir = get(dir_port, method, target);
+            let from_file = get(file_port, method, target);
+            assert_eq!(from_dir, from_file, "{method} {target} ({name})");
+        }
+        // What both sent is what the directory holds, labelled as it is encoded.
+        for (z, x, y, path) in &tiles {
+            let (status, headers, body) = get(file_port, "GET", &format!("/{z}/{x}/{y}.terrain"));
+            assert_eq!(status, "HTTP/1.1 200 OK");
+            assert_eq!(body, std::fs::read(path).unwrap());
+            let gzip = (encoding == TileEncoding::Gzip).then_some("gzip");
+            assert_eq!(header(&headers, "content-encoding"), gzip, "{path:?}");
+            assert_eq!(
+                header(&headers, "content-type"),
+                Some("application/vnd.quantized-mesh")
+            );
+            assert_eq!(header(&headers, "access-control-allow-origin"), Some("*"));
+        }
+        let (status, headers, body) = get(file_port, "GET", "/layer.json");
+        assert_eq!(status, "HTTP/1.1 200 OK");
+        assert_eq!(header(&headers, "content-type"), Some("application/json"));
+        assert_eq!(
+            body,
+            std::fs::read(dir.path(name).join("layer.json")).unwrap()
+        );
+    }
+}
+
+#[test]
+fn a_file_that_is_not_mbtiles_is_refused_by_name() {
+    let dir = Dir::new();
+    dir.write(
+        "notes.mbtiles",
+        "some text that is not an SQLite database at all\n",
+    );
+    let o = dir.run(&["serve", "notes.mbtiles", "--port", "0"]);
+    assert_fails_naming(&o, &["notes.mbtiles", "not an SQLite database"]);
+    let o = dir.run(&["serve", "missing.mbtiles", "--port", "0"]);
+    assert_fails_naming(
+        &o,
+        &["missing.mbtiles", "no such directory or MBTiles file"],
+    );
 }

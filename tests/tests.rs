@@ -8,6 +8,7 @@ mod cli_reference;
 mod contour;
 mod foreign;
 mod formats;
+mod mbtiles;
 mod mesh_and_verify;
 mod object_storage;
 mod serve;

@@ -195,3 +195,53 @@ pub fn port_of(base: &str) -> u16 {
         .and_then(|p| p.parse().ok())
         .unwrap_or_else(|| panic!("no port in {base:?}"))
 }
+
+/// Copies the directory pyramid at `dir` (`{z}/{x}/{y}.terrain`, `layer.json`) into a new
+/// MBTiles file at `out` through `tinsmith_store::MbtilesStore`, each tile labelled with
+/// `encoding` (as `tinsmith tiles` made them: gzipped unless `--no-gzip`). Returns the
+/// number of tiles copied.
+pub fn pack_mbtiles(dir: &Path, out: &Path, encoding: tinsmith_store::TileEncoding) -> usize {
+    use tinsmith_store::TileStore;
+    let store = tinsmith_store::MbtilesStore::create(out).expect("create the MBTiles file");
+    let mut count = 0;
+    for (z, x, y, path) in pyramid_tiles(dir) {
+        let bytes = std::fs::read(path).expect("read a tile");
+        store
+            .put_tile(z, x, y, &bytes, encoding)
+            .expect("put a tile");
+        count += 1;
+    }
+    let layer = std::fs::read(dir.join("layer.json")).expect("layer.json");
+    store
+        .put_file("layer.json", &layer)
+        .expect("put layer.json");
+    store.commit().expect("commit the MBTiles file");
+    count
+}
+
+/// The tiles of the directory pyramid at `dir`: (z, x, y, path), sorted.
+pub fn pyramid_tiles(dir: &Path) -> Vec<(u8, u32, u32, PathBuf)> {
+    let number = |p: &Path| -> Option<u32> { p.file_stem()?.to_str()?.parse().ok() };
+    let entries = |d: &Path| -> Vec<PathBuf> {
+        let mut v: Vec<PathBuf> = std::fs::read_dir(d)
+            .expect("read a pyramid directory")
+            .map(|e| e.expect("entry").path())
+            .collect();
+        v.sort();
+        v
+    };
+    let mut tiles = Vec::new();
+    for zd in entries(dir).into_iter().filter(|p| p.is_dir()) {
+        let Some(z) = number(&zd) else { continue };
+        for xd in entries(&zd).into_iter().filter(|p| p.is_dir()) {
+            let x = number(&xd).expect("a column directory");
+            for tile in entries(&xd) {
+                assert_eq!(tile.extension().and_then(|e| e.to_str()), Some("terrain"));
+                let y = number(&tile).expect("a tile file");
+                tiles.push((z as u8, x, y, tile));
+            }
+        }
+    }
+    tiles.sort();
+    tiles
+}

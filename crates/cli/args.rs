@@ -41,7 +41,7 @@ pub enum Command {
     /// Build a Cesium quantized-mesh terrain pyramid (EPSG:4326 TMS) with layer.json.
     #[command(allow_negative_numbers = true)]
     Tiles(TilesArgs),
-    /// Serve a directory (a terrain pyramid) over HTTP on 127.0.0.1, for CesiumJS.
+    /// Serve a terrain pyramid (directory or MBTiles) over HTTP on 127.0.0.1, for CesiumJS.
     #[command(allow_negative_numbers = true)]
     Serve(ServeArgs),
 }
@@ -126,8 +126,8 @@ pub struct MergeArgs {
 
 #[derive(Debug, Args)]
 pub struct ServeArgs {
-    /// The directory to serve (made by `tinsmith tiles`).
-    pub dir: PathBuf,
+    /// The pyramid to serve: its directory, or an MBTiles file holding it.
+    pub path: PathBuf,
     /// Port on 127.0.0.1 (0 picks a free one; the address is printed).
     #[arg(long, default_value_t = 8000)]
     pub port: u16,
@@ -210,7 +210,7 @@ impl ServeArgs {
     /// What these flags ask to serve.
     pub fn options(&self) -> ServeOptions {
         ServeOptions {
-            dir: self.dir.clone(),
+            path: self.path.clone(),
             port: self.port,
             max_requests: self.max_requests,
         }

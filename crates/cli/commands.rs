@@ -52,7 +52,7 @@ pub fn serve(args: &ServeArgs) -> Result<bool> {
     let _ = writeln!(
         stdout,
         "serving {} at http://{}/",
-        args.dir.display(),
+        args.path.display(),
         server.addr()?
     );
     let _ = stdout.flush();

@@ -5,8 +5,9 @@
 //! # Guarantees
 //! - **Complete outputs or the old ones.** An output is written to a temporary
 //!   (`.tinsmith-*.tmp`, a file or a directory) next to its target and renamed into place
-//!   only when complete ([`write_atomically`], [`write_bytes_atomically`], [`StagedDir`]); a sidecar
-//!   (a mesh's `.prj`) is staged with its file and renamed just before it
+//!   only when complete ([`write_atomically`], [`write_bytes_atomically`], [`StagedDir`],
+//!   and [`StagedFile`] for a file another library writes, such as an SQLite database);
+//!   a sidecar (a mesh's `.prj`) is staged with its file and renamed just before it
 //!   ([`write_atomically_with_sidecar`]). A run that fails leaves the previous output at
 //!   the target untouched (or none); a file it replaces keeps its permissions; a symbolic
 //!   link at the target stays a link to the new content; a device or pipe is written in
@@ -30,8 +31,8 @@ mod pending;
 
 pub use error::{Error, RenameError, Result};
 pub use local::atomic::{
-    is_special_file, unnamed_temp_file, write_atomically, write_atomically_with_sidecar,
-    write_bytes_atomically,
+    is_special_file, resolve_output, unnamed_temp_file, write_atomically,
+    write_atomically_with_sidecar, write_bytes_atomically, StagedFile,
 };
 pub use local::check::{check_distinct, check_not_inside, check_writable_target};
 pub use local::report::{ReservedReport, REPORT_RESERVE_BYTES};

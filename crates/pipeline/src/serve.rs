@@ -1,22 +1,26 @@
 //! `tinsmith serve`: a small static file server on 127.0.0.1 for trying a terrain pyramid
 //! in CesiumJS: quantized-mesh and JSON content types, `Content-Encoding: gzip` for
-//! gzipped tiles, CORS for pages on other origins.
+//! gzipped tiles, CORS for pages on other origins. The pyramid is a directory or an
+//! MBTiles file (see the `source` module), served alike.
 //!
 //! std::net, one thread per connection, `Connection: close`: enough for a local viewer,
 //! no dependency to keep up to date. Not meant to face a network (see docs/serving.md for
 //! nginx and Apache).
 
+mod source;
+
 use std::fs::File;
-use std::io::{BufReader, ErrorKind, Read, Seek, Write};
+use std::io::{BufReader, ErrorKind, Read, Write};
 use std::net::{Ipv4Addr, SocketAddr, TcpListener, TcpStream};
 use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::error::{bail, Context};
+use crate::error::Context;
 use crate::Feedback;
 use crate::Result;
+use source::Source;
 
 /// The longest request head read.
 const MAX_HEAD: usize = 16 * 1024;
@@ -26,57 +30,44 @@ const HEAD_DEADLINE: Duration = Duration::from_secs(10);
 const WRITE_TIMEOUT: Duration = Duration::from_secs(30);
 /// Connections served at once; more are closed at once (a local viewer opens a few).
 const MAX_CONNECTIONS: usize = 256;
-/// Gzip files up to this size are checked whole before being sent as gzip (tiles are a
-/// few kB); larger ones by their header.
-const GZIP_CHECK_BYTES: u64 = 16 << 20;
 
-/// A local HTTP server for a directory (a terrain pyramid), bound to 127.0.0.1 and not
-/// yet serving: [`Server::addr`] says where, [`Server::run`] serves.
+/// A local HTTP server for a terrain pyramid (a directory or an MBTiles file), bound to
+/// 127.0.0.1 and not yet serving: [`Server::addr`] says where, [`Server::run`] serves.
 #[derive(Debug)]
 pub struct Server {
-    dir: PathBuf,
+    source: Arc<Source>,
     listener: TcpListener,
 }
 
 /// What [`serve`] serves and where.
 #[derive(Debug, Clone)]
 pub struct ServeOptions {
-    /// The directory served (made by `tinsmith tiles`).
-    pub dir: PathBuf,
+    /// The directory or MBTiles file served (made by `tinsmith tiles`).
+    pub path: PathBuf,
     /// Port on 127.0.0.1; 0 picks a free one.
     pub port: u16,
     /// Stop after this many requests (for tests); `None` serves until killed.
     pub max_requests: Option<u64>,
 }
 
-/// Binds a server for `options.dir` on 127.0.0.1; fails, naming it, when the directory is
-/// missing or the port taken. Notes when the directory holds no `layer.json` (CesiumJS
-/// would not load it as terrain).
+/// Binds a server for `options.path` (a directory, or an MBTiles file of quantized-mesh
+/// tiles) on 127.0.0.1; fails, naming it, when it is missing, a file that is not such an
+/// MBTiles file, or the port is taken. Notes when there is no `layer.json` (CesiumJS would
+/// not load it as terrain).
 pub fn serve(options: &ServeOptions, feedback: &dyn Feedback) -> Result<Server> {
-    let dir = &options.dir;
-    if !dir.exists() {
-        bail!("{}: no such directory", dir.display());
-    }
-    if !dir.is_dir() {
-        bail!("{}: not a directory", dir.display());
-    }
-    let has_layer = |dir: &Path| dir.join("layer.json").is_file();
-    let pyramid_below = std::fs::read_dir(dir).is_ok_and(|entries| {
-        entries
-            .flatten()
-            .any(|e| e.path().is_dir() && has_layer(&e.path()))
-    });
-    if !has_layer(dir) && !pyramid_below {
+    let path = &options.path;
+    let source = Source::open(path)?;
+    if !source.has_layer() {
         feedback.note(&format!(
             "{}: note: no layer.json here, so CesiumJS will not load it as a terrain \
-             pyramid (serve the directory `tinsmith tiles -o` made)",
-            dir.display()
+             pyramid (serve the directory or MBTiles file `tinsmith tiles -o` made)",
+            path.display()
         ));
     }
     let listener = TcpListener::bind((Ipv4Addr::LOCALHOST, options.port))
         .with_context(|| format!("cannot listen on 127.0.0.1:{}", options.port))?;
     Ok(Server {
-        dir: dir.clone(),
+        source: Arc::new(source),
         listener,
     })
 }
@@ -99,10 +90,10 @@ impl Server {
             // unanswered: it only concerns its client.
             if open.load(Ordering::Acquire) < MAX_CONNECTIONS {
                 open.fetch_add(1, Ordering::AcqRel);
-                let root = self.dir.clone();
+                let source = Arc::clone(&self.source);
                 let count = Arc::clone(&open);
                 let spawned = std::thread::Builder::new().spawn(move || {
-                    let _ = handle(stream, &root);
+                    let _ = handle(stream, &source);
                     count.fetch_sub(1, Ordering::AcqRel);
                 });
                 match spawned {
@@ -137,16 +128,18 @@ enum Body {
     Text(&'static str),
     /// A file, streamed, of this length.
     File(File, u64),
+    /// Bytes read already (a tile or file of an MBTiles file).
+    Bytes(Vec<u8>),
 }
 
-fn handle(stream: TcpStream, root: &Path) -> std::io::Result<()> {
+fn handle(stream: TcpStream, source: &Source) -> std::io::Result<()> {
     let Some(request_line) = read_head(&stream)? else {
         return Ok(());
     };
     let request_line = String::from_utf8_lossy(&request_line);
     let mut parts = request_line.split_whitespace();
     let (method, target) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
-    let (head, body) = respond(method, target, root);
+    let (head, body) = respond(method, target, source);
     stream.set_write_timeout(Some(WRITE_TIMEOUT))?;
     let mut out = std::io::BufWriter::new(&stream);
     write!(out, "HTTP/1.1 {}\r\n", head.status)?;
@@ -157,6 +150,7 @@ fn handle(stream: TcpStream, root: &Path) -> std::io::Result<()> {
         Body::Nothing => {}
         Body::Text(text) => write!(out, "Content-Length: {}\r\n", text.len())?,
         Body::File(_, length) => write!(out, "Content-Length: {length}\r\n")?,
+        Body::Bytes(bytes) => write!(out, "Content-Length: {}\r\n", bytes.len())?,
     }
     write!(
         out,
@@ -172,6 +166,7 @@ fn handle(stream: TcpStream, root: &Path) -> std::io::Result<()> {
             Body::File(file, _) => {
                 std::io::copy(&mut BufReader::new(file), &mut out)?;
             }
+            Body::Bytes(bytes) => out.write_all(&bytes)?,
         }
     }
     out.flush()
@@ -209,7 +204,7 @@ fn read_head(mut stream: &TcpStream) -> std::io::Result<Option<Vec<u8>>> {
     Ok((!first.is_empty()).then(|| first.to_vec()))
 }
 
-fn respond(method: &str, target: &str, root: &Path) -> (Head, Body) {
+fn respond(method: &str, target: &str, source: &Source) -> (Head, Body) {
     let plain = |status, text: &'static str| {
         (
             Head {
@@ -237,28 +232,14 @@ fn respond(method: &str, target: &str, root: &Path) -> (Head, Body) {
             return (head, body);
         }
     }
-    let Some(path) = file_path(root, target) else {
+    let Some(relative) = request_path(target) else {
         return plain("400 Bad Request", "bad path\n");
     };
-    let path = if path.is_dir() {
-        path.join("index.html")
-    } else {
-        path
-    };
-    // Regular files only (following links): a FIFO would block the thread for good.
-    let file = match std::fs::metadata(&path) {
-        Ok(m) if m.is_file() => File::open(&path).ok().map(|f| (f, m.len())),
-        _ => None,
-    };
-    let Some((mut file, length)) = file else {
+    let Some(found) = source.find(&relative) else {
         return plain("404 Not Found", "not found\n");
     };
-    let mut headers = vec![("Content-Type", content_type(&path).to_string())];
-    let gzip = !has_extension(&path, "gz") && is_gzip(&mut file, length);
-    if file.rewind().is_err() {
-        return plain("404 Not Found", "not found\n");
-    }
-    if gzip {
+    let mut headers = vec![("Content-Type", found.content_type.to_string())];
+    if found.gzip {
         headers.push(("Content-Encoding", "gzip".into()));
     }
     (
@@ -266,36 +247,14 @@ fn respond(method: &str, target: &str, root: &Path) -> (Head, Body) {
             status: "200 OK",
             headers,
         },
-        Body::File(file, length),
+        found.body,
     )
 }
 
-/// Whether `file` (read from its start; the caller rewinds it after) is gzip: its header
-/// names deflate with no reserved flags, and (up to [`GZIP_CHECK_BYTES`]) the whole
-/// member decompresses with a matching checksum. An uncompressed tile (`tiles --no-gzip`)
-/// begins with an `f64` whose low bytes are arbitrary and can match gzip's two magic
-/// bytes; it must not be sent as gzip.
-fn is_gzip(file: &mut File, length: u64) -> bool {
-    let mut header = [0u8; 4];
-    if file.read_exact(&mut header).is_err()
-        || header[..3] != [0x1f, 0x8b, 0x08]
-        || header[3] & 0xe0 != 0
-    {
-        return false;
-    }
-    if length > GZIP_CHECK_BYTES {
-        return true;
-    }
-    if file.rewind().is_err() {
-        return false;
-    }
-    let mut decoder = flate2::read::GzDecoder::new(file);
-    std::io::copy(&mut decoder, &mut std::io::sink()).is_ok()
-}
-
-/// The file a request target names under `root`: query dropped, `%XX` decoded, and
-/// refused when it would leave `root` (`..`, absolute parts).
-fn file_path(root: &Path, target: &str) -> Option<PathBuf> {
+/// The path a request target names, relative to what is served: query dropped, `%XX`
+/// decoded, `.` parts dropped, and refused when it would leave the top (`..`, absolute
+/// parts).
+fn request_path(target: &str) -> Option<PathBuf> {
     let path = target.split(['?', '#']).next()?;
     // The absolute form (`http://host:port/path`), which servers must accept.
     let path = match path.split_once("://") {
@@ -304,14 +263,15 @@ fn file_path(root: &Path, target: &str) -> Option<PathBuf> {
     };
     let path = path.strip_prefix('/')?;
     let decoded = percent_decode(path)?;
-    let relative = Path::new(&decoded);
-    if !relative
-        .components()
-        .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
-    {
-        return None;
+    let mut relative = PathBuf::new();
+    for component in Path::new(&decoded).components() {
+        match component {
+            Component::Normal(part) => relative.push(part),
+            Component::CurDir => {}
+            _ => return None,
+        }
     }
-    Some(root.join(relative))
+    Some(relative)
 }
 
 fn percent_decode(s: &str) -> Option<String> {
@@ -331,55 +291,31 @@ fn percent_decode(s: &str) -> Option<String> {
     String::from_utf8(out).ok()
 }
 
-fn has_extension(path: &Path, ext: &str) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
-}
-
-fn content_type(path: &Path) -> &'static str {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    match ext.as_str() {
-        "terrain" => "application/vnd.quantized-mesh",
-        "json" => "application/json",
-        "html" | "htm" => "text/html; charset=utf-8",
-        "js" | "mjs" => "text/javascript",
-        "css" => "text/css",
-        "png" => "image/png",
-        "jpg" | "jpeg" => "image/jpeg",
-        "svg" => "image/svg+xml",
-        "wasm" => "application/wasm",
-        "xml" => "application/xml",
-        "glb" => "model/gltf-binary",
-        _ => "application/octet-stream",
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn paths_stay_under_the_root() {
-        let root = Path::new("/srv/t");
+    fn paths_stay_under_the_top() {
         assert_eq!(
-            file_path(root, "/0/1/0.terrain?v=1.0.0"),
-            Some(PathBuf::from("/srv/t/0/1/0.terrain"))
+            request_path("/0/1/0.terrain?v=1.0.0"),
+            Some(PathBuf::from("0/1/0.terrain"))
         );
         assert_eq!(
-            file_path(root, "/a%20b.json"),
-            Some(PathBuf::from("/srv/t/a b.json"))
+            request_path("/./0/./1/0.terrain"),
+            Some(PathBuf::from("0/1/0.terrain"))
         );
-        assert_eq!(file_path(root, "/../etc/passwd"), None);
-        assert_eq!(file_path(root, "/%2e%2e/etc/passwd"), None);
-        assert_eq!(file_path(root, "relative"), None);
+        assert_eq!(request_path("/a%20b.json"), Some(PathBuf::from("a b.json")));
+        assert_eq!(request_path("/"), Some(PathBuf::new()));
+        assert_eq!(request_path("/../etc/passwd"), None);
+        assert_eq!(request_path("/%2e%2e/etc/passwd"), None);
+        assert_eq!(request_path("/a/../../etc/passwd"), None);
+        assert_eq!(request_path("//etc/passwd"), None);
+        assert_eq!(request_path("relative"), None);
         assert_eq!(
-            file_path(root, "http://127.0.0.1:8000/layer.json"),
-            Some(PathBuf::from("/srv/t/layer.json"))
+            request_path("http://127.0.0.1:8000/layer.json"),
+            Some(PathBuf::from("layer.json"))
         );
-        assert_eq!(file_path(root, "http://127.0.0.1:8000"), None);
+        assert_eq!(request_path("http://127.0.0.1:8000"), None);
     }
 }

@@ -1,7 +1,7 @@
 //! Where a terrain pyramid goes: tiles addressed by `z/x/y` and a few small named files
 //! (`layer.json`, shard records) beside them, behind one trait ([`TileStore`]) so that the
 //! pyramid builder does not know whether it writes a local directory, a single-file
-//! container or an object store.
+//! container ([`MbtilesStore`]) or an object store.
 //!
 //! # Guarantees every store keeps
 //! - A `put` either stores the whole value under its key or leaves the previous value (or
@@ -11,12 +11,16 @@
 //!   `/`-separated names without `..`.
 
 mod directory;
+mod encoding;
 mod error;
 mod object;
+mod mbtiles;
 
 pub use directory::DirectoryStore;
+pub use encoding::detect_encoding;
 pub use error::{StoreError, StoreResult};
 pub use object::{is_object_url, BucketStore};
+pub use mbtiles::{MbtilesStore, ACCEPTED_FORMATS, MBTILES_FORMAT};
 
 /// How a tile's bytes are encoded, so a store can label them for HTTP clients.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -47,6 +51,22 @@ pub trait TileStore: Send + Sync {
 
     /// The bytes stored as tile `z/x/y`, or `None` when there is none.
     fn get_tile(&self, z: u8, x: u32, y: u32) -> StoreResult<Option<Vec<u8>>>;
+
+    /// The bytes stored as tile `z/x/y` and how they are encoded (for a server's
+    /// `Content-Encoding`), or `None` when there is none. The encoding is the one the
+    /// store recorded when it keeps a record, else [`detect_encoding`]'s reading of the
+    /// bytes.
+    fn get_tile_encoded(
+        &self,
+        z: u8,
+        x: u32,
+        y: u32,
+    ) -> StoreResult<Option<(Vec<u8>, TileEncoding)>> {
+        Ok(self.get_tile(z, x, y)?.map(|bytes| {
+            let encoding = detect_encoding(&bytes);
+            (bytes, encoding)
+        }))
+    }
 
     /// Removes tile `z/x/y`; no error when there is none.
     fn delete_tile(&self, z: u8, x: u32, y: u32) -> StoreResult<()>;

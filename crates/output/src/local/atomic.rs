@@ -121,6 +121,12 @@ impl StagedFile {
         })
     }
 
+    /// The temporary file's path (`.tinsmith-*.tmp` beside the target), for a library that
+    /// opens the file itself.
+    pub fn path(&self) -> &Path {
+        self.temp.path()
+    }
+
     /// The temporary file.
     pub fn file(&self) -> &File {
         self.temp.as_file()

@@ -11,7 +11,7 @@ use std::process::Command;
 use serde_json::Value;
 
 use crate::tiles::gdal_samples;
-use crate::util::{fixture, pack_mbtiles, serve, stderr, Dir};
+use crate::util::{fixture, serve, stderr, Dir};
 
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
@@ -64,12 +64,9 @@ fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
     assert!(points.len() >= 3, "too few sample points with data");
     let points_file = dir.write("points.json", &serde_json::to_string(&points).unwrap());
 
-    let tiles = pack_mbtiles(
-        &dir.path("site/terrain"),
-        &dir.path("terrain.mbtiles"),
-        tinsmith_store::TileEncoding::Gzip,
-    );
-    assert!(tiles > 0);
+    // The same pyramid written as one MBTiles file by `tiles -o`.
+    let o = dir.run(&["tiles", &input, "-o", "terrain.mbtiles", "--normals", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
 
     let (_server, base) = serve(&dir, &["site"]);
     let (_mbtiles_server, mbtiles_base) = serve(&dir, &["terrain.mbtiles"]);

@@ -116,6 +116,40 @@ fn python_sqlite3_reads_the_directory_pyramid_back() {
 }
 
 #[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn tiles_writes_an_mbtiles_file_holding_the_directory_pyramid() {
+    let dir = Dir::new();
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    for out in ["pyramid", "terrain.mbtiles"] {
+        let o = dir.run(&["tiles", &input, "-o", out, "--normals", "-q"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let out = Command::new(python())
+        .arg(repo().join("tests/oracles/mbtiles_read.py"))
+        .arg(dir.path("terrain.mbtiles"))
+        .output()
+        .expect("python runs");
+    assert!(out.status.success(), "{}", stderr(&out));
+    let read: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(read["integrity"], "ok");
+    let layer_text = std::fs::read_to_string(dir.path("pyramid/layer.json")).unwrap();
+    // The layer is named after the input, whatever the output.
+    assert_eq!(read["metadata"]["json"], layer_text.as_str());
+    let tiles = pyramid_tiles(&dir.path("pyramid"));
+    let want: Vec<Value> = tiles
+        .iter()
+        .map(|(z, x, y, path)| serde_json::json!([z, x, y, hex(&std::fs::read(path).unwrap())]))
+        .collect();
+    assert!(want.len() > 20);
+    assert_eq!(read["tiles"], Value::Array(want));
+    // Written whole: no temporary left beside it, and shards refuse one file.
+    assert_eq!(dir.files().iter().filter(|f| f.contains(".tmp")).count(), 0);
+    let o = dir.run(&["tiles", &input, "-o", "s.mbtiles", "--shard", "0/2"]);
+    assert!(!o.status.success() && stderr(&o).contains("directory or a bucket"));
+    assert!(!dir.path("s.mbtiles").exists());
+}
+
+#[test]
 fn the_binary_exports_no_sqlite_function() {
     // GDAL, PROJ and SpatiaLite call the system's libsqlite3; had the binary exported the
     // bundled copy's functions, some of their calls would bind to it (see

@@ -8,8 +8,9 @@ use tinsmith_terrain::{
     ShardReport, TerrainOptions, TerrainReport,
 };
 
-use tinsmith_store::{is_object_url, BucketStore, DirectoryStore, TileStore};
+use tinsmith_store::{is_object_url, BucketStore, DirectoryStore, MbtilesStore, TileStore};
 
+use crate::error::bail;
 use crate::output_paths::NamingFile;
 use crate::{Feedback, Result};
 
@@ -32,15 +33,31 @@ pub fn tiles(
         .map(crate::output_paths::ReservedReport::reserve)
         .transpose()?;
     let mut progress = |p: Progress<'_>| show(feedback, p);
-    let built = match output.to_str().filter(|o| is_object_url(o)) {
-        Some(url) => {
+    let built = match destination(output) {
+        Destination::Bucket(url) => {
             let store = BucketStore::open(url)?;
             store.probe()?;
-            build_terrain_in(input, &store, options, &mut progress)
+            build_terrain_in(input, &store, options, &mut progress).naming_file(input)?
         }
-        None => build_terrain(input, output, options, &mut progress),
-    }
-    .naming_file(input)?;
+        Destination::Mbtiles => {
+            if options.update {
+                bail!(
+                    "{}: --update works on a directory or a bucket; build the MBTiles file \
+                     again (it is written whole)",
+                    output.display()
+                );
+            }
+            crate::output_paths::check_writable_target(output, input)?;
+            let store = MbtilesStore::create(output)?;
+            let built =
+                build_terrain_in(input, &store, options, &mut progress).naming_file(input)?;
+            store.commit()?;
+            built
+        }
+        Destination::Directory => {
+            build_terrain(input, output, options, &mut progress).naming_file(input)?
+        }
+    };
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&built)?)?;
     }
@@ -162,15 +179,44 @@ pub fn merge_tiles(
     Ok(built)
 }
 
+/// Where `-o` puts a pyramid.
+enum Destination<'a> {
+    /// An object store (`s3://bucket/prefix`).
+    Bucket(&'a str),
+    /// One MBTiles file (`.mbtiles`).
+    Mbtiles,
+    /// A local directory.
+    Directory,
+}
+
+fn destination(output: &Path) -> Destination<'_> {
+    match output.to_str() {
+        Some(url) if is_object_url(url) => Destination::Bucket(url),
+        _ if output
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("mbtiles")) =>
+        {
+            Destination::Mbtiles
+        }
+        _ => Destination::Directory,
+    }
+}
+
 /// The store a pyramid built in shards goes to: an object store for an `s3://` URL
 /// (checked reachable before any work), else the directory `output` (made when missing).
+/// Shards cannot share one MBTiles file.
 fn pyramid_store(output: &Path) -> Result<Box<dyn TileStore>> {
-    match output.to_str().filter(|o| is_object_url(o)) {
-        Some(url) => {
+    match destination(output) {
+        Destination::Bucket(url) => {
             let store = BucketStore::open(url)?;
             store.probe()?;
             Ok(Box::new(store))
         }
-        None => Ok(Box::new(DirectoryStore::open(output)?)),
+        Destination::Mbtiles => bail!(
+            "{}: shards write into a directory or a bucket that they share, not one MBTiles \
+             file; give a directory",
+            output.display()
+        ),
+        Destination::Directory => Ok(Box::new(DirectoryStore::open(output)?)),
     }
 }

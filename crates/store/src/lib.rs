@@ -13,14 +13,14 @@
 mod directory;
 mod encoding;
 mod error;
-mod object;
 mod mbtiles;
+mod object;
 
 pub use directory::DirectoryStore;
 pub use encoding::detect_encoding;
 pub use error::{StoreError, StoreResult};
-pub use object::{is_object_url, BucketStore};
 pub use mbtiles::{MbtilesStore, ACCEPTED_FORMATS, MBTILES_FORMAT};
+pub use object::{is_object_url, BucketStore};
 
 /// How a tile's bytes are encoded, so a store can label them for HTTP clients.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -9,6 +9,9 @@
 //! too large for one grid, [`WindowReader`] (or [`read_window`]) reads a rectangle at a
 //! time, decoded exactly as [`read_samples`] decodes the whole band, and
 //! [`RasterInfo::max_abs_value`] of [`open_info`] gives the raster-wide largest |height|.
+//! For terrain tiles, [`geographic_bounds`] places a raster in EPSG:4326 and
+//! [`sample_geographic`] samples it on a longitude/latitude lattice, each sample a function
+//! of the raster and its position alone.
 //!
 //! # What callers can rely on
 //! - **Nodata.** A sample is nodata exactly when it is NaN or infinite, is zero in the
@@ -51,6 +54,7 @@
 //! # }
 //! ```
 
+mod bilinear;
 mod cache;
 mod coverage;
 mod decode;
@@ -61,17 +65,17 @@ mod info;
 mod quiet;
 mod read;
 mod reproject;
+mod sample;
 mod window;
 
 pub use cache::limit_block_cache;
 pub use coverage::{coverage, Coverage};
 pub use error::{Error, Result};
 pub use files::input_files;
-pub use geographic::{
-    geographic_bounds, heights_may_exceed_f32, warp_to_geographic, GeoBounds, GeoLattice,
-};
+pub use geographic::{geographic_bounds, heights_may_exceed_f32, GeoBounds, GeoLattice};
 pub use info::{Raster, RasterInfo};
 pub use quiet::silence_gdal_errors;
 pub use read::{open_info, open_info_with_progress, read_samples};
 pub use reproject::{from_wgs84, is_geographic, is_wgs84_lon_lat, same_crs, to_wgs84};
+pub use sample::sample_geographic;
 pub use window::{read_window, WindowReader};

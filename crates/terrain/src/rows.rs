@@ -95,16 +95,17 @@ impl LevelRows {
         self.end() == self.height
     }
 
-    /// The positions of lattice rows `rows`, columns `columns`, for the warp: computed
-    /// from global lattice indices, so a block's positions do not depend on its origin
-    /// beyond the float rounding of one multiplication.
+    /// Lattice rows `rows`, columns `columns` (level-wide), as a window of the global
+    /// lattice of the level (column 0 at -180°, row 0 at -90°): each point's position
+    /// depends on its global indices only, whatever the window.
     pub(super) fn lattice(&self, rows: Range<usize>, columns: Range<usize>) -> GeoLattice {
-        let d = step(self.level);
-        let cells = f64::from(TILE_CELLS);
+        let cells = u64::from(TILE_CELLS);
         GeoLattice {
-            west: -180.0 + (f64::from(self.tx0) * cells + columns.start as f64) * d,
-            south: -90.0 + (f64::from(self.ty0) * cells + rows.start as f64) * d,
-            step: d,
+            west: -180.0,
+            south: -90.0,
+            step: step(self.level),
+            first_column: u64::from(self.tx0) * cells + columns.start as u64,
+            first_row: u64::from(self.ty0) * cells + rows.start as u64,
             width: columns.len() as u32,
             height: rows.len() as u32,
         }

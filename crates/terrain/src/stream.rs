@@ -8,7 +8,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use tinsmith_raster::warp_to_geographic;
+use tinsmith_raster::sample_geographic;
 
 use crate::rows::LevelRows;
 use crate::tms::{TileRect, TILE_CELLS};
@@ -21,18 +21,9 @@ pub(super) trait RowSource: Sync {
     fn rows(&self, level: &LevelRows, rows: Range<usize>) -> TerrainResult<Vec<f32>>;
 }
 
-/// A band of the input, reprojected by GDAL ([`warp_to_geographic`]): a level that fits in
-/// one band in one piece, any other band in square blocks.
-///
-/// GDAL chooses its bilinear kernel per warp from the ratio of the output's size to the
-/// bounding box of the input window it reads: when the box looks larger than the output,
-/// as it does for a long thin strip of lon/lat rows tilted against a projected grid, it
-/// widens the kernel as if downsampling, and smooths. Blocks as wide as they are tall keep
-/// the whole warp's four-sample kernel on the test rasters
-/// (`crates/raster/tests/geographic.rs`); GDAL's heuristic still varies on large or
-/// 0..360 inputs, as it did between the chunks of a large whole warp (docs/results.md).
-/// The samples only have to be the same in both passes, which they are: the bands and
-/// blocks are fixed by the level alone.
+/// A band of the input, sampled at the level's lattice points ([`sample_geographic`]):
+/// each sample depends only on the input and its position, so a row gets the same
+/// samples in any band, and a band is sampled in one call.
 pub(super) struct Warp<'a> {
     pub(super) path: &'a Path,
     pub(super) band: usize,
@@ -40,25 +31,8 @@ pub(super) struct Warp<'a> {
 
 impl RowSource for Warp<'_> {
     fn rows(&self, level: &LevelRows, rows: Range<usize>) -> TerrainResult<Vec<f32>> {
-        let (width, height) = (level.width, rows.len());
-        if height == level.height {
-            return Ok(warp_to_geographic(
-                self.path,
-                self.band,
-                &level.lattice(rows, 0..width),
-            )?);
-        }
-        let mut out = vec![f32::NAN; width * height];
-        let block = height.max(1);
-        for c0 in (0..width).step_by(block) {
-            let w = block.min(width - c0);
-            let lattice = level.lattice(rows.clone(), c0..c0 + w);
-            let values = warp_to_geographic(self.path, self.band, &lattice)?;
-            for (r, row) in values.chunks_exact(w).enumerate() {
-                out[r * width + c0..][..w].copy_from_slice(row);
-            }
-        }
-        Ok(out)
+        let lattice = level.lattice(rows, 0..level.width);
+        Ok(sample_geographic(self.path, self.band, &lattice)?)
     }
 }
 
@@ -248,14 +222,11 @@ pub(super) struct Hills {
 impl RowSource for Hills {
     fn rows(&self, level: &LevelRows, rows: Range<usize>) -> TerrainResult<Vec<f32>> {
         let lattice = level.lattice(rows, 0..level.width);
-        let d = lattice.step;
-        let i0 = ((lattice.west + 180.0) / d).round();
-        let j0 = ((lattice.south + 90.0) / d).round();
         let mut out = Vec::with_capacity(lattice.width as usize * lattice.height as usize);
         for j in 0..lattice.height {
-            let lat = -90.0 + (j0 + f64::from(j)) * d;
+            let lat = lattice.lat(j);
             for i in 0..lattice.width {
-                let lon = -180.0 + (i0 + f64::from(i)) * d;
+                let lon = lattice.lon(i);
                 let [cx, cy, r] = self.hole;
                 let v = if (lon - cx).hypot(lat - cy) < r {
                     f32::NAN

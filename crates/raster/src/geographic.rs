@@ -228,6 +228,27 @@ pub(crate) fn corner_box(gt: &[f64; 6], info: &RasterInfo) -> [f64; 4] {
     [min(xs), min(ys), max(xs), max(ys)]
 }
 
+/// The raster's extent in EPSG:4326 as PROJ's area of interest wants it (west and east in
+/// -180..180, west > east across the antimeridian), as GDAL's warper sets it so that PROJ
+/// picks one transformation for the whole raster; `None` when PROJ cannot give the extent.
+pub(crate) fn area_of_interest(path: &Path, opened: &OpenBand) -> Option<[f64; 4]> {
+    let [west, south, east, north] = raw_bounds(path, opened).ok()?;
+    // Into -180..180, the east edge at 180 (not -180) unless the west one is there too.
+    let lon = |v: f64| v - 360.0 * ((v + 180.0) / 360.0).floor();
+    let (west, east) = if west <= east && east - west >= 360.0 {
+        (-180.0, 180.0)
+    } else {
+        (lon(west), lon(east))
+    };
+    let east = if east == -180.0 && west > -180.0 {
+        180.0
+    } else {
+        east
+    };
+    let aoi = [west, south.max(-90.0), east, north.min(90.0)];
+    aoi.iter().all(|v| v.is_finite()).then_some(aoi)
+}
+
 /// The raster's extent in EPSG:4326 as PROJ gives it, longitudes not wrapped.
 fn raw_bounds(path: &Path, opened: &OpenBand) -> Result<[f64; 4]> {
     let gt = geo_transform(path, &opened.info)?;

@@ -6,11 +6,13 @@
 use std::path::Path;
 
 use gdal::raster::RasterBand;
-use gdal::spatial_ref::CoordTransform;
+use gdal::spatial_ref::{CoordTransform, CoordTransformOptions};
 
 use crate::bilinear::{Footprint, PixelGrid, Window};
 use crate::error::Result;
-use crate::geographic::{corner_box, geo_transform, source_crs, warp_error, wgs84, GeoLattice};
+use crate::geographic::{
+    area_of_interest, corner_box, geo_transform, source_crs, warp_error, wgs84, GeoLattice,
+};
 use crate::read::OpenBand;
 
 /// Lattice points a side of the blocks the lattice is sampled in: the points of one block
@@ -30,13 +32,14 @@ const PIXELS_PER_POINT: usize = 16;
 ///
 /// Each sample is the bilinear interpolation of the band between the centres of the four
 /// pixels around the point's position in the raster: longitude and latitude transformed
-/// exactly to the raster's CRS by PROJ (not at all when the raster is in WGS84 longitude,
-/// latitude), then to pixel coordinates by the inverse geotransform (rotated or sheared
-/// ones too). The pixels are decoded as [`crate::read_samples`] decodes them (nodata
-/// value, mask or alpha band, NaN and infinities are nodata; scale and offset applied).
-/// Pixels that are nodata or outside the raster get no weight and the others' weights are
-/// renormalised; the sample is NaN when no pixel of nonzero weight is valid, and when the
-/// position is outside the raster's pixel edges (or PROJ cannot transform it).
+/// exactly to the raster's CRS by PROJ (one transformation over the raster's area, as
+/// GDAL's warper picks it; none when the raster is in WGS84 longitude, latitude), then to
+/// pixel coordinates by the inverse geotransform (rotated or sheared ones too). The pixels
+/// are decoded as [`crate::read_samples`] decodes them (nodata value, mask or alpha band,
+/// NaN and infinities are nodata; scale and offset applied). Pixels that are nodata or
+/// outside the raster get no weight and the others' weights are renormalised; the sample
+/// is NaN when no pixel of nonzero weight is valid, and when the position is outside the
+/// raster's pixel edges (or PROJ cannot transform it).
 ///
 /// A raster in a geographic CRS is sampled at its longitude moved by whole turns into its
 /// own range (a raster in 0..360° or east of 180° is sampled at -170° too); one whose first
@@ -199,7 +202,18 @@ impl Locator {
         let transform = if wgs84_lon_lat {
             None
         } else {
-            Some(CoordTransform::new(&wgs84()?, &source).map_err(|e| warp_error(path, e))?)
+            // As GDAL's warper does: over the raster's area PROJ picks one transformation
+            // (among several of a datum's, each with its own area of use) for every point.
+            let mut options = CoordTransformOptions::new().map_err(|e| warp_error(path, e))?;
+            if let Some([w, s, e, n]) = area_of_interest(path, opened) {
+                options
+                    .set_area_of_interest(w, s, e, n)
+                    .map_err(|err| warp_error(path, err))?;
+            }
+            Some(
+                CoordTransform::new_with_options(&wgs84()?, &source, &options)
+                    .map_err(|e| warp_error(path, e))?,
+            )
         };
         let turn = if !source.is_geographic() {
             None

@@ -1046,6 +1046,56 @@ mod tests {
     }
 
     #[test]
+    fn sampled_pyramid_bytes_do_not_depend_on_the_band_height() {
+        // The real sampler: a projected raster at its own level, and a global one (whose
+        // columns wrap) at level 2, sampled in bands of one tile row and of a whole level.
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        for (input, max_zoom) in [
+            ("data/becmodel_dem_bc_albers_50m.tif", 11),
+            ("tests/fixtures/etopo5_2deg_i16.tif", 2),
+        ] {
+            let input = root.join(input);
+            let bounds = geographic_bounds(&input, 1).unwrap();
+            let source = Warp {
+                path: &input,
+                band: 1,
+            };
+            let options = TerrainOptions {
+                max_zoom: Some(max_zoom),
+                normals: true,
+                threads: 2,
+                ..TerrainOptions::default()
+            };
+            let mut outputs = Vec::new();
+            for band_rows in [1, 100] {
+                let dir = tempfile::tempdir().unwrap();
+                let (mut levels, available) = build_pyramid(
+                    &source,
+                    &bounds,
+                    max_zoom,
+                    band_rows,
+                    dir.path(),
+                    &options,
+                    &mut |_| {},
+                )
+                .unwrap();
+                for level in &mut levels {
+                    level.seconds = 0.0;
+                }
+                outputs.push((files(dir.path()), levels, available));
+            }
+            let finest = &outputs[0].1[usize::from(max_zoom)];
+            let rows = LevelRows::new(&bounds, max_zoom).tiles_y;
+            assert!(finest.tiles > 0 && rows > 2, "{}", input.display());
+            assert!(
+                outputs[0] == outputs[1],
+                "{}: bands of 1 and 100 tile rows differ",
+                input.display()
+            );
+        }
+    }
+
+    #[test]
     fn metadata_lists_levels_below() {
         let mut available: Available = vec![BTreeSet::new(); 3];
         available[1].insert((0, 0));

@@ -1,9 +1,9 @@
 //! `sample_geographic`: each sample depends only on the raster and the point's position,
 //! so any window of a lattice gets the same bits as the whole lattice (checked on
-//! projected rasters, global rasters in every longitude frame, nodata holes, lattices
-//! coarser than the raster); the frame a global raster is stored in does not matter; and
-//! the samples agree with GDAL's own exact bilinear warp (`gdalwarp -et 0 -r bilinear`)
-//! wherever both have all four pixels.
+//! projected rasters, global rasters in every longitude frame, a raster east of 180°,
+//! nodata holes, lattices coarser than the raster); the frame a raster is stored in does
+//! not matter; and the samples agree with GDAL's own exact bilinear warp (`gdalwarp -et 0
+//! -r bilinear`) wherever both have all four pixels.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -251,6 +251,67 @@ fn a_global_raster_samples_alike_in_0_to_360_minus_360_to_0_and_minus_180_to_180
                 lattice.lon(differ[0] as u32 % width),
                 a[differ[0]],
                 b[differ[0]]
+            );
+        }
+    }
+}
+
+#[test]
+fn a_raster_east_of_180_samples_as_the_same_raster_west_of_it() {
+    // 40 x 20 pixels of 0.25°, stored from 185° east (the far part of a 0..360 grid) and
+    // from -175°: the same place, sampled alike on a lattice in either frame, and the same
+    // in any window.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let values: Vec<f32> = (0..40 * 20)
+        .map(|k| {
+            let (i, j) = ((k % 40) as f32, (k / 40) as f32);
+            if (i - 30.0).abs() < 2.0 && (j - 5.0).abs() < 2.0 {
+                -9999.0
+            } else {
+                50.0 * (i * 0.4).sin() + 3.0 * j * j
+            }
+        })
+        .collect();
+    let write = |name: &str, west: f64| {
+        let path = dir.path().join(name);
+        let driver = DriverManager::get_driver_by_name("GTiff").expect("GTiff");
+        let mut ds = driver
+            .create_with_band_type_with_options::<f32, _>(
+                &path,
+                40,
+                20,
+                1,
+                &RasterCreationOptions::default(),
+            )
+            .expect("create");
+        ds.set_geo_transform(&[west, 0.25, 0.0, -30.0, 0.0, -0.25])
+            .expect("geotransform");
+        ds.set_spatial_ref(&SpatialRef::from_epsg(4326).expect("EPSG:4326"))
+            .expect("CRS");
+        let mut band = ds.rasterband(1).expect("band");
+        band.set_no_data_value(Some(-9999.0)).expect("nodata");
+        let mut buffer = Buffer::new((40, 20), values.clone());
+        band.write((0, 0), (40, 20), &mut buffer).expect("write");
+        path
+    };
+    let (east, west) = (write("east.tif", 185.0), write("west.tif", -175.0));
+    for lon0 in [-176.0, 184.0] {
+        let lattice = GeoLattice {
+            west: lon0,
+            south: -36.0,
+            step: 0.0625,
+            first_column: 0,
+            first_row: 0,
+            width: 193,
+            height: 97,
+        };
+        let a = check_windows(&east, &lattice, 5, &[]);
+        let b = sample_geographic(&west, 1, &lattice).expect("west");
+        assert!(a.iter().filter(|v| v.is_finite()).count() > 10_000);
+        for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+            assert!(
+                same(*x, *y),
+                "from {lon0}: point {k}: {x} east of 180, {y} west"
             );
         }
     }

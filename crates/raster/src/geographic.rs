@@ -53,9 +53,17 @@ pub struct GeoLattice {
 }
 
 impl GeoLattice {
-    /// The longitude of column `i`: `west + (first_column + i) * step`.
+    /// The longitude of column `i`: `west + (first_column + i) * step`, the column counted
+    /// modulo a turn when `step` divides 360 degrees into whole columns. So a point a turn
+    /// east (a window round the globe that runs on past 180°) gets the very position, to
+    /// the bit, of the same point in the first turn.
     pub fn lon(&self, i: u32) -> f64 {
-        self.west + (self.first_column + u64::from(i)) as f64 * self.step
+        let mut column = self.first_column + u64::from(i);
+        let turn = (360.0 / self.step).round();
+        if turn >= 1.0 && (turn * self.step - 360.0).abs() <= 1e-9 {
+            column %= turn as u64;
+        }
+        self.west + column as f64 * self.step
     }
 
     /// The latitude of row `j`: `south + (first_row + j) * step`.

@@ -972,58 +972,9 @@ mod tests {
         let mut outputs = Vec::new();
         for (split, band_rows) in [(8, 1), (8, 100), (10, 1), (12, 100), (11, 3)] {
             let dir = tempfile::tempdir().unwrap();
-            let store = DirectoryStore::open(dir.path()).unwrap();
             let cut = Cut { anchor: 12, split };
-            let pool = worker_pool(&bounds, 12, 2).unwrap();
-            let known = Entries::new();
-            let mut written = Written::default();
-            let mut samples = SplitSamples::default();
-            for block in blocks(&bounds, cut) {
-                let (built, values) = build_block(
-                    &source,
-                    &bounds,
-                    cut,
-                    12,
-                    block,
-                    Some(band_rows),
-                    &store,
-                    &options,
-                    &pool,
-                    &known,
-                )
-                .unwrap();
-                if let Some(values) = values {
-                    let x = tile_column(cut.split, block.x0);
-                    samples.tiles.insert((x, block.y0), values);
-                }
-                written.absorb(built);
-            }
-            let mut finished = Vec::new();
-            let (mut levels, _) = finish_pyramid(
-                "hills",
-                written,
-                &samples,
-                &bounds,
-                cut,
-                12,
-                &store,
-                &options,
-                &pool,
-                &known,
-                &mut |p| {
-                    if let Progress::Level(level) = p {
-                        finished.push(level.level)
-                    }
-                },
-            )
-            .unwrap();
-            assert_eq!(finished, [12, 11, 10, 9]);
-            for level in &mut levels {
-                level.seconds = 0.0;
-            }
-            // The records say how the run was cut; the pyramid does not.
-            let mut files = files(dir.path());
-            files.retain(|p, _| !p.starts_with(RECORDS_DIR));
+            let (levels, files) =
+                build_in(&source, &bounds, cut, 12, band_rows, dir.path(), &options);
             outputs.push((files, levels));
         }
         let (files, levels) = &outputs[0];
@@ -1045,10 +996,73 @@ mod tests {
         }
     }
 
+    /// The pyramid of `source` cut at `cut`, streamed in bands of `band_rows` tile rows,
+    /// into `dir`: its level reports and files (not the records, which say how it was cut).
+    fn build_in(
+        source: &dyn RowSource,
+        bounds: &GeoBounds,
+        cut: Cut,
+        max_zoom: u8,
+        band_rows: u32,
+        dir: &Path,
+        options: &TerrainOptions,
+    ) -> (
+        Vec<LevelReport>,
+        std::collections::BTreeMap<PathBuf, Vec<u8>>,
+    ) {
+        let store = DirectoryStore::open(dir).unwrap();
+        let pool = worker_pool(bounds, max_zoom.max(cut.anchor), 2).unwrap();
+        let known = Entries::new();
+        let mut written = Written::default();
+        let mut samples = SplitSamples::default();
+        for block in blocks(bounds, cut) {
+            let (built, values) = build_block(
+                source,
+                bounds,
+                cut,
+                max_zoom,
+                block,
+                Some(band_rows),
+                &store,
+                options,
+                &pool,
+                &known,
+            )
+            .unwrap();
+            if let Some(values) = values {
+                samples
+                    .tiles
+                    .insert((tile_column(cut.split, block.x0), block.y0), values);
+            }
+            written.absorb(built);
+        }
+        let (mut levels, _) = finish_pyramid(
+            "test",
+            written,
+            &samples,
+            bounds,
+            cut,
+            max_zoom,
+            &store,
+            options,
+            &pool,
+            &known,
+            &mut |_| {},
+        )
+        .unwrap();
+        for level in &mut levels {
+            level.seconds = 0.0;
+        }
+        let mut files = files(dir);
+        files.retain(|p, _| !p.starts_with(RECORDS_DIR));
+        (levels, files)
+    }
+
     #[test]
-    fn sampled_pyramid_bytes_do_not_depend_on_the_band_height() {
+    fn sampled_pyramid_bytes_do_not_depend_on_the_band_height_or_the_cut() {
         // The real sampler: a projected raster at its own level, and a global one (whose
-        // columns wrap) at level 2, sampled in bands of one tile row and of a whole level.
+        // columns wrap) two levels finer than its own, in bands of one tile row and of a
+        // whole level, cut at two levels.
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
         for (input, max_zoom) in [
             ("data/becmodel_dem_bc_albers_50m.tif", 11),
@@ -1066,30 +1080,34 @@ mod tests {
                 threads: 2,
                 ..TerrainOptions::default()
             };
+            let anchor = own_level(&bounds);
+            let coarsest = Cut::coarsest(anchor);
+            let finer = Cut {
+                anchor,
+                split: (coarsest.split + 2).min(anchor),
+            };
             let mut outputs = Vec::new();
-            for band_rows in [1, 100] {
+            for (cut, band_rows) in [(coarsest, 1), (finer, 100)] {
                 let dir = tempfile::tempdir().unwrap();
-                let (mut levels, available) = build_pyramid(
+                outputs.push(build_in(
                     &source,
                     &bounds,
+                    cut,
                     max_zoom,
                     band_rows,
                     dir.path(),
                     &options,
-                    &mut |_| {},
-                )
-                .unwrap();
-                for level in &mut levels {
-                    level.seconds = 0.0;
-                }
-                outputs.push((files(dir.path()), levels, available));
+                ));
             }
-            let finest = &outputs[0].1[usize::from(max_zoom)];
-            let rows = LevelRows::new(&bounds, max_zoom).tiles_y;
-            assert!(finest.tiles > 0 && rows > 2, "{}", input.display());
+            let finest = outputs[0].0.last().unwrap();
+            assert!(
+                finest.tiles > 2 && domain(&bounds, max_zoom).height > 2,
+                "{}",
+                input.display()
+            );
             assert!(
                 outputs[0] == outputs[1],
-                "{}: bands of 1 and 100 tile rows differ",
+                "{}: other cuts and bands give other tiles",
                 input.display()
             );
         }

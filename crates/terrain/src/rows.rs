@@ -95,14 +95,34 @@ impl LevelRows {
         self.end() == self.height
     }
 
+    /// The first column (local) east of 180°: a block's window round the globe may reach
+    /// a turn east of the level's last column. `width` when none is.
+    pub(super) fn past_antimeridian(&self) -> usize {
+        let turn = (2usize << self.level) * CELLS;
+        (turn + 1)
+            .saturating_sub(self.tx0 as usize * CELLS)
+            .min(self.width)
+    }
+
     /// The positions of lattice rows `rows`, columns `columns`, for the warp: computed
     /// from global lattice indices, so a block's positions do not depend on its origin
-    /// beyond the float rounding of one multiplication.
+    /// beyond the float rounding of one multiplication. Columns east of 180° (all of
+    /// `columns` or none, see [`LevelRows::past_antimeridian`]) are placed a turn west,
+    /// from the indices a window that does not wrap gives them: the same positions.
     pub(super) fn lattice(&self, rows: Range<usize>, columns: Range<usize>) -> GeoLattice {
         let d = step(self.level);
         let cells = f64::from(TILE_CELLS);
+        let past = self.past_antimeridian();
+        debug_assert!(
+            columns.end <= past || columns.start >= past,
+            "{columns:?} across 180"
+        );
+        let mut column = self.tx0 as usize * CELLS + columns.start;
+        if columns.start >= past {
+            column -= (2usize << self.level) * CELLS;
+        }
         GeoLattice {
-            west: -180.0 + (f64::from(self.tx0) * cells + columns.start as f64) * d,
+            west: -180.0 + column as f64 * d,
             south: -90.0 + (f64::from(self.ty0) * cells + rows.start as f64) * d,
             step: d,
             width: columns.len() as u32,

@@ -41,7 +41,12 @@ pub(super) struct Warp<'a> {
 impl RowSource for Warp<'_> {
     fn rows(&self, level: &LevelRows, rows: Range<usize>) -> TerrainResult<Vec<f32>> {
         let (width, height) = (level.width, rows.len());
-        if height == level.height {
+        // A window round the globe that reaches past 180° is warped in two parts, the part
+        // east of 180° at its longitudes a turn west, where the raster is (the warper does
+        // not wrap it, and a warp reaching past the raster's edge smooths near it).
+        let past = level.past_antimeridian();
+        let parts = [0..past, past..width];
+        if height == level.height && past == width {
             return Ok(warp_to_geographic(
                 self.path,
                 self.band,
@@ -49,13 +54,19 @@ impl RowSource for Warp<'_> {
             )?);
         }
         let mut out = vec![f32::NAN; width * height];
-        let block = height.max(1);
-        for c0 in (0..width).step_by(block) {
-            let w = block.min(width - c0);
-            let lattice = level.lattice(rows.clone(), c0..c0 + w);
-            let values = warp_to_geographic(self.path, self.band, &lattice)?;
-            for (r, row) in values.chunks_exact(w).enumerate() {
-                out[r * width + c0..][..w].copy_from_slice(row);
+        let block = if height == level.height {
+            width
+        } else {
+            height.max(1)
+        };
+        for part in parts.into_iter().filter(|p| !p.is_empty()) {
+            for c0 in part.clone().step_by(block) {
+                let w = block.min(part.end - c0);
+                let lattice = level.lattice(rows.clone(), c0..c0 + w);
+                let values = warp_to_geographic(self.path, self.band, &lattice)?;
+                for (r, row) in values.chunks_exact(w).enumerate() {
+                    out[r * width + c0..][..w].copy_from_slice(row);
+                }
             }
         }
         Ok(out)

@@ -159,6 +159,7 @@ pub fn build_shard(
     shard: Shard,
     note: &mut dyn FnMut(&str),
 ) -> TerrainResult<ShardReport> {
+    let start = std::time::Instant::now();
     let Prepared {
         bounds,
         own_level,
@@ -181,6 +182,17 @@ pub fn build_shard(
     let cut = plan.cut();
     let all = plan.blocks();
     let mine = plan.shard_blocks(shard.index);
+    let total_weight: u64 = plan.weights.iter().sum();
+    note(&format!(
+        "shard {shard}: planned in {:.2} s: {} blocks at level {} (anchor {}), this shard's \
+         {} of them, {:.2} % of the weight",
+        start.elapsed().as_secs_f64(),
+        all.len(),
+        cut.split,
+        cut.anchor,
+        mine.len(),
+        100.0 * plan.weights[mine.clone()].iter().sum::<u64>() as f64 / total_weight as f64
+    ));
     let pool = worker_pool(&bounds, max_zoom.max(cut.anchor), options.threads)?;
     let source = Warp {
         path: input,

@@ -7,7 +7,12 @@ DEMO_DEM := data/becmodel_dem_bc_albers_50m.tif
 DEMO_ERROR := 5
 VENV := .venv
 TOOLS := .tools
-PY_ORACLES := trimesh==4.12.2 numpy==2.2.6
+# trimesh and numpy read our meshes back (tests/formats.rs); Dask runs the shards of a
+# pyramid (tools/dask_tiles.py, tests/dask.rs); PyYAML reads the deploy/ manifests.
+PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 dask[distributed]==2026.8.0 pyyaml==6.0.4
+# The stamp is named after the package list, so changing the list installs again into an
+# existing .venv.
+PY_STAMP := $(VENV)/.ok-$(shell printf '%s' '$(PY_ORACLES)' | sha256sum | cut -c1-16)
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
 .PHONY: deps gdal oracles demo test bench-results bench-contour bench-compare bench-tiles
@@ -28,15 +33,16 @@ gdal:
 
 ## The independent readers the format tests check our files with (tests/formats.rs):
 ## trimesh in .venv (PyPI) and the Khronos glTF validator in .tools (npm). Idempotent.
-oracles: $(VENV)/.ok $(TOOLS)/node_modules/gltf-validator/package.json qm-oracles
+oracles: $(PY_STAMP) $(TOOLS)/node_modules/gltf-validator/package.json qm-oracles
 
-$(VENV)/.ok:
+$(PY_STAMP):
 	@# Debian's python3 needs python3-venv (ensurepip) to create a venv.
-	python3 -m venv $(VENV) 2>/dev/null || { rm -rf $(VENV); \
+	@[ -x $(VENV)/bin/python ] || python3 -m venv $(VENV) 2>/dev/null || { rm -rf $(VENV); \
 	  $(SUDO) apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends python3-venv && \
 	  python3 -m venv $(VENV); }
-	$(VENV)/bin/pip install --quiet --disable-pip-version-check $(PY_ORACLES)
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check $(foreach p,$(PY_ORACLES),'$(p)')
+	@rm -f $(VENV)/.ok-*
 	@touch $@
 
 $(TOOLS)/node_modules/gltf-validator/package.json:

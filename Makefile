@@ -7,9 +7,11 @@ DEMO_DEM := data/becmodel_dem_bc_albers_50m.tif
 DEMO_ERROR := 5
 VENV := .venv
 TOOLS := .tools
-# moto's standalone S3 server and boto3 (tests/object_storage.rs): a local S3 to write
-# to and read from, and an independent client to check what was stored.
-PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5
+# trimesh and numpy read our meshes back (tests/formats.rs); moto's standalone S3 server
+# and boto3 are a local S3 and an independent client (tests/object_storage.rs); Dask runs
+# the shards of a pyramid (tools/dask_tiles.py, tests/dask.rs); PyYAML reads deploy/.
+PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
+  dask[distributed]==2026.8.0 pyyaml==6.0.4
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
 .PHONY: deps gdal oracles demo test bench-results bench-contour bench-compare bench-tiles
@@ -29,7 +31,7 @@ gdal:
 	@command -v cargo >/dev/null || { echo "Rust is missing: install it from https://rustup.rs"; exit 1; }
 
 ## The independent readers the format tests check our files with (tests/formats.rs):
-## trimesh, moto and boto3 in .venv (PyPI) and the Khronos glTF validator in .tools (npm).
+## trimesh, moto, boto3, Dask and PyYAML in .venv (PyPI) and the Khronos glTF validator in .tools (npm).
 ## Idempotent.
 oracles: py-oracles $(TOOLS)/node_modules/gltf-validator/package.json qm-oracles
 
@@ -46,7 +48,7 @@ py-oracles:
 	      python3 -m venv $(VENV); } || exit 1; \
 	  fi; \
 	  echo "installing $(PY_ORACLES) into $(VENV)"; \
-	  $(VENV)/bin/pip install --quiet --disable-pip-version-check $(PY_ORACLES) && \
+	  $(VENV)/bin/pip install --quiet --disable-pip-version-check $(foreach p,$(PY_ORACLES),'$(p)') && \
 	  echo "$(PY_ORACLES)" > $(VENV)/.ok; \
 	fi
 

@@ -81,6 +81,50 @@ fn shards_of_a_globe_meet_across_the_antimeridian() {
 }
 
 #[test]
+fn a_globe_on_0_360_is_whole_and_the_same_in_shards() {
+    // A global raster stored on 0..360 (as ETOPO5 is): a block at column 0 reads its
+    // window a turn east of the last column. That part once came back empty, so the
+    // pyramid lacked tiles west of 0 (with ETOPO5, 310 of 682, fewer the more shards), and
+    // the tiles built there had their header and normals computed a turn east, off in the
+    // last bits (2 of the 10 tiles at the 0.5-degree globe's own level differed from a
+    // 3-shard run's).
+    let dir = Dir::new();
+    let relabelled = crate::tiles::relabelled(
+        &dir,
+        "etopo5_2deg_i16.tif",
+        "globe360.tif",
+        ["-1", "90", "358.99999999999", "-90"],
+    );
+    let status = std::process::Command::new("gdal_translate")
+        .args([
+            "-q",
+            "-outsize",
+            "720",
+            "360",
+            "-r",
+            "bilinear",
+            &relabelled,
+        ])
+        .arg(dir.path("globe360_half_degree.tif"))
+        .status()
+        .expect("gdal_translate runs");
+    assert!(status.success());
+    let input = dir.path("globe360_half_degree.tif");
+    let input = input.to_str().unwrap();
+    for (max_zoom, tiles) in [("1", 2 + 8), ("3", 2 + 8 + 32 + 128)] {
+        check_shards(&dir, input, &["--max-zoom", max_zoom, "--normals"], &[3]);
+        let one = pyramid_files(&dir.path("one"));
+        let count = one
+            .keys()
+            .filter(|p| p.extension().is_some_and(|e| e == "terrain"))
+            .count();
+        assert_eq!(count, tiles, "every tile of levels 0 to {max_zoom}");
+        std::fs::remove_dir_all(dir.path("one")).unwrap();
+        std::fs::remove_dir_all(dir.path("sharded-3")).unwrap();
+    }
+}
+
+#[test]
 fn a_merge_names_missing_and_foreign_shards_and_writes_no_layer_json() {
     let dir = Dir::new();
     let input = fixture("becmodel_dem_bc_albers_50m.tif");

@@ -6,6 +6,7 @@ mod bad_input;
 mod cesium;
 mod cli_reference;
 mod contour;
+mod dask;
 mod foreign;
 mod formats;
 mod mbtiles;

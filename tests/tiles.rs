@@ -641,7 +641,7 @@ fn covered(t: &Tile) -> f64 {
 
 /// `input` relabelled as EPSG:4326 over `[west, north, east, south]` (`gdal_translate
 /// -a_ullr`).
-fn relabelled(dir: &Dir, input: &str, name: &str, ullr: [&str; 4]) -> String {
+pub(crate) fn relabelled(dir: &Dir, input: &str, name: &str, ullr: [&str; 4]) -> String {
     let out = dir.path(name);
     let status = Command::new("gdal_translate")
         .args(["-q", "-a_srs", "EPSG:4326", "-a_ullr"])

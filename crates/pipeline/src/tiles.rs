@@ -88,6 +88,18 @@ fn show(feedback: &dyn Feedback, progress: Progress<'_>) {
             feedback.status(&format!("blocks: {done} of {total} built"))
         }
         Progress::Block { .. } => feedback.clear_status(),
+        Progress::Planned {
+            seconds,
+            blocks,
+            split,
+            anchor,
+            shard_blocks,
+            share,
+        } => feedback.note(&format!(
+            "planned in {seconds:.2} s: {blocks} blocks at level {split} (anchor {anchor}), \
+             {shard_blocks} of them this shard's, {:.2} % of the weight",
+            100.0 * share
+        )),
         Progress::Level(level) => note_level(feedback, level),
     }
 }

@@ -386,6 +386,21 @@ pub enum Progress<'a> {
     },
     /// A level is finished (all of them at the end, finest first).
     Level(&'a LevelReport),
+    /// A shard's plan is made.
+    Planned {
+        /// Seconds the plan took (the input's checks, fingerprint and coarse read).
+        seconds: f64,
+        /// Blocks in the plan.
+        blocks: usize,
+        /// Their level.
+        split: u8,
+        /// The raster's own level.
+        anchor: u8,
+        /// Of them, this shard's.
+        shard_blocks: usize,
+        /// This shard's share of the plan's weight, 0 to 1.
+        share: f64,
+    },
 }
 
 /// What every run of a pyramid works out from its input and options first.

@@ -73,6 +73,7 @@ pub fn build_shard(
     shard: Shard,
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> TerrainResult<ShardReport> {
+    let start = std::time::Instant::now();
     let Prepared {
         bounds,
         own_level,
@@ -88,6 +89,15 @@ pub fn build_shard(
     let cut = plan.cut();
     let mine = plan.shard_blocks(shard.index);
     let blocks = plan.blocks()[mine.clone()].to_vec();
+    let total_weight: u64 = plan.weights.iter().sum();
+    progress(Progress::Planned {
+        seconds: start.elapsed().as_secs_f64(),
+        blocks: plan.weights.len(),
+        split: cut.split,
+        anchor: cut.anchor,
+        shard_blocks: mine.len(),
+        share: plan.weights[mine.clone()].iter().sum::<u64>() as f64 / total_weight as f64,
+    });
     let pool = worker_pool(&bounds, max_zoom.max(cut.anchor), options.threads)?;
     let source = Warp {
         path: input,

@@ -158,7 +158,8 @@ pub(super) fn build_tile(
         });
     }
 
-    let rect = tile_rectangle(z, x, y);
+    // At its own column's longitudes, as a window that does not wrap places it.
+    let rect = tile_rectangle(z, column, y);
     let normals: Option<Vec<[f64; 3]>> = options.normals.then(|| {
         let d = step(z);
         tin.vertices()

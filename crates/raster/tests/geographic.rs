@@ -190,7 +190,26 @@ fn global_rasters_in_any_frame_sample_the_same_in_any_window() {
                 .filter(|&c| c >= 1 && c < i64::from(lattice.width) - 1)
                 .map(|c| c as u32)
                 .collect();
-            check_windows(path, &lattice, seed + 10 * k as u64, &seed_columns(&seam));
+            let whole = check_windows(path, &lattice, seed + 10 * k as u64, &seed_columns(&seam));
+            // A turn is a whole number of the finest level's steps: the same lattice a turn
+            // east is the same columns, with the same bits.
+            if coarser == 1.0 {
+                let turn = (360.0 / lattice.step).round() as u64;
+                for turns in [1, 3] {
+                    let east = GeoLattice {
+                        first_column: lattice.first_column + turns * turn,
+                        ..lattice
+                    };
+                    let again = sample_geographic(path, 1, &east).expect("a turn east");
+                    let differ = (0..whole.len())
+                        .filter(|&k| {
+                            whole[k].to_bits() != again[k].to_bits()
+                                && !(whole[k].is_nan() && again[k].is_nan())
+                        })
+                        .count();
+                    assert_eq!(differ, 0, "{}: {turns} turns east", path.display());
+                }
+            }
         }
     }
 }

@@ -1129,6 +1129,47 @@ mod tests {
     }
 
     #[test]
+    fn a_sampled_globe_is_the_same_for_every_cut() {
+        // The 2-degree global ETOPO sampled at level 2 and cut at levels 0, 1 and 2: the
+        // blocks' windows at levels 1 and 2 reach a turn east of the first, where the
+        // lattice's columns and the tiles' rectangles must be those of the first turn
+        // (headers and normals of tiles held a turn east came out an ulp apart).
+        let input =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/fixtures/etopo5_2deg_i16.tif");
+        let bounds = geographic_bounds(&input, 1).unwrap();
+        let source = Warp {
+            path: &input,
+            band: 1,
+        };
+        let options = TerrainOptions {
+            max_zoom: Some(2),
+            normals: true,
+            threads: 2,
+            ..TerrainOptions::default()
+        };
+        let cuts = [(0, 100), (0, 1), (1, 1), (2, 3)];
+        let outputs: Vec<_> = cuts
+            .iter()
+            .map(|&(split, band_rows)| {
+                let dir = tempfile::tempdir().unwrap();
+                let cut = Cut { anchor: 2, split };
+                build_in(&source, &bounds, cut, 2, band_rows, dir.path(), &options)
+            })
+            .collect();
+        assert_eq!(outputs[0].0.last().unwrap().tiles, 32);
+        for (k, output) in outputs.iter().enumerate().skip(1) {
+            let differ: Vec<_> = (output.1.keys().chain(outputs[0].1.keys()))
+                .filter(|p| output.1.get(*p) != outputs[0].1.get(*p))
+                .collect();
+            assert!(
+                differ.is_empty(),
+                "cut {:?}: other bytes in {differ:?}",
+                cuts[k]
+            );
+        }
+    }
+
+    #[test]
     fn metadata_lists_levels_below() {
         let mut available: Available = vec![BTreeSet::new(); 3];
         available[1].insert((0, 0));

@@ -695,7 +695,9 @@ fn a_whole_turn_of_longitudes_is_a_globe_stitched_across_180_at_every_level() {
     // every level the last column's east edge is the first column's west edge, vertex for
     // vertex and height for height. (It used to be taken for a raster across the
     // antimeridian just short of a turn: root tile 0/0/0 covered a sliver, and the coarse
-    // levels did not filter across 180 degrees, so the seam's heights differed.)
+    // levels did not filter across 180 degrees, so the seam's heights differed.) Level 3
+    // is built in blocks whose windows lie west of 0 degrees too: GDAL's warper, given
+    // such a window of a 0..360 raster, left it empty (102 of the 170 tiles were written).
     let dir = Dir::new();
     let input = relabelled(
         &dir,
@@ -703,9 +705,9 @@ fn a_whole_turn_of_longitudes_is_a_globe_stitched_across_180_at_every_level() {
         "globe360.tif",
         ["-1", "90", "358.99999999999", "-90"],
     );
-    pyramid(&dir, &input, "p", &["--max-zoom", "2", "-q"]);
+    pyramid(&dir, &input, "p", &["--max-zoom", "3", "-q"]);
     let tiles = decode_pyramid(&dir.path("p"));
-    assert_eq!(tiles.len(), 2 + 8 + 32, "every tile of levels 0 to 2");
+    assert_eq!(tiles.len(), 2 + 8 + 32 + 128, "every tile of levels 0 to 3");
     let mut seams = 0;
     for (&(z, x, y), t) in &tiles {
         check_tile((z, x, y), t);
@@ -721,7 +723,7 @@ fn a_whole_turn_of_longitudes_is_a_globe_stitched_across_180_at_every_level() {
         );
         seams += 1;
     }
-    assert_eq!(seams, 1 + 2 + 4);
+    assert_eq!(seams, 1 + 2 + 4 + 8);
     assert!(check_shared_edges(&tiles) > 0);
 }
 

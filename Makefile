@@ -15,7 +15,7 @@ PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 dask[distributed]==2026.8.0 pyyaml==6
 PY_STAMP := $(VENV)/.ok-$(shell printf '%s' '$(PY_ORACLES)' | sha256sum | cut -c1-16)
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps gdal oracles demo test bench-results bench-contour bench-compare bench-tiles
+.PHONY: deps gdal oracles demo test bench-results bench-contour bench-compare bench-tiles bench-shards
 
 ## Everything the tests need: GDAL, then the independent oracles.
 deps: gdal
@@ -33,7 +33,7 @@ gdal:
 
 ## The independent readers the format tests check our files with (tests/formats.rs):
 ## trimesh in .venv (PyPI) and the Khronos glTF validator in .tools (npm). Idempotent.
-oracles: $(PY_STAMP) $(TOOLS)/node_modules/gltf-validator/package.json qm-oracles
+oracles: $(PY_STAMP) gnu-time $(TOOLS)/node_modules/gltf-validator/package.json qm-oracles
 
 $(PY_STAMP):
 	@# Debian's python3 needs python3-venv (ensurepip) to create a venv.
@@ -44,6 +44,12 @@ $(PY_STAMP):
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check $(foreach p,$(PY_ORACLES),'$(p)')
 	@rm -f $(VENV)/.ok-*
 	@touch $@
+
+## GNU time: tools/dask_tiles.py measures each shard's own process with it (tests/dask.rs).
+.PHONY: gnu-time
+gnu-time:
+	@[ -x /usr/bin/time ] || { echo "installing time"; $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends time; }
 
 $(TOOLS)/node_modules/gltf-validator/package.json:
 	@command -v npm >/dev/null || { \
@@ -105,3 +111,10 @@ bench-compare: deps
 bench-tiles:
 	cargo build --release --quiet
 	python3 bench/tiles.py --out /tmp/tinsmith-bench/results.md
+
+## Sharded pyramids: ETOPO5 and a 16384 x 8192 resample in one process vs 4 shards on a
+## Dask LocalCluster, and 1000 shards of a planet-size VRT (docs/results.md, "Sharded
+## pyramids"; about 20 minutes). Work files in /tmp/tinsmith-shards.
+bench-shards: deps
+	cargo build --release --quiet
+	$(VENV)/bin/python bench/shards.py --shared ../shared --out /tmp/tinsmith-shards/results.md

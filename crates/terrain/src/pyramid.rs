@@ -203,7 +203,7 @@ pub struct TerrainReport {
 ///   input, z/x/y and the options that shape tiles (band, quality, normals, metadata,
 ///   gzip): not on `--min-zoom`, `--max-zoom` (except the metadata extension of levels
 ///   0, 10 and 20, which lists the tiles below down to `--max-zoom`), the threads, or
-///   which other tiles a run (or a shard of one, [`build_shard`]) builds. Level L's
+///   which other tiles a run (or a shard of one, [`build_shard`](crate::build_shard)) builds. Level L's
 ///   lattice is defined once: the raster's own level is sampled from the raster (bilinear,
 ///   each sample from its position alone), each coarser level is the finer one filtered
 ///   (binomial 5 x 5) and halved, and each finer level is sampled alone.

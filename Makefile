@@ -14,7 +14,7 @@ PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
   dask[distributed]==2026.8.0 pyyaml==6.0.4
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps gdal oracles demo test bench-results bench-contour bench-compare bench-tiles
+.PHONY: deps gdal oracles demo test bench-results bench-contour bench-compare bench-tiles bench-shards
 
 ## Everything the tests need: GDAL, then the independent oracles.
 deps: gdal
@@ -31,9 +31,9 @@ gdal:
 	@command -v cargo >/dev/null || { echo "Rust is missing: install it from https://rustup.rs"; exit 1; }
 
 ## The independent readers the format tests check our files with (tests/formats.rs):
-## trimesh, moto, boto3, Dask and PyYAML in .venv (PyPI) and the Khronos glTF validator in .tools (npm).
-## Idempotent.
-oracles: py-oracles $(TOOLS)/node_modules/gltf-validator/package.json qm-oracles
+## trimesh, moto, boto3, Dask and PyYAML in .venv (PyPI), GNU time (the Dask driver
+## measures each shard with it) and the Khronos glTF validator in .tools (npm). Idempotent.
+oracles: py-oracles gnu-time $(TOOLS)/node_modules/gltf-validator/package.json qm-oracles
 
 ## .venv/.ok records the PY_ORACLES installed: a venv made for another list is brought up
 ## to this one. Debian's python3 needs python3-venv (ensurepip) to create a venv.
@@ -51,6 +51,12 @@ py-oracles:
 	  $(VENV)/bin/pip install --quiet --disable-pip-version-check $(foreach p,$(PY_ORACLES),'$(p)') && \
 	  echo "$(PY_ORACLES)" > $(VENV)/.ok; \
 	fi
+
+## GNU time: tools/dask_tiles.py measures each shard's own process with it (tests/dask.rs).
+.PHONY: gnu-time
+gnu-time:
+	@[ -x /usr/bin/time ] || { echo "installing time"; $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends time; }
 
 $(TOOLS)/node_modules/gltf-validator/package.json:
 	@command -v npm >/dev/null || { \
@@ -112,3 +118,10 @@ bench-compare: deps
 bench-tiles:
 	cargo build --release --quiet
 	python3 bench/tiles.py --out /tmp/tinsmith-bench/results.md
+
+## Sharded pyramids: ETOPO5 and a 16384 x 8192 resample in one process vs 4 shards on a
+## Dask LocalCluster, and 1000 shards of a planet-size VRT (docs/results.md, "Sharded
+## pyramids"; about 20 minutes). Work files in /tmp/tinsmith-shards.
+bench-shards: deps
+	cargo build --release --quiet
+	$(VENV)/bin/python bench/shards.py --shared ../shared --out /tmp/tinsmith-shards/results.md

@@ -97,8 +97,13 @@ fn check_summary(summary: &Value, n: u32) {
             .starts_with("tcp://127.0.0.1:"));
         assert!(r["wall_s"].as_f64().unwrap() > 0.0);
         assert!(r["cpu_s"].as_f64().unwrap() > 0.0);
-        // A tinsmith process with GDAL loaded, not an empty measurement.
+        // A tinsmith process with GDAL loaded, not an empty measurement, and measured
+        // alone by GNU time (`make deps` installs it), not with its worker's memory.
         assert!(r["max_rss_mb"].as_f64().unwrap() > 5.0, "{r}");
+        assert_eq!(
+            r["rss_includes_parent"], false,
+            "/usr/bin/time missing? {r}"
+        );
         weight += as_u64(&r["weight"]);
         assert_eq!(r["total_weight"], results[0]["total_weight"]);
     }

@@ -27,7 +27,8 @@ the driver names every failed shard with the tail of its stderr, runs no merge, 
 1. Run the driver again once the cause is fixed: finished tiles are kept.
 
 Each task measures its own child, not its worker: wall time, CPU time (user + system)
-and peak RSS come from os.wait4() on the child's pid. The JSON summary on stdout (and in
+and peak RSS of the `tinsmith` process alone, through GNU time (/usr/bin/time; see
+run_measured for why not os.wait4 alone). The JSON summary on stdout (and in
 --summary FILE) lists, per shard and for the merge: exit code, wall_s, cpu_s, user_s,
 sys_s, max_rss_mb, the pid and host of the process that ran it (a worker's, for the
 shards) and, from the shard's own report, its blocks and weight; then the totals. Logs
@@ -56,41 +57,69 @@ import time
 STDERR_TAIL = 4000
 
 
+# GNU time measures its child alone; setpriv gives that child the parent-death signal.
+GNU_TIME = "/usr/bin/time"
+SETPRIV = "/usr/bin/setpriv"
+
+
 def run_measured(cmd, tail=STDERR_TAIL):
     """Runs `cmd` (a list) to completion; returns its exit code, the last `tail`
-    characters of its stderr and what it cost: wall, user and system CPU seconds and peak RSS of the child alone
-    (os.wait4 on its pid, so concurrent children of the same process are not mixed in).
-    The child is killed if the thread that started it dies (a lost worker)."""
+    characters of its stderr and what it cost: wall, user and system CPU seconds and peak
+    RSS of that process alone.
+
+    The costs come from GNU time (/usr/bin/time, Debian's `time`), which forks the command
+    from its own small process: os.wait4 on a child forked from this Python process would
+    count this process's memory in the child's peak RSS (Linux keeps the high-water mark
+    of the memory image an exec replaces), and a Dask worker holds tens of MB or more.
+    Without GNU time, wait4 is used and `rss_includes_parent` says so. The command is
+    killed if the thread that started it dies (a lost worker): PR_SET_PDEATHSIG, through
+    setpriv for the command under GNU time."""
     import ctypes
     import signal
     import subprocess
     import tempfile
 
     def die_with_parent():
-        # PR_SET_PDEATHSIG = 1: SIGKILL the child when the thread that forked it exits.
+        # PR_SET_PDEATHSIG = 1: SIGKILL this process when the thread that forked it exits.
         try:
             ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)
         except (OSError, AttributeError):
             pass
 
-    with tempfile.TemporaryFile() as err:
+    timed = os.access(GNU_TIME, os.X_OK)
+    with tempfile.TemporaryFile() as err, tempfile.NamedTemporaryFile("r") as costs:
+        run = list(cmd)
+        if timed:
+            if os.access(SETPRIV, os.X_OK):
+                run = [SETPRIV, "--pdeathsig", "KILL", *run]
+            run = [GNU_TIME, "-o", costs.name, "-f", "%e %U %S %M", *run]
         start = time.monotonic()
         child = subprocess.Popen(
-            cmd, stdin=subprocess.DEVNULL, stdout=err, stderr=err, preexec_fn=die_with_parent
+            run, stdin=subprocess.DEVNULL, stdout=err, stderr=err, preexec_fn=die_with_parent
         )
         _, status, usage = os.wait4(child.pid, 0)
         wall = time.monotonic() - start
         child.returncode = os.waitstatus_to_exitcode(status)
         err.seek(0)
         text = err.read().decode("utf-8", "replace")
+        lines = costs.read().split("\n") if timed else []
+    # GNU time's last line is the format; a line before it may say how the command ended.
+    fields = [line for line in lines if line.strip()][-1:]
+    if timed and fields and len(fields[0].split()) == 4:
+        _, user, system, rss_kib = fields[0].split()
+        user, system, rss_kib = float(user), float(system), int(rss_kib)
+    else:
+        timed = False
+        user, system, rss_kib = usage.ru_utime, usage.ru_stime, usage.ru_maxrss
     return {
         "exit": child.returncode,
         "wall_s": round(wall, 3),
-        "cpu_s": round(usage.ru_utime + usage.ru_stime, 3),
-        "user_s": round(usage.ru_utime, 3),
-        "sys_s": round(usage.ru_stime, 3),
-        # Linux reports ru_maxrss in KiB.
-        "max_rss_mb": round(usage.ru_maxrss / 1024, 1),
+        "cpu_s": round(user + system, 3),
+        "user_s": round(user, 3),
+        "sys_s": round(system, 3),
+        # KiB, from GNU time and from Linux's ru_maxrss alike.
+        "max_rss_mb": round(rss_kib / 1024, 1),
+        "rss_includes_parent": not timed,
         "pid": os.getpid(),
         "host": socket.gethostname(),
         "stderr_tail": text[-tail:],

@@ -25,13 +25,7 @@ pub fn tiles(
     options: &TerrainOptions,
     feedback: &dyn Feedback,
 ) -> Result<TerrainReport> {
-    if let Some(report) = report {
-        crate::output_paths::check_not_inside(output, report, "the pyramid directory")?;
-        crate::output_paths::check_writable_target(report, input)?;
-    }
-    let reserved = report
-        .map(crate::output_paths::ReservedReport::reserve)
-        .transpose()?;
+    let reserved = reserve_report(output, report, input)?;
     let mut progress = |p: Progress<'_>| show(feedback, p);
     let built = match destination(output) {
         Destination::Bucket(url) => {
@@ -132,13 +126,7 @@ pub fn tiles_shard(
     shard: Shard,
     feedback: &dyn Feedback,
 ) -> Result<ShardReport> {
-    if let Some(report) = report {
-        crate::output_paths::check_not_inside(output, report, "the pyramid directory")?;
-        crate::output_paths::check_writable_target(report, input)?;
-    }
-    let reserved = report
-        .map(crate::output_paths::ReservedReport::reserve)
-        .transpose()?;
+    let reserved = reserve_report(output, report, input)?;
     let store = pyramid_store(output)?;
     let built = build_shard(input, &*store, options, shard, &mut |p| show(feedback, p))
         .naming_file(input)?;
@@ -231,4 +219,20 @@ fn pyramid_store(output: &Path) -> Result<Box<dyn TileStore>> {
         ),
         Destination::Directory => Ok(Box::new(DirectoryStore::open(output)?)),
     }
+}
+
+/// Checks the report's path (outside the pyramid, writable, not the input) and takes its
+/// room before any tile is made.
+fn reserve_report(
+    output: &Path,
+    report: Option<&Path>,
+    input: &Path,
+) -> Result<Option<crate::output_paths::ReservedReport>> {
+    if let Some(report) = report {
+        crate::output_paths::check_not_inside(output, report, "the pyramid directory")?;
+        crate::output_paths::check_writable_target(report, input)?;
+    }
+    Ok(report
+        .map(crate::output_paths::ReservedReport::reserve)
+        .transpose()?)
 }

@@ -9,7 +9,7 @@ use std::ops::Range;
 
 use tinsmith_raster::GeoBounds;
 
-use crate::rows::LevelRows;
+use crate::rows::{LevelRows, Reach};
 use crate::stream::RowSource;
 use crate::tms::{tile_column, TileRect, TILE_CELLS};
 use crate::TerrainResult;
@@ -66,8 +66,8 @@ pub(super) fn blocks(bounds: &GeoBounds, cut: Cut) -> Vec<TileRect> {
 /// the domain goes all the way round, a turn east when the ring would start west of
 /// column 0). Its samples near the block are those of the whole level: the ring holds
 /// every sample the block's tiles, their halos and the filter down to the block's level
-/// read (a ring of 217 samples at the anchor is filtered down to 1 after 7 levels, more
-/// than [`BLOCK_DEPTH`]).
+/// read (at most [`reach_margin`] of [`BLOCK_DEPTH`] levels, 46 of the ring's 217 samples,
+/// which is all [`block_level`] makes of it).
 pub(super) fn block_window(bounds: &GeoBounds, block: TileRect, level: u8) -> TileRect {
     let d = domain(bounds, level);
     let f = level - block.level;
@@ -108,6 +108,51 @@ pub(super) fn block_window(bounds: &GeoBounds, block: TileRect, level: u8) -> Ti
     }
 }
 
+/// How far (in samples of `level`) beyond a block's tiles the block's levels down to
+/// `top` read, where `level` is at or below `top`: a tile reads one sample past its edges
+/// (edges, normals, fingerprint), and a sample of level `z` is filtered from samples of
+/// `z + 1` up to two steps either side of its double, so the reach doubles and grows by
+/// two per level: 1, 4, 10, 22, 46 samples.
+pub(super) fn reach_margin(top: u8, level: u8) -> usize {
+    3 * (1usize << (level - top)) - 2
+}
+
+/// The lattice of `level` a block is built from: its window ([`block_window`]), made only
+/// within `margin` samples of the block's tiles (as [`reach_margin`] gives it): the ring
+/// beyond is never sampled, nor filtered.
+pub(super) fn block_level(
+    bounds: &GeoBounds,
+    block: TileRect,
+    level: u8,
+    margin: usize,
+) -> LevelRows {
+    let window = block_window(bounds, block, level);
+    let rows = LevelRows::new(window);
+    let cells = i64::from(TILE_CELLS);
+    let f = level - block.level;
+    let margin = margin as i64;
+    // The block's samples, global lattice columns and rows, widened by the margin.
+    let west = (i64::from(block.x0) << f) * cells - margin;
+    let span = (i64::from(block.width) << f) * cells + 2 * margin;
+    let south = (i64::from(block.y0) << f) * cells - margin;
+    let north = (i64::from(block.y0 + block.height) << f) * cells + margin;
+    // Columns compare round the globe: a window may lie a turn east of its block.
+    let turn = (2i64 << level) * cells;
+    let columns = (0..rows.width as i64)
+        .map(|i| {
+            let column = i64::from(window.x0) * cells + i;
+            span >= turn || (column - west).rem_euclid(turn) <= span
+        })
+        .collect();
+    let first_row = i64::from(window.y0) * cells;
+    let local = |row: i64| (row - first_row).clamp(0, rows.height as i64) as usize;
+    let reach = Reach {
+        rows: local(south)..local(north + 1),
+        columns,
+    };
+    rows.within(reach)
+}
+
 /// The samples of the split level's tiles, as the blocks handed them over, keyed by
 /// (column, TMS row); tiles without any are nodata.
 #[derive(Debug, Default)]
@@ -116,7 +161,12 @@ pub(super) struct SplitSamples {
 }
 
 impl RowSource for SplitSamples {
-    fn rows(&self, level: &LevelRows, rows: Range<usize>) -> TerrainResult<Vec<f32>> {
+    fn rows(
+        &self,
+        level: &LevelRows,
+        rows: Range<usize>,
+        columns: Range<usize>,
+    ) -> TerrainResult<Vec<f32>> {
         let n = TILE_CELLS as usize;
         let side = n + 1;
         let mut out = vec![f32::NAN; level.width * rows.len()];
@@ -132,6 +182,13 @@ impl RowSource for SplitSamples {
                 let row = &tile[oj * side..(oj + 1) * side];
                 out[k * level.width + ti * n..][..side].copy_from_slice(row);
             }
+        }
+        if columns != (0..level.width) {
+            out = out
+                .chunks_exact(level.width)
+                .flat_map(|row| &row[columns.clone()])
+                .copied()
+                .collect();
         }
         Ok(out)
     }
@@ -173,6 +230,44 @@ mod tests {
                     assert!(w.contains(x, y), "{x} {y}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn a_block_reaches_its_margin_and_no_further() {
+        let globe = GeoBounds {
+            west: -180.0,
+            south: -80.0,
+            east: 180.0,
+            north: 80.0,
+            resolution: 0.05,
+        };
+        let block = TileRect {
+            level: 2,
+            x0: 0,
+            y0: 1,
+            width: 1,
+            height: 1,
+        };
+        let n = TILE_CELLS as usize;
+        for (level, margin) in [(2, 1), (4, reach_margin(2, 4))] {
+            let rows = block_level(&globe, block, level, margin);
+            let reach = rows.reach().expect("a block's level has a reach");
+            let core = n << (level - 2);
+            // The window's first column is a turn east of the block's west edge less a
+            // ring tile: the block starts a tile in.
+            let first = n;
+            assert_eq!(
+                reach.column_runs(),
+                vec![first - margin..first + core + margin + 1],
+                "level {level}"
+            );
+            // The block's southern row, local to the window (which may start at the domain).
+            let block_south = ((1usize << (level - 2)) - rows.ty0 as usize) * n;
+            assert_eq!(
+                reach.rows,
+                block_south - margin..block_south + core + margin + 1
+            );
         }
     }
 

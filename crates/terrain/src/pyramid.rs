@@ -7,13 +7,14 @@ use std::path::Path;
 use tinsmith_output::StagedDir;
 use tinsmith_raster::{geographic_bounds, GeoBounds};
 
-use crate::blocks::{block_window, blocks, domain, Cut, SplitSamples};
+use crate::blocks::{block_level, block_window, blocks, domain, reach_margin, Cut, SplitSamples};
 use crate::budget::LevelBudget;
 use crate::layer::{layer_json, Available};
 use crate::records::{
     block_name, gzip_samples, options_key, put_record, read_record, top_name, BlockRecord, Entries,
     TopRecord, RECORDS_DIR,
 };
+use crate::rows::LevelRows;
 use crate::stream::{band_tile_rows, stream_levels, RowSource, Warp};
 use crate::tms::{bounds_array, step, tile_column, TileRect, TILE_CELLS};
 use crate::writer::{Scope, TileWriter, Written};
@@ -571,15 +572,16 @@ pub(super) fn build_block(
         under: Some(block),
     };
     let mut writer = TileWriter::new(scope, max_zoom, Vec::new(), known, store, options, pool);
-    let window = |z: u8| block_window(bounds, block, z);
-    let band = |z: u8| band_rows.unwrap_or_else(|| band_tile_rows(window(z)));
+    let band = |z: u8| band_rows.unwrap_or_else(|| band_tile_rows(block_window(bounds, block, z)));
     // Levels finer than the anchor first, each sampled alone; then the anchor and the
     // levels filtered from it, down to the block's own.
     for z in (cut.anchor + 1..=max_zoom).rev() {
-        stream_levels(source, &window, (z, z), band(z), pool, &mut writer)?;
+        let level = |z: u8| block_level(bounds, block, z, reach_margin(z, z));
+        stream_levels(source, &level, (z, z), band(z), pool, &mut writer)?;
     }
+    let level = |z: u8| block_level(bounds, block, z, reach_margin(cut.split, z));
     let zooms = (cut.split, cut.anchor);
-    stream_levels(source, &window, zooms, band(cut.anchor), pool, &mut writer)?;
+    stream_levels(source, &level, zooms, band(cut.anchor), pool, &mut writer)?;
     let samples = writer
         .block_samples
         .take()
@@ -675,11 +677,11 @@ pub(super) fn build_top(
         under: None,
     };
     let mut writer = TileWriter::new(scope, max_zoom, available, known, store, options, pool);
-    let rect = |z: u8| domain(bounds, z);
-    let band = band_tile_rows(rect(cut.split));
+    let level = |z: u8| LevelRows::new(domain(bounds, z));
+    let band = band_tile_rows(domain(bounds, cut.split));
     stream_levels(
         samples,
-        &rect,
+        &level,
         (options.min_zoom, cut.split),
         band,
         pool,

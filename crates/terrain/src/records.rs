@@ -153,10 +153,11 @@ pub(super) fn put_record<T: Serialize>(
 
 /// A block's samples, gzipped.
 pub(super) fn gzip_samples(values: &[f32]) -> Vec<u8> {
+    // One write: the encoder does a compression step per write, which for 4-byte writes
+    // cost more than the rest of a shard's bookkeeping.
+    let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
     let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
-    for v in values {
-        e.write_all(&v.to_le_bytes()).expect("writing to memory");
-    }
+    e.write_all(&bytes).expect("writing to memory");
     e.finish().expect("writing to memory")
 }
 

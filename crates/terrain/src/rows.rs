@@ -47,6 +47,32 @@ pub(super) struct LevelRows {
     first: usize,
     /// Rows `first..end()`, row-major.
     values: Vec<f32>,
+    /// The samples anything built from this level reads, when not all of them.
+    reach: Option<Reach>,
+}
+
+/// The part of a level that the tiles built from it depend on (see
+/// [`LevelRows::within`]): its samples elsewhere are never made and stay NaN.
+#[derive(Debug, Clone)]
+pub(super) struct Reach {
+    /// Rows (local) in reach.
+    pub(super) rows: Range<usize>,
+    /// Per column (local), whether it is in reach.
+    pub(super) columns: Vec<bool>,
+}
+
+impl Reach {
+    /// The runs of consecutive columns in reach, west to east.
+    pub(super) fn column_runs(&self) -> Vec<Range<usize>> {
+        let mut runs: Vec<Range<usize>> = Vec::new();
+        for (i, _) in self.columns.iter().enumerate().filter(|(_, &c)| c) {
+            match runs.last_mut() {
+                Some(run) if run.end == i => run.end = i + 1,
+                _ => runs.push(i..i + 1),
+            }
+        }
+        runs
+    }
 }
 
 impl LevelRows {
@@ -64,7 +90,26 @@ impl LevelRows {
             wraps: rect.wraps(),
             first: 0,
             values: Vec::new(),
+            reach: None,
         }
+    }
+
+    /// The same level, of which only `reach` is made: the finest level is sampled there
+    /// alone and coarser levels filter there alone, NaN elsewhere. Whatever reads only
+    /// samples in reach gets the same values as from the whole level, provided each
+    /// coarser level's reach is filtered from samples in this one's.
+    ///
+    /// # Panics
+    /// When `reach` does not fit the level.
+    pub(super) fn within(mut self, reach: Reach) -> LevelRows {
+        assert!(reach.columns.len() == self.width && reach.rows.end <= self.height);
+        self.reach = Some(reach);
+        self
+    }
+
+    /// What is made of the level: `None` for all of it.
+    pub(super) fn reach(&self) -> Option<&Reach> {
+        self.reach.as_ref()
     }
 
     /// Tile `x`, `y` of `level` alone, at height 0 everywhere (the ellipsoid), every row
@@ -82,6 +127,7 @@ impl LevelRows {
             wraps: false,
             first: 0,
             values: vec![0.0; side * side],
+            reach: None,
         }
     }
 
@@ -372,7 +418,8 @@ impl LevelRows {
     /// the samples a whole turn away where this level has them. The domain so grows by at most
     /// one coarse sample per level, which keeps small inputs visible at coarse levels.
     /// Rows are filtered in parallel; each sample's sum runs in the same order whatever
-    /// the rows held, so the result depends only on the level's samples.
+    /// the rows held, so the result depends only on the level's samples. Only the
+    /// coarser level's reach ([`LevelRows::within`]) is filtered; the rest is NaN.
     ///
     /// # Panics
     /// When a row the filter reads is not held (see [`LevelRows::coarser_rows_ready`]).
@@ -385,23 +432,42 @@ impl LevelRows {
         let width = coarser.width;
         // Lattice columns in a whole turn of this level.
         let turn = (2i64 << self.level) * cells;
+        // The column here of each tap of each coarse column, `None` outside this level:
+        // the same for every row, so worked out once.
+        let columns: Vec<[Option<usize>; 5]> = (0..width)
+            .map(|i| {
+                let gx = 2 * (cx0 + i as i64);
+                TAPS.map(|(dx, _)| {
+                    let i = (gx + dx - fx0).rem_euclid(turn);
+                    (i < self.width as i64).then_some(i as usize)
+                })
+            })
+            .collect();
+        let all = vec![true; width];
+        let (reach_rows, reach_columns) = match &coarser.reach {
+            Some(reach) => (reach.rows.clone(), &reach.columns),
+            None => (0..coarser.height, &all),
+        };
         let mut out = vec![f32::NAN; width * rows.len()];
         out.par_chunks_mut(width).enumerate().for_each(|(k, row)| {
+            if !reach_rows.contains(&(rows.start + k)) {
+                return;
+            }
             let gy = 2 * (cy0 + (rows.start + k) as i64);
             let fine_rows = TAPS.map(|(dy, _)| self.row(gy + dy - fy0));
-            let fine = |r: Option<&[f32]>, gx: i64| -> f32 {
-                let i = (gx - fx0).rem_euclid(turn);
-                match r {
-                    Some(r) if i < self.width as i64 => r[i as usize],
-                    _ => f32::NAN,
-                }
-            };
-            for (i, slot) in row.iter_mut().enumerate() {
-                let gx = 2 * (cx0 + i as i64);
+            for ((slot, taps), _) in row
+                .iter_mut()
+                .zip(&columns)
+                .zip(reach_columns)
+                .filter(|(_, &in_reach)| in_reach)
+            {
                 let (mut sum, mut weight) = (0.0f64, 0.0f64);
                 for (r, (_, wy)) in fine_rows.iter().zip(TAPS) {
-                    for (dx, wx) in TAPS {
-                        let v = fine(*r, gx + dx);
+                    let Some(r) = r else { continue };
+                    for (column, (_, wx)) in taps.iter().zip(TAPS) {
+                        let Some(v) = column.map(|c| r[c]) else {
+                            continue;
+                        };
                         if v.is_finite() {
                             sum += wx * wy * f64::from(v);
                             weight += wx * wy;

@@ -16,9 +16,41 @@ use crate::TerrainResult;
 
 /// Where the finest level's samples come from.
 pub(super) trait RowSource: Sync {
-    /// Rows `rows` of `level`'s lattice, all columns, row-major, row 0 the southernmost,
-    /// NaN where there is no data. A row must get the same samples in any band.
-    fn rows(&self, level: &LevelRows, rows: Range<usize>) -> TerrainResult<Vec<f32>>;
+    /// Rows `rows`, columns `columns` of `level`'s lattice (local indices), row-major, row
+    /// 0 the southernmost, NaN where there is no data. A sample must be the same whatever
+    /// rows and columns are asked with it.
+    fn rows(
+        &self,
+        level: &LevelRows,
+        rows: Range<usize>,
+        columns: Range<usize>,
+    ) -> TerrainResult<Vec<f32>>;
+}
+
+/// Rows `rows` of `level`, all columns, from `source` where they are in the level's reach
+/// ([`LevelRows::within`]), NaN elsewhere.
+fn sample_reach(
+    source: &dyn RowSource,
+    level: &LevelRows,
+    rows: Range<usize>,
+) -> TerrainResult<Vec<f32>> {
+    let Some(reach) = level.reach() else {
+        return source.rows(level, rows, 0..level.width);
+    };
+    let width = level.width;
+    let mut out = vec![f32::NAN; width * rows.len()];
+    let inner = rows.start.max(reach.rows.start)..rows.end.min(reach.rows.end);
+    if inner.is_empty() {
+        return Ok(out);
+    }
+    for columns in reach.column_runs() {
+        let values = source.rows(level, inner.clone(), columns.clone())?;
+        for (k, row) in values.chunks_exact(columns.len()).enumerate() {
+            let start = (inner.start - rows.start + k) * width + columns.start;
+            out[start..start + columns.len()].copy_from_slice(row);
+        }
+    }
+    Ok(out)
 }
 
 /// A band of the input, sampled at the level's lattice points ([`sample_geographic`]):
@@ -30,8 +62,13 @@ pub(super) struct Warp<'a> {
 }
 
 impl RowSource for Warp<'_> {
-    fn rows(&self, level: &LevelRows, rows: Range<usize>) -> TerrainResult<Vec<f32>> {
-        let lattice = level.lattice(rows, 0..level.width);
+    fn rows(
+        &self,
+        level: &LevelRows,
+        rows: Range<usize>,
+        columns: Range<usize>,
+    ) -> TerrainResult<Vec<f32>> {
+        let lattice = level.lattice(rows, columns);
         Ok(sample_geographic(self.path, self.band, &lattice)?)
     }
 }
@@ -82,10 +119,10 @@ struct Level {
     done: bool,
 }
 
-/// Streams levels `max_zoom` down to `min_zoom`, each over the tiles `rect_of(level)`, from
-/// `source` into `sink`. Each level's rectangle must cover the next coarser one's samples'
-/// sources wherever they matter (the coarser level reads the finer samples around twice its
-/// own indices; outside the finer rectangle it reads nodata).
+/// Streams levels `max_zoom` down to `min_zoom`, each the lattice `level_of(level)` (its
+/// tiles and reach), from `source` into `sink`. Each level's rectangle must cover the next
+/// coarser one's samples' sources wherever they matter (the coarser level reads the finer
+/// samples around twice its own indices; outside the finer rectangle it reads nodata).
 ///
 /// The finest level is read in bands of `band_tile_rows` tile rows, a group of one band per
 /// thread at a time, in parallel; the next group is warped while this group's rows go
@@ -110,7 +147,7 @@ struct Level {
 /// The first error of the source or the sink; the stream stops there.
 pub(super) fn stream_levels(
     source: &dyn RowSource,
-    rect_of: &dyn Fn(u8) -> TileRect,
+    level_of: &dyn Fn(u8) -> LevelRows,
     zooms: (u8, u8),
     band_tile_rows: u32,
     pool: &rayon::ThreadPool,
@@ -120,7 +157,7 @@ pub(super) fn stream_levels(
     let mut levels: Vec<Level> = (min_zoom..=max_zoom)
         .rev()
         .map(|z| Level {
-            rows: LevelRows::new(rect_of(z)),
+            rows: level_of(z),
             next_tile_row: 0,
             seconds: 0.0,
             done: false,
@@ -129,13 +166,13 @@ pub(super) fn stream_levels(
     let bands = bands(&levels[0].rows, band_tile_rows);
     let groups: Vec<&[Range<usize>]> = bands.chunks(pool.current_num_threads().max(1)).collect();
     // The finest level's geometry, for the warps running beside the tiles.
-    let finest = LevelRows::new(rect_of(max_zoom));
+    let finest = level_of(max_zoom);
     let warp = |group: &[Range<usize>]| -> (Vec<TerrainResult<Vec<f32>>>, f64) {
         let t = Instant::now();
         let warped = pool.install(|| {
             group
                 .par_iter()
-                .map(|rows| source.rows(&finest, rows.clone()))
+                .map(|rows| sample_reach(source, &finest, rows.clone()))
                 .collect()
         });
         (warped, t.elapsed().as_secs_f64())
@@ -220,8 +257,13 @@ pub(super) struct Hills {
 
 #[cfg(test)]
 impl RowSource for Hills {
-    fn rows(&self, level: &LevelRows, rows: Range<usize>) -> TerrainResult<Vec<f32>> {
-        let lattice = level.lattice(rows, 0..level.width);
+    fn rows(
+        &self,
+        level: &LevelRows,
+        rows: Range<usize>,
+        columns: Range<usize>,
+    ) -> TerrainResult<Vec<f32>> {
+        let lattice = level.lattice(rows, columns);
         let mut out = Vec::with_capacity(lattice.width as usize * lattice.height as usize);
         for j in 0..lattice.height {
             let lat = lattice.lat(j);
@@ -372,7 +414,11 @@ mod tests {
         // The whole levels, made at once.
         let mut whole = Vec::new();
         let finest = LevelRows::new(TileRect::covering(&bounds, max_zoom));
-        whole.push(source.rows(&finest, 0..finest.height).unwrap());
+        whole.push(
+            source
+                .rows(&finest, 0..finest.height, 0..finest.width)
+                .unwrap(),
+        );
         for z in (min_zoom..max_zoom).rev() {
             let fine = LevelRows::new(TileRect::covering(&bounds, z + 1));
             let coarse = LevelRows::new(TileRect::covering(&bounds, z));
@@ -407,7 +453,7 @@ mod tests {
             };
             stream_levels(
                 &source,
-                &|z| TileRect::covering(&bounds, z),
+                &|z| LevelRows::new(TileRect::covering(&bounds, z)),
                 (min_zoom, max_zoom),
                 band_rows,
                 &pool,

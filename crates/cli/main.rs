@@ -46,12 +46,12 @@ fn main() -> ExitCode {
     if matches!(cli.command, Command::Info(_) | Command::Verify(_)) {
         end_quietly_on_closed_stdout();
     }
-    if !matches!(cli.command, Command::Tiles(_) | Command::Serve(_)) {
-        // These read each block of the raster once (a scan, a whole-raster read, or tiles
-        // in order): GDAL's default cache, 5 % of the machine's memory, would only hold
-        // blocks never read again (`info` on a 40k x 40k raster peaked at 1.16 GB).
-        tinsmith_raster::limit_block_cache(BLOCK_CACHE_MB);
-    }
+    // Every command reads each block of a raster once per open dataset (a scan, a
+    // whole-raster read, tiles in order, a pyramid's plan at a coarse size): GDAL's default
+    // cache, 5 % of the machine's memory, would only hold blocks never read again (`info`
+    // on a 40k x 40k raster peaked at 1.16 GB; a pyramid shard's plan of a 537 MB raster
+    // at 577 MB).
+    tinsmith_raster::limit_block_cache(BLOCK_CACHE_MB);
     let quiet = match &cli.command {
         Command::Mesh(a) => a.quiet,
         Command::Contour(a) => a.quiet,
@@ -124,8 +124,8 @@ fn note_removed_stale(quiet: bool) {
     );
 }
 
-/// GDAL block cache, in MB, for the commands that read each block once: several rows of
-/// tiles of a 16k-wide Float32 raster, whether it is stored in strips or blocks.
+/// GDAL block cache, in MB, for every command (each reads a block once per open dataset):
+/// several rows of tiles of a 16k-wide Float32 raster, whether in strips or blocks.
 const BLOCK_CACHE_MB: u64 = 256;
 
 /// `info` and `verify` print their results on stdout and write no file: like other Unix

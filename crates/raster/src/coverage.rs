@@ -39,6 +39,52 @@ pub fn coverage(path: &Path, band: usize, side: usize) -> Result<Coverage> {
             hint: "tiles need both; see `tinsmith info`",
         });
     };
+    let Coarse {
+        width: cw,
+        height: ch,
+        values,
+        cell: (sx, sy),
+    } = coarse_read(&opened, side)?;
+    let mut points: Vec<[f64; 3]> = (0..ch)
+        .flat_map(|j| {
+            (0..cw).map(move |i| {
+                let (px, py) = ((i as f64 + 0.5) * sx, (j as f64 + 0.5) * sy);
+                [
+                    gt[0] + px * gt[1] + py * gt[2],
+                    gt[3] + px * gt[4] + py * gt[5],
+                    0.0,
+                ]
+            })
+        })
+        .collect();
+    if !crate::is_wgs84_lon_lat(&wkt) {
+        crate::to_wgs84(&wkt, &mut points)?;
+    }
+    Ok(Coverage {
+        width: cw,
+        height: ch,
+        values,
+        centres: points.iter().map(|p| [p[0], p[1]]).collect(),
+    })
+}
+
+/// A band read at most `side` cells a side: each cell the sample GDAL picks for it
+/// (nearest, from the overview closest in size), NaN where it is nodata.
+pub(crate) struct Coarse {
+    /// Cells across.
+    pub(crate) width: usize,
+    /// Cells down (row 0 at the top).
+    pub(crate) height: usize,
+    /// Row-major heights, scale and offset applied.
+    pub(crate) values: Vec<f32>,
+    /// A cell's width and height in samples of the band.
+    pub(crate) cell: (f64, f64),
+}
+
+/// Band `opened` read coarsely (see [`Coarse`]).
+pub(crate) fn coarse_read(opened: &OpenBand, side: usize) -> Result<Coarse> {
+    let info = &opened.info;
+    let (path, band) = (info.path.as_path(), info.band);
     let (w, h) = (info.width as usize, info.height as usize);
     let scale = (w.max(h) as f64 / side.max(1) as f64).max(1.0);
     let (cw, ch) = (
@@ -81,26 +127,10 @@ pub fn coverage(path: &Path, band: usize, side: usize) -> Result<Coverage> {
             }
         })
         .collect();
-    let (sx, sy) = (w as f64 / cw as f64, h as f64 / ch as f64);
-    let mut points: Vec<[f64; 3]> = (0..ch)
-        .flat_map(|j| {
-            (0..cw).map(move |i| {
-                let (px, py) = ((i as f64 + 0.5) * sx, (j as f64 + 0.5) * sy);
-                [
-                    gt[0] + px * gt[1] + py * gt[2],
-                    gt[3] + px * gt[4] + py * gt[5],
-                    0.0,
-                ]
-            })
-        })
-        .collect();
-    if !crate::is_wgs84_lon_lat(&wkt) {
-        crate::to_wgs84(&wkt, &mut points)?;
-    }
-    Ok(Coverage {
+    Ok(Coarse {
         width: cw,
         height: ch,
         values,
-        centres: points.iter().map(|p| [p[0], p[1]]).collect(),
+        cell: (w as f64 / cw as f64, h as f64 / ch as f64),
     })
 }

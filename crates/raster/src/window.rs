@@ -4,9 +4,19 @@ use std::path::Path;
 
 use tinsmith_georef::Samples;
 
+use crate::coverage::coarse_read;
 use crate::error::{Error, Result};
 use crate::info::RasterInfo;
 use crate::read::OpenBand;
+
+/// Cells a side of [`WindowReader::has_valid_cell`]'s coarse look.
+const COARSE_SIDE: usize = 256;
+
+/// Cells with data the coarse look tries before the full scan.
+const COARSE_TRIES: usize = 16;
+
+/// The largest side, in samples, of the window read about a coarse cell with data.
+const NEAR: u32 = 256;
 
 /// One band of a raster kept open for reading windows of it, one after another.
 ///
@@ -121,9 +131,14 @@ impl WindowReader {
         })
     }
 
-    /// Whether the band has a 2x2 block of valid samples (a cell a TIN can cover): read in
-    /// bands of whole rows (about 2^20 samples, sharing a row), stopping at the first such
-    /// block, so a raster with data answers after its first band.
+    /// Whether the band has a 2x2 block of valid samples (a cell a TIN can cover).
+    ///
+    /// First a coarse look (at most 256 cells a side, from overviews where the file has
+    /// them): around each of the first few cells with data, a small window at full
+    /// resolution, which usually holds such a block. Otherwise the whole band in bands of
+    /// whole rows (about 2^20 samples, sharing a row), stopping at the first such block.
+    /// So the answer is exact, and quick for a raster with data, even one whose first rows
+    /// are all nodata (a land DEM of the globe starts with the Arctic Ocean).
     ///
     /// # Errors
     /// As [`WindowReader::read_window`].
@@ -131,6 +146,26 @@ impl WindowReader {
         let (width, height) = (self.width(), self.height());
         if width < 2 || height < 2 {
             return Ok(false);
+        }
+        let coarse = coarse_read(&self.opened, COARSE_SIDE)?;
+        let hits = coarse.values.iter().enumerate().filter(|(_, v)| v.is_finite());
+        for (k, _) in hits.take(COARSE_TRIES) {
+            let (i, j) = (k % coarse.width, k / coarse.width);
+            // The sample GDAL picked for the cell lies within it: the window is the cell,
+            // at most `NEAR` samples a side about its centre, at least 2.
+            let (cx, cy) = (
+                (i as f64 + 0.5) * coarse.cell.0,
+                (j as f64 + 0.5) * coarse.cell.1,
+            );
+            let span = |cell: f64, total: u32| (cell.ceil() as u32).clamp(2, NEAR).min(total);
+            let (w, h) = (span(coarse.cell.0, width), span(coarse.cell.1, height));
+            let start = |centre: f64, len: u32, total: u32| {
+                ((centre - f64::from(len) / 2.0).max(0.0) as u32).min(total - len)
+            };
+            let (x0, y0) = (start(cx, w, width), start(cy, h, height));
+            if self.read_window(x0, y0, w, h)?.valid_cell_count() > 0 {
+                return Ok(true);
+            }
         }
         let rows = ((1u32 << 20) / width).clamp(2, height);
         let mut y0 = 0;

@@ -188,7 +188,14 @@ fn a_valid_cell_is_found_wherever_it_is_and_only_if_there_is_one() {
     let wide = (1usize << 19, 4);
     let block = [(7, 1), (8, 1), (7, 2), (8, 2)];
     type Samples = Vec<(usize, usize)>;
-    let cases: [(&str, (usize, usize), Samples, bool); 5] = [
+    let cases: [(&str, (usize, usize), Samples, bool); 6] = [
+        // Nodata down to row 702: the coarse look (every 4th sample) lands on the block.
+        (
+            "far.tif",
+            (1024, 1024),
+            vec![(702, 702), (703, 702), (702, 703), (703, 703)],
+            true,
+        ),
         ("straddling.tif", wide, block.to_vec(), true),
         ("empty.tif", wide, vec![], false),
         // Valid samples, but no four of them in a 2x2 block.

@@ -133,12 +133,13 @@ impl WindowReader {
 
     /// Whether the band has a 2x2 block of valid samples (a cell a TIN can cover).
     ///
-    /// First a coarse look (at most 256 cells a side, from overviews where the file has
-    /// them): around each of the first few cells with data, a small window at full
-    /// resolution, which usually holds such a block. Otherwise the whole band in bands of
-    /// whole rows (about 2^20 samples, sharing a row), stopping at the first such block.
-    /// So the answer is exact, and quick for a raster with data, even one whose first rows
-    /// are all nodata (a land DEM of the globe starts with the Arctic Ocean).
+    /// The band is scanned in bands of whole rows (about 2^20 samples, sharing a row),
+    /// stopping at the first such block; but when the first band has none, a coarse look
+    /// comes before the rest of the scan (at most 256 cells a side, from overviews where
+    /// the file has them): around each of the first few cells with data, a small window
+    /// at full resolution, which usually holds such a block. So the answer is exact, and
+    /// quick for a raster with data, even one whose first rows are all nodata (a land DEM
+    /// of the globe starts with the Arctic Ocean).
     ///
     /// # Errors
     /// As [`WindowReader::read_window`].
@@ -147,8 +148,34 @@ impl WindowReader {
         if width < 2 || height < 2 {
             return Ok(false);
         }
+        let rows = ((1u32 << 20) / width).clamp(2, height);
+        let mut y0 = 0;
+        loop {
+            let band = rows.min(height - y0);
+            if self.read_window(0, y0, width, band)?.valid_cell_count() > 0 {
+                return Ok(true);
+            }
+            if y0 + band >= height {
+                return Ok(false);
+            }
+            if y0 == 0 && self.valid_cell_near_coarse_data()? {
+                return Ok(true);
+            }
+            // The next band starts on this one's last row: no cell is skipped.
+            y0 += band - 1;
+        }
+    }
+
+    /// Whether a window about one of the first cells with data of a coarse look at the
+    /// band holds a 2x2 block of valid samples (see [`WindowReader::has_valid_cell`]).
+    fn valid_cell_near_coarse_data(&self) -> Result<bool> {
+        let (width, height) = (self.width(), self.height());
         let coarse = coarse_read(&self.opened, COARSE_SIDE)?;
-        let hits = coarse.values.iter().enumerate().filter(|(_, v)| v.is_finite());
+        let hits = coarse
+            .values
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.is_finite());
         for (k, _) in hits.take(COARSE_TRIES) {
             let (i, j) = (k % coarse.width, k / coarse.width);
             // The sample GDAL picked for the cell lies within it: the window is the cell,
@@ -167,19 +194,7 @@ impl WindowReader {
                 return Ok(true);
             }
         }
-        let rows = ((1u32 << 20) / width).clamp(2, height);
-        let mut y0 = 0;
-        loop {
-            let band = rows.min(height - y0);
-            if self.read_window(0, y0, width, band)?.valid_cell_count() > 0 {
-                return Ok(true);
-            }
-            if y0 + band >= height {
-                return Ok(false);
-            }
-            // The next band starts on this one's last row: no cell is skipped.
-            y0 += band - 1;
-        }
+        Ok(false)
     }
 }
 

@@ -189,11 +189,12 @@ fn a_valid_cell_is_found_wherever_it_is_and_only_if_there_is_one() {
     let block = [(7, 1), (8, 1), (7, 2), (8, 2)];
     type Samples = Vec<(usize, usize)>;
     let cases: [(&str, (usize, usize), Samples, bool); 6] = [
-        // Nodata down to row 702: the coarse look (every 4th sample) lands on the block.
+        // Nodata in the first band of rows (256 of 4096 columns): the coarse look (every
+        // 16th sample) lands on the block, before the scan would.
         (
             "far.tif",
-            (1024, 1024),
-            vec![(702, 702), (703, 702), (702, 703), (703, 703)],
+            (4096, 1024),
+            vec![(712, 712), (713, 712), (712, 713), (713, 713)],
             true,
         ),
         ("straddling.tif", wide, block.to_vec(), true),

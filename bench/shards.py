@@ -99,15 +99,18 @@ def own_level_samples(work):
     return finest["level"], finest["tiles"] * TILE_CELLS ** 2
 
 
-def ring_overhead(split, anchor):
-    """Lattice area a global pyramid's blocks warp at the anchor level (each block's tiles
-    with a ring of one tile, clipped at the poles, as blocks.rs's block_window), over the
-    level's own area."""
+def reach_overhead(split, anchor):
+    """Lattice samples a global pyramid's blocks sample at the anchor level (each block's
+    tiles and the band of 3 x 2^(anchor - split) - 2 samples around them that its tiles and
+    filters read, clipped at the poles, as blocks.rs's block_level), over the level's own."""
     f = anchor - split
-    side, rows, turn = 1 << f, 1 << anchor, 2 << anchor
-    width = min(side + 2, turn)
-    heights = [min((y + 1) * side + 1, rows) - max(y * side - 1, 0) for y in range(1 << split)]
-    return width * sum(heights) * (2 << split) / (turn * rows)
+    margin = 3 * (1 << f) - 2
+    side = (1 << f) * TILE_CELLS
+    columns, rows = (2 << anchor) * TILE_CELLS, (1 << anchor) * TILE_CELLS
+    width = min(side + 2 * margin, columns)
+    heights = [min((y + 1) * side + margin, rows) - max(y * side - margin, 0)
+               for y in range(1 << split)]
+    return width * sum(heights) * (2 << split) / (columns * rows)
 
 
 def compare(args, label, path, repeat, single_thread=False):
@@ -198,11 +201,11 @@ def compare_markdown(c):
     global_ = plan["bounds"][:4] == [-180.0, -90.0, 180.0, 90.0]
     if global_:
         one_split = max(plan["anchor"] - 4, 0)
-        rings = (ring_overhead(one_split, plan["anchor"]),
-                 ring_overhead(plan["split"], plan["anchor"]))
-        ring_text = (f" Each block warps its tiles with a ring of one tile: at the anchor "
+        rings = (reach_overhead(one_split, plan["anchor"]),
+                 reach_overhead(plan["split"], plan["anchor"]))
+        ring_text = (f" Each block samples its tiles and a band around them: at the anchor "
                      f"level {plan['anchor']} the one process (blocks at level {one_split}) "
-                     f"warps {rings[0]:.3f} x the level's samples, the {SHARDS} shards "
+                     f"samples {rings[0]:.3f} x the level's samples, the {SHARDS} shards "
                      f"(blocks at level {plan['split']}, for at least 8 per shard) "
                      f"{rings[1]:.3f} x.")
     else:

@@ -142,35 +142,15 @@ impl Plan {
             hash.update(v.to_bits().to_le_bytes());
         }
         let fingerprint = hex(&hash.finalize());
-        // The coarsest split (fewest, largest blocks) that still gives every shard a few
-        // blocks to balance with.
-        let lowest = anchor.saturating_sub(BLOCK_DEPTH);
-        let split = (lowest..=anchor)
-            .find(|&s| domain(bounds, s).tiles() >= BLOCKS_PER_SHARD * u64::from(shards))
-            .unwrap_or(anchor);
-        let cut = Cut { anchor, split };
-        let all = blocks(bounds, cut);
-        let index = |x: u32, y: u32| {
-            all.iter()
-                .position(|b| tile_column(split, b.x0) == x && b.y0 == y)
-        };
-        let mut weights = vec![1u64; all.len()];
-        let size = 180.0 / (1u64 << split) as f64;
-        for (centre, value) in coverage.centres.iter().zip(&coverage.values) {
-            if !value.is_finite() || !centre[0].is_finite() || !centre[1].is_finite() {
-                continue;
-            }
-            let x = ((centre[0] + 180.0) / size)
-                .floor()
-                .rem_euclid(f64::from(2u32 << split));
-            let y = ((centre[1] + 90.0) / size).floor();
-            if y < 0.0 || y >= f64::from(1u32 << split) {
-                continue;
-            }
-            if let Some(k) = index(x as u32, y as u32) {
-                weights[k] += 1;
-            }
-        }
+        let centres: Vec<[f64; 2]> = coverage
+            .centres
+            .iter()
+            .zip(&coverage.values)
+            .filter(|(c, v)| v.is_finite() && c[0].is_finite() && c[1].is_finite())
+            .map(|(&c, _)| c)
+            .collect();
+        let cells = (coverage.width * coverage.height) as u64;
+        let (split, weights) = split_and_weights(bounds, anchor, shards, &centres, cells);
         Ok(Plan {
             input: input.display().to_string(),
             name: input
@@ -243,6 +223,66 @@ impl Plan {
     }
 }
 
+/// Where to cut a pyramid over `bounds` (anchored at `anchor`) for `shards` shards, and
+/// each block's weight: one, plus the coarse read's cells with data (`centres`, WGS84
+/// longitude and latitude, out of `cells` in all) that fall in it.
+///
+/// The split is the coarsest level (at most [`BLOCK_DEPTH`] above the anchor) that gives
+/// every shard [`BLOCKS_PER_SHARD`] blocks; then finer while the heaviest block weighs
+/// more than a quarter of a shard's share (whole blocks are the unit a shard's share is
+/// made of: a land DEM's blocks of sea weigh 1 and of land up to 17) and the coarse read
+/// still has 4 cells a block.
+pub(super) fn split_and_weights(
+    bounds: &GeoBounds,
+    anchor: u8,
+    shards: u32,
+    centres: &[[f64; 2]],
+    cells: u64,
+) -> (u8, Vec<u64>) {
+    let lowest = anchor.saturating_sub(BLOCK_DEPTH);
+    let mut split = (lowest..=anchor)
+        .find(|&s| domain(bounds, s).tiles() >= BLOCKS_PER_SHARD * u64::from(shards))
+        .unwrap_or(anchor);
+    let mut weights = block_weights(bounds, Cut { anchor, split }, centres);
+    while split < anchor && cells >= 4 * domain(bounds, split + 1).tiles() {
+        let total: u64 = weights.iter().sum();
+        let heaviest = weights.iter().copied().max().unwrap_or(0);
+        if heaviest * 4 * u64::from(shards) <= total {
+            break;
+        }
+        split += 1;
+        weights = block_weights(bounds, Cut { anchor, split }, centres);
+    }
+    (split, weights)
+}
+
+/// One plus the points of `centres` (longitude, latitude) in each block of `cut`, in block
+/// order.
+fn block_weights(bounds: &GeoBounds, cut: Cut, centres: &[[f64; 2]]) -> Vec<u64> {
+    let split = cut.split;
+    let all = blocks(bounds, cut);
+    let index: std::collections::HashMap<(u32, u32), usize> = all
+        .iter()
+        .enumerate()
+        .map(|(k, b)| ((tile_column(split, b.x0), b.y0), k))
+        .collect();
+    let mut weights = vec![1u64; all.len()];
+    let size = 180.0 / (1u64 << split) as f64;
+    for centre in centres {
+        let x = ((centre[0] + 180.0) / size)
+            .floor()
+            .rem_euclid(f64::from(2u32 << split));
+        let y = ((centre[1] + 90.0) / size).floor();
+        if y < 0.0 || y >= f64::from(1u32 << split) {
+            continue;
+        }
+        if let Some(&k) = index.get(&(x as u32, y as u32)) {
+            weights[k] += 1;
+        }
+    }
+    weights
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -267,6 +307,45 @@ mod tests {
             shards,
             weights,
         }
+    }
+
+    #[test]
+    fn lumpy_weights_cut_finer_until_no_block_outweighs_a_quarter_share() {
+        let globe = GeoBounds {
+            west: -180.0,
+            south: -90.0,
+            east: 180.0,
+            north: 90.0,
+            resolution: 0.05,
+        };
+        // A coarse read of 128 x 64 cells, one per 2.8 degrees.
+        let grid = |keep: &dyn Fn(f64, f64) -> bool| -> Vec<[f64; 2]> {
+            (0..64)
+                .flat_map(|j| (0..128).map(move |i| (i, j)))
+                .map(|(i, j)| {
+                    [
+                        -180.0 + (i as f64 + 0.5) * 2.8125,
+                        -90.0 + (j as f64 + 0.5) * 2.8125,
+                    ]
+                })
+                .filter(|c| keep(c[0], c[1]))
+                .collect()
+        };
+        let cells = 128 * 64;
+        // Data everywhere: the coarsest split with 8 blocks a shard (level 2: 32 blocks).
+        let (split, weights) = split_and_weights(&globe, 6, 4, &grid(&|_, _| true), cells);
+        assert_eq!((split, weights.len()), (2, 32));
+        // Data in one corner: finer, until the heaviest block is at most a quarter of a
+        // shard's share, or the coarse read has fewer than 4 cells a block.
+        let corner = grid(&|lon, lat| lon < -135.0 && lat < -45.0);
+        let (split, weights) = split_and_weights(&globe, 6, 4, &corner, cells);
+        // Level 2: one block of 257 in 288; level 3: four of 65 in 384; level 4: sixteen
+        // of 17 in 768, and 17 x 4 shards x 4 <= 768.
+        let total: u64 = weights.iter().sum();
+        assert_eq!((split, weights.iter().max(), total), (4, Some(&17), 768));
+        // No finer than the coarse read allows: 4 cells a block (level 4 has 512).
+        let (split, _) = split_and_weights(&globe, 6, 4, &corner, 2047);
+        assert_eq!(split, 3);
     }
 
     #[test]

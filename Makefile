@@ -8,10 +8,11 @@ DEMO_ERROR := 5
 VENV := .venv
 TOOLS := .tools
 # trimesh and numpy read our meshes back (tests/formats.rs); moto's standalone S3 server
-# and boto3 are a local S3 and an independent client (tests/object_storage.rs); Dask runs
-# the shards of a pyramid (tools/dask_tiles.py, tests/dask.rs); PyYAML reads deploy/.
+# and boto3 are a local S3 and an independent client (tests/object_storage.rs), and
+# azure-storage-blob the client for Azurite (npm, below); Dask runs the shards of a
+# pyramid (tools/dask_tiles.py, tests/dask.rs); PyYAML reads deploy/.
 PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
-  dask[distributed]==2026.8.0 pyyaml==6.0.4
+  azure-storage-blob==12.27.1 dask[distributed]==2026.8.0 pyyaml==6.0.4
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
 .PHONY: deps gdal oracles demo test bench-results bench-contour bench-compare bench-tiles bench-shards
@@ -66,9 +67,11 @@ $(TOOLS)/node_modules/gltf-validator/package.json:
 	npm install --prefix $(TOOLS) --no-audit --no-fund --silent $(NPM_ORACLES)
 
 ## The quantized-mesh oracles, pinned, in .tools/: the HERE quantized-mesh decoder (npm),
-## CesiumJS and playwright-core (npm) with Debian's Chromium for the real-client test.
+## CesiumJS and playwright-core (npm) with Debian's Chromium for the real-client test;
+## Azurite, Microsoft's Azure Storage emulator, for the az:// tests.
 ## Tests that need an oracle fail (never skip) when it is missing.
-ORACLES_NPM := @here/quantized-mesh-decoder@1.2.8 cesium@1.140.0 playwright-core@1.64.1
+ORACLES_NPM := @here/quantized-mesh-decoder@1.2.8 cesium@1.140.0 playwright-core@1.64.1 \
+  azurite@3.37.0
 .PHONY: qm-oracles
 qm-oracles:
 	@command -v npm >/dev/null || { echo "installing nodejs npm"; $(SUDO) apt-get update -qq && \
@@ -77,7 +80,8 @@ qm-oracles:
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends chromium; }
 	@if [ ! -f .tools/node_modules/@here/quantized-mesh-decoder/package.json ] || \
 	    [ ! -f .tools/node_modules/cesium/Build/Cesium/Cesium.js ] || \
-	    [ ! -f .tools/node_modules/playwright-core/package.json ]; then \
+	    [ ! -f .tools/node_modules/playwright-core/package.json ] || \
+	    [ ! -f .tools/node_modules/azurite/package.json ]; then \
 	  mkdir -p .tools && npm install --silent --no-audit --no-fund --prefix .tools $(ORACLES_NPM); \
 	fi
 

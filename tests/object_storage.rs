@@ -44,6 +44,17 @@ impl Moto {
         if tls {
             command.arg("-s");
         }
+        Moto::spawn(command)
+    }
+
+    /// The same server for Google Cloud Storage's client (`tests/oracles/moto_for_gcs.py`).
+    fn start_for_google() -> Moto {
+        let mut command = Command::new(repo().join(".venv/bin/python3"));
+        command.arg(repo().join("tests/oracles/moto_for_gcs.py"));
+        Moto::spawn(command)
+    }
+
+    fn spawn(mut command: Command) -> Moto {
         let mut child = command
             .stdin(Stdio::null())
             .stdout(Stdio::null())
@@ -600,4 +611,213 @@ fn a_bucket_that_goes_away_fails_the_run_and_a_re_run_completes_it() {
         .boto3("terrain", &["keys", "s/layer.json"])
         .trim()
         .is_empty());
+}
+
+/// A service account key that sends Google Cloud Storage's XML API, unauthenticated, to
+/// `endpoint` (fields `object_store` reads for test servers); returns its path.
+fn google_key_for(dir: &Dir, endpoint: &str) -> String {
+    let key = serde_json::json!({
+        "private_key": "unused",
+        "private_key_id": "unused",
+        "client_email": "tinsmith@example.invalid",
+        "disable_oauth": true,
+        "gcs_base_url": endpoint,
+    });
+    let path = dir.path("google-key.json");
+    std::fs::write(&path, key.to_string()).unwrap();
+    path.to_string_lossy().into_owned()
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn a_pyramid_goes_to_google_cloud_storage_through_its_own_client() {
+    // Google Cloud Storage's XML API (which `object_store`'s client speaks) is S3's for
+    // what the store does: moto serves it, and boto3 reads back what the Google client
+    // wrote.
+    let moto = Moto::start_for_google();
+    moto.boto3("terrain", &["mkbucket"]);
+    let dir = Dir::new();
+    let env = vec![(
+        "GOOGLE_SERVICE_ACCOUNT",
+        google_key_for(&dir, &moto.endpoint),
+    )];
+
+    let store = BucketStore::open_with_env("gs://terrain/direct/", env.clone()).unwrap();
+    assert_eq!(store.location(), "gs://terrain/direct");
+    store.probe().unwrap();
+    let tile = gzipped(b"a tile through the Google client");
+    store.put_tile(3, 5, 2, &tile, TileEncoding::Gzip).unwrap();
+    store.put_file("layer.json", b"{}").unwrap();
+    assert_eq!(store.get_tile(3, 5, 2).unwrap(), Some(tile.clone()));
+    assert_eq!(
+        store.list_files("").unwrap(),
+        ["3/5/2.terrain", "layer.json"]
+    );
+    let seen = moto.show("terrain", &["direct/3/5/2.terrain", "direct/layer.json"]);
+    assert_eq!(
+        seen["direct/3/5/2.terrain"]["content_type"],
+        "application/vnd.quantized-mesh"
+    );
+    assert_eq!(seen["direct/3/5/2.terrain"]["content_encoding"], "gzip");
+    assert_eq!(seen["direct/3/5/2.terrain"]["body"], hex(&tile));
+    assert_eq!(
+        seen["direct/layer.json"]["content_type"],
+        "application/json"
+    );
+    store.delete_tile(3, 5, 2).unwrap();
+    assert_eq!(store.get_tile(3, 5, 2).unwrap(), None);
+
+    // The binary: the same pyramid as on disk.
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    let run = |args: &[&str]| {
+        let o = run_with(&dir, &env, args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    };
+    run(&["tiles", &input, "-o", "local", "-q"]);
+    run(&["tiles", &input, "-o", "gs://terrain/pyramid", "-q"]);
+    let local: BTreeMap<String, String> = tree(&dir.path("local"))
+        .into_iter()
+        .filter(|(p, _)| !p.starts_with("tinsmith"))
+        .map(|(p, bytes)| (p.to_string_lossy().into_owned(), hex(&bytes)))
+        .collect();
+    let remote: BTreeMap<String, String> = bucket_tree(&moto, "terrain", "pyramid")
+        .into_iter()
+        .filter(|(k, _)| !k.starts_with("tinsmith/"))
+        .map(|(k, v)| (k, v.2))
+        .collect();
+    assert!(local.len() > 20);
+    assert_eq!(remote, local);
+}
+
+#[test]
+fn google_and_azure_urls_are_object_stores_and_say_what_they_lack() {
+    assert!(tinsmith_store::is_object_url("gs://bucket/prefix"));
+    assert!(tinsmith_store::is_object_url("AZ://container"));
+    assert!(!tinsmith_store::is_object_url("gcs://bucket"));
+    let no_vars: [(&str, &str); 0] = [];
+    let e = BucketStore::open_with_env("gs:///prefix", no_vars)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no bucket name after gs://"), "{e}");
+    // Azure needs an account: the client's own message, naming the URL.
+    let e = BucketStore::open_with_env("az://container/p", no_vars)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("az://container/p"), "{e}");
+    let emulator = [("AZURE_STORAGE_USE_EMULATOR", "true")];
+    let store = BucketStore::open_with_env("az://container/p", emulator).unwrap();
+    assert_eq!(store.location(), "az://container/p");
+}
+
+/// Azurite, Microsoft's Azure Storage emulator (npm, installed by `make deps` into
+/// .tools), serving blobs on 127.0.0.1, killed when dropped.
+struct Azurite {
+    child: Child,
+    /// `http://127.0.0.1:PORT`.
+    endpoint: String,
+    _data: Dir,
+}
+
+impl Azurite {
+    /// Starts the blob service and waits until it accepts connections. Fails the test when
+    /// Azurite is missing.
+    fn start() -> Azurite {
+        let bin = repo().join(".tools/node_modules/.bin/azurite-blob");
+        assert!(
+            bin.exists(),
+            "oracle missing: {} (azurite); run `make deps`",
+            bin.display()
+        );
+        // A port the system had free a moment ago.
+        let port = std::net::TcpListener::bind("127.0.0.1:0")
+            .and_then(|l| l.local_addr())
+            .expect("a free port")
+            .port();
+        let data = Dir::new();
+        let child = Command::new(&bin)
+            .args(["--blobHost", "127.0.0.1", "--blobPort", &port.to_string()])
+            .args(["--silent", "--skipApiVersionCheck", "--location"])
+            .arg(data.path(""))
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("azurite-blob starts");
+        let azurite = Azurite {
+            child,
+            endpoint: format!("http://127.0.0.1:{port}"),
+            _data: data,
+        };
+        let deadline = Instant::now() + Duration::from_secs(60);
+        while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+            assert!(Instant::now() < deadline, "azurite listening within 60 s");
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        azurite
+    }
+
+    /// Runs the azure-storage-blob client on `container`; returns its stdout.
+    fn client(&self, container: &str, args: &[&str]) -> String {
+        let python = repo().join(".venv/bin/python3");
+        let out = Command::new(&python)
+            .arg(repo().join("tests/oracles/azure_blobs.py"))
+            .args([&self.endpoint, container])
+            .args(args)
+            .output()
+            .unwrap_or_else(|e| panic!("{} runs: {e}", python.display()));
+        assert!(
+            out.status.success(),
+            "azure client {args:?}: {}",
+            stderr(&out)
+        );
+        stdout(&out)
+    }
+}
+
+impl Drop for Azurite {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn a_pyramid_goes_to_azure_blob_storage_as_it_goes_to_disk() {
+    let azurite = Azurite::start();
+    azurite.client("terrain", &["mkcontainer"]);
+    let dir = Dir::new();
+    let env = vec![
+        ("AZURE_STORAGE_USE_EMULATOR", "true".to_owned()),
+        ("AZURITE_BLOB_STORAGE_URL", azurite.endpoint.clone()),
+    ];
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    let run = |args: &[&str]| {
+        let o = run_with(&dir, &env, args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    };
+    run(&["tiles", &input, "-o", "local", "-q"]);
+    run(&["tiles", &input, "-o", "az://terrain/pyramid", "-q"]);
+    let local: BTreeMap<String, String> = tree(&dir.path("local"))
+        .into_iter()
+        .filter(|(p, _)| !p.starts_with("tinsmith"))
+        .map(|(p, bytes)| (p.to_string_lossy().into_owned(), hex(&bytes)))
+        .collect();
+    assert!(local.len() > 20);
+    let mut remote = BTreeMap::new();
+    for line in azurite.client("terrain", &["dump", "pyramid/"]).lines() {
+        let v: Value = serde_json::from_str(line).expect("a JSON line");
+        let key = v["key"].as_str().unwrap().strip_prefix("pyramid/").unwrap();
+        if key.starts_with("tinsmith/") {
+            continue;
+        }
+        if key.ends_with(".terrain") {
+            assert_eq!(v["content_type"], "application/vnd.quantized-mesh", "{key}");
+            assert_eq!(v["content_encoding"], "gzip", "{key}");
+        } else {
+            assert_eq!(v["content_type"], "application/json", "{key}");
+        }
+        remote.insert(key.to_owned(), v["body"].as_str().unwrap().to_owned());
+    }
+    assert_eq!(remote, local);
 }

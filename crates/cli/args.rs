@@ -55,9 +55,9 @@ pub struct TilesArgs {
     #[arg(required = true)]
     pub input: Option<PathBuf>,
     /// Output directory, new or empty: {z}/{x}/{y}.terrain and layer.json, moved into place
-    /// whole when done; or NAME.mbtiles (one file, written whole); or s3://bucket/prefix
-    /// (layer.json written last). With --shard, a directory or bucket every shard writes
-    /// into.
+    /// whole when done; or NAME.mbtiles (one file, written whole); or s3://bucket/prefix,
+    /// gs://bucket/prefix, az://container/prefix (layer.json written last). With --shard,
+    /// a directory or bucket every shard writes into.
     #[arg(short, long, required = true)]
     pub output: Option<PathBuf>,
     /// Build only shard I of N (I from 0 to N-1), balanced by valid samples, into OUTPUT

@@ -181,7 +181,7 @@ pub fn merge_tiles(
 
 /// Where `-o` puts a pyramid.
 enum Destination<'a> {
-    /// An object store (`s3://bucket/prefix`).
+    /// An object store (`s3://bucket/prefix`, `gs://...`, `az://...`).
     Bucket(&'a str),
     /// One MBTiles file (`.mbtiles`).
     Mbtiles,
@@ -202,8 +202,9 @@ fn destination(output: &Path) -> Destination<'_> {
     }
 }
 
-/// The store a pyramid built in shards goes to: an object store for an `s3://` URL
-/// (checked reachable before any work), else the directory `output` (made when missing).
+/// The store a pyramid built in shards goes to: an object store for an `s3://`, `gs://` or
+/// `az://` URL (checked reachable before any work), else the directory `output` (made when
+/// missing).
 /// Shards cannot share one MBTiles file.
 fn pyramid_store(output: &Path) -> Result<Box<dyn TileStore>> {
     match destination(output) {

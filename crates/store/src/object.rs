@@ -1,22 +1,34 @@
 //! A pyramid in an object store bucket (Amazon S3 or an S3-compatible server: MinIO, Ceph,
-//! R2, moto): one object per tile and per named file under a key prefix, each written with
-//! one PUT, through the `object_store` crate's client.
+//! R2, moto; Google Cloud Storage; Azure Blob Storage): one object per tile and per named
+//! file under a key prefix, each written with one PUT, through the `object_store` crate's
+//! clients.
 //!
 //! The [`TileStore`] trait is synchronous; the store owns a small tokio runtime and blocks
 //! on it, so it can be called from any thread (rayon's workers, or a thread already inside
 //! another tokio runtime, whose future is then driven on a scoped thread instead).
 //!
 //! # Configuration
-//! [`BucketStore::open`] takes `s3://bucket/prefix` (or `s3a://`) and reads everything else
-//! from the environment, as `object_store`'s `AmazonS3Builder::from_env` does: every
-//! `AWS_*` variable it knows, among them `AWS_ACCESS_KEY_ID`, `AWS_SECRET_ACCESS_KEY`,
-//! `AWS_SESSION_TOKEN`, `AWS_REGION` (else `AWS_DEFAULT_REGION`, else `us-east-1`),
-//! `AWS_ENDPOINT_URL` (an S3-compatible server), `AWS_ALLOW_HTTP` (required for an
-//! `http://` endpoint), `AWS_VIRTUAL_HOSTED_STYLE_REQUEST`, `AWS_SKIP_SIGNATURE`,
-//! `AWS_WEB_IDENTITY_TOKEN_FILE` with `AWS_ROLE_ARN`, the container credential variables,
-//! and the client settings `AWS_TIMEOUT` (default 30 s per request) and
-//! `AWS_CONNECT_TIMEOUT` (default 5 s). Without keys it asks the instance metadata service.
-//! `AWS_PROFILE` and `~/.aws/config` / `~/.aws/credentials` are **not** read.
+//! [`BucketStore::open`] takes `s3://bucket/prefix` (or `s3a://`), `gs://bucket/prefix` or
+//! `az://container/prefix` (or `azure://`) and reads everything else from the environment,
+//! as `object_store`'s builders' `from_env` do:
+//! - **S3**: every `AWS_*` variable the builder knows, among them `AWS_ACCESS_KEY_ID`,
+//!   `AWS_SECRET_ACCESS_KEY`, `AWS_SESSION_TOKEN`, `AWS_REGION` (else
+//!   `AWS_DEFAULT_REGION`, else `us-east-1`), `AWS_ENDPOINT_URL` (an S3-compatible
+//!   server), `AWS_ALLOW_HTTP` (required for an `http://` endpoint),
+//!   `AWS_VIRTUAL_HOSTED_STYLE_REQUEST`, `AWS_SKIP_SIGNATURE`,
+//!   `AWS_WEB_IDENTITY_TOKEN_FILE` with `AWS_ROLE_ARN`, the container credential variables,
+//!   and the client settings `AWS_TIMEOUT` (default 30 s per request) and
+//!   `AWS_CONNECT_TIMEOUT` (default 5 s). Without keys it asks the instance metadata
+//!   service. `AWS_PROFILE` and `~/.aws/config` / `~/.aws/credentials` are **not** read.
+//! - **Google Cloud Storage**: every `GOOGLE_*` variable the builder knows, among them
+//!   `GOOGLE_SERVICE_ACCOUNT` (a service account key file) and
+//!   `GOOGLE_APPLICATION_CREDENTIALS`; without them, the instance metadata service.
+//! - **Azure**: every `AZURE_*` variable the builder knows, among them
+//!   `AZURE_STORAGE_ACCOUNT_NAME`, `AZURE_STORAGE_ACCOUNT_KEY`, `AZURE_STORAGE_SAS_KEY`,
+//!   `AZURE_CLIENT_ID` / `AZURE_CLIENT_SECRET` / `AZURE_TENANT_ID`, and
+//!   `AZURE_STORAGE_USE_EMULATOR` (Azurite on 127.0.0.1:10000).
+//!
+//! Each client retries as [`retry_config`] says.
 
 use std::future::Future;
 use std::sync::Arc;
@@ -24,6 +36,8 @@ use std::time::Duration;
 
 use futures_util::TryStreamExt;
 use object_store::aws::{AmazonS3Builder, AmazonS3ConfigKey};
+use object_store::azure::MicrosoftAzureBuilder;
+use object_store::gcp::GoogleCloudStorageBuilder;
 use object_store::path::Path as ObjectPath;
 use object_store::{
     Attribute, Attributes, BackoffConfig, ClientConfigKey, ObjectStore, ObjectStoreExt, PutOptions,
@@ -35,8 +49,43 @@ use crate::{
     QUANTIZED_MESH_CONTENT_TYPE,
 };
 
-/// The URL schemes [`BucketStore::open`] accepts.
-const SCHEMES: [&str; 2] = ["s3", "s3a"];
+/// The object stores [`BucketStore::open`] reaches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Provider {
+    S3,
+    Google,
+    Azure,
+}
+
+impl Provider {
+    /// The provider of URL scheme `scheme` (any case): `s3`, `s3a`, `gs`, `az`, `azure`.
+    fn of_scheme(scheme: &str) -> Option<Provider> {
+        match scheme.to_ascii_lowercase().as_str() {
+            "s3" | "s3a" => Some(Provider::S3),
+            "gs" => Some(Provider::Google),
+            "az" | "azure" => Some(Provider::Azure),
+            _ => None,
+        }
+    }
+
+    /// The scheme the store's URL is written with in messages.
+    fn scheme(self) -> &'static str {
+        match self {
+            Provider::S3 => "s3",
+            Provider::Google => "gs",
+            Provider::Azure => "az",
+        }
+    }
+
+    /// The prefix of the environment variables the provider's builder reads.
+    fn variables(self) -> &'static str {
+        match self {
+            Provider::S3 => "AWS_",
+            Provider::Google => "GOOGLE_",
+            Provider::Azure => "AZURE_",
+        }
+    }
+}
 
 /// How often and how long a failed request is tried again: at most 4 more times, after
 /// random waits from 0.1 s up to twice the previous (at most 4 s), and none after 20 s.
@@ -54,20 +103,21 @@ fn retry_config() -> RetryConfig {
     }
 }
 
-/// Whether `destination` names an object store (`s3://...`) rather than a local path.
+/// Whether `destination` names an object store (`s3://...`, `gs://...`, `az://...`) rather
+/// than a local path.
 pub fn is_object_url(destination: &str) -> bool {
     destination
         .split_once("://")
-        .is_some_and(|(scheme, _)| SCHEMES.contains(&scheme.to_ascii_lowercase().as_str()))
+        .is_some_and(|(scheme, _)| Provider::of_scheme(scheme).is_some())
 }
 
 /// Tiles and named files as objects under `prefix` in a bucket. Tiles are stored with
 /// `Content-Type: application/vnd.quantized-mesh`, and `Content-Encoding: gzip` when
 /// gzipped, so that the bucket can serve them to CesiumJS as they are; `.json` files with
-/// `Content-Type: application/json`. Every error names the object's `s3://` URL.
+/// `Content-Type: application/json`. Every error names the object's URL.
 #[derive(Debug)]
 pub struct BucketStore {
-    /// `s3://bucket` or `s3://bucket/prefix`, without a trailing `/`.
+    /// `s3://bucket` or `s3://bucket/prefix` (or `gs://`, `az://`), without a trailing `/`.
     url: String,
     store: Arc<dyn ObjectStore>,
     prefix: ObjectPath,
@@ -85,20 +135,22 @@ impl BucketStore {
         }
     }
 
-    /// The store for `url` (`s3://bucket`, `s3://bucket/some/prefix/`), configured from
-    /// the environment (see the module documentation). Nothing is sent to the server:
-    /// [`BucketStore::probe`] checks that it can be reached.
+    /// The store for `url` (`s3://bucket`, `s3://bucket/some/prefix/`, `gs://...`,
+    /// `az://container/...`), configured from the environment (see the module
+    /// documentation). Nothing is sent to the server: [`BucketStore::probe`] checks that it
+    /// can be reached.
     ///
     /// # Errors
-    /// [`StoreError::Unusable`] when `url` is not an `s3://` URL with a bucket and a valid
-    /// prefix, when the environment's settings are invalid, or when the endpoint is
-    /// `http://` without `AWS_ALLOW_HTTP=true`.
+    /// [`StoreError::Unusable`] when `url` is not such a URL with a bucket and a valid
+    /// prefix, when the environment's settings are invalid or incomplete, or when an S3
+    /// endpoint is `http://` without `AWS_ALLOW_HTTP=true`.
     pub fn open(url: &str) -> StoreResult<BucketStore> {
         BucketStore::open_with_env(url, std::env::vars_os())
     }
 
-    /// [`BucketStore::open`] with `vars` in place of the process's environment: the
-    /// `AWS_*` names among them are read, others ignored.
+    /// [`BucketStore::open`] with `vars` in place of the process's environment: the names
+    /// the URL's provider reads (`AWS_*`, `GOOGLE_*`, `AZURE_*`) among them are read,
+    /// others ignored.
     ///
     /// # Errors
     /// As [`BucketStore::open`].
@@ -114,38 +166,65 @@ impl BucketStore {
             location: url.to_owned(),
             reason,
         };
-        let (scheme, rest) = url
+        let (provider, rest) = url
             .split_once("://")
-            .filter(|(scheme, _)| SCHEMES.contains(&scheme.to_ascii_lowercase().as_str()))
-            .ok_or_else(|| unusable("not an s3:// URL".into()))?;
+            .and_then(|(scheme, rest)| Some((Provider::of_scheme(scheme)?, rest)))
+            .ok_or_else(|| unusable("not an s3://, gs:// or az:// URL".into()))?;
+        let scheme = provider.scheme();
         let (bucket, prefix) = rest.split_once('/').unwrap_or((rest, ""));
         if bucket.is_empty() {
-            return Err(unusable("no bucket name after s3://".into()));
+            return Err(unusable(format!("no bucket name after {scheme}://")));
         }
         let prefix = prefix.trim_end_matches('/');
         let prefix = ObjectPath::parse(prefix)
             .map_err(|e| unusable(format!("the key prefix {prefix:?} is not usable: {e}")))?;
-
-        let mut builder = AmazonS3Builder::new();
-        for (key, value) in vars {
-            let (Some(key), Some(value)) = (key.as_ref().to_str(), value.as_ref().to_str()) else {
-                continue;
-            };
-            // As AmazonS3Builder::from_env: AWS_* names the builder knows.
-            if key.starts_with("AWS_") {
-                if let Ok(config_key) = key.to_ascii_lowercase().parse() {
-                    builder = builder.with_config(config_key, value);
-                }
-            }
-        }
-        let builder = builder
-            .with_url(format!("{scheme}://{bucket}"))
-            .with_retry(retry_config());
-        check_http_allowed(&builder).map_err(unusable)?;
+        // As the builders' from_env: the provider's names the builder knows.
+        let settings: Vec<(String, String)> = vars
+            .into_iter()
+            .filter_map(|(key, value)| {
+                let key = key.as_ref().to_str()?;
+                let value = value.as_ref().to_str()?;
+                key.starts_with(provider.variables())
+                    .then(|| (key.to_ascii_lowercase(), value.to_owned()))
+            })
+            .collect();
         // TLS through rustls with ring (the default, aws-lc-rs, adds 1.5 min to a build).
         // The process's default provider: an error means one is installed already.
         let _ = rustls::crypto::ring::default_provider().install_default();
-        let store = builder.build().map_err(|e| unusable(e.to_string()))?;
+        let bucket_url = format!("{scheme}://{bucket}");
+        let store: Arc<dyn ObjectStore> = match provider {
+            Provider::S3 => {
+                let mut builder = AmazonS3Builder::new();
+                for (key, value) in &settings {
+                    if let Ok(config_key) = key.parse() {
+                        builder = builder.with_config(config_key, value);
+                    }
+                }
+                let builder = builder.with_url(&bucket_url).with_retry(retry_config());
+                check_http_allowed(&builder).map_err(unusable)?;
+                Arc::new(builder.build().map_err(|e| unusable(e.to_string()))?)
+            }
+            Provider::Google => {
+                let mut builder = GoogleCloudStorageBuilder::new();
+                for (key, value) in &settings {
+                    if let Ok(config_key) = key.parse() {
+                        builder = builder.with_config(config_key, value);
+                    }
+                }
+                let builder = builder.with_url(&bucket_url).with_retry(retry_config());
+                Arc::new(builder.build().map_err(|e| unusable(e.to_string()))?)
+            }
+            Provider::Azure => {
+                let mut builder = MicrosoftAzureBuilder::new();
+                for (key, value) in &settings {
+                    if let Ok(config_key) = key.parse() {
+                        builder = builder.with_config(config_key, value);
+                    }
+                }
+                let builder = builder.with_url(&bucket_url).with_retry(retry_config());
+                Arc::new(builder.build().map_err(|e| unusable(e.to_string()))?)
+            }
+        };
         let runtime = tokio::runtime::Builder::new_multi_thread()
             .worker_threads(2)
             .thread_name("tinsmith-store")
@@ -153,13 +232,13 @@ impl BucketStore {
             .build()
             .map_err(|e| unusable(format!("cannot start the I/O runtime: {e}")))?;
         let url = if prefix.as_ref().is_empty() {
-            format!("s3://{bucket}")
+            bucket_url
         } else {
-            format!("s3://{bucket}/{prefix}")
+            format!("{bucket_url}/{prefix}")
         };
         Ok(BucketStore {
             url,
-            store: Arc::new(store),
+            store,
             prefix,
             runtime: Some(runtime),
         })
@@ -368,18 +447,23 @@ mod tests {
     const NO_VARS: [(&str, &str); 0] = [];
 
     #[test]
-    fn only_s3_urls_with_a_bucket_open() {
+    fn only_object_store_urls_with_a_bucket_open() {
         assert!(is_object_url("s3://b/p"));
         assert!(is_object_url("S3A://b"));
+        assert!(is_object_url("gs://b/p"));
+        assert!(is_object_url("azure://c"));
         assert!(!is_object_url("out/pyramid"));
         assert!(!is_object_url("/vsis3/b/k"));
         assert!(!is_object_url("file:///tmp/x"));
+        assert!(!is_object_url("gcs://b/p"));
         for bad in [
             "s3://",
             "s3:///prefix",
             "out/dir",
-            "gs://b/p",
+            "gcs://b/p",
             "s3://b/a//c",
+            "gs://",
+            "az://c/a//b",
         ] {
             let e = BucketStore::open_with_env(bad, NO_VARS).unwrap_err();
             assert!(

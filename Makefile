@@ -10,12 +10,13 @@ TOOLS := .tools
 # trimesh and numpy read our meshes back (tests/formats.rs); moto's standalone S3 server
 # and boto3 are a local S3 and an independent client (tests/object_storage.rs), and
 # azure-storage-blob the client for Azurite (npm, below); Dask runs the shards of a
-# pyramid (tools/dask_tiles.py, tests/dask.rs); PyYAML reads deploy/.
+# pyramid (tools/dask_tiles.py, tests/dask.rs); PyYAML reads deploy/; Pillow reads the
+# previews back (tests/preview.rs).
 PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
-  azure-storage-blob==12.27.1 dask[distributed]==2026.8.0 pyyaml==6.0.4
+  azure-storage-blob==12.27.1 dask[distributed]==2026.8.0 pyyaml==6.0.4 pillow==11.3.0
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps gdal oracles demo test bench-results bench-contour bench-compare bench-tiles bench-shards
+.PHONY: deps gdal oracles demo pictures test bench-results bench-contour bench-compare bench-tiles bench-shards
 
 ## Everything the tests need: GDAL, then the independent oracles.
 deps: gdal
@@ -92,6 +93,13 @@ demo: gdal
 	target/release/tinsmith info $(DEMO_DEM)
 	target/release/tinsmith mesh $(DEMO_DEM) --max-error $(DEMO_ERROR) -o out/demo.ply --report out/demo-report.json
 	target/release/tinsmith verify $(DEMO_DEM) out/demo.ply --max-error $(DEMO_ERROR)
+
+## The README's picture: the demo DEM's TIN at 20 m over its hillshade.
+pictures: gdal
+	cargo build --release --quiet
+	mkdir -p out docs/images
+	target/release/tinsmith mesh $(DEMO_DEM) --max-error 20 -o out/picture.ply -q
+	target/release/tinsmith preview $(DEMO_DEM) out/picture.ply -o docs/images/demo-tin.png --size 640
 
 ## Format, lints, docs and the whole test suite. The tests that read our files back with
 ## the oracles `make deps` installs are #[ignore]d, so that a bare `cargo test` passes with

@@ -12,6 +12,7 @@ mod formats;
 mod mbtiles;
 mod mesh_and_verify;
 mod object_storage;
+mod preview;
 mod serve;
 mod shards;
 mod tiled_mesh;

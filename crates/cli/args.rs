@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
 use tinsmith_formats::MeshFormat;
-use tinsmith_pipeline::{ServeOptions, VerifyJob};
+use tinsmith_pipeline::{PreviewJob, ServeOptions, VerifyJob};
 use tinsmith_terrain::TerrainOptions;
 
 pub use contour::ContourArgs;
@@ -44,6 +44,64 @@ pub enum Command {
     /// Serve a terrain pyramid (directory or MBTiles) over HTTP on 127.0.0.1, for CesiumJS.
     #[command(allow_negative_numbers = true)]
     Serve(ServeArgs),
+    /// Draw a PNG of a raster's hillshade with its TIN's edges, or the TIN's signed error.
+    #[command(allow_negative_numbers = true)]
+    Preview(PreviewArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct PreviewArgs {
+    /// The raster the mesh was made from.
+    pub input: PathBuf,
+    /// The mesh (any format `verify` reads); it must be a valid TIN of INPUT.
+    pub mesh: PathBuf,
+    /// The PNG to write (replaced only by a complete one).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// The picture's longer side in pixels (16 to 16384); each pixel shows the sample
+    /// nearest its centre.
+    #[arg(long, default_value_t = 1600)]
+    pub size: u32,
+    /// Draw the raster as a hillshade (gdaldem's default light). Without any of
+    /// --hillshade, --wireframe, --error: hillshade and wireframe.
+    #[arg(long)]
+    pub hillshade: bool,
+    /// Draw the TIN's edges.
+    #[arg(long)]
+    pub wireframe: bool,
+    /// Colour each pixel by the signed error TIN - raster (blue below, red above), with a
+    /// legend from -E to +E.
+    #[arg(long)]
+    pub error: bool,
+    /// E for --error's colours (default: the largest error measured).
+    #[arg(long, value_parser = parse_max_error, allow_hyphen_values = true)]
+    pub max_error: Option<f64>,
+    /// The mesh's format, whatever its extension (as `verify --format`).
+    #[arg(long, value_name = "NAME", value_parser = tinsmith_pipeline::parse_format)]
+    pub format: Option<MeshFormat>,
+    /// Band the mesh was made from (1-based).
+    #[arg(long, default_value_t = 1)]
+    pub band: usize,
+    /// The mesh holds (column, row, value) coordinates (it was written with --pixel-coords).
+    #[arg(long)]
+    pub pixel_coords: bool,
+}
+
+impl PreviewArgs {
+    /// The job these flags ask for.
+    pub fn job(&self) -> PreviewJob {
+        let mut job = PreviewJob::new(&self.input, &self.mesh, &self.output);
+        let none = !(self.hillshade || self.wireframe || self.error);
+        job.hillshade = self.hillshade || none;
+        job.wireframe = self.wireframe || none;
+        job.error = self.error;
+        job.max_error = self.max_error;
+        job.size = self.size;
+        job.format = self.format;
+        job.band = self.band;
+        job.pixel_coords = self.pixel_coords;
+        job
+    }
 }
 
 #[derive(Debug, Args)]

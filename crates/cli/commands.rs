@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 
-use crate::args::{ContourArgs, MeshArgs, ServeArgs, TilesArgs, TilesStep};
+use crate::args::{ContourArgs, MeshArgs, PreviewArgs, ServeArgs, TilesArgs, TilesStep};
 use crate::progress::Stderr;
 
 /// `tinsmith mesh`; `Ok(true)` once the verified mesh is written.
@@ -57,5 +57,26 @@ pub fn serve(args: &ServeArgs) -> Result<bool> {
     );
     let _ = stdout.flush();
     server.run(args.max_requests)?;
+    Ok(true)
+}
+
+/// `tinsmith preview`: draws the picture and says what it shows.
+pub fn preview(args: &PreviewArgs) -> Result<bool> {
+    let drawn = tinsmith_pipeline::preview(&args.job())?;
+    let scale = drawn
+        .error_scale
+        .map(|e| format!("; error colours span +/-{}", tinsmith_pipeline::readable(e)))
+        .unwrap_or_default();
+    eprintln!(
+        "wrote {} ({} x {} pixels, {} samples per pixel; {} vertices, {} triangles, max error \
+         {}{scale})",
+        args.output.display(),
+        drawn.width,
+        drawn.height,
+        tinsmith_pipeline::readable(drawn.samples_per_pixel),
+        drawn.vertices,
+        drawn.triangles,
+        tinsmith_pipeline::readable(drawn.max_error),
+    );
     Ok(true)
 }

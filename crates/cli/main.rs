@@ -56,7 +56,7 @@ fn main() -> ExitCode {
         Command::Mesh(a) => a.quiet,
         Command::Contour(a) => a.quiet,
         Command::Tiles(a) => a.quiet,
-        Command::Info(_) | Command::Verify(_) | Command::Serve(_) => true,
+        Command::Info(_) | Command::Verify(_) | Command::Serve(_) | Command::Preview(_) => true,
     };
     let result = match cli.command {
         Command::Info(a) => info::run(&a),
@@ -65,6 +65,7 @@ fn main() -> ExitCode {
         Command::Contour(a) => commands::contour(&a),
         Command::Tiles(a) => commands::tiles(&a),
         Command::Serve(a) => commands::serve(&a),
+        Command::Preview(a) => commands::preview(&a),
     };
     if tinsmith_output::interrupted() {
         // The signal handler is removing the unfinished output (the error, if any, comes

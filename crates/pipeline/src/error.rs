@@ -52,6 +52,9 @@ pub enum Error {
     /// A file position is not on a sample of the raster.
     #[error(transparent)]
     Position(#[from] tinsmith_georef::PositionError),
+    /// A picture could not be drawn.
+    #[error(transparent)]
+    Preview(#[from] tinsmith_preview::PreviewError),
     /// An I/O operation failed (the `io::Error` is also the source, so that a closed
     /// pipe can be told apart).
     #[error("{0}")]

@@ -288,3 +288,54 @@ impl VerifyJob {
         }
     }
 }
+
+/// `tinsmith preview`: a picture of a raster and a TIN of it.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct PreviewJob {
+    /// The raster the mesh was made from.
+    pub input: PathBuf,
+    /// The mesh file.
+    pub mesh: PathBuf,
+    /// The PNG to write (`.png`).
+    pub output: PathBuf,
+    /// The mesh's format, whatever its extension.
+    pub format: Option<MeshFormat>,
+    /// Band the mesh was made from, 1-based.
+    pub band: usize,
+    /// The mesh holds (column, row, value) coordinates.
+    pub pixel_coords: bool,
+    /// The picture's longer side, in pixels.
+    pub size: u32,
+    /// The raster as a hillshade.
+    pub hillshade: bool,
+    /// The TIN's edges.
+    pub wireframe: bool,
+    /// The signed error TIN - raster in colours, with a legend.
+    pub error: bool,
+    /// The bound the error colours span (default: the measured largest error).
+    pub max_error: Option<f64>,
+}
+
+impl PreviewJob {
+    /// A picture of `mesh` over `input` in `output`: 1600 pixels, hillshade and wireframe.
+    pub fn new(
+        input: impl Into<PathBuf>,
+        mesh: impl Into<PathBuf>,
+        output: impl Into<PathBuf>,
+    ) -> PreviewJob {
+        PreviewJob {
+            input: input.into(),
+            mesh: mesh.into(),
+            output: output.into(),
+            format: None,
+            band: 1,
+            pixel_coords: false,
+            size: 1600,
+            hillshade: true,
+            wireframe: true,
+            error: false,
+            max_error: None,
+        }
+    }
+}

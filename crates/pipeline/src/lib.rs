@@ -34,6 +34,7 @@ mod memory;
 mod mesh;
 mod mesh_file;
 mod output_paths;
+mod preview;
 mod report;
 mod scan;
 mod serve;
@@ -47,9 +48,12 @@ pub use contour::contour;
 pub use error::{Error, Result};
 pub use feedback::{Feedback, Silent};
 pub use format_plan::{parse_format, FormatPlan};
-pub use jobs::{ContourJob, ExportChoices, MeshJob, TileFormat, VerifyJob, DEFAULT_TILE_SIZE};
+pub use jobs::{
+    ContourJob, ExportChoices, MeshJob, PreviewJob, TileFormat, VerifyJob, DEFAULT_TILE_SIZE,
+};
 pub use memory::available_bytes;
 pub use mesh::mesh;
+pub use preview::{preview, Previewed};
 pub use scan::scan_raster;
 pub use serve::{serve, ServeOptions};
 pub use tiles::{merge_tiles, tiles, tiles_shard};

@@ -52,6 +52,7 @@ mod predicates;
 mod problems;
 mod report;
 mod scan_convert;
+mod surface;
 mod verify;
 
 pub use error::{Result, VerifyError};
@@ -59,4 +60,5 @@ pub use grid::GridRef;
 pub use mesh::MeshRef;
 pub use options::{Orientation, VerifyOptions};
 pub use report::{ErrorLocation, Report};
+pub use surface::surface;
 pub use verify::verify;

@@ -1,0 +1,191 @@
+//! `tinsmith preview`: a picture of a raster and a TIN of it, as a PNG.
+
+use tinsmith_georef::Placement;
+use tinsmith_preview::{encode_png, render, Layers, Scene};
+use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
+
+use crate::error::{bail, Context};
+use crate::mesh_file::{
+    expected_orientation, mesh_format, orient_polygon_triangles, read_mesh_file, sample_positions,
+};
+use crate::{PreviewJob, Result};
+
+/// What [`preview`] drew.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct Previewed {
+    /// Pixels across and down.
+    pub width: u32,
+    /// Pixels down.
+    pub height: u32,
+    /// Raster samples per pixel along each axis.
+    pub samples_per_pixel: f64,
+    /// The mesh's vertices and triangles.
+    pub vertices: usize,
+    /// Triangles of the mesh.
+    pub triangles: usize,
+    /// The largest error the verifier measured.
+    pub max_error: f64,
+    /// The bound the error colours span, when drawn.
+    pub error_scale: Option<f64>,
+}
+
+/// Reads the mesh back onto its raster as `verify` does, refuses one that is not a valid
+/// TIN of it (naming the verifier's first problem), draws the layers the job asks for and
+/// writes the PNG atomically (an existing file is replaced only by a complete one). The
+/// PNG's text chunks name the input, the mesh, the counts and the error bound.
+///
+/// # Errors
+/// As `verify`, and when the output does not end in `.png`, is the input, cannot be
+/// written, or the size is outside 16 to 16,384 pixels.
+pub fn preview(job: &PreviewJob) -> Result<Previewed> {
+    let is_png = job
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !is_png {
+        bail!(
+            "{}: a preview is a PNG; give an output ending in .png",
+            job.output.display()
+        );
+    }
+    if !(16..=16_384).contains(&job.size) {
+        bail!(
+            "--size {}: a preview is 16 to 16384 pixels on its longer side",
+            job.size
+        );
+    }
+    crate::output_paths::check_writable_target(&job.output, &job.input)?;
+    let format = mesh_format(&job.mesh, job.format)?;
+    crate::memory::check_whole_raster_fits(
+        &job.input,
+        crate::memory::raster_size(&job.input, job.band)?,
+        crate::memory::Need {
+            bytes_per_sample: 40,
+            extra_bytes: crate::memory::mesh_file_memory(&job.mesh, format),
+        },
+        "preview",
+        "a preview reads the whole raster; use a machine with more memory",
+    )?;
+    let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
+    crate::transform_check::check_transform(&raster.info, job.pixel_coords)?;
+    let placement = Placement::new(raster.info.transform(), job.pixel_coords);
+    let mesh = read_mesh_file(&job.mesh, format, &raster, placement)?;
+    let positions = sample_positions(&job.mesh, &mesh, format, &raster, placement)?;
+    let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();
+    let orientation = expected_orientation(&placement);
+    let mut triangles = mesh.triangles;
+    orient_polygon_triangles(format, &positions, &mut triangles, orientation);
+    let grid = &raster.samples;
+    let (width, height) = (grid.width(), grid.height());
+    let tin = MeshRef::new(&positions, &heights, &triangles);
+    let report = tinsmith_verify::verify(
+        GridRef::new(width, height, grid.values()),
+        tin,
+        &VerifyOptions::new().with_orientation(orientation),
+    )
+    .with_context(|| format!("{}: cannot verify", job.mesh.display()))?;
+    if !report.mesh_is_valid() {
+        bail!(
+            "{}: not a valid TIN of {} ({}); `tinsmith verify` says more",
+            job.mesh.display(),
+            job.input.display(),
+            report
+                .problems
+                .first()
+                .map_or("the verifier found problems", String::as_str)
+        );
+    }
+    let surface = if job.error {
+        Some(tinsmith_verify::surface(width, height, tin)?)
+    } else {
+        None
+    };
+    let error_scale = job.error.then(|| {
+        job.max_error
+            .filter(|&e| e > 0.0)
+            .unwrap_or(if report.max_error > 0.0 {
+                report.max_error
+            } else {
+                1.0
+            })
+    });
+    let scene = Scene {
+        width,
+        height,
+        values: grid.values(),
+        resolution: resolution(&raster.info, job.pixel_coords),
+        positions: &positions,
+        triangles: &triangles,
+        surface: surface.as_deref(),
+    };
+    let layers = Layers {
+        hillshade: job.hillshade,
+        wireframe: job.wireframe,
+        error: error_scale,
+        title: match job.max_error {
+            Some(_) => "error, TIN - raster (to the bound)".into(),
+            None => "error, TIN - raster (to the largest)".into(),
+        },
+    };
+    let picture = render(&scene, &layers, job.size)?;
+    let text = [
+        (
+            "Software",
+            format!("tinsmith {}", env!("CARGO_PKG_VERSION")),
+        ),
+        ("Source", job.input.display().to_string()),
+        ("Mesh", job.mesh.display().to_string()),
+        (
+            "Counts",
+            format!(
+                "{} vertices, {} triangles",
+                positions.len(),
+                triangles.len()
+            ),
+        ),
+        ("Max error", tinsmith_georef::readable(report.max_error)),
+        (
+            "Error scale",
+            error_scale.map_or("none".into(), tinsmith_georef::readable),
+        ),
+        (
+            "Samples per pixel",
+            tinsmith_georef::readable(picture.samples_per_pixel),
+        ),
+    ];
+    let bytes = encode_png(&picture, &text);
+    tinsmith_output::write_bytes_atomically(&job.output, &bytes)
+        .with_context(|| format!("{}: cannot write", job.output.display()))?;
+    Ok(Previewed {
+        width: picture.width,
+        height: picture.height,
+        samples_per_pixel: picture.samples_per_pixel,
+        vertices: positions.len(),
+        triangles: triangles.len(),
+        max_error: report.max_error,
+        error_scale,
+    })
+}
+
+/// Sample spacing for the hillshade, in metres where the raster's CRS is geographic
+/// (degrees at the raster's middle latitude), else in its own units; one unit a sample
+/// for a raster without a transform or a mesh in pixel coordinates.
+fn resolution(info: &tinsmith_raster::RasterInfo, pixel_coords: bool) -> [f64; 2] {
+    let Some(gt) = info.geo_transform.filter(|_| !pixel_coords) else {
+        return [1.0, -1.0];
+    };
+    let geographic = info
+        .crs_wkt
+        .as_deref()
+        .is_some_and(|wkt| tinsmith_raster::is_geographic(wkt).unwrap_or(false));
+    if !geographic {
+        return [gt[1], gt[5]];
+    }
+    let middle = gt[3] + gt[5] * f64::from(info.height) / 2.0;
+    let metres = 111_320.0;
+    [
+        gt[1] * metres * middle.to_radians().cos().max(0.01),
+        gt[5] * metres,
+    ]
+}

@@ -94,12 +94,15 @@ demo: gdal
 	target/release/tinsmith mesh $(DEMO_DEM) --max-error $(DEMO_ERROR) -o out/demo.ply --report out/demo-report.json
 	target/release/tinsmith verify $(DEMO_DEM) out/demo.ply --max-error $(DEMO_ERROR)
 
-## The README's picture: the demo DEM's TIN at 20 m over its hillshade.
-pictures: gdal
+## The docs' pictures: the README's (the demo DEM's TIN at 20 m over its hillshade), and
+## tinsmith's TIN beside hmm's on two DEMs of ../shared (docs/results.md, "Pictures").
+pictures: deps
 	cargo build --release --quiet
 	mkdir -p out docs/images
 	target/release/tinsmith mesh $(DEMO_DEM) --max-error 20 -o out/picture.ply -q
 	target/release/tinsmith preview $(DEMO_DEM) out/picture.ply -o docs/images/demo-tin.png --size 640
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check pydelatin rasterio
+	$(VENV)/bin/python bench/pictures.py --shared ../shared
 
 ## Format, lints, docs and the whole test suite. The tests that read our files back with
 ## the oracles `make deps` installs are #[ignore]d, so that a bare `cargo test` passes with

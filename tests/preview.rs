@@ -100,7 +100,7 @@ fn a_preview_shows_the_tins_edges_where_the_mesh_has_them() {
     let points: Vec<(u32, u32)> = on_edges.iter().chain(&inside).copied().collect();
     let wired = pillow(&dir.path("wired.png"), &points);
     let plain = pillow(&dir.path("plain.png"), &points);
-    assert_eq!(wired["mode"], "RGBA");
+    assert_eq!(wired["mode"], "RGB");
     assert_eq!(
         wired["width"]
             .as_u64()

@@ -114,7 +114,8 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
         width,
         height,
         values: grid.values(),
-        resolution: resolution(&raster.info, job.pixel_coords),
+        resolution: resolution(&raster.info)
+            .unwrap_or_else(|| unit_free_resolution(grid.values(), width as usize)),
         positions: &positions,
         triangles: &triangles,
         surface: surface.as_deref(),
@@ -169,23 +170,41 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
 }
 
 /// Sample spacing for the hillshade, in metres where the raster's CRS is geographic
-/// (degrees at the raster's middle latitude), else in its own units; one unit a sample
-/// for a raster without a transform or a mesh in pixel coordinates.
-fn resolution(info: &tinsmith_raster::RasterInfo, pixel_coords: bool) -> [f64; 2] {
-    let Some(gt) = info.geo_transform.filter(|_| !pixel_coords) else {
-        return [1.0, -1.0];
-    };
+/// (degrees at the raster's middle latitude), else in its own units; `None` for a raster
+/// without a transform.
+fn resolution(info: &tinsmith_raster::RasterInfo) -> Option<[f64; 2]> {
+    let gt = info.geo_transform?;
     let geographic = info
         .crs_wkt
         .as_deref()
         .is_some_and(|wkt| tinsmith_raster::is_geographic(wkt).unwrap_or(false));
     if !geographic {
-        return [gt[1], gt[5]];
+        return Some([gt[1], gt[5]]);
     }
     let middle = gt[3] + gt[5] * f64::from(info.height) / 2.0;
     let metres = 111_320.0;
-    [
+    Some([
         gt[1] * metres * middle.to_radians().cos().max(0.01),
         gt[5] * metres,
-    ]
+    ])
+}
+
+/// A sample spacing for a raster whose spacing is unknown (no transform): the one that
+/// makes the steepest tenth of its steps between neighbours 45°, so that its relief reads
+/// whatever the heights' unit.
+fn unit_free_resolution(values: &[f64], width: usize) -> [f64; 2] {
+    let mut steps: Vec<f64> = values
+        .windows(2)
+        .enumerate()
+        .filter(|(k, _)| (k + 1) % width != 0)
+        .map(|(_, pair)| (pair[1] - pair[0]).abs())
+        .filter(|d| d.is_finite())
+        .collect();
+    if steps.is_empty() {
+        return [1.0, -1.0];
+    }
+    let k = steps.len() * 9 / 10;
+    let (_, step, _) = steps.select_nth_unstable_by(k, f64::total_cmp);
+    let spacing = if *step > 0.0 { *step } else { 1.0 };
+    [spacing, -spacing]
 }

@@ -2,23 +2,32 @@
 
 use crate::Picture;
 
-/// The picture as an 8-bit RGBA PNG, with one `tEXt` chunk per `(keyword, text)` (PNG
+/// The picture as an 8-bit RGB PNG (it is opaque), with one `tEXt` chunk per
+/// `(keyword, text)` (PNG
 /// keywords are 1 to 79 Latin-1 characters; others are left out). No time chunk: the
 /// same picture and text give the same bytes.
 pub fn encode_png(picture: &Picture, text: &[(&str, String)]) -> Vec<u8> {
     let mut bytes = Vec::new();
     {
         let mut encoder = png::Encoder::new(&mut bytes, picture.width, picture.height);
-        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
+        // Pictures go into docs and repositories: the smallest files the encoder makes.
+        encoder.set_compression(png::Compression::High);
+        encoder.set_filter(png::Filter::Adaptive);
         for (keyword, value) in text {
             // Refused keywords and non-Latin-1 text are left out rather than failing.
             let _ = encoder.add_text_chunk(keyword.to_string(), value.clone());
         }
         let mut writer = encoder.write_header().expect("writing to memory");
+        let rgb: Vec<u8> = picture
+            .rgba
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
         writer
-            .write_image_data(&picture.rgba)
-            .expect("width x height x 4 bytes");
+            .write_image_data(&rgb)
+            .expect("width x height x 3 bytes");
     }
     bytes
 }
@@ -42,7 +51,12 @@ mod tests {
         let mut out = vec![0; reader.output_buffer_size().unwrap()];
         let info = reader.next_frame(&mut out).unwrap();
         assert_eq!((info.width, info.height), (3, 2));
-        assert_eq!(&out[..info.buffer_size()], &picture.rgba[..]);
+        let rgb: Vec<u8> = picture
+            .rgba
+            .chunks(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
+        assert_eq!(&out[..info.buffer_size()], &rgb[..]);
         let texts = &reader.info().uncompressed_latin1_text;
         assert!(texts
             .iter()

@@ -1,0 +1,88 @@
+#!/usr/bin/env python3
+"""Pictures for docs/results.md ("Pictures"): tinsmith's TIN beside hmm's (pydelatin) at
+the same epsilon on two real DEMs, each drawn by `tinsmith preview` over the DEM's
+hillshade, with both meshes' triangle counts and their error measured by `tinsmith verify`.
+
+Setup and run (from the repository root; `make pictures` does both):
+    .venv/bin/pip install pydelatin numpy rasterio
+    .venv/bin/python bench/pictures.py [--shared ../shared] [--out docs/images]
+Prints the Markdown of the section.
+"""
+import argparse
+import importlib.util
+import pathlib
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+from pydelatin import Delatin
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+# (case of bench/compare.py, epsilon, picture size)
+PICTURES = [("bigtujunga", 30.0, 800), ("fuji", 20.0, 560)]
+
+
+def compare_module():
+    """bench/compare.py, for its DEM list, loader and writers."""
+    spec = importlib.util.spec_from_file_location("compare", ROOT / "bench/compare.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def run(cmd):
+    p = subprocess.run([str(c) for c in cmd], capture_output=True, text=True)
+    if p.returncode != 0:
+        sys.exit(f"{cmd[0]} {cmd[1]} failed: {p.stderr}")
+    return p
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--shared", default="../shared")
+    ap.add_argument("--bin", default=str(ROOT / "target/release/tinsmith"))
+    ap.add_argument("--out", default=str(ROOT / "docs/images"))
+    args = ap.parse_args()
+    compare = compare_module()
+    data = pathlib.Path(args.shared) / "data"
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    lines = []
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = pathlib.Path(tmp)
+        for name, eps, size in PICTURES:
+            rel, decode = compare.CASES[name]
+            grid = compare.load(data / rel, decode)
+            raster = tmp / f"{name}.tif"
+            compare.write_tif(raster, grid)
+            h, w = grid.shape
+            ours, theirs = tmp / f"{name}-tinsmith.ply", tmp / f"{name}-hmm.obj"
+            run([args.bin, "mesh", raster, "-o", ours, "--max-error", eps, "--pixel-coords",
+                 "-q", "--threads", "1"])
+            tin = Delatin(grid.astype(np.float32), max_error=eps)
+            compare.write_obj(theirs, tin.vertices, tin.triangles, h)
+            counts = {}
+            for label, mesh in (("tinsmith", ours), ("hmm", theirs)):
+                report = compare.verify(args.bin, raster, mesh, eps)
+                counts[label] = (report["triangles"], report["max_error"])
+                png = out / f"{name}-{label}.png"
+                run([args.bin, "preview", raster, mesh, "-o", png, "--pixel-coords",
+                     "--size", size])
+            (t_tris, t_err), (h_tris, h_err) = counts["tinsmith"], counts["hmm"]
+            lines += [
+                f"**{name}** ({w} x {h} samples), ε = {eps:g}: tinsmith {t_tris:,} triangles "
+                f"(measured max error {t_err:.3g}), hmm {h_tris:,} (measured {h_err:.3g}): "
+                f"{t_tris / h_tris:.2f} x.",
+                "",
+                f"| tinsmith, {t_tris:,} triangles | hmm, {h_tris:,} triangles |",
+                "|---|---|",
+                f"| ![tinsmith's TIN of {name}](images/{name}-tinsmith.png) "
+                f"| ![hmm's TIN of {name}](images/{name}-hmm.png) |",
+                "",
+            ]
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()

@@ -1100,6 +1100,51 @@ fn an_interrupted_run_leaves_no_temporary_file() {
 
 #[cfg(unix)]
 #[test]
+fn an_interrupt_after_the_first_output_is_in_place_completes_the_run() {
+    // One rule for every command and output: a signal before the first output is renamed
+    // into place cancels the run and leaves every old output; after it, the run puts the
+    // rest in place and exits 0. The hook sends the signal just after that first rename
+    // (the mesh, or an OBJ's .prj sidecar, or the pyramid), when the report is still old.
+    let d = Dir::new();
+    for (signal, args) in [
+        ("2", ["mesh", "-o", "out.ply", "--max-error", "1"]),
+        ("15", ["mesh", "-o", "out.obj", "--max-error", "1"]),
+        ("2", ["tiles", "-o", "terrain", "--band", "1"]),
+    ] {
+        let output = args[2];
+        if args[0] == "mesh" {
+            d.write(output, "old");
+        }
+        d.write("r.json", "old");
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+            .args([args[0], &dem()])
+            .args(&args[1..])
+            .args(["--report", "r.json", "-q"])
+            .env("TINSMITH_TEST_SIGNAL_AFTER_PLACING", signal)
+            .current_dir(d.path(""))
+            .output()
+            .expect("run tinsmith");
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {err}");
+        assert!(!err.contains("interrupted"), "{err}");
+        let report = std::fs::read_to_string(d.path("r.json")).unwrap();
+        assert!(
+            report.starts_with('{'),
+            "{args:?}: the report is still the old one"
+        );
+        let written = d.path(output);
+        assert!(written.is_dir() || std::fs::read(&written).unwrap() != b"old");
+        let left: Vec<String> = d
+            .files()
+            .into_iter()
+            .filter(|f| f.starts_with(".tinsmith-"))
+            .collect();
+        assert!(left.is_empty(), "{args:?}: {left:?}");
+    }
+}
+
+#[cfg(unix)]
+#[test]
 fn a_killed_runs_temporary_file_is_removed_by_the_next_run_there() {
     // SIGKILL (the out-of-memory killer) gives no chance to clean up: the temporary file
     // stays, and the next run writing in that directory removes it once it is a minute

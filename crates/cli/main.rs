@@ -171,10 +171,13 @@ fn is_broken_pipe(err: &anyhow::Error) -> bool {
     err.chain().any(broken)
 }
 
-/// Starts the thread that, on SIGINT, SIGTERM or SIGHUP, removes unfinished output and
-/// exits with 128 + the signal's number (0 when every output is already complete). If
-/// the handlers cannot be registered, the signals keep their default action (the process
-/// ends at once, leaving its temporary files).
+/// Starts the thread that, on SIGINT, SIGTERM or SIGHUP, applies `tinsmith_output`'s one
+/// rule (see `tinsmith_output::on_signal`): before the run's first output is in place it
+/// removes the unfinished output and exits with 128 + the signal's number, every old
+/// output left as it was; after, it lets the run put the rest in place and exit 0 (a
+/// second signal while it does ends the process at once). If the handlers cannot be
+/// registered, the signals keep their default action (the process ends at once, leaving
+/// its temporary files).
 fn on_signal_remove_pending_output() {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
@@ -188,15 +191,34 @@ fn on_signal_remove_pending_output() {
             let Some(signal) = signals.forever().next() else {
                 return;
             };
-            if tinsmith_output::finished() {
-                // Every output is complete and in place; only memory was being freed.
-                // SAFETY: as below.
-                unsafe { libc::_exit(0) }
-            }
-            if tinsmith_output::remove_pending() > 0 {
-                note!("\ntinsmith: interrupted; unfinished output removed");
-            } else {
-                note!("\ntinsmith: interrupted");
+            match tinsmith_output::on_signal() {
+                tinsmith_output::Interrupt::Completing => {
+                    if !tinsmith_output::finished() {
+                        note!(
+                            "\ntinsmith: signal received while the outputs were being put in \
+                             place; finishing them (signal again to stop at once)"
+                        );
+                    }
+                    // The rest is renames and a report: moments. `main` may also end first,
+                    // with the run's own exit code.
+                    while !tinsmith_output::finished() {
+                        if let Some(again) = signals.pending().next() {
+                            // SAFETY: as below.
+                            unsafe { libc::_exit(EXIT_SIGNALLED + again) }
+                        }
+                        std::thread::sleep(std::time::Duration::from_millis(10));
+                    }
+                    // Every output is complete and in place; only memory is being freed.
+                    // SAFETY: as below.
+                    unsafe { libc::_exit(0) }
+                }
+                tinsmith_output::Interrupt::Cancelled { removed } => {
+                    if removed > 0 {
+                        note!("\ntinsmith: interrupted; unfinished output removed");
+                    } else {
+                        note!("\ntinsmith: interrupted");
+                    }
+                }
             }
             // SAFETY: `_exit` takes no pointers and never returns. Unlike `process::exit`
             // it runs no atexit handlers, which would tear GDAL's global state down under

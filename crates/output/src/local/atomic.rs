@@ -50,11 +50,11 @@ where
         return main.commit();
     };
     let side = stage(sidecar_path, |w| w.write_all(bytes))?;
-    crate::pending::commit_together(|| {
-        side.commit()?;
-        main.commit().inspect_err(|_| {
-            let _ = std::fs::remove_file(sidecar_path);
-        })
+    // Once the sidecar is in place, a signal lets the run complete (see
+    // `crate::on_signal`): the main file follows it.
+    side.commit()?;
+    main.commit().inspect_err(|_| {
+        let _ = std::fs::remove_file(sidecar_path);
     })
 }
 
@@ -95,7 +95,7 @@ impl Staged {
 }
 
 /// A temporary file `.tinsmith-*.tmp` beside the file it is to replace, registered for
-/// removal on a signal (see [`crate::remove_pending`]) until [`StagedFile::commit`] renames
+/// removal on a signal (see [`crate::on_signal`]) until [`StagedFile::commit`] renames
 /// it over its target; dropped without that, it is removed.
 #[derive(Debug)]
 pub struct StagedFile {
@@ -156,13 +156,14 @@ pub(crate) enum Temp {
 }
 
 /// Renames a staged temporary over `target`: the one step by which every output (a file,
-/// its sidecar, a whole directory) appears in place. The temporary stays locked until
-/// the rename is done (a sweep cannot take it between); on failure it is removed.
+/// its sidecar, a whole directory) appears in place, and the run's commit point (see
+/// [`crate::on_signal`]). The temporary stays locked until the rename is done (a sweep
+/// cannot take it between); on failure it is removed.
 pub(crate) fn publish(temp: Temp, target: &Path) -> io::Result<()> {
-    match temp {
+    crate::pending::place(|| match temp {
         Temp::File(temp) => temp.persist(target).map(drop).map_err(|error| error.error),
         Temp::Dir(dir) => dir.rename_into_place(target),
-    }
+    })
 }
 
 /// Gives the temporary file at `temp` the permissions of the regular file at `target` it

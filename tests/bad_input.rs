@@ -454,6 +454,64 @@ fn verify_against_the_wrong_band_says_which_band_it_read() {
 }
 
 #[test]
+fn verify_against_another_raster_on_the_same_lattice_says_it_is_not_its_mesh() {
+    // A crop of the meshed DEM, as a raster of its own: its grid holds the lattice of the
+    // mesh's vertices but not their extent. That was exit 1 ("max error: 0", "vertex
+    // outside the grid"); like a mesh off the lattice, it is another raster's mesh: 2.
+    let d = Dir::new();
+    let dem = dem();
+    let o = d.run(&["mesh", &dem, "-o", "m.ply", "--max-error", "1", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info = tinsmith_raster::open_info(std::path::Path::new(&dem), 1).expect("info");
+    let g = info.geo_transform.expect("a geotransform");
+    let (x0, y0) = (20.0, 10.0);
+    let crop = [
+        g[0] + x0 * g[1] + y0 * g[2],
+        g[1],
+        g[2],
+        g[3] + x0 * g[4] + y0 * g[5],
+        g[4],
+        g[5],
+    ];
+    d.write(
+        "crop.vrt",
+        &format!(
+            r#"<VRTDataset rasterXSize="60" rasterYSize="50">
+  <GeoTransform>{:?}, {:?}, {:?}, {:?}, {:?}, {:?}</GeoTransform>
+  <VRTRasterBand dataType="Float32" band="1">
+    <NoDataValue>-3.4028234663852886e+38</NoDataValue>
+    <SimpleSource>
+      <SourceFilename relativeToVRT="0">{dem}</SourceFilename>
+      <SourceBand>1</SourceBand>
+      <SrcRect xOff="20" yOff="10" xSize="60" ySize="50"/>
+      <DstRect xOff="0" yOff="0" xSize="60" ySize="50"/>
+    </SimpleSource>
+  </VRTRasterBand>
+</VRTDataset>
+"#,
+            crop[0], crop[1], crop[2], crop[3], crop[4], crop[5]
+        ),
+    );
+    for command in ["verify", "contour"] {
+        let o = match command {
+            "verify" => d.run(&["verify", "crop.vrt", "m.ply", "--max-error", "1"]),
+            _ => d.run(&[
+                "contour",
+                "crop.vrt",
+                "--mesh",
+                "m.ply",
+                "-o",
+                "c.geojson",
+                "--levels",
+                "500",
+            ]),
+        };
+        assert_fails_naming(&o, &["m.ply", "crop.vrt", "outside", "not of this raster"]);
+    }
+    assert_eq!(d.files(), vec!["crop.vrt", "m.ply"]);
+}
+
+#[test]
 fn info_says_nan_samples_are_nodata_when_none_is_declared() {
     // "nodata: none" beside "(2 nodata)" read as a contradiction.
     let d = Dir::new();

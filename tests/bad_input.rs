@@ -939,16 +939,57 @@ fn a_report_over_another_file_of_the_run_is_refused() {
 
 #[cfg(unix)]
 #[test]
-fn a_symlinked_output_stays_a_link() {
+fn an_output_at_a_symbolic_link_is_refused_file_or_directory() {
+    // `-o` through a link once replaced the file it pointed to, wherever that was, while
+    // `tiles` refused a linked directory: every output at a link is refused now.
     let d = Dir::new();
+    d.write("real.ply", "old");
     std::os::unix::fs::symlink("real.ply", d.path("link.ply")).unwrap();
-    let o = d.run(&["mesh", &dem(), "-o", "link.ply", "--max-error", "1", "-q"]);
-    assert!(o.status.success(), "{}", crate::util::stderr(&o));
-    let link = std::fs::symlink_metadata(d.path("link.ply")).unwrap();
-    assert!(link.file_type().is_symlink());
-    assert!(std::fs::read(d.path("real.ply"))
-        .unwrap()
-        .starts_with(b"ply"));
+    std::fs::create_dir(d.path("real")).unwrap();
+    std::os::unix::fs::symlink("real", d.path("linked")).unwrap();
+    std::os::unix::fs::symlink("real.ply", d.path("r.json")).unwrap();
+    std::os::unix::fs::symlink("real.ply", d.path("lines.geojson")).unwrap();
+    let dem = dem();
+    for (args, named) in [
+        (
+            vec!["mesh", &dem, "-o", "link.ply", "--max-error", "1"],
+            "link.ply",
+        ),
+        (
+            vec!["contour", &dem, "-o", "lines.geojson", "--levels", "500"],
+            "lines.geojson",
+        ),
+        (vec!["tiles", &dem, "-o", "linked"], "linked"),
+        (
+            vec![
+                "mesh",
+                &dem,
+                "-o",
+                "m.ply",
+                "--max-error",
+                "1",
+                "--report",
+                "r.json",
+            ],
+            "r.json",
+        ),
+    ] {
+        let o = d.run(&args);
+        assert_fails_naming(&o, &[named, "symbolic link"]);
+    }
+    assert_eq!(std::fs::read(d.path("real.ply")).unwrap(), b"old");
+    assert!(std::fs::read_dir(d.path("real")).unwrap().next().is_none());
+    assert_eq!(
+        d.files(),
+        vec![
+            "lines.geojson",
+            "link.ply",
+            "linked",
+            "r.json",
+            "real",
+            "real.ply"
+        ]
+    );
 }
 
 #[test]

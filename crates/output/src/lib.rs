@@ -9,8 +9,9 @@
 //!   and [`StagedFile`] for a file another library writes, such as an SQLite database);
 //!   a sidecar (a mesh's `.prj`) is staged with its file and renamed just before it
 //!   ([`write_atomically_with_sidecar`]). A run that fails leaves the previous output at
-//!   the target untouched (or none); a file it replaces keeps its permissions; a symbolic
-//!   link at the target stays a link to the new content; a device or pipe is written in
+//!   the target untouched (or none); a file it replaces keeps its permissions; an output
+//!   at a symbolic link is refused, a file as a directory (the link's target may be
+//!   anywhere); a device or pipe (even through a link, as `/dev/stdout`) is written in
 //!   place.
 //! - **One rule for a signal.** The first output renamed into place is the run's commit
 //!   point ([`on_signal`]): a signal before it cancels the run, removing every pending
@@ -35,7 +36,7 @@ mod pending;
 
 pub use error::{Error, RenameError, Result};
 pub use local::atomic::{
-    is_special_file, resolve_output, unnamed_temp_file, write_atomically,
+    check_not_symlink, is_special_file, resolve_output, unnamed_temp_file, write_atomically,
     write_atomically_with_sidecar, write_bytes_atomically, StagedFile,
 };
 pub use local::check::{check_distinct, check_not_inside, check_writable_target};

@@ -43,6 +43,22 @@ fn input_that_is_not_a_raster() {
     assert_eq!(d.files(), vec!["notes.txt"]);
 }
 
+#[cfg(unix)]
+#[test]
+fn a_device_as_input_is_named_as_not_a_file() {
+    // /dev/zero has length 0 and was reported as "an empty file".
+    let d = Dir::new();
+    for args in [
+        vec!["mesh", "/dev/zero", "-o", "out.ply", "--max-error", "1"],
+        vec!["info", "/dev/zero"],
+    ] {
+        let o = d.run(&args);
+        assert_fails_naming(&o, &["/dev/zero", "device, not a file"]);
+        assert!(!stderr(&o).contains("empty"), "{}", stderr(&o));
+    }
+    assert!(d.files().is_empty());
+}
+
 #[test]
 fn a_vrt_whose_source_is_missing_says_so_once() {
     // The message quoted GDAL's reason, then the gdal crate's wrapper of the same reason

@@ -59,6 +59,56 @@ fn a_device_as_input_is_named_as_not_a_file() {
     assert!(d.files().is_empty());
 }
 
+/// The CT fixture with two malformed tags (an ImageDescription past the end of the file, an
+/// XResolution of an unknown type), on which GDAL warns when opening it, and cut to
+/// `keep` of its bytes.
+fn tiff_with_bad_tags(keep: f64) -> Vec<u8> {
+    let mut bytes = std::fs::read(fixture("ct_brain_crop_128_i16.tif")).unwrap();
+    assert_eq!(
+        &bytes[..8],
+        b"II*\0\x08\0\0\0",
+        "a little-endian TIFF, first IFD at 8"
+    );
+    let entries = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    for i in 0..entries {
+        let at = 10 + 12 * i;
+        match u16::from_le_bytes([bytes[at], bytes[at + 1]]) {
+            270 => bytes[at + 8..at + 12].copy_from_slice(&1_000_000u32.to_le_bytes()),
+            282 => bytes[at + 2..at + 4].copy_from_slice(&99u16.to_le_bytes()),
+            _ => {}
+        }
+    }
+    bytes.truncate((bytes.len() as f64 * keep) as usize);
+    bytes
+}
+
+#[test]
+fn a_malformed_tiff_gives_our_one_line_error_and_no_gdal_warnings() {
+    // GDAL's warnings about the bad tags came first, then the error; they are kept for a
+    // run that succeeds.
+    let d = Dir::new();
+    std::fs::write(d.path("cut.tif"), tiff_with_bad_tags(0.5)).unwrap();
+    let o = d.run(&["mesh", "cut.tif", "-o", "out.ply", "--max-error", "1"]);
+    assert_fails_naming(&o, &["cut.tif"]);
+    let err = stderr(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!err.contains("arning"), "{err}");
+    assert_eq!(d.files(), vec!["cut.tif"]);
+
+    std::fs::write(d.path("whole.tif"), tiff_with_bad_tags(1.0)).unwrap();
+    let o = d.run(&[
+        "mesh",
+        "whole.tif",
+        "-o",
+        "out.ply",
+        "--max-error",
+        "1",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("GDAL warning: "), "{}", stderr(&o));
+}
+
 #[test]
 fn a_vrt_whose_source_is_missing_says_so_once() {
     // The message quoted GDAL's reason, then the gdal crate's wrapper of the same reason

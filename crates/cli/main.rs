@@ -41,7 +41,8 @@ fn main() -> ExitCode {
     // behind (their owners' drops, which remove them on errors, do not run on a signal's
     // exit). The signals are taken on a thread of their own, where files can be removed.
     on_signal_remove_pending_output();
-    // Errors come back as values with GDAL's message; GDAL need not print them too.
+    // Errors come back as values with GDAL's message; GDAL need not print them too, and
+    // its warnings wait for the end of the run.
     tinsmith_raster::silence_gdal_errors();
     if matches!(cli.command, Command::Info(_) | Command::Verify(_)) {
         end_quietly_on_closed_stdout();
@@ -74,6 +75,14 @@ fn main() -> ExitCode {
         }
     }
     note_removed_stale(quiet);
+    // GDAL's warnings only on success: a failure is one line naming the file and the
+    // problem, which warnings about the same malformed file would bury.
+    let warnings = tinsmith_raster::take_gdal_warnings();
+    if result.is_ok() {
+        for warning in warnings {
+            note!("GDAL warning: {warning}");
+        }
+    }
     match result {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(EXIT_VERIFY_FAILED),

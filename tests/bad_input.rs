@@ -43,6 +43,72 @@ fn input_that_is_not_a_raster() {
     assert_eq!(d.files(), vec!["notes.txt"]);
 }
 
+#[cfg(unix)]
+#[test]
+fn a_device_as_input_is_named_as_not_a_file() {
+    // /dev/zero has length 0 and was reported as "an empty file".
+    let d = Dir::new();
+    for args in [
+        vec!["mesh", "/dev/zero", "-o", "out.ply", "--max-error", "1"],
+        vec!["info", "/dev/zero"],
+    ] {
+        let o = d.run(&args);
+        assert_fails_naming(&o, &["/dev/zero", "device, not a file"]);
+        assert!(!stderr(&o).contains("empty"), "{}", stderr(&o));
+    }
+    assert!(d.files().is_empty());
+}
+
+/// The CT fixture with two malformed tags (an ImageDescription past the end of the file, an
+/// XResolution of an unknown type), on which GDAL warns when opening it, and cut to
+/// `keep` of its bytes.
+fn tiff_with_bad_tags(keep: f64) -> Vec<u8> {
+    let mut bytes = std::fs::read(fixture("ct_brain_crop_128_i16.tif")).unwrap();
+    assert_eq!(
+        &bytes[..8],
+        b"II*\0\x08\0\0\0",
+        "a little-endian TIFF, first IFD at 8"
+    );
+    let entries = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    for i in 0..entries {
+        let at = 10 + 12 * i;
+        match u16::from_le_bytes([bytes[at], bytes[at + 1]]) {
+            270 => bytes[at + 8..at + 12].copy_from_slice(&1_000_000u32.to_le_bytes()),
+            282 => bytes[at + 2..at + 4].copy_from_slice(&99u16.to_le_bytes()),
+            _ => {}
+        }
+    }
+    bytes.truncate((bytes.len() as f64 * keep) as usize);
+    bytes
+}
+
+#[test]
+fn a_malformed_tiff_gives_our_one_line_error_and_no_gdal_warnings() {
+    // GDAL's warnings about the bad tags came first, then the error; they are kept for a
+    // run that succeeds.
+    let d = Dir::new();
+    std::fs::write(d.path("cut.tif"), tiff_with_bad_tags(0.5)).unwrap();
+    let o = d.run(&["mesh", "cut.tif", "-o", "out.ply", "--max-error", "1"]);
+    assert_fails_naming(&o, &["cut.tif"]);
+    let err = stderr(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!err.contains("arning"), "{err}");
+    assert_eq!(d.files(), vec!["cut.tif"]);
+
+    std::fs::write(d.path("whole.tif"), tiff_with_bad_tags(1.0)).unwrap();
+    let o = d.run(&[
+        "mesh",
+        "whole.tif",
+        "-o",
+        "out.ply",
+        "--max-error",
+        "1",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("GDAL warning: "), "{}", stderr(&o));
+}
+
 #[test]
 fn a_vrt_whose_source_is_missing_says_so_once() {
     // The message quoted GDAL's reason, then the gdal crate's wrapper of the same reason
@@ -451,6 +517,64 @@ fn verify_against_the_wrong_band_says_which_band_it_read() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!stderr(&o).contains("band"), "{}", stderr(&o));
+}
+
+#[test]
+fn verify_against_another_raster_on_the_same_lattice_says_it_is_not_its_mesh() {
+    // A crop of the meshed DEM, as a raster of its own: its grid holds the lattice of the
+    // mesh's vertices but not their extent. That was exit 1 ("max error: 0", "vertex
+    // outside the grid"); like a mesh off the lattice, it is another raster's mesh: 2.
+    let d = Dir::new();
+    let dem = dem();
+    let o = d.run(&["mesh", &dem, "-o", "m.ply", "--max-error", "1", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info = tinsmith_raster::open_info(std::path::Path::new(&dem), 1).expect("info");
+    let g = info.geo_transform.expect("a geotransform");
+    let (x0, y0) = (20.0, 10.0);
+    let crop = [
+        g[0] + x0 * g[1] + y0 * g[2],
+        g[1],
+        g[2],
+        g[3] + x0 * g[4] + y0 * g[5],
+        g[4],
+        g[5],
+    ];
+    d.write(
+        "crop.vrt",
+        &format!(
+            r#"<VRTDataset rasterXSize="60" rasterYSize="50">
+  <GeoTransform>{:?}, {:?}, {:?}, {:?}, {:?}, {:?}</GeoTransform>
+  <VRTRasterBand dataType="Float32" band="1">
+    <NoDataValue>-3.4028234663852886e+38</NoDataValue>
+    <SimpleSource>
+      <SourceFilename relativeToVRT="0">{dem}</SourceFilename>
+      <SourceBand>1</SourceBand>
+      <SrcRect xOff="20" yOff="10" xSize="60" ySize="50"/>
+      <DstRect xOff="0" yOff="0" xSize="60" ySize="50"/>
+    </SimpleSource>
+  </VRTRasterBand>
+</VRTDataset>
+"#,
+            crop[0], crop[1], crop[2], crop[3], crop[4], crop[5]
+        ),
+    );
+    for command in ["verify", "contour"] {
+        let o = match command {
+            "verify" => d.run(&["verify", "crop.vrt", "m.ply", "--max-error", "1"]),
+            _ => d.run(&[
+                "contour",
+                "crop.vrt",
+                "--mesh",
+                "m.ply",
+                "-o",
+                "c.geojson",
+                "--levels",
+                "500",
+            ]),
+        };
+        assert_fails_naming(&o, &["m.ply", "crop.vrt", "outside", "not of this raster"]);
+    }
+    assert_eq!(d.files(), vec!["crop.vrt", "m.ply"]);
 }
 
 #[test]
@@ -881,16 +1005,57 @@ fn a_report_over_another_file_of_the_run_is_refused() {
 
 #[cfg(unix)]
 #[test]
-fn a_symlinked_output_stays_a_link() {
+fn an_output_at_a_symbolic_link_is_refused_file_or_directory() {
+    // `-o` through a link once replaced the file it pointed to, wherever that was, while
+    // `tiles` refused a linked directory: every output at a link is refused now.
     let d = Dir::new();
+    d.write("real.ply", "old");
     std::os::unix::fs::symlink("real.ply", d.path("link.ply")).unwrap();
-    let o = d.run(&["mesh", &dem(), "-o", "link.ply", "--max-error", "1", "-q"]);
-    assert!(o.status.success(), "{}", crate::util::stderr(&o));
-    let link = std::fs::symlink_metadata(d.path("link.ply")).unwrap();
-    assert!(link.file_type().is_symlink());
-    assert!(std::fs::read(d.path("real.ply"))
-        .unwrap()
-        .starts_with(b"ply"));
+    std::fs::create_dir(d.path("real")).unwrap();
+    std::os::unix::fs::symlink("real", d.path("linked")).unwrap();
+    std::os::unix::fs::symlink("real.ply", d.path("r.json")).unwrap();
+    std::os::unix::fs::symlink("real.ply", d.path("lines.geojson")).unwrap();
+    let dem = dem();
+    for (args, named) in [
+        (
+            vec!["mesh", &dem, "-o", "link.ply", "--max-error", "1"],
+            "link.ply",
+        ),
+        (
+            vec!["contour", &dem, "-o", "lines.geojson", "--levels", "500"],
+            "lines.geojson",
+        ),
+        (vec!["tiles", &dem, "-o", "linked"], "linked"),
+        (
+            vec![
+                "mesh",
+                &dem,
+                "-o",
+                "m.ply",
+                "--max-error",
+                "1",
+                "--report",
+                "r.json",
+            ],
+            "r.json",
+        ),
+    ] {
+        let o = d.run(&args);
+        assert_fails_naming(&o, &[named, "symbolic link"]);
+    }
+    assert_eq!(std::fs::read(d.path("real.ply")).unwrap(), b"old");
+    assert!(std::fs::read_dir(d.path("real")).unwrap().next().is_none());
+    assert_eq!(
+        d.files(),
+        vec![
+            "lines.geojson",
+            "link.ply",
+            "linked",
+            "r.json",
+            "real",
+            "real.ply"
+        ]
+    );
 }
 
 #[test]
@@ -1095,6 +1260,51 @@ fn an_interrupted_run_leaves_no_temporary_file() {
         );
         assert!(crate::util::stderr(&out).contains("interrupted"));
         assert_eq!(d.files(), vec!["big.vrt"], "SIG{signal}");
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn an_interrupt_after_the_first_output_is_in_place_completes_the_run() {
+    // One rule for every command and output: a signal before the first output is renamed
+    // into place cancels the run and leaves every old output; after it, the run puts the
+    // rest in place and exits 0. The hook sends the signal just after that first rename
+    // (the mesh, or an OBJ's .prj sidecar, or the pyramid), when the report is still old.
+    let d = Dir::new();
+    for (signal, args) in [
+        ("2", ["mesh", "-o", "out.ply", "--max-error", "1"]),
+        ("15", ["mesh", "-o", "out.obj", "--max-error", "1"]),
+        ("2", ["tiles", "-o", "terrain", "--band", "1"]),
+    ] {
+        let output = args[2];
+        if args[0] == "mesh" {
+            d.write(output, "old");
+        }
+        d.write("r.json", "old");
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+            .args([args[0], &dem()])
+            .args(&args[1..])
+            .args(["--report", "r.json", "-q"])
+            .env("TINSMITH_TEST_SIGNAL_AFTER_PLACING", signal)
+            .current_dir(d.path(""))
+            .output()
+            .expect("run tinsmith");
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {err}");
+        assert!(!err.contains("interrupted"), "{err}");
+        let report = std::fs::read_to_string(d.path("r.json")).unwrap();
+        assert!(
+            report.starts_with('{'),
+            "{args:?}: the report is still the old one"
+        );
+        let written = d.path(output);
+        assert!(written.is_dir() || std::fs::read(&written).unwrap() != b"old");
+        let left: Vec<String> = d
+            .files()
+            .into_iter()
+            .filter(|f| f.starts_with(".tinsmith-"))
+            .collect();
+        assert!(left.is_empty(), "{args:?}: {left:?}");
     }
 }
 

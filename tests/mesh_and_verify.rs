@@ -387,6 +387,43 @@ fn both_count_targets_are_met() {
 }
 
 #[test]
+fn a_bound_far_beyond_the_relief_keeps_heights_on_the_data() {
+    // Heights of 26.6 to 44.1, with nodata holes whose outlines keep inner vertices:
+    // --max-error 1e308 raised them to 5.96e300 (PLY, OBJ, GeoJSON), and from 1e46 the
+    // raise overflowed float32, so STL and glTF failed their own verification with an
+    // internal error printing a 309-digit number.
+    let dem = fixture("tintn_valid_raster_3857.tif");
+    let raster = tinsmith_raster::read_samples(std::path::Path::new(&dem), 1).expect("raster");
+    let (lo, hi) = (raster.info.min.expect("min"), raster.info.max.expect("max"));
+    let d = Dir::new();
+    for (ext, bound) in [
+        ("ply", "1e308"),
+        ("obj", "1e308"),
+        ("geojson", "1e308"),
+        ("stl", "1e46"),
+        ("glb", "1e46"),
+        ("stl", "1e308"),
+        ("glb", "1e308"),
+    ] {
+        let out = format!("m.{ext}");
+        let o = d.run(&["mesh", &dem, "-o", &out, "--max-error", bound]);
+        let err = stderr(&o);
+        assert!(o.status.success(), "{out} at {bound}: {err}");
+        assert!(!err.contains("0000000000"), "{err}");
+        let mesh = tinsmith_formats::read_mesh(&d.path(&out)).expect("mesh");
+        for v in &mesh.vertices {
+            assert!(
+                v[2] >= lo - 1e-3 && v[2] <= hi + 1e-3,
+                "{out} at {bound}: height {} outside {lo}..{hi}",
+                v[2]
+            );
+        }
+        let v = d.run(&["verify", &dem, &out, "--max-error", bound]);
+        assert!(v.status.success(), "{}", stdout(&v));
+    }
+}
+
+#[test]
 fn heights_far_from_zero_say_how_much_of_the_bound_is_left() {
     // At 1e12 the rounding margin (2^-40 of the largest |height|) took 0.9 of a bound of 1
     // and nothing said so: far fewer triangles went than the bound allowed.

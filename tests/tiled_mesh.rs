@@ -289,23 +289,33 @@ fn same_bytes_for_one_and_two_threads_and_run_to_run() {
 }
 
 #[test]
-fn no_more_workers_start_than_there_are_tiles_and_at_most_1024() {
+fn no_more_workers_start_than_there_are_cores_or_tiles_and_at_most_1024() {
     // --threads 100000 started ~15,700 threads before one failed to start, then hung;
-    // --threads 1000 on four tiles took 5 s. Workers beyond the tile count are not started.
+    // --threads 1000 on four tiles took 5 s; --threads 1024 on 1,015 tiles and 2 cores
+    // took 17 s and 1.19 GB instead of 0.31 s and 60 MB. Workers beyond the cores the
+    // process may use, or the tiles, are not started.
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let dem = fixture("becmodel_dem_bc_albers_50m.tif");
     let d = Dir::new();
-    let args = [
-        &dem,
-        "-o",
-        "m.ply",
-        "--max-error",
-        "5",
-        "--tile-size",
-        "300",
-    ];
-    let r = mesh(&d, &[&args[..], &["--threads", "64"]].concat());
-    assert_eq!(r["tiles"]["count"], 4);
-    assert_eq!(r["tiles"]["threads"], 4);
+    for (tile_size, threads) in [("300", "64"), ("16", "1024")] {
+        let args = [
+            &dem,
+            "-o",
+            "m.ply",
+            "--max-error",
+            "5",
+            "--tile-size",
+            tile_size,
+        ];
+        let r = mesh(&d, &[&args[..], &["--threads", threads]].concat());
+        let tiles = r["tiles"]["count"].as_u64().expect("tile count") as usize;
+        assert_eq!(tiles, if tile_size == "300" { 4 } else { 1015 });
+        assert_eq!(
+            r["tiles"]["threads"],
+            cores.min(tiles),
+            "--threads {threads}"
+        );
+    }
     for command in [
         vec![
             "mesh",

@@ -150,7 +150,8 @@ pub struct TilesArgs {
     /// Content-Encoding: gzip).
     #[arg(long)]
     pub no_gzip: bool,
-    /// Worker threads, at most 1024 (default: all cores).
+    /// Worker threads, at most 1024 (default: all cores); no more are started than there
+    /// are cores.
     #[arg(long, default_value_t = 0, value_parser = threads_or_all)]
     pub threads: usize,
     /// Write the per-level report (bounds, measured error, tiles, bytes) as JSON.
@@ -173,7 +174,8 @@ pub enum TilesStep {
 pub struct MergeArgs {
     /// The directory the shards wrote into.
     pub dir: PathBuf,
-    /// Worker threads, at most 1024 (default: all cores).
+    /// Worker threads, at most 1024 (default: all cores); no more are started than there
+    /// are cores.
     #[arg(long, default_value_t = 0, value_parser = threads_or_all)]
     pub threads: usize,
     /// Write the per-level report (bounds, measured error, tiles, bytes) as JSON.

@@ -41,7 +41,8 @@ fn main() -> ExitCode {
     // behind (their owners' drops, which remove them on errors, do not run on a signal's
     // exit). The signals are taken on a thread of their own, where files can be removed.
     on_signal_remove_pending_output();
-    // Errors come back as values with GDAL's message; GDAL need not print them too.
+    // Errors come back as values with GDAL's message; GDAL need not print them too, and
+    // its warnings wait for the end of the run.
     tinsmith_raster::silence_gdal_errors();
     if matches!(cli.command, Command::Info(_) | Command::Verify(_)) {
         end_quietly_on_closed_stdout();
@@ -75,6 +76,14 @@ fn main() -> ExitCode {
         }
     }
     note_removed_stale(quiet);
+    // GDAL's warnings only on success: a failure is one line naming the file and the
+    // problem, which warnings about the same malformed file would bury.
+    let warnings = tinsmith_raster::take_gdal_warnings();
+    if result.is_ok() {
+        for warning in warnings {
+            note!("GDAL warning: {warning}");
+        }
+    }
     match result {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(EXIT_VERIFY_FAILED),
@@ -172,10 +181,13 @@ fn is_broken_pipe(err: &anyhow::Error) -> bool {
     err.chain().any(broken)
 }
 
-/// Starts the thread that, on SIGINT, SIGTERM or SIGHUP, removes unfinished output and
-/// exits with 128 + the signal's number (0 when every output is already complete). If
-/// the handlers cannot be registered, the signals keep their default action (the process
-/// ends at once, leaving its temporary files).
+/// Starts the thread that, on SIGINT, SIGTERM or SIGHUP, applies `tinsmith_output`'s one
+/// rule (see `tinsmith_output::on_signal`): before the run's first output is in place it
+/// removes the unfinished output and exits with 128 + the signal's number, every old
+/// output left as it was; after, it lets the run put the rest in place and exit 0 (a
+/// second signal while it does ends the process at once). If the handlers cannot be
+/// registered, the signals keep their default action (the process ends at once, leaving
+/// its temporary files).
 fn on_signal_remove_pending_output() {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
@@ -189,15 +201,34 @@ fn on_signal_remove_pending_output() {
             let Some(signal) = signals.forever().next() else {
                 return;
             };
-            if tinsmith_output::finished() {
-                // Every output is complete and in place; only memory was being freed.
-                // SAFETY: as below.
-                unsafe { libc::_exit(0) }
-            }
-            if tinsmith_output::remove_pending() > 0 {
-                note!("\ntinsmith: interrupted; unfinished output removed");
-            } else {
-                note!("\ntinsmith: interrupted");
+            match tinsmith_output::on_signal() {
+                tinsmith_output::Interrupt::Completing => {
+                    if !tinsmith_output::finished() {
+                        note!(
+                            "\ntinsmith: signal received while the outputs were being put in \
+                             place; finishing them (signal again to stop at once)"
+                        );
+                    }
+                    // The rest is renames and a report: moments. `main` may also end first,
+                    // with the run's own exit code.
+                    while !tinsmith_output::finished() {
+                        if let Some(again) = signals.pending().next() {
+                            // SAFETY: as below.
+                            unsafe { libc::_exit(EXIT_SIGNALLED + again) }
+                        }
+                        std::thread::sleep(std::time::Duration::from_millis(10));
+                    }
+                    // Every output is complete and in place; only memory is being freed.
+                    // SAFETY: as below.
+                    unsafe { libc::_exit(0) }
+                }
+                tinsmith_output::Interrupt::Cancelled { removed } => {
+                    if removed > 0 {
+                        note!("\ntinsmith: interrupted; unfinished output removed");
+                    } else {
+                        note!("\ntinsmith: interrupted");
+                    }
+                }
             }
             // SAFETY: `_exit` takes no pointers and never returns. Unlike `process::exit`
             // it runs no atexit handlers, which would tear GDAL's global state down under

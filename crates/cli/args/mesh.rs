@@ -99,8 +99,9 @@ pub struct MeshArgs {
     #[arg(long, value_name = "N", default_value_t = tinsmith_pipeline::DEFAULT_TILE_SIZE,
           value_parser = clap::value_parser!(u32).range(2..))]
     pub tile_size: u32,
-    /// Worker threads for tiles, at most 1024 and no more than there are tiles; 0 (the
-    /// default) for one per core, as in `tiles`.
+    /// Worker threads for tiles, at most 1024; 0 (the default) for one per core, as in
+    /// `tiles`. No more are started than there are cores or tiles: more would only wait,
+    /// each with its tiles in memory.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(0..=1024))]
     pub threads: Option<u32>,
     /// Write one mesh file per tile into DIR (which must not exist, or be empty) instead

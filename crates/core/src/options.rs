@@ -81,8 +81,9 @@ pub enum VertexHeights {
     Samples,
     /// Each vertex off the grid's outer rows and columns raised above its sample by a hair
     /// (2^-24 of the bound plus the largest |height|, at most
-    /// 1/[`crate::RAISED_HEIGHT_SHARE`] of the bound; exact model with a bound and no
-    /// contour levels only; otherwise as `Samples`). The bound still holds at every
+    /// 1/[`crate::RAISED_HEIGHT_SHARE`] of the bound, and whatever the bound at most 2^-24
+    /// of three times the largest |height|: see [`crate::vertex_raise`]; exact model with
+    /// a bound and no contour levels only; otherwise as `Samples`). The bound still holds at every
     /// sample, the vertices' own included. On integer heights many candidate triangles
     /// have a sample exactly the bound away from their plane (through integer vertices),
     /// which the rounding margin then refuses; raised, those with the sample above the

@@ -51,6 +51,17 @@ pub enum Error {
         /// The output as given.
         path: PathBuf,
     },
+    /// The output path is a symbolic link: outputs are not written through links, files
+    /// and directories alike (the link's target may be anywhere).
+    #[error(
+        "{}: is a symbolic link, and outputs are not written through links (give the \
+         path it points to, or a new one)",
+        .path.display()
+    )]
+    Symlink {
+        /// The output as given.
+        path: PathBuf,
+    },
     /// The output's name is too long for its file system.
     #[error(
         "{}: the name is too long for its file system; choose a shorter one",
@@ -195,6 +206,7 @@ impl Error {
             | Error::MissingDirectory { path, .. }
             | Error::EndsWithSlash { path }
             | Error::SymlinkLoop { path }
+            | Error::Symlink { path }
             | Error::NameTooLong { path }
             | Error::IsInput { path, .. }
             | Error::ReadByInput { path, .. }

@@ -1,6 +1,8 @@
 //! Temporary files and directories on their way to becoming outputs, so that an
-//! interrupted run (Ctrl-C, SIGTERM) can remove them: a temporary file is otherwise removed
-//! only when its owner is dropped, which a signal's exit skips.
+//! interrupted run (Ctrl-C, SIGTERM) can remove them (a temporary file is otherwise
+//! removed only when its owner is dropped, which a signal's exit skips), and the one rule
+//! for a signal: before the run's first output is in place the run is cancelled and every
+//! output keeps its old content; from then on the run completes.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -10,18 +12,70 @@ static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 static MADE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 static FINISHED: AtomicBool = AtomicBool::new(false);
-/// Held while files that belong together are renamed into place (see [`commit_together`]),
-/// and for good by [`remove_pending`].
-static COMMITTING: Mutex<()> = Mutex::new(());
+/// Set once an output of the run has been renamed into place (see [`place`]).
+static PLACED: AtomicBool = AtomicBool::new(false);
+/// Held while an output is renamed into place (see [`place`]), and for good by
+/// [`on_signal`] once it cancels the run.
+static PLACING: Mutex<()> = Mutex::new(());
 
-/// Runs `commit` (renames that must all happen or none, such as a mesh and its `.prj`)
-/// so that [`remove_pending`], on a signal, waits for it to end and then lets no other
-/// commit start: an interrupt never leaves half of such a pair in place.
-pub(crate) fn commit_together<T>(commit: impl FnOnce() -> T) -> T {
-    let _guard = COMMITTING
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner());
-    commit()
+/// What [`on_signal`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Interrupt {
+    /// No output of the run was in place: every registered temporary was removed (this
+    /// many), and from now on [`interrupted`] is true and no output is renamed into place.
+    /// Every output the run would have replaced keeps its old content; the process is to
+    /// exit as interrupted.
+    Cancelled {
+        /// Temporaries that were registered (and are now removed).
+        removed: usize,
+    },
+    /// An output of the run is in place already: the run goes on until the others are
+    /// ([`finished`]), so the outputs are never part new and part old; the process is to
+    /// exit as a success then.
+    Completing,
+}
+
+/// Renames one output into place through `rename`, the commit point of a run: once an
+/// output is in place, [`on_signal`] lets the run complete instead of cancelling it. A
+/// signal handled before waits for nothing and the rename never starts; one handled
+/// during it waits for it to end.
+pub(crate) fn place<T, E>(rename: impl FnOnce() -> Result<T, E>) -> Result<T, E> {
+    let placed = {
+        let _guard = PLACING
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        let placed = rename();
+        if placed.is_ok() {
+            PLACED.store(true, Ordering::SeqCst);
+        }
+        placed
+    };
+    if placed.is_ok() {
+        signal_after_first_placement();
+    }
+    placed
+}
+
+/// For tests of the commit point: with `TINSMITH_TEST_SIGNAL_AFTER_PLACING` set to a
+/// signal number, the process sends itself that signal just after its first output is
+/// renamed into place, then gives the signal handler a moment to act, as if the user
+/// pressed Ctrl-C at that very instant.
+#[allow(unsafe_code)]
+fn signal_after_first_placement() {
+    static SENT: AtomicBool = AtomicBool::new(false);
+    let Some(signal) = std::env::var("TINSMITH_TEST_SIGNAL_AFTER_PLACING")
+        .ok()
+        .and_then(|s| s.parse::<i32>().ok())
+    else {
+        return;
+    };
+    if !SENT.swap(true, Ordering::SeqCst) {
+        // SAFETY: kill and getpid take no pointers.
+        unsafe {
+            libc::kill(libc::getpid(), signal);
+        }
+        std::thread::sleep(std::time::Duration::from_millis(500));
+    }
 }
 
 /// Records that every output of the run is complete and in place: a signal from now on
@@ -58,7 +112,7 @@ impl Drop for PendingGuard {
 }
 
 /// Registers directories made for an output (deepest first) until the returned guard is
-/// dropped: [`remove_pending`] removes those that are empty then, and only those (another
+/// dropped: [`on_signal`] removes those that are empty then, and only those (another
 /// program may have put files there meanwhile).
 pub fn track_made_dirs(dirs: &[PathBuf]) -> MadeDirsGuard {
     if let Ok(mut made) = MADE.lock() {
@@ -83,22 +137,26 @@ impl Drop for MadeDirsGuard {
     }
 }
 
-/// Removes every registered temporary file and directory (for a signal handler, just
-/// before the process exits), and from then on [`interrupted`] is true; returns how many
-/// were registered. Paths that are gone already are skipped. It first waits for a
-/// rename of files that belong together to end, and from then on no such rename starts.
+/// What a signal handler calls on Ctrl-C, SIGTERM or SIGHUP: the one rule for every
+/// command and every output. Before any output of the run is renamed into place, the run
+/// is cancelled: every registered temporary file and directory is removed (and the empty
+/// directories made for them), no output is renamed into place from then on, and
+/// [`interrupted`] becomes true ([`Interrupt::Cancelled`]). Once one is in place, nothing
+/// is removed and the run is left to put the others in place ([`Interrupt::Completing`]).
+/// A rename under way is waited for first.
 ///
 /// Writers check [`interrupted`] before each file they add, but one may be between its
 /// check and its write when the flag goes up (and `create_dir_all` would make a removed
 /// directory again), so the paths are removed a second time after a short pause.
-pub fn remove_pending() -> usize {
-    // Wait for renames under way to end, and keep any other from starting (the process
-    // exits after this).
-    std::mem::forget(
-        COMMITTING
-            .lock()
-            .unwrap_or_else(|poisoned| poisoned.into_inner()),
-    );
+pub fn on_signal() -> Interrupt {
+    let guard = PLACING
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    if PLACED.load(Ordering::SeqCst) || finished() {
+        return Interrupt::Completing;
+    }
+    // No output is renamed into place from now on (the process exits after this).
+    std::mem::forget(guard);
     INTERRUPTED.store(true, Ordering::SeqCst);
     // Read again for the second pass: a path registered meanwhile (its owner was
     // between creating it and registering it) is removed too.
@@ -106,7 +164,7 @@ pub fn remove_pending() -> usize {
         Ok(pending) => pending.clone(),
         Err(poisoned) => poisoned.into_inner().clone(),
     };
-    let count = paths().len();
+    let removed = paths().len();
     let remove_all = || {
         for path in &paths() {
             if path.is_dir() {
@@ -126,10 +184,10 @@ pub fn remove_pending() -> usize {
     for dir in &made {
         let _ = std::fs::remove_dir(dir);
     }
-    count
+    Interrupt::Cancelled { removed }
 }
 
-/// Whether [`remove_pending`] has run: the work still going on may fail on the files it
+/// Whether [`on_signal`] cancelled the run: the work still going on may fail on the files it
 /// removed, and should leave the process to the signal handler's exit.
 pub fn interrupted() -> bool {
     INTERRUPTED.load(Ordering::SeqCst)
@@ -141,8 +199,8 @@ mod tests {
 
     #[test]
     fn paths_are_registered_until_their_guard_drops() {
-        // Inspects the registry rather than calling `remove_pending`, which would flag the
-        // whole test process as interrupted and remove other tests' temporary files.
+        // Inspects the registry rather than cancelling through `on_signal`, which would
+        // flag the whole test process as interrupted and remove other tests' temporaries.
         let dir = tempfile::tempdir().expect("temp dir");
         let (a, b) = (dir.path().join("a.tmp"), dir.path().join("b.tmp"));
         let registered = |p: &Path| PENDING.lock().unwrap().iter().any(|q| q == p);
@@ -159,5 +217,24 @@ mod tests {
         assert!(MADE.lock().unwrap().contains(&made[0]));
         drop(guard);
         assert!(!MADE.lock().unwrap().contains(&made[0]));
+    }
+
+    #[test]
+    fn a_signal_after_the_first_output_is_in_place_lets_the_run_complete() {
+        use std::io::Write as _;
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mesh = dir.path().join("mesh.ply");
+        let report = dir.path().join("report.json");
+        std::fs::write(&report, b"old").expect("seed");
+        crate::write_atomically(&mesh, |w| w.write_all(b"new")).expect("placed");
+        // The run's other output, staged but not yet in place, when the signal comes.
+        let staged = crate::StagedFile::new(&report).expect("staged");
+        assert_eq!(on_signal(), Interrupt::Completing);
+        // Nothing was removed and the run may go on: the report still goes in place.
+        assert!(!interrupted());
+        assert!(staged.path().exists());
+        std::fs::write(staged.path(), b"new").expect("write");
+        staged.commit().expect("renamed after the signal");
+        assert_eq!(std::fs::read(&report).expect("read"), b"new");
     }
 }

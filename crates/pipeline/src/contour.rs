@@ -63,10 +63,11 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
             job.output.display()
         );
     }
-    check_writable_target(&job.output, &job.input)?;
+    // The --mesh input first: by any path (a link too) it is the most telling refusal.
     if let Some(mesh) = &job.mesh {
         check_distinct(mesh, &job.output, "the --mesh input")?;
     }
+    check_writable_target(&job.output, &job.input)?;
     let e = job.max_error.unwrap_or(0.0);
     let size =
         crate::transform_check::check_input_transform(&job.input, job.band, job.pixel_coords)?;

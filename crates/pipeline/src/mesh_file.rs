@@ -62,7 +62,9 @@ pub fn read_mesh_file(
 
 /// The sample (column, row) under each vertex of `mesh`, read from `path` in `format`;
 /// fails naming the first vertex that is not on a sample centre, to within the rounding
-/// of the format's positions (see [`position_tolerance`]).
+/// of the format's positions (see [`position_tolerance`]), or whose sample lies outside
+/// the raster (a mesh of another raster whose lattice this one's extends): either way the
+/// mesh is not one of this raster, and nothing is measured.
 pub fn sample_positions(
     path: &Path,
     mesh: &Mesh,
@@ -74,12 +76,25 @@ pub fn sample_positions(
     // Other tools rewrite RFC 7946 GeoJSON with 7 decimals (ogr2ogr's default), about
     // 1 cm: too coarse for the mesh's vertices to name their samples on fine rasters.
     let wgs84 = transformed_from_wgs84(mesh, raster, placement);
+    let (width, height) = (raster.info.width, raster.info.height);
+    let outside = |i: usize, [x, y]: [i64; 2]| {
+        crate::Error::Refused(format!(
+            "{}: vertex {i} is at column {x}, row {y} of {}'s sample lattice, outside its \
+             {width} x {height} samples: the mesh is not of this raster (another raster's \
+             on the same lattice, or another extent) and cannot be measured against it",
+            path.display(),
+            raster.info.path.display()
+        ))
+    };
+    let inside = |[x, y]: [i64; 2]| {
+        (0..i64::from(width)).contains(&x) && (0..i64::from(height)).contains(&y)
+    };
     mesh.vertices
         .iter()
         .enumerate()
         .map(|(i, v)| {
             let p = [v[0], v[1]];
-            placement.sample_at(p, tolerance).map_err(|e| {
+            let at = placement.sample_at(p, tolerance).map_err(|e| {
                 if !matches!(e, PositionError::NearMiss { .. }) {
                     return crate::Error::Refused(format!("{}: vertex {i}: {e:#}", path.display()));
                 }
@@ -95,7 +110,12 @@ pub fn sample_positions(
                      written, and the mesh is measured as written{ogr2ogr}",
                     path.display()
                 ))
-            })
+            })?;
+            if inside(at) {
+                Ok(at)
+            } else {
+                Err(outside(i, at))
+            }
         })
         .collect()
 }

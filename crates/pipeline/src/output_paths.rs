@@ -26,7 +26,8 @@ pub fn check_writable_target(path: &Path, input: &Path) -> Result<()> {
 /// grid keeps its CRS in its `.prj`); it is read-only; or it holds another
 /// CRS than `crs_wkt` (the raster's) while no file is at `output`, so it is not from an
 /// earlier mesh there but another file's (a shapefile's of the same name). Output to a
-/// device or pipe writes no sidecar. (With `--pixel-coords` no sidecar is written.)
+/// device or pipe writes no sidecar; a sidecar at a symbolic link is refused, as any output
+/// is. (With `--pixel-coords` no sidecar is written.)
 pub fn check_sidecar(
     output: &Path,
     input: &Path,
@@ -37,6 +38,9 @@ pub fn check_sidecar(
         return Ok(());
     }
     let ours = tinsmith_formats::prj_path(output);
+    if crs_wkt.is_some() {
+        tinsmith_output::check_not_symlink(&ours)?;
+    }
     // GDAL's file list of the input names its `.prj` when it reads one (ESRI ASCII, EHdr);
     // a `.prj` merely named like a GeoTIFF input is not the input's (it is usually the
     // sidecar of an earlier mesh of it).

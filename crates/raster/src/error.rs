@@ -31,11 +31,11 @@ pub enum Error {
         #[source]
         source: Box<gdal::errors::GdalError>,
     },
-    /// The path is a pipe or socket: GDAL would block on a FIFO with no writer, and reads
-    /// rasters by seeking.
+    /// The path is a pipe, socket or character device (`/dev/zero`), not a regular file:
+    /// GDAL would block on a FIFO with no writer, and reads rasters by seeking.
     #[error(
-        "{}: is a pipe or socket, not a file: GDAL needs a file it can seek (save the \
-         stream to a file first)",
+        "{}: is a pipe, socket or device, not a file: GDAL reads rasters from files it \
+         can seek (save the stream to a file first)",
         path.display()
     )]
     NotAFile {

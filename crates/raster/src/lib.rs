@@ -35,8 +35,9 @@
 //!   the functions can be called from several threads at once. A [`WindowReader`] keeps
 //!   its dataset open: it can move between threads but not be shared; open one per thread.
 //!
-//! GDAL also prints its errors to standard error by default; [`silence_gdal_errors`] stops
-//! that for the whole process (the messages stay in the returned errors).
+//! GDAL also prints its errors and warnings to standard error by default;
+//! [`silence_gdal_errors`] stops that for the whole process (the errors' messages stay in
+//! the returned errors; the warnings are held for [`take_gdal_warnings`]).
 //!
 //! # Example
 //! ```no_run
@@ -74,7 +75,7 @@ pub use error::{Error, Result};
 pub use files::input_files;
 pub use geographic::{geographic_bounds, heights_may_exceed_f32, GeoBounds, GeoLattice};
 pub use info::{Raster, RasterInfo};
-pub use quiet::silence_gdal_errors;
+pub use quiet::{silence_gdal_errors, take_gdal_warnings};
 pub use read::{open_info, open_info_with_progress, read_samples};
 pub use reproject::{from_wgs84, is_geographic, is_wgs84_lon_lat, same_crs, to_wgs84};
 pub use sample::sample_geographic;

@@ -1,29 +1,58 @@
-//! Keeping GDAL's own error printing off standard error.
+//! Keeping GDAL's own error and warning printing off standard error.
+
+use std::sync::Mutex;
 
 use gdal::errors::CplErrType;
 
+/// GDAL's warnings since [`silence_gdal_errors`], distinct, in order, until
+/// [`take_gdal_warnings`] takes them.
+static WARNINGS: Mutex<Vec<String>> = Mutex::new(Vec::new());
+
+/// How many distinct warnings are held; later ones are dropped (a warning repeated for
+/// every tile is held once).
+const MAX_HELD_WARNINGS: usize = 20;
+
 /// Stops GDAL from printing its errors (`ERROR 4: ... not recognized as a supported file
-/// format`) to standard error, for the whole process. Warnings and debug messages are still
-/// printed, prefixed with `GDAL warning:` or `GDAL debug:`.
+/// format`) and warnings to standard error, for the whole process. Warnings are held for
+/// [`take_gdal_warnings`]; debug messages (`CPL_DEBUG`) are still printed, prefixed with
+/// `GDAL debug:`.
 ///
 /// Nothing is lost: the functions of this crate return GDAL's error message inside their
-/// [`crate::Error`]. Call this once, early, from a binary (a library should leave GDAL's
-/// process-wide handler alone); calling it again is harmless. It replaces any error handler
-/// installed before through `gdal::config::set_error_handler`.
+/// [`crate::Error`], so a failed run says why in one line, which the warnings GDAL gives
+/// on the way (a malformed TIFF's tags) would only bury. Call this once, early, from a
+/// binary (a library should leave GDAL's process-wide handler alone); calling it again is
+/// harmless. It replaces any error handler installed before through
+/// `gdal::config::set_error_handler`.
 pub fn silence_gdal_errors() {
-    // Called from C: a closed stderr must not panic here (that would abort the process).
-    gdal::config::set_error_handler(|class, _number, msg| {
-        use std::io::Write as _;
-        let prefix = match class {
-            // Int64/UInt64 nodata is read with the exact getters; GDAL's own readers (the
-            // warper's) still take the f64 one, which says so.
-            CplErrType::Warning if msg.contains("returns an approximate value") => return,
-            CplErrType::Warning => "GDAL warning",
-            CplErrType::Debug => "GDAL debug",
-            CplErrType::None | CplErrType::Failure | CplErrType::Fatal => return,
-        };
-        let _ = writeln!(std::io::stderr(), "{prefix}: {msg}");
+    // Called from C: a closed stderr or a poisoned lock must not panic here (that would
+    // abort the process).
+    gdal::config::set_error_handler(|class, _number, msg| match class {
+        // Int64/UInt64 nodata is read with the exact getters; GDAL's own readers (the
+        // warper's) still take the f64 one, which says so.
+        CplErrType::Warning if msg.contains("returns an approximate value") => {}
+        CplErrType::Warning => {
+            if let Ok(mut held) = WARNINGS.lock() {
+                if held.len() < MAX_HELD_WARNINGS && !held.iter().any(|w| w == msg) {
+                    held.push(msg.to_owned());
+                }
+            }
+        }
+        CplErrType::Debug => {
+            use std::io::Write as _;
+            let _ = writeln!(std::io::stderr(), "GDAL debug: {msg}");
+        }
+        CplErrType::None | CplErrType::Failure | CplErrType::Fatal => {}
     });
+}
+
+/// The warnings GDAL gave since [`silence_gdal_errors`] (or the last call), distinct and
+/// in order, at most 20: for a binary to print once a run has succeeded. A failed run's
+/// error names the file and the problem alone.
+pub fn take_gdal_warnings() -> Vec<String> {
+    match WARNINGS.lock() {
+        Ok(mut held) => std::mem::take(&mut *held),
+        Err(poisoned) => std::mem::take(&mut *poisoned.into_inner()),
+    }
 }
 
 /// Set once a dataset read through HDF5 (GDAL's netCDF or HDF5 drivers) has been opened:

@@ -400,9 +400,10 @@ pub(crate) fn open_dataset(path: &Path) -> Result<Dataset> {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
-        // GDAL would block reading a FIFO with no writer, and seeks where there is none.
+        // GDAL would block reading a FIFO with no writer, and seeks where there is none;
+        // a character device (`/dev/zero`, a terminal) has no size and no raster either.
         if let Ok(kind) = std::fs::metadata(path).map(|m| m.file_type()) {
-            if kind.is_fifo() || kind.is_socket() {
+            if kind.is_fifo() || kind.is_socket() || kind.is_char_device() {
                 return Err(Error::NotAFile {
                     path: path.to_path_buf(),
                 });
@@ -424,7 +425,7 @@ pub(crate) fn open_dataset(path: &Path) -> Result<Dataset> {
         let reason = gdal_reason(&source, path);
         let reason = match std::fs::metadata(path) {
             Ok(m) if m.is_dir() => format!("a directory: {reason}"),
-            Ok(m) if m.len() == 0 => format!("an empty file: {reason}"),
+            Ok(m) if m.is_file() && m.len() == 0 => format!("an empty file: {reason}"),
             _ => reason,
         };
         Error::NotARaster {

@@ -2,7 +2,7 @@
 
 use std::fs;
 
-use tinsmith_raster::{open_info, silence_gdal_errors, Error};
+use tinsmith_raster::{open_info, silence_gdal_errors, take_gdal_warnings, Error};
 
 #[test]
 fn silenced_errors_are_still_reported_in_the_returned_error() {
@@ -31,4 +31,34 @@ fn silenced_errors_are_still_reported_in_the_returned_error() {
             .nodata_samples,
         2028
     );
+}
+
+#[test]
+fn warnings_are_held_until_taken_not_printed() {
+    silence_gdal_errors();
+    // The fixture with its GDALMetadata tag (42112) pointing past the end of the file:
+    // GDAL warns that it ignores the tag, and reads the raster.
+    let fixture = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/tintn_valid_raster_3857.tif"
+    );
+    let mut bytes = fs::read(fixture).expect("fixture");
+    assert_eq!(
+        &bytes[..8],
+        b"II*\0\x08\0\0\0",
+        "a little-endian TIFF, first IFD at 8"
+    );
+    let entries = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let at = (0..entries)
+        .map(|i| 10 + 12 * i)
+        .find(|&at| u16::from_le_bytes([bytes[at], bytes[at + 1]]) == 42112)
+        .expect("a GDALMetadata tag");
+    bytes[at + 8..at + 12].copy_from_slice(&1_000_000u32.to_le_bytes());
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let path = dir.path().join("bad_tag.tif");
+    fs::write(&path, bytes).expect("write");
+    open_info(&path, 1).expect("read despite the ignored tag");
+    let held = take_gdal_warnings();
+    assert!(held.iter().any(|w| w.contains("GDALMetadata")), "{held:?}");
+    assert!(take_gdal_warnings().is_empty());
 }

@@ -50,11 +50,11 @@ where
         return main.commit();
     };
     let side = stage(sidecar_path, |w| w.write_all(bytes))?;
-    crate::pending::commit_together(|| {
-        side.commit()?;
-        main.commit().inspect_err(|_| {
-            let _ = std::fs::remove_file(sidecar_path);
-        })
+    // Once the sidecar is in place, a signal lets the run complete (see
+    // `crate::on_signal`): the main file follows it.
+    side.commit()?;
+    main.commit().inspect_err(|_| {
+        let _ = std::fs::remove_file(sidecar_path);
     })
 }
 
@@ -95,7 +95,7 @@ impl Staged {
 }
 
 /// A temporary file `.tinsmith-*.tmp` beside the file it is to replace, registered for
-/// removal on a signal (see [`crate::remove_pending`]) until [`StagedFile::commit`] renames
+/// removal on a signal (see [`crate::on_signal`]) until [`StagedFile::commit`] renames
 /// it over its target; dropped without that, it is removed.
 #[derive(Debug)]
 pub struct StagedFile {
@@ -108,7 +108,7 @@ pub struct StagedFile {
 
 impl StagedFile {
     /// Creates the temporary file in the directory of `target` (the file the rename is
-    /// to land on: a symbolic link is not followed here, see [`resolve_output`]).
+    /// to land on: a symbolic link there would be replaced, not followed).
     ///
     /// # Errors
     /// The I/O error of creating the temporary file.
@@ -156,13 +156,14 @@ pub(crate) enum Temp {
 }
 
 /// Renames a staged temporary over `target`: the one step by which every output (a file,
-/// its sidecar, a whole directory) appears in place. The temporary stays locked until
-/// the rename is done (a sweep cannot take it between); on failure it is removed.
+/// its sidecar, a whole directory) appears in place, and the run's commit point (see
+/// [`crate::on_signal`]). The temporary stays locked until the rename is done (a sweep
+/// cannot take it between); on failure it is removed.
 pub(crate) fn publish(temp: Temp, target: &Path) -> io::Result<()> {
-    match temp {
+    crate::pending::place(|| match temp {
         Temp::File(temp) => temp.persist(target).map(drop).map_err(|error| error.error),
         Temp::Dir(dir) => dir.rename_into_place(target),
-    }
+    })
 }
 
 /// Gives the temporary file at `temp` the permissions of the regular file at `target` it
@@ -190,8 +191,26 @@ pub fn output_parent(path: &Path) -> (&Path, Option<&Path>) {
     (parent, file)
 }
 
-/// Where writing `path` lands: when `path` is a symbolic link, the file it points to (so
-/// the link stays a link, as when a program opens it for writing), else `path`.
+/// Fails when `path` is a symbolic link (dangling or not) and not a device or pipe (see
+/// [`is_special_file`]; `/dev/stdout` is a link): an output is never written through a
+/// link, as a staged directory is never renamed over one, since the link's target may be
+/// anywhere (another user's file, a system file).
+///
+/// # Errors
+/// [`Error::Symlink`].
+pub fn check_not_symlink(path: &Path) -> Result<()> {
+    let link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    if link && !is_special_file(path) {
+        return Err(Error::Symlink {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok(())
+}
+
+/// The file `path` names: when `path` is a symbolic link, the file it points to, else
+/// `path`. Outputs at links are refused ([`crate::check_writable_target`]); this is for
+/// telling which file a path is (the input, another output).
 pub fn resolve_output(path: &Path) -> PathBuf {
     match std::fs::symlink_metadata(path) {
         Ok(meta) if meta.file_type().is_symlink() => std::fs::canonicalize(path)
@@ -321,15 +340,15 @@ pub(crate) fn parent_dir(path: &Path) -> &Path {
     }
 }
 
-/// Writes the content of `path` to a synced temporary file beside its target (see
-/// [`resolve_output`]); dropping the result without [`Staged::commit`] removes the
-/// temporary file. A device or pipe (see [`is_special_file`]) is written in place.
+/// Writes the content of `path` to a synced temporary file beside it; dropping the result
+/// without [`Staged::commit`] removes the temporary file. A device or pipe (see
+/// [`is_special_file`]) is written in place; a symbolic link is refused.
 fn stage<F>(path: &Path, write: F) -> Result<Staged>
 where
     F: FnOnce(&mut BufWriter<&mut File>) -> io::Result<()>,
 {
-    let target = resolve_output(path);
-    let dir = parent_dir(&target);
+    check_not_symlink(path)?;
+    let dir = parent_dir(path);
     let io_error = |action: &'static str| {
         move |source: io::Error| Error::Io {
             path: path.to_path_buf(),
@@ -362,7 +381,7 @@ where
         });
     }
 
-    let mut staged = StagedFile::new(&target)
+    let mut staged = StagedFile::new(path)
         .map_err(io_error("create a temporary file in the output directory"))?;
     if crate::interrupted() {
         // The signal handler may have passed already: the temporary file goes now.
@@ -562,31 +581,34 @@ mod tests {
 
     #[cfg(unix)]
     #[test]
-    fn a_symlink_stays_a_link_to_the_new_content() -> Result<()> {
+    fn an_output_at_a_symbolic_link_is_refused_and_its_target_kept() {
         let dir = tempfile::tempdir().expect("temp dir");
         let real = dir.path().join("real.bin");
         std::fs::write(&real, b"old").expect("seed");
         let link = dir.path().join("link.bin");
         std::os::unix::fs::symlink("real.bin", &link).expect("symlink");
-        write_atomically(&link, |w| w.write_all(b"new"))?;
-        assert!(std::fs::symlink_metadata(&link)
-            .expect("stat")
-            .file_type()
-            .is_symlink());
-        assert_eq!(std::fs::read(&real).expect("read back"), b"new");
-        // A dangling link gets its target created.
         let dangling = dir.path().join("dangling.bin");
         std::os::unix::fs::symlink("made.bin", &dangling).expect("symlink");
-        write_atomically(&dangling, |w| w.write_all(b"made"))?;
-        assert_eq!(
-            std::fs::read(dir.path().join("made.bin")).expect("read"),
-            b"made"
-        );
-        assert_eq!(
-            entries(dir.path()),
-            vec![dangling, link, dir.path().join("made.bin"), real.clone()]
-        );
-        Ok(())
+        for path in [&link, &dangling] {
+            let err = write_atomically(path, |w| w.write_all(b"new")).expect_err("refused");
+            assert!(
+                matches!(&err, Error::Symlink { path: p } if p == path),
+                "{err:?}"
+            );
+            assert!(err.to_string().contains("is a symbolic link"), "{err}");
+            let input = dir.path().join("in.tif");
+            let err =
+                crate::check_writable_target(path, &input, Vec::<PathBuf>::new).expect_err("early");
+            assert!(matches!(err, Error::Symlink { .. }), "{err:?}");
+            let err = crate::ReservedReport::reserve(path).expect_err("report");
+            assert!(matches!(err, Error::Symlink { .. }), "{err:?}");
+        }
+        assert_eq!(std::fs::read(&real).expect("read back"), b"old");
+        assert_eq!(entries(dir.path()), vec![dangling, link, real]);
+        // A link to a device is written through: nothing is replaced.
+        let null = dir.path().join("null");
+        std::os::unix::fs::symlink("/dev/null", &null).expect("symlink");
+        write_atomically(&null, |w| w.write_all(b"gone")).expect("written to /dev/null");
     }
 
     #[cfg(unix)]

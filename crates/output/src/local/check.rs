@@ -3,13 +3,14 @@
 
 use std::path::{Path, PathBuf};
 
-use super::atomic::{output_parent, parent_dir, resolve_output};
+use super::atomic::{check_not_symlink, output_parent, parent_dir, resolve_output};
 use crate::error::{Error, Result};
 
 /// Fails early, before long work, when `path` ends with '/', is a looping symbolic link,
 /// has a name too long for its file system, is the `input` file or one the input is read
-/// from (see `check_not_input`), is a directory, is a read-only file or one the
-/// directory's sticky bit keeps this user from replacing, or its directory is missing.
+/// from (see `check_not_input`), is a symbolic link (outputs are not written through
+/// links), is a directory, is a read-only file or one the directory's sticky bit keeps
+/// this user from replacing, or its directory is missing.
 ///
 /// # Errors
 /// The first of those found, as the [`Error`] variant of that name.
@@ -30,6 +31,7 @@ where
         return Err(Error::NameTooLong { path: path_buf() });
     }
     check_not_input(path, input, input_files)?;
+    check_not_symlink(path)?;
     let (dir, file_in_the_way) = output_parent(path);
     if let Some(file) = file_in_the_way {
         return Err(Error::FileInTheWay {
@@ -48,11 +50,10 @@ where
     }
     // The write renames a new file over it, which the directory allows whatever the file's
     // mode: a file made read-only is not replaced behind its owner's back.
-    let target = resolve_output(path);
-    if std::fs::metadata(&target).is_ok_and(|m| m.is_file() && m.permissions().readonly()) {
+    if std::fs::metadata(path).is_ok_and(|m| m.is_file() && m.permissions().readonly()) {
         return Err(Error::ReadOnly { path: path_buf() });
     }
-    if sticky_keeps(&target) {
+    if sticky_keeps(path) {
         return Err(Error::StickyOwner { path: path_buf() });
     }
     Ok(())

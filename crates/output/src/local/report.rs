@@ -3,7 +3,7 @@
 use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
-use super::atomic::{is_special_file, parent_dir, resolve_output, StagedFile};
+use super::atomic::{check_not_symlink, is_special_file, parent_dir, StagedFile};
 use crate::error::{Error, RenameError, Result};
 
 /// Room for a `--report` file taken before the run's outputs are committed: its temporary
@@ -26,19 +26,20 @@ impl ReservedReport {
     /// [`REPORT_RESERVE_BYTES`] spaces (a device or pipe is written in place, later).
     ///
     /// # Errors
-    /// [`Error::CannotCreate`] when the temporary file cannot be made,
-    /// [`Error::WriteFailed`] when the room cannot be written.
+    /// [`Error::Symlink`] when `path` is a symbolic link, [`Error::CannotCreate`] when the
+    /// temporary file cannot be made, [`Error::WriteFailed`] when the room cannot be
+    /// written.
     pub fn reserve(path: &Path) -> Result<ReservedReport> {
-        let target = resolve_output(path);
         if is_special_file(path) {
             return Ok(ReservedReport {
                 path: path.to_path_buf(),
                 file: None,
             });
         }
-        let mut tmp = StagedFile::new(&target).map_err(|source| Error::CannotCreate {
+        check_not_symlink(path)?;
+        let mut tmp = StagedFile::new(path).map_err(|source| Error::CannotCreate {
             path: path.to_path_buf(),
-            dir: parent_dir(&target).to_path_buf(),
+            dir: parent_dir(path).to_path_buf(),
             source,
         })?;
         let file = tmp.file_mut();

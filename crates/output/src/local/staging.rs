@@ -11,7 +11,7 @@ use crate::pending::{MadeDirsGuard, PendingGuard};
 /// not exist, or be an empty directory), and the missing parents made for it, as
 /// `mkdir -p` would. Dropped unfinished (an error), it removes the directory and the
 /// parents it made while they are empty; on a signal, the pending-output registry does the
-/// same (see [`crate::remove_pending`]).
+/// same (see [`crate::on_signal`]).
 #[derive(Debug)]
 pub struct StagedDir {
     temp: Option<OutputTempDir>,

@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """Pictures for docs/results.md ("Pictures"): tinsmith's TIN beside hmm's (pydelatin) at
 the same epsilon on two real DEMs, each drawn by `tinsmith preview` over the DEM's
-hillshade, with both meshes' triangle counts and their error measured by `tinsmith verify`.
+hillshade, with both meshes' triangle counts and their error measured by `tinsmith verify`;
+then two CesiumJS screenshots of `tinsmith tiles` pyramids served by `tinsmith serve` (a
+global view of ETOPO5, a close view of Big Tujunga), by bench/cesium_shot.cjs in headless
+Chromium (CesiumJS and playwright-core from `make deps`).
 
 Setup and run (from the repository root; `make pictures` does both):
     .venv/bin/pip install pydelatin numpy rasterio
@@ -11,6 +14,7 @@ Prints the Markdown of the section.
 import argparse
 import importlib.util
 import pathlib
+import os
 import subprocess
 import sys
 import tempfile
@@ -21,6 +25,20 @@ from pydelatin import Delatin
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 # (case of bench/compare.py, epsilon, picture size)
 PICTURES = [("bigtujunga", 30.0, 800), ("fuji", 20.0, 560)]
+# (name, DEM under ../shared/data, terrain directory, camera: lon, lat, height m, heading,
+# pitch, vertical exaggeration)
+CESIUM = [
+    ("cesium-global", "dem/etopo5_global_5arcmin.tif", "etopo5",
+     (85, 25, 11_000_000, 0, -90, 20)),
+    ("cesium-close", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga",
+     (-118.19, 34.16, 9_000, 20, -30, 1)),
+]
+PAGE = ("<!doctype html><html><head><link rel=\"icon\" href=\"data:,\">"
+        "<script>window.CESIUM_BASE_URL = '/cesium/';</script>"
+        "<script src=\"/cesium/Cesium.js\"></script>"
+        "<link href=\"/cesium/Widgets/widgets.css\" rel=\"stylesheet\">"
+        "<style>html,body,#v{width:100%;height:100%;margin:0;padding:0;overflow:hidden}</style>"
+        "</head><body><div id=\"v\"></div></body></html>\n")
 
 
 def compare_module():
@@ -81,7 +99,39 @@ def main():
                 f"| ![hmm's TIN of {name}](images/{name}-hmm.png) |",
                 "",
             ]
+        lines += cesium_pictures(args, data, out, tmp)
     print("\n".join(lines))
+
+
+def cesium_pictures(args, data, out, tmp):
+    """Builds each CESIUM pyramid, serves them, screenshots each; the Markdown lines."""
+    site = tmp / "site"
+    site.mkdir()
+    (site / "index.html").write_text(PAGE)
+    os.symlink(ROOT / ".tools/node_modules/cesium/Build/Cesium", site / "cesium")
+    for _, dem, terrain, _ in CESIUM:
+        run([args.bin, "tiles", data / dem, "-o", site / terrain, "--normals", "-q"])
+    server = subprocess.Popen([args.bin, "serve", site, "--port", "0"], stdout=subprocess.PIPE,
+                              text=True)
+    try:
+        base = server.stdout.readline().strip().rsplit(" ", 1)[-1]
+        for name, _, terrain, view in CESIUM:
+            run(["node", ROOT / "bench/cesium_shot.cjs", f"{base}index.html",
+                 f"{base}{terrain}/", out / f"{name}.png", *view])
+    finally:
+        server.kill()
+        server.wait()
+    return [
+        "CesiumJS 1.140 in headless Chromium, pyramids by `tinsmith tiles --normals` served by "
+        "`tinsmith serve`, no imagery, lit by the pyramids' normals: ETOPO5 (levels 0–4, "
+        "heights exaggerated 20 x) and Big Tujunga (30 m, levels 0–12, not exaggerated).",
+        "",
+        "| ETOPO5, the whole globe | Big Tujunga, close |",
+        "|---|---|",
+        "| ![ETOPO5 in CesiumJS](images/cesium-global.png) "
+        "| ![Big Tujunga in CesiumJS](images/cesium-close.png) |",
+        "",
+    ]
 
 
 if __name__ == "__main__":

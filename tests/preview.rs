@@ -214,3 +214,36 @@ fn the_hillshade_is_gdaldems() {
     }
     assert!(compared > w * h / 2);
 }
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn without_a_mesh_the_raster_is_decimated_first_as_mesh_decimates_it() {
+    let dir = Dir::new();
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let o = dir.run(&["mesh", &dem, "--max-error", "20", "-o", "m.ply", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = dir.run(&[
+        "preview",
+        &dem,
+        "-o",
+        "d.png",
+        "--max-error",
+        "20",
+        "--size",
+        "300",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mesh = tinsmith_formats::read_mesh(&dir.path("m.ply")).unwrap();
+    let seen = pillow(&dir.path("d.png"), &[]);
+    let counts = format!(
+        "{} vertices, {} triangles",
+        mesh.vertices.len(),
+        mesh.triangles.len()
+    );
+    assert_eq!(seen["text"]["Counts"], counts.as_str());
+    assert_eq!(seen["text"]["Mesh"], "decimated by tinsmith within 20");
+    // No temporary mesh left beside the picture.
+    assert_eq!(dir.files(), ["d.png", "m.ply"]);
+    let o = dir.run(&["preview", &dem, "-o", "e.png"]);
+    assert_fails_naming(&o, &["MESH", "--max-error"]);
+}

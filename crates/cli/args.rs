@@ -53,8 +53,9 @@ pub enum Command {
 pub struct PreviewArgs {
     /// The raster the mesh was made from.
     pub input: PathBuf,
-    /// The mesh (any format `verify` reads); it must be a valid TIN of INPUT.
-    pub mesh: PathBuf,
+    /// The mesh (any format `verify` reads); it must be a valid TIN of INPUT. Without it,
+    /// INPUT is decimated first within --max-error (`mesh`'s other defaults).
+    pub mesh: Option<PathBuf>,
     /// The PNG to write (replaced only by a complete one).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -73,7 +74,8 @@ pub struct PreviewArgs {
     /// legend from -E to +E.
     #[arg(long)]
     pub error: bool,
-    /// E for --error's colours (default: the largest error measured).
+    /// E for --error's colours (default: the largest error measured); without MESH, also
+    /// the bound the TIN is decimated within.
     #[arg(long, value_parser = parse_max_error, allow_hyphen_values = true)]
     pub max_error: Option<f64>,
     /// The mesh's format, whatever its extension (as `verify --format`).
@@ -90,7 +92,8 @@ pub struct PreviewArgs {
 impl PreviewArgs {
     /// The job these flags ask for.
     pub fn job(&self) -> PreviewJob {
-        let mut job = PreviewJob::new(&self.input, &self.mesh, &self.output);
+        let mesh = self.mesh.clone().unwrap_or_default();
+        let mut job = PreviewJob::new(&self.input, mesh, &self.output);
         let none = !(self.hillshade || self.wireframe || self.error);
         job.hillshade = self.hillshade || none;
         job.wireframe = self.wireframe || none;

@@ -62,7 +62,18 @@ pub fn serve(args: &ServeArgs) -> Result<bool> {
 
 /// `tinsmith preview`: draws the picture and says what it shows.
 pub fn preview(args: &PreviewArgs) -> Result<bool> {
-    let drawn = tinsmith_pipeline::preview(&args.job())?;
+    let drawn = match (&args.mesh, args.max_error) {
+        (Some(_), _) => tinsmith_pipeline::preview(&args.job())?,
+        (None, Some(bound)) => {
+            let mut decimate = tinsmith_pipeline::MeshJob::new(&args.input);
+            decimate.max_error = Some(bound);
+            tinsmith_pipeline::preview_decimated(&args.job(), &decimate, &Stderr::new(true))?
+        }
+        (None, None) => anyhow::bail!(
+            "{}: give the MESH to draw, or --max-error to decimate the raster first",
+            args.input.display()
+        ),
+    };
     let scale = drawn
         .error_scale
         .map(|e| format!("; error colours span +/-{}", tinsmith_pipeline::readable(e)))

@@ -315,6 +315,8 @@ pub struct PreviewJob {
     pub error: bool,
     /// The bound the error colours span (default: the measured largest error).
     pub max_error: Option<f64>,
+    /// What the PNG's text says the mesh is (default: its path).
+    pub mesh_label: Option<String>,
 }
 
 impl PreviewJob {
@@ -336,6 +338,7 @@ impl PreviewJob {
             wireframe: true,
             error: false,
             max_error: None,
+            mesh_label: None,
         }
     }
 }

@@ -8,7 +8,7 @@ use crate::error::{bail, Context};
 use crate::mesh_file::{
     expected_orientation, mesh_format, orient_polygon_triangles, read_mesh_file, sample_positions,
 };
-use crate::{PreviewJob, Result};
+use crate::{Feedback, MeshJob, PreviewJob, Result};
 
 /// What [`preview`] drew.
 #[derive(Debug, Clone, PartialEq)]
@@ -136,7 +136,12 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
             format!("tinsmith {}", env!("CARGO_PKG_VERSION")),
         ),
         ("Source", job.input.display().to_string()),
-        ("Mesh", job.mesh.display().to_string()),
+        (
+            "Mesh",
+            job.mesh_label
+                .clone()
+                .unwrap_or_else(|| job.mesh.display().to_string()),
+        ),
         (
             "Counts",
             format!(
@@ -207,4 +212,39 @@ fn unit_free_resolution(values: &[f64], width: usize) -> [f64; 2] {
     let (_, step, _) = steps.select_nth_unstable_by(k, f64::total_cmp);
     let spacing = if *step > 0.0 { *step } else { 1.0 };
     [spacing, -spacing]
+}
+
+/// [`preview`] of the TIN `decimate` makes (its `output` is ignored): the mesh is written to
+/// a temporary PLY (removed after), verified as `mesh` verifies it, and drawn from there.
+/// The PNG's "Mesh" text says it was decimated, within which bound.
+///
+/// # Errors
+/// As `mesh` and [`preview`].
+pub fn preview_decimated(
+    job: &PreviewJob,
+    decimate: &MeshJob,
+    feedback: &dyn Feedback,
+) -> Result<Previewed> {
+    let scratch = tempfile::Builder::new()
+        .prefix(".tinsmith-preview-")
+        .tempdir()
+        .with_context(|| "cannot make a temporary directory for the mesh")?;
+    let mesh = scratch.path().join("decimated.ply");
+    let mut decimate = decimate.clone();
+    decimate.input = job.input.clone();
+    decimate.output = Some(mesh.clone());
+    decimate.export.format = None;
+    decimate.band = job.band;
+    decimate.pixel_coords = job.pixel_coords;
+    decimate.report = None;
+    crate::mesh(&decimate, feedback)?;
+    let mut from_mesh = job.clone();
+    from_mesh.mesh = mesh;
+    from_mesh.format = None;
+    from_mesh.max_error = job.max_error.or(decimate.max_error);
+    let bound = decimate
+        .max_error
+        .map_or("a count target".to_owned(), tinsmith_georef::readable);
+    from_mesh.mesh_label = Some(format!("decimated by tinsmith within {bound}"));
+    preview(&from_mesh)
 }

@@ -247,3 +247,55 @@ fn without_a_mesh_the_raster_is_decimated_first_as_mesh_decimates_it() {
     let o = dir.run(&["preview", &dem, "-o", "e.png"]);
     assert_fails_naming(&o, &["MESH", "--max-error"]);
 }
+
+#[test]
+fn mesh_preview_is_the_picture_preview_draws_of_the_written_mesh() {
+    let dir = Dir::new();
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    // Tiled (the default tiles are smaller than the raster) and untiled.
+    for (name, tiles) in [("tiled", "256"), ("whole", "4096")] {
+        let (ply, png, again) = (
+            format!("{name}.ply"),
+            format!("{name}.png"),
+            format!("{name}-again.png"),
+        );
+        let o = dir.run(&[
+            "mesh",
+            &dem,
+            "--max-error",
+            "20",
+            "-o",
+            &ply,
+            "--preview",
+            &png,
+            "--tile-size",
+            tiles,
+            "-q",
+        ]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let o = dir.run(&["preview", &dem, &ply, "-o", &again]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let (a, b) = (
+            std::fs::read(dir.path(&png)).unwrap(),
+            std::fs::read(dir.path(&again)).unwrap(),
+        );
+        assert!(
+            a.starts_with(b"\x89PNG") && a == b,
+            "{name}: not the same picture"
+        );
+    }
+    // A bad picture name is refused before anything is written.
+    let before = dir.files();
+    let o = dir.run(&[
+        "mesh",
+        &dem,
+        "--max-error",
+        "20",
+        "-o",
+        "x.ply",
+        "--preview",
+        "x.jpg",
+    ]);
+    assert_fails_naming(&o, &["x.jpg", ".png"]);
+    assert_eq!(dir.files(), before);
+}

@@ -94,6 +94,10 @@ pub struct MeshArgs {
     /// Write a JSON report of sizes, counts, measured error and timings.
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
+    /// Also write a PNG of the mesh's edges over the raster's hillshade, as `tinsmith
+    /// preview` draws it (1600 pixels); untiled meshes only.
+    #[arg(long, value_name = "FILE.png")]
+    pub preview: Option<PathBuf>,
     /// Samples per tile side, shared row and column included: a raster wider or taller
     /// than this is meshed tile by tile (in parallel, in bounded memory).
     #[arg(long, value_name = "N", default_value_t = tinsmith_pipeline::DEFAULT_TILE_SIZE,
@@ -166,6 +170,7 @@ impl MeshArgs {
         job.contour_levels = self.contour_levels.clone();
         job.pixel_coords = self.pixel_coords;
         job.report = self.report.clone();
+        job.preview = self.preview.clone();
         job.tile_size = self.tile_size;
         job.threads = self.threads;
         job.per_tile = self.per_tile.clone();

@@ -73,6 +73,9 @@ pub struct MeshJob {
     pub per_tile: Option<PathBuf>,
     /// Format of the `per_tile` files (PLY when `None`).
     pub tile_format: Option<TileFormat>,
+    /// A PNG of the mesh's edges over the raster's hillshade (`tinsmith preview`'s
+    /// default picture, 1600 pixels), written after the mesh.
+    pub preview: Option<PathBuf>,
 }
 
 /// The format of the files a per-tile run writes.
@@ -129,6 +132,7 @@ impl MeshJob {
             threads: None,
             per_tile: None,
             tile_format: None,
+            preview: None,
         }
     }
 

@@ -9,7 +9,7 @@ use tinsmith_formats::MeshFormat;
 use tinsmith_georef::Placement;
 use tinsmith_tiling::check_tin;
 
-use crate::error::bail;
+use crate::error::{bail, Context};
 use crate::jobs::MeshJob;
 use crate::output_paths::NamingFile;
 use crate::output_paths::{check_distinct, check_writable_target, ReservedReport};
@@ -63,9 +63,42 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
             );
         }
     }
+    if let Some(png) = &job.preview {
+        crate::preview::check_picture_path(png, PREVIEW_SIZE)?;
+        crate::output_paths::check_writable_target(png, &job.input)?;
+        if job.per_tile.is_some() {
+            bail!("--preview draws one mesh; --per-tile writes many");
+        }
+    }
     let Some(output) = crate::tiled_mesh::untiled_output(job)? else {
-        return crate::tiled_mesh::run(job, feedback);
+        let Some(png) = &job.preview else {
+            return crate::tiled_mesh::run(job, feedback);
+        };
+        // A tiled mesh is drawn from the file once written, the whole raster read again:
+        // refused now if that would not fit.
+        let output = job
+            .output
+            .as_deref()
+            .expect("a tiled run without --per-tile has -o");
+        let mut picture = crate::PreviewJob::new(&job.input, output, png);
+        picture.format = job.export.format;
+        picture.band = job.band;
+        picture.pixel_coords = job.pixel_coords;
+        picture.size = PREVIEW_SIZE;
+        crate::preview::check_fits(&picture)?;
+        crate::tiled_mesh::run(job, feedback)?;
+        crate::preview(&picture)?;
+        return Ok(());
     };
+    if let Some(png) = &job.preview {
+        let others = [Some(output), job.report.as_deref()];
+        for other in others.into_iter().flatten() {
+            if other == png.as_path() {
+                bail!("{}: --preview names another output too", png.display());
+            }
+            crate::output_paths::check_distinct(other, png, "another output")?;
+        }
+    }
     let total = Instant::now();
     // `untiled_output` has checked the output path and its sidecar.
     let format = crate::format_plan::format(job)?;
@@ -119,12 +152,30 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         );
     }
 
+    // Drawn before anything is written, so that a picture that cannot be made leaves the
+    // old outputs alone.
+    let picture = match &job.preview {
+        Some(_) => Some(draw_preview(
+            job,
+            output,
+            &raster.info,
+            grid,
+            tin,
+            check.max_error,
+        )?),
+        None => None,
+    };
+
     let t = Instant::now();
     let (vertices, triangles) = placement.file_mesh(
         tin.vertices().iter().map(|v| (v.x, v.y, v.z)),
         tin.triangles().iter().copied(),
     );
     crate::format_plan::write(&plan, job, &raster.info, vertices, &triangles, feedback)?;
+    if let (Some(png), Some(bytes)) = (&job.preview, &picture) {
+        tinsmith_output::write_bytes_atomically(png, bytes)
+            .with_context(|| format!("{}: cannot write", png.display()))?;
+    }
     let write_seconds = t.elapsed().as_secs_f64();
 
     let r = &result.report;
@@ -160,6 +211,45 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     }
     tinsmith_output::mark_finished();
     Ok(())
+}
+
+/// The longer side of `--preview`'s picture, in pixels.
+const PREVIEW_SIZE: u32 = 1600;
+
+/// `--preview`'s PNG of `tin` (verified, largest error `max_error`) over `grid`, as
+/// `tinsmith preview` draws the mesh file `output`.
+fn draw_preview(
+    job: &MeshJob,
+    output: &Path,
+    info: &tinsmith_raster::RasterInfo,
+    grid: &Grid,
+    tin: &tinsmith_core::Tin,
+    max_error: f64,
+) -> Result<Vec<u8>> {
+    let positions: Vec<[i64; 2]> = tin
+        .vertices()
+        .iter()
+        .map(|v| [i64::from(v.x), i64::from(v.y)])
+        .collect();
+    let heights: Vec<f64> = tin.vertices().iter().map(|v| v.z).collect();
+    let drawing = crate::preview::Drawing {
+        input: &job.input,
+        info,
+        values: grid.values(),
+        positions: &positions,
+        heights: &heights,
+        triangles: tin.triangles(),
+        mesh_label: output.display().to_string(),
+        max_error,
+    };
+    let choices = crate::preview::PictureChoices {
+        size: PREVIEW_SIZE,
+        hillshade: true,
+        wireframe: true,
+        error: false,
+        max_error: None,
+    };
+    Ok(drawing.png(&choices)?.1)
 }
 
 /// Checks `--report` before the work (writable; not the input, the output, its `.prj`

@@ -39,34 +39,9 @@ pub struct Previewed {
 /// As `verify`, and when the output does not end in `.png`, is the input, cannot be
 /// written, or the size is outside 16 to 16,384 pixels.
 pub fn preview(job: &PreviewJob) -> Result<Previewed> {
-    let is_png = job
-        .output
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-    if !is_png {
-        bail!(
-            "{}: a preview is a PNG; give an output ending in .png",
-            job.output.display()
-        );
-    }
-    if !(16..=16_384).contains(&job.size) {
-        bail!(
-            "--size {}: a preview is 16 to 16384 pixels on its longer side",
-            job.size
-        );
-    }
+    check_picture_path(&job.output, job.size)?;
     crate::output_paths::check_writable_target(&job.output, &job.input)?;
-    let format = mesh_format(&job.mesh, job.format)?;
-    crate::memory::check_whole_raster_fits(
-        &job.input,
-        crate::memory::raster_size(&job.input, job.band)?,
-        crate::memory::Need {
-            bytes_per_sample: 40,
-            extra_bytes: crate::memory::mesh_file_memory(&job.mesh, format),
-        },
-        "preview",
-        "a preview reads the whole raster; use a machine with more memory",
-    )?;
+    let format = check_fits(job)?;
     let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
     crate::transform_check::check_transform(&raster.info, job.pixel_coords)?;
     let placement = Placement::new(raster.info.transform(), job.pixel_coords);
@@ -96,71 +71,22 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
                 .map_or("the verifier found problems", String::as_str)
         );
     }
-    let surface = if job.error {
-        Some(tinsmith_verify::surface(width, height, tin)?)
-    } else {
-        None
-    };
-    let error_scale = job.error.then(|| {
-        job.max_error
-            .filter(|&e| e > 0.0)
-            .unwrap_or(if report.max_error > 0.0 {
-                report.max_error
-            } else {
-                1.0
-            })
-    });
-    let scene = Scene {
-        width,
-        height,
+    let label = job
+        .mesh_label
+        .clone()
+        .unwrap_or_else(|| job.mesh.display().to_string());
+    let drawing = Drawing {
+        input: &job.input,
+        info: &raster.info,
         values: grid.values(),
-        resolution: resolution(&raster.info)
-            .unwrap_or_else(|| unit_free_resolution(grid.values(), width as usize)),
         positions: &positions,
+        heights: &heights,
         triangles: &triangles,
-        surface: surface.as_deref(),
+        mesh_label: label,
+        max_error: report.max_error,
     };
-    let layers = Layers {
-        hillshade: job.hillshade,
-        wireframe: job.wireframe,
-        error: error_scale,
-        title: match job.max_error {
-            Some(_) => "error, TIN - raster (to the bound)".into(),
-            None => "error, TIN - raster (to the largest)".into(),
-        },
-    };
-    let picture = render(&scene, &layers, job.size)?;
-    let text = [
-        (
-            "Software",
-            format!("tinsmith {}", env!("CARGO_PKG_VERSION")),
-        ),
-        ("Source", job.input.display().to_string()),
-        (
-            "Mesh",
-            job.mesh_label
-                .clone()
-                .unwrap_or_else(|| job.mesh.display().to_string()),
-        ),
-        (
-            "Counts",
-            format!(
-                "{} vertices, {} triangles",
-                positions.len(),
-                triangles.len()
-            ),
-        ),
-        ("Max error", tinsmith_georef::readable(report.max_error)),
-        (
-            "Error scale",
-            error_scale.map_or("none".into(), tinsmith_georef::readable),
-        ),
-        (
-            "Samples per pixel",
-            tinsmith_georef::readable(picture.samples_per_pixel),
-        ),
-    ];
-    let bytes = encode_png(&picture, &text);
+    let (picture, bytes) = drawing.png(&choices(job))?;
+    let error_scale = picture.error_scale;
     tinsmith_output::write_bytes_atomically(&job.output, &bytes)
         .with_context(|| format!("{}: cannot write", job.output.display()))?;
     Ok(Previewed {
@@ -172,6 +98,168 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
         max_error: report.max_error,
         error_scale,
     })
+}
+
+/// Fails when the whole raster and the mesh (or, before it exists, a mesh as large as the
+/// raster allows) would not fit in memory; returns the mesh's format.
+pub(crate) fn check_fits(job: &PreviewJob) -> Result<tinsmith_formats::MeshFormat> {
+    let format = mesh_format(&job.mesh, job.format)?;
+    let size = crate::memory::raster_size(&job.input, job.band)?;
+    // A mesh not written yet: at most a vertex and two triangles a sample, about 40 bytes.
+    let mesh_bytes = match std::fs::metadata(&job.mesh) {
+        Ok(_) => crate::memory::mesh_file_memory(&job.mesh, format),
+        Err(_) => 0,
+    };
+    let per_sample = if mesh_bytes == 0 { 80 } else { 40 };
+    crate::memory::check_whole_raster_fits(
+        &job.input,
+        size,
+        crate::memory::Need {
+            bytes_per_sample: per_sample,
+            extra_bytes: mesh_bytes,
+        },
+        "preview",
+        "a preview reads the whole raster; use a machine with more memory",
+    )?;
+    Ok(format)
+}
+
+/// What a picture shows and how large it is.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PictureChoices {
+    pub(crate) size: u32,
+    pub(crate) hillshade: bool,
+    pub(crate) wireframe: bool,
+    pub(crate) error: bool,
+    /// The error colours' span (default: the measured largest error).
+    pub(crate) max_error: Option<f64>,
+}
+
+fn choices(job: &PreviewJob) -> PictureChoices {
+    PictureChoices {
+        size: job.size,
+        hillshade: job.hillshade,
+        wireframe: job.wireframe,
+        error: job.error,
+        max_error: job.max_error,
+    }
+}
+
+/// A raster and a valid TIN of it on its lattice, to draw.
+pub(crate) struct Drawing<'a> {
+    pub(crate) input: &'a std::path::Path,
+    pub(crate) info: &'a tinsmith_raster::RasterInfo,
+    /// The samples, row-major, NaN for nodata.
+    pub(crate) values: &'a [f64],
+    pub(crate) positions: &'a [[i64; 2]],
+    pub(crate) heights: &'a [f64],
+    pub(crate) triangles: &'a [[u32; 3]],
+    /// What the PNG's text calls the mesh.
+    pub(crate) mesh_label: String,
+    /// The measured largest error.
+    pub(crate) max_error: f64,
+}
+
+/// A drawn picture's size and scale.
+pub(crate) struct Drawn {
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) samples_per_pixel: f64,
+    pub(crate) error_scale: Option<f64>,
+}
+
+impl Drawing<'_> {
+    /// The picture `choices` ask for, as PNG bytes with text chunks naming the input, the
+    /// mesh, the counts and the error bound.
+    pub(crate) fn png(&self, choices: &PictureChoices) -> Result<(Drawn, Vec<u8>)> {
+        let (width, height) = (self.info.width, self.info.height);
+        let tin = MeshRef::new(self.positions, self.heights, self.triangles);
+        let surface = if choices.error {
+            Some(tinsmith_verify::surface(width, height, tin)?)
+        } else {
+            None
+        };
+        let error_scale = choices.error.then(|| {
+            choices
+                .max_error
+                .filter(|&e| e > 0.0)
+                .unwrap_or(if self.max_error > 0.0 {
+                    self.max_error
+                } else {
+                    1.0
+                })
+        });
+        let scene = Scene {
+            width,
+            height,
+            values: self.values,
+            resolution: resolution(self.info)
+                .unwrap_or_else(|| unit_free_resolution(self.values, width as usize)),
+            positions: self.positions,
+            triangles: self.triangles,
+            surface: surface.as_deref(),
+        };
+        let layers = Layers {
+            hillshade: choices.hillshade,
+            wireframe: choices.wireframe,
+            error: error_scale,
+            title: match choices.max_error {
+                Some(_) => "error, TIN - raster (to the bound)".into(),
+                None => "error, TIN - raster (to the largest)".into(),
+            },
+        };
+        let picture = render(&scene, &layers, choices.size)?;
+        let text = [
+            (
+                "Software",
+                format!("tinsmith {}", env!("CARGO_PKG_VERSION")),
+            ),
+            ("Source", self.input.display().to_string()),
+            ("Mesh", self.mesh_label.clone()),
+            (
+                "Counts",
+                format!(
+                    "{} vertices, {} triangles",
+                    self.positions.len(),
+                    self.triangles.len()
+                ),
+            ),
+            ("Max error", tinsmith_georef::readable(self.max_error)),
+            (
+                "Error scale",
+                error_scale.map_or("none".into(), tinsmith_georef::readable),
+            ),
+            (
+                "Samples per pixel",
+                tinsmith_georef::readable(picture.samples_per_pixel),
+            ),
+        ];
+        let bytes = encode_png(&picture, &text);
+        let drawn = Drawn {
+            width: picture.width,
+            height: picture.height,
+            samples_per_pixel: picture.samples_per_pixel,
+            error_scale,
+        };
+        Ok((drawn, bytes))
+    }
+}
+
+/// Fails unless `path` ends in `.png` and `size` is drawable, before any work.
+pub(crate) fn check_picture_path(path: &std::path::Path, size: u32) -> Result<()> {
+    let is_png = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !is_png {
+        bail!(
+            "{}: a preview is a PNG; give an output ending in .png",
+            path.display()
+        );
+    }
+    if !(16..=16_384).contains(&size) {
+        bail!("--size {size}: a preview is 16 to 16384 pixels on its longer side");
+    }
+    Ok(())
 }
 
 /// Sample spacing for the hillshade, in metres where the raster's CRS is geographic

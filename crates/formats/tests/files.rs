@@ -27,6 +27,7 @@ const MALFORMED: &[(&str, &str)] = &[
     ("garbage.ply", "does not start with `ply`"),
     ("header_only.ply", "truncated"),
     ("huge_count.ply", "truncated"),
+    ("huge_feature.fgb", "truncated"),
     ("index_out_of_range.obj", "out of range"),
     ("index_out_of_range.ply", "out of range"),
     ("nan_vertex.ply", "non-finite"),

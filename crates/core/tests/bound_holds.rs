@@ -632,3 +632,21 @@ fn a_count_target_stops_at_the_count_on_a_plane() {
     .unwrap();
     assert_eq!(r.tin.vertices().len(), 300);
 }
+
+#[test]
+fn a_flat_grid_with_flips_decimates_under_debug_assertions() {
+    // Found by the `decimate` fuzz target: a zero error came out as 0.0 from the unit-hole
+    // shortcut and as -0.0 from the scan, and the debug check of the shortcut compared
+    // their bits.
+    let spec = GridSpec {
+        width: 3,
+        height: 9,
+        values: vec![0.0; 27],
+    };
+    let mut options = DecimationOptions::new(7.25)
+        .with_initial_mesh(InitialMesh::Full)
+        .with_flip_rounds(1);
+    options.dp_max_ring = 14;
+    let tin = check_with(&spec, &options).unwrap();
+    assert_eq!(tin.triangles().len(), 2);
+}

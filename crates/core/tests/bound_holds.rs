@@ -650,3 +650,23 @@ fn a_flat_grid_with_flips_decimates_under_debug_assertions() {
     let tin = check_with(&spec, &options).unwrap();
     assert_eq!(tin.triangles().len(), 2);
 }
+
+#[test]
+fn a_bound_far_beyond_any_height_raises_vertices_only_within_range() {
+    // Found by the `decimate` fuzz target: at a bound of 9e252 the raise (2^-24 of the
+    // bound) lifted a flat grid's vertices to 6e245, where the hole errors overflow.
+    let spec = GridSpec {
+        width: 11,
+        height: 9,
+        values: vec![0.0; 99],
+    };
+    let mut options =
+        DecimationOptions::new(9.372_899_046_627_583e252).with_initial_mesh(InitialMesh::Full);
+    options.dp_max_ring = 0;
+    let tin = check_with(&spec, &options).unwrap();
+    assert_eq!(tin.triangles().len(), 2);
+    assert!(tin
+        .vertices()
+        .iter()
+        .all(|v| v.z <= tinsmith_core::MAX_ABS_HEIGHT));
+}

@@ -31,7 +31,9 @@ const RAISE_IN_SLACKS: f64 = 65536.0;
 
 /// How far [`crate::VertexHeights::Raised`] puts a vertex above its sample for `max_error` on
 /// data whose largest |value| is `max_abs_value`: 2^16 rounding slacks (2^-24 of `max_error
-/// + max_abs_value`), at most the enforced bound over [`RAISED_HEIGHT_SHARE`].
+/// + max_abs_value`), at most the enforced bound over [`RAISED_HEIGHT_SHARE`] and at most
+/// [`MAX_ABS_HEIGHT`] (a bound far beyond any height would otherwise lift the vertices out
+/// of the range where errors fit in `f32`).
 ///
 /// The raise only has to lift a sample exactly the bound above its triangle's plane (ties
 /// on integer heights) clear of the slack, which the rounding of any verifier stays far
@@ -42,7 +44,9 @@ const RAISE_IN_SLACKS: f64 = 65536.0;
 /// one (the float32 formats' rounding margin relies on that).
 pub fn vertex_raise(max_error: f64, max_abs_value: f64) -> f64 {
     let slack = ROUNDING_SLACK * (max_error.min(f64::MAX) + max_abs_value);
-    (RAISE_IN_SLACKS * slack).min(effective_limit(max_error, max_abs_value) / RAISED_HEIGHT_SHARE)
+    (RAISE_IN_SLACKS * slack)
+        .min(effective_limit(max_error, max_abs_value) / RAISED_HEIGHT_SHARE)
+        .min(MAX_ABS_HEIGHT)
 }
 
 /// The largest |height| decimation accepts: error bounds are stored as `f32`, and between

@@ -14,7 +14,7 @@ use std::rc::Rc;
 
 use flatgeobuf::geozero::{ColumnValue, FeatureProcessor, GeomProcessor, PropertyProcessor};
 use flatgeobuf::{
-    ColumnType, FallibleStreamingIterator, FeatureProperties, FgbCrs, FgbReader, FgbWriter,
+    ColumnType, FallibleStreamingIterator, FgbCrs, FgbFeature, FgbReader, FgbWriter,
     FgbWriterOptions, Geometry, GeometryType,
 };
 
@@ -168,6 +168,15 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
             "{kind:?} geometries; only Triangle, Polygon, MultiPolygon and TIN are read"
         )));
     }
+    let columns: Vec<(ColumnType, bool)> = header
+        .columns()
+        .map(|columns| {
+            columns
+                .iter()
+                .map(|c| (c.type_(), c.name() == ID))
+                .collect()
+        })
+        .unwrap_or_default();
     let mut features = reader.select_all_seq().map_err(Problem::malformed)?;
     let mut welder = Welder::default();
     let mut ids: Vec<Option<i64>> = Vec::new();
@@ -176,7 +185,7 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
         let geometry = feature.geometry().ok_or_else(|| {
             Problem::malformed(format_args!("feature {feature_number} has no geometry"))
         })?;
-        let id = feature.property::<i64>(ID).ok();
+        let id = feature_id(feature, &columns, feature_number)?;
         let mut triangles = Vec::new();
         match geometry.parts() {
             Some(parts) => {
@@ -228,6 +237,58 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
         mesh.vertices = welder.into_vertices();
     }
     Ok(mesh)
+}
+
+/// The feature's `id` (a `Long` column), read from its property bytes with every length
+/// checked: the `flatgeobuf` crate reads them unchecked and panics on a value cut short.
+/// `None` when the feature has no `id` of that type, or has columns the crate cannot read.
+/// `columns` are the header's column types, each with whether it is the `id` column.
+fn feature_id(
+    feature: &FgbFeature,
+    columns: &[(ColumnType, bool)],
+    number: usize,
+) -> Result<Option<i64>, Problem> {
+    let Some(properties) = feature.fbs_feature().properties() else {
+        return Ok(None);
+    };
+    let bytes = properties.bytes();
+    let short = || {
+        Problem::malformed(format_args!(
+            "feature {number}: its properties end inside a value"
+        ))
+    };
+    let mut at = 0usize;
+    while at + 1 < bytes.len() {
+        let column = usize::from(u16::from_le_bytes([bytes[at], bytes[at + 1]]));
+        at += 2;
+        if column >= columns.len() {
+            return Ok(None);
+        }
+        let (kind, is_id) = columns[column];
+        let size = match kind {
+            ColumnType::Byte | ColumnType::UByte | ColumnType::Bool => 1,
+            ColumnType::Short | ColumnType::UShort => 2,
+            ColumnType::Int | ColumnType::UInt | ColumnType::Float => 4,
+            ColumnType::Long | ColumnType::ULong | ColumnType::Double => 8,
+            ColumnType::String | ColumnType::Json | ColumnType::DateTime | ColumnType::Binary => {
+                let len = bytes.get(at..at + 4).ok_or_else(short)?;
+                at += 4;
+                u32::from_le_bytes([len[0], len[1], len[2], len[3]]) as usize
+            }
+            _ => return Ok(None),
+        };
+        let value = at
+            .checked_add(size)
+            .and_then(|end| bytes.get(at..end))
+            .ok_or_else(short)?;
+        if is_id && kind == ColumnType::Long {
+            let mut raw = [0u8; 8];
+            raw.copy_from_slice(value);
+            return Ok(Some(i64::from_le_bytes(raw)));
+        }
+        at += size;
+    }
+    Ok(None)
 }
 
 /// Bytes of the packed R-tree index of `features` items in nodes of `node_size` items, as

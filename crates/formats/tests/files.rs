@@ -36,6 +36,7 @@ const MALFORMED: &[(&str, &str)] = &[
     ("no_end_header.ply", "end_header"),
     ("quad_face.obj", "only triangles"),
     ("quad_face.ply", "only triangles"),
+    ("short_property.fgb", "properties end inside a value"),
     ("short_vertex.obj", "3 coordinates"),
     ("truncated_faces.ply", "truncated"),
     ("truncated_vertices.ply", "truncated"),

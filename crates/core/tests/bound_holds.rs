@@ -87,6 +87,19 @@ fn check_with(spec: &GridSpec, options: &DecimationOptions) -> Result<Tin, TestC
     prop_assert!(report.passed(), "{options:?}: {:?}", report.problems);
     prop_assert!(report.max_error <= bound);
     prop_assert!(result.report.max_bound <= bound);
+    // The reported bound is exact; the measurement rounds (by far less than this slack).
+    let max_abs = spec
+        .values
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let rounding = (result.report.max_bound + max_abs) / (1u64 << 40) as f64;
+    prop_assert!(
+        report.max_error <= result.report.max_bound + rounding,
+        "{options:?}: measured {} above the reported bound {}",
+        report.max_error,
+        result.report.max_bound
+    );
     prop_assert_eq!(result.report.final_triangles, tin.triangles().len());
     for [x, y] in domain_corners(spec) {
         prop_assert!(
@@ -669,4 +682,24 @@ fn a_bound_far_beyond_any_height_raises_vertices_only_within_range() {
         .vertices()
         .iter()
         .all(|v| v.z <= tinsmith_core::MAX_ABS_HEIGHT));
+}
+
+#[test]
+fn the_reported_bound_covers_the_raise_of_vertices_no_removal_measured() {
+    // Found by the `decimate` fuzz target: on a flat grid whose full-grid start kept its
+    // raised inner vertex, the report gave a bound of 0 for a true error of the raise.
+    let mut values = vec![0.0; 16];
+    values[..10].fill(f64::NAN);
+    let spec = GridSpec {
+        width: 4,
+        height: 4,
+        values,
+    };
+    let mut options = DecimationOptions::new(0.5)
+        .with_selection(EdgeSelection::MinError)
+        .with_initial_mesh(InitialMesh::Full)
+        .with_extend_rounds(1);
+    options.dp_max_ring = 3;
+    options.max_abs_value = Some(6.194_999_670_005_428e-268);
+    check_with(&spec, &options).unwrap();
 }

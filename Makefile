@@ -112,6 +112,31 @@ test: deps
 	cargo clippy --workspace --all-targets -- -D warnings
 	RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 	cargo test --workspace -- --include-ignored
+	@$(MAKE) --no-print-directory fuzz-smoke
+
+## The fuzz targets (fuzz/, docs/fuzzing.md) build, and each runs for a few seconds from its
+## seeds without a finding. Installs the nightly toolchain (minimal) and cargo-fuzz when
+## missing. The fuzz crate is its own workspace, built in fuzz/target.
+FUZZ_SMOKE_SECONDS := 3
+CARGO_FUZZ_VERSION := 0.13.2
+.PHONY: fuzz-tools fuzz-smoke
+fuzz-tools:
+	@rustup toolchain list | grep -q '^nightly' || rustup toolchain install nightly --profile minimal
+	@cargo fuzz --version >/dev/null 2>&1 || cargo install cargo-fuzz --locked --version $(CARGO_FUZZ_VERSION)
+
+fuzz-smoke: fuzz-tools
+	cargo fmt --manifest-path fuzz/Cargo.toml --check
+	env -u CARGO_TARGET_DIR cargo +nightly fuzz build
+	@smoke=$$(mktemp -d) && trap 'rm -rf "$$smoke"' EXIT && \
+	  fuzz/seed.sh "$$smoke" >/dev/null && \
+	  for target in $$(cargo +nightly fuzz list); do \
+	    if env -u CARGO_TARGET_DIR cargo +nightly fuzz run $$target "$$smoke/$$target" -- \
+	        -max_total_time=$(FUZZ_SMOKE_SECONDS) -timeout=10 >"$$smoke/$$target.log" 2>&1; then \
+	      echo "fuzz smoke: $$target: $$(grep -E '^Done' "$$smoke/$$target.log")"; \
+	    else \
+	      tail -n 40 "$$smoke/$$target.log"; echo "fuzz smoke: $$target failed"; exit 1; \
+	    fi; \
+	  done
 
 ## Regenerate docs/results.md's decimation table from ../shared/data.
 bench-results:

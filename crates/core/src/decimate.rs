@@ -325,6 +325,12 @@ fn extract(mesh: Mesh<'_>, grid: &Grid) -> (Tin, f64) {
         .live_triangles()
         .fold(0.0f64, |m, (t, _)| m.max(mesh.bound(t).max()));
     let (kept, triangles) = mesh.into_numbered();
+    // A raised vertex is off its own sample by the raise, which the bounds of triangles
+    // never measured (those of the full-grid start) do not hold.
+    let max_bound = kept.iter().fold(max_bound, |m, &v| {
+        let i = v as usize;
+        m.max((grid.vertex_height(i) - grid.values()[i]).abs())
+    });
     let width = grid.width();
     let vertices = kept
         .iter()

@@ -87,6 +87,19 @@ fn check_with(spec: &GridSpec, options: &DecimationOptions) -> Result<Tin, TestC
     prop_assert!(report.passed(), "{options:?}: {:?}", report.problems);
     prop_assert!(report.max_error <= bound);
     prop_assert!(result.report.max_bound <= bound);
+    // The reported bound is exact; the measurement rounds (by far less than this slack).
+    let max_abs = spec
+        .values
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let rounding = (result.report.max_bound + max_abs) / (1u64 << 40) as f64;
+    prop_assert!(
+        report.max_error <= result.report.max_bound + rounding,
+        "{options:?}: measured {} above the reported bound {}",
+        report.max_error,
+        result.report.max_bound
+    );
     prop_assert_eq!(result.report.final_triangles, tin.triangles().len());
     for [x, y] in domain_corners(spec) {
         prop_assert!(
@@ -631,4 +644,62 @@ fn a_count_target_stops_at_the_count_on_a_plane() {
     )
     .unwrap();
     assert_eq!(r.tin.vertices().len(), 300);
+}
+
+#[test]
+fn a_flat_grid_with_flips_decimates_under_debug_assertions() {
+    // Found by the `decimate` fuzz target: a zero error came out as 0.0 from the unit-hole
+    // shortcut and as -0.0 from the scan, and the debug check of the shortcut compared
+    // their bits.
+    let spec = GridSpec {
+        width: 3,
+        height: 9,
+        values: vec![0.0; 27],
+    };
+    let mut options = DecimationOptions::new(7.25)
+        .with_initial_mesh(InitialMesh::Full)
+        .with_flip_rounds(1);
+    options.dp_max_ring = 14;
+    let tin = check_with(&spec, &options).unwrap();
+    assert_eq!(tin.triangles().len(), 2);
+}
+
+#[test]
+fn a_bound_far_beyond_any_height_raises_vertices_only_within_range() {
+    // Found by the `decimate` fuzz target: at a bound of 9e252 the raise (2^-24 of the
+    // bound) lifted a flat grid's vertices to 6e245, where the hole errors overflow.
+    let spec = GridSpec {
+        width: 11,
+        height: 9,
+        values: vec![0.0; 99],
+    };
+    let mut options =
+        DecimationOptions::new(9.372_899_046_627_583e252).with_initial_mesh(InitialMesh::Full);
+    options.dp_max_ring = 0;
+    let tin = check_with(&spec, &options).unwrap();
+    assert_eq!(tin.triangles().len(), 2);
+    assert!(tin
+        .vertices()
+        .iter()
+        .all(|v| v.z <= tinsmith_core::MAX_ABS_HEIGHT));
+}
+
+#[test]
+fn the_reported_bound_covers_the_raise_of_vertices_no_removal_measured() {
+    // Found by the `decimate` fuzz target: on a flat grid whose full-grid start kept its
+    // raised inner vertex, the report gave a bound of 0 for a true error of the raise.
+    let mut values = vec![0.0; 16];
+    values[..10].fill(f64::NAN);
+    let spec = GridSpec {
+        width: 4,
+        height: 4,
+        values,
+    };
+    let mut options = DecimationOptions::new(0.5)
+        .with_selection(EdgeSelection::MinError)
+        .with_initial_mesh(InitialMesh::Full)
+        .with_extend_rounds(1);
+    options.dp_max_ring = 3;
+    options.max_abs_value = Some(6.194_999_670_005_428e-268);
+    check_with(&spec, &options).unwrap();
 }

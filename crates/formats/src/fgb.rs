@@ -8,11 +8,13 @@
 //! but pyogrio (geopandas' default engine) and the flatgeobuf JavaScript reader (web maps)
 //! read no `Triangle`. Files of `Triangle` features, as tinsmith wrote before, are read.
 
+use std::cell::Cell;
 use std::io::{self, Read, Write};
+use std::rc::Rc;
 
 use flatgeobuf::geozero::{ColumnValue, FeatureProcessor, GeomProcessor, PropertyProcessor};
 use flatgeobuf::{
-    ColumnType, FallibleStreamingIterator, FeatureProperties, FgbCrs, FgbReader, FgbWriter,
+    ColumnType, FallibleStreamingIterator, FgbCrs, FgbFeature, FgbReader, FgbWriter,
     FgbWriterOptions, Geometry, GeometryType,
 };
 
@@ -124,8 +126,25 @@ fn corners(geometry: &Geometry<'_>, feature: usize) -> Result<[[f64; 3]; 3], Pro
 /// welding equal positions into shared vertices; when every feature has an `id`, the
 /// triangles are put in `id` order.
 pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
-    let reader = FgbReader::open(r).map_err(Problem::malformed)?;
+    let frames = Rc::new(Frames::default());
+    let framed = Framed {
+        inner: r,
+        frames: Rc::clone(&frames),
+        feature: Vec::new(),
+        passed: 0,
+    };
+    let reader = FgbReader::open(framed).map_err(Problem::malformed)?;
     let header = reader.header();
+    let index = index_size(header.features_count(), header.index_node_size())
+        .and_then(|index| frames.position.get().checked_add(index))
+        .ok_or_else(|| {
+            Problem::malformed(format_args!(
+                "no index of {} features in nodes of {} fits in a file",
+                header.features_count(),
+                header.index_node_size()
+            ))
+        })?;
+    frames.features_at.set(Some(index));
     let mut mesh = Mesh::default();
     if let Some(crs) = header.crs() {
         mesh.epsg = u32::try_from(crs.code())
@@ -149,6 +168,15 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
             "{kind:?} geometries; only Triangle, Polygon, MultiPolygon and TIN are read"
         )));
     }
+    let columns: Vec<(ColumnType, bool)> = header
+        .columns()
+        .map(|columns| {
+            columns
+                .iter()
+                .map(|c| (c.type_(), c.name() == ID))
+                .collect()
+        })
+        .unwrap_or_default();
     let mut features = reader.select_all_seq().map_err(Problem::malformed)?;
     let mut welder = Welder::default();
     let mut ids: Vec<Option<i64>> = Vec::new();
@@ -157,7 +185,7 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
         let geometry = feature.geometry().ok_or_else(|| {
             Problem::malformed(format_args!("feature {feature_number} has no geometry"))
         })?;
-        let id = feature.property::<i64>(ID).ok();
+        let id = feature_id(feature, &columns, feature_number)?;
         let mut triangles = Vec::new();
         match geometry.parts() {
             Some(parts) => {
@@ -178,6 +206,12 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
             ids.push(id);
         }
         feature_number += 1;
+    }
+    drop(features);
+    if frames.truncated.get() {
+        return Err(Problem::malformed(format_args!(
+            "the file ends inside feature {feature_number} (truncated)"
+        )));
     }
     if declared > 0 && feature_number as u64 != declared {
         return Err(Problem::malformed(format_args!(
@@ -203,6 +237,150 @@ pub(crate) fn read<R: Read>(r: R) -> Result<Mesh, Problem> {
         mesh.vertices = welder.into_vertices();
     }
     Ok(mesh)
+}
+
+/// The feature's `id` (a `Long` column), read from its property bytes with every length
+/// checked: the `flatgeobuf` crate reads them unchecked and panics on a value cut short.
+/// `None` when the feature has no `id` of that type, or has columns the crate cannot read.
+/// `columns` are the header's column types, each with whether it is the `id` column.
+fn feature_id(
+    feature: &FgbFeature,
+    columns: &[(ColumnType, bool)],
+    number: usize,
+) -> Result<Option<i64>, Problem> {
+    let Some(properties) = feature.fbs_feature().properties() else {
+        return Ok(None);
+    };
+    let bytes = properties.bytes();
+    let short = || {
+        Problem::malformed(format_args!(
+            "feature {number}: its properties end inside a value"
+        ))
+    };
+    let mut at = 0usize;
+    while at + 1 < bytes.len() {
+        let column = usize::from(u16::from_le_bytes([bytes[at], bytes[at + 1]]));
+        at += 2;
+        if column >= columns.len() {
+            return Ok(None);
+        }
+        let (kind, is_id) = columns[column];
+        let size = match kind {
+            ColumnType::Byte | ColumnType::UByte | ColumnType::Bool => 1,
+            ColumnType::Short | ColumnType::UShort => 2,
+            ColumnType::Int | ColumnType::UInt | ColumnType::Float => 4,
+            ColumnType::Long | ColumnType::ULong | ColumnType::Double => 8,
+            ColumnType::String | ColumnType::Json | ColumnType::DateTime | ColumnType::Binary => {
+                let len = bytes.get(at..at + 4).ok_or_else(short)?;
+                at += 4;
+                u32::from_le_bytes([len[0], len[1], len[2], len[3]]) as usize
+            }
+            _ => return Ok(None),
+        };
+        let value = at
+            .checked_add(size)
+            .and_then(|end| bytes.get(at..end))
+            .ok_or_else(short)?;
+        if is_id && kind == ColumnType::Long {
+            let mut raw = [0u8; 8];
+            raw.copy_from_slice(value);
+            return Ok(Some(i64::from_le_bytes(raw)));
+        }
+        at += size;
+    }
+    Ok(None)
+}
+
+/// Bytes of the packed R-tree index of `features` items in nodes of `node_size` items, as
+/// the `flatgeobuf` crate computes it (0 for none); `None` when that overflows or for nodes
+/// of 1 item, which the crate cannot index.
+fn index_size(features: u64, node_size: u16) -> Option<u64> {
+    /// Bytes of one node: a bounding box and an offset.
+    const NODE_BYTES: u64 = 40;
+    if features == 0 || node_size == 0 {
+        return Some(0);
+    }
+    if node_size == 1 {
+        return None;
+    }
+    let (mut level, mut nodes) = (features, features);
+    loop {
+        level = level.div_ceil(u64::from(node_size));
+        nodes = nodes.checked_add(level)?;
+        if level == 1 {
+            return nodes.checked_mul(NODE_BYTES);
+        }
+    }
+}
+
+/// What a [`Framed`] reader shares with the function that handed it to `flatgeobuf`.
+#[derive(Debug, Default)]
+struct Frames {
+    /// Bytes passed on so far.
+    position: Cell<u64>,
+    /// Where the first feature's length prefix is, once the header is known.
+    features_at: Cell<Option<u64>>,
+    /// Whether the input ended inside a feature or its length prefix.
+    truncated: Cell<bool>,
+}
+
+/// The input as the `flatgeobuf` crate reads it, except that a feature's length prefix is
+/// passed on only once all the bytes it announces have arrived: the crate sizes a buffer
+/// by the prefix before reading, so a few bytes announcing a 4 GB feature would otherwise
+/// allocate 4 GB. A feature cut short ends the features with [`Frames::truncated`] set.
+struct Framed<R> {
+    inner: R,
+    frames: Rc<Frames>,
+    /// The current feature, length prefix included.
+    feature: Vec<u8>,
+    /// How much of `feature` was passed on.
+    passed: usize,
+}
+
+impl<R: Read> Read for Framed<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let position = self.frames.position.get();
+        let n = match self.frames.features_at.get() {
+            Some(at) if position >= at => self.read_feature(buf)?,
+            at => {
+                let before = at.map_or(u64::MAX, |at| at - position);
+                let len = usize::try_from(before).map_or(buf.len(), |b| b.min(buf.len()));
+                self.inner.read(&mut buf[..len])?
+            }
+        };
+        self.frames.position.set(position + n as u64);
+        Ok(n)
+    }
+}
+
+impl<R: Read> Framed<R> {
+    /// Passes on the current feature, after reading the next one whole when it is done.
+    fn read_feature(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        if self.passed == self.feature.len() {
+            self.feature.clear();
+            self.passed = 0;
+            let prefix = (&mut self.inner).take(4).read_to_end(&mut self.feature)?;
+            if prefix == 0 {
+                return Ok(0);
+            }
+            let len = match self.feature[..] {
+                [a, b, c, d] => u32::from_le_bytes([a, b, c, d]),
+                _ => 0,
+            };
+            // Grows as the bytes arrive, never beyond them.
+            (&mut self.inner)
+                .take(u64::from(len))
+                .read_to_end(&mut self.feature)?;
+            if prefix < 4 || self.feature.len() - 4 < len as usize {
+                self.frames.truncated.set(true);
+                return Err(io::ErrorKind::UnexpectedEof.into());
+            }
+        }
+        let n = buf.len().min(self.feature.len() - self.passed);
+        buf[..n].copy_from_slice(&self.feature[self.passed..self.passed + n]);
+        self.passed += n;
+        Ok(n)
+    }
 }
 
 #[cfg(test)]
@@ -317,6 +495,38 @@ mod tests {
         assert_eq!(mesh.vertices, vertices);
         assert_eq!(mesh.triangles, [[0, 1, 2]]);
         Ok(())
+    }
+
+    #[test]
+    fn a_feature_longer_than_the_file_is_refused_before_it_is_allocated() {
+        let vertices = [[0.0, 0.0, 1.0], [1.0, 0.0, 2.0], [0.0, 1.0, 3.0]];
+        let mut bytes = write_to_vec(MeshRef::new(&vertices, &[[0, 1, 2]]));
+        // Magic, header length and header, then the index of one feature (2 nodes).
+        let header = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
+        let feature = 12 + header + 80;
+        bytes[feature..feature + 4].copy_from_slice(&0xFFFF_FFF0u32.to_le_bytes());
+        let problem = read(bytes.as_slice()).expect_err("a 4 GB feature in a small file");
+        assert!(
+            format!("{problem:?}").contains("ends inside feature 0 (truncated)"),
+            "{problem:?}"
+        );
+    }
+
+    #[test]
+    fn index_sizes_match_the_crate_and_overflow_is_refused() {
+        for (features, node_size) in [(1, 16), (2, 2), (1000, 16), (70_000, 3)] {
+            assert_eq!(
+                index_size(features, node_size),
+                Some(flatgeobuf::packed_r_tree::PackedRTree::index_size(
+                    features as usize,
+                    node_size
+                ) as u64)
+            );
+        }
+        assert_eq!(index_size(0, 16), Some(0));
+        assert_eq!(index_size(5, 0), Some(0));
+        assert_eq!(index_size(5, 1), None);
+        assert_eq!(index_size(u64::MAX, 2), None);
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Writing and reading mesh files by path: format dispatch, validation and error context.
 
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
 use tinsmith_output::write_atomically_with_sidecar;
@@ -246,22 +246,56 @@ pub fn read_mesh_as(path: &Path, format: MeshFormat) -> Result<Mesh> {
         .filter(|metadata| metadata.is_file())
         .map(|metadata| metadata.len());
     let reader = BufReader::with_capacity(BUFFER_SIZE, file);
-    let result: std::result::Result<Mesh, Problem> = match format {
-        MeshFormat::Ply => ply::read(reader, file_len),
-        MeshFormat::Obj => obj::read(reader),
-        MeshFormat::Stl => stl::read(reader, file_len),
-        MeshFormat::Glb => glb::read(reader, file_len),
-        MeshFormat::GeoJson => geojson::read(reader),
-        MeshFormat::FlatGeobuf => fgb::read(reader),
-        MeshFormat::LandXml => landxml::read(reader),
-    };
-    let mut mesh = result.map_err(|problem| problem.at(path, format))?;
+    let mut mesh =
+        read_from(reader, file_len, format).map_err(|problem| problem.at(path, format))?;
     if mesh.crs_wkt.is_none() && format.uses_prj_sidecar() {
         if let Ok(wkt) = std::fs::read_to_string(prj_path(path)) {
             mesh.crs_wkt = MeshRef::new(&[], &[]).with_crs_wkt(wkt.as_str()).crs_line();
         }
     }
     Ok(mesh)
+}
+
+/// Reads a mesh of `format` from `bytes`, as [`read_mesh_as`] reads a file with that
+/// content; `name` is the file name the errors give (nothing is opened, and no `.prj`
+/// sidecar is read).
+///
+/// For meshes that do not come from a local file (a download, an archive member, a
+/// database blob) and for fuzzing the readers.
+///
+/// # Errors
+/// [`Error::Malformed`] and [`Error::Unsupported`] as [`read_mesh_as`], naming `name`.
+///
+/// # Example
+/// ```
+/// use std::path::Path;
+/// use tinsmith_formats::{read_mesh_bytes, MeshFormat};
+/// # fn main() -> tinsmith_formats::Result<()> {
+/// let obj = b"v 0 0 1\nv 1 0 2\nv 0 1 3\nf 1 2 3\n";
+/// let mesh = read_mesh_bytes(Path::new("upload.obj"), obj, MeshFormat::Obj)?;
+/// assert_eq!(mesh.triangles, [[0, 1, 2]]);
+/// # Ok(())
+/// # }
+/// ```
+pub fn read_mesh_bytes(name: &Path, bytes: &[u8], format: MeshFormat) -> Result<Mesh> {
+    read_from(bytes, Some(bytes.len() as u64), format).map_err(|problem| problem.at(name, format))
+}
+
+/// Reads a mesh of `format` from `reader`, whose content is `len` bytes long when known.
+fn read_from<R: BufRead>(
+    reader: R,
+    len: Option<u64>,
+    format: MeshFormat,
+) -> std::result::Result<Mesh, Problem> {
+    match format {
+        MeshFormat::Ply => ply::read(reader, len),
+        MeshFormat::Obj => obj::read(reader),
+        MeshFormat::Stl => stl::read(reader, len),
+        MeshFormat::Glb => glb::read(reader, len),
+        MeshFormat::GeoJson => geojson::read(reader),
+        MeshFormat::FlatGeobuf => fgb::read(reader),
+        MeshFormat::LandXml => landxml::read(reader),
+    }
 }
 
 #[cfg(test)]
@@ -501,6 +535,31 @@ mod tests {
             error.to_string(),
             format!("{}: invalid OBJ file: the file is empty", empty.display())
         );
+    }
+
+    #[test]
+    fn bytes_read_as_the_file_and_errors_name_the_given_name() -> Result<()> {
+        let dir = tempfile::tempdir().expect("temp dir");
+        for format in MeshFormat::ALL {
+            let path = dir.path().join(format!("tile.{}", format.extension()));
+            write_mesh(
+                &path,
+                format,
+                MeshRef::new(&MODERATE, &[[0, 1, 2], [1, 3, 2]]),
+            )?;
+            let bytes = std::fs::read(&path).expect("read back");
+            let from_bytes = read_mesh_bytes(Path::new("blob"), &bytes, format)?;
+            let from_file = read_mesh(&path)?;
+            assert_eq!(
+                bits(&from_bytes.vertices),
+                bits(&from_file.vertices),
+                "{format}"
+            );
+            assert_eq!(from_bytes.triangles, from_file.triangles, "{format}");
+            let error = read_mesh_bytes(Path::new("blob"), b"", format).expect_err("empty");
+            assert!(error.to_string().starts_with("blob: "), "{format}: {error}");
+        }
+        Ok(())
     }
 
     #[test]

@@ -74,7 +74,7 @@ mod weld;
 
 pub use antimeridian::cut_at_antimeridian;
 pub use error::{Error, Result};
-pub use file::{prj_path, read_mesh, read_mesh_as, write_mesh, write_mesh_with};
+pub use file::{prj_path, read_mesh, read_mesh_as, read_mesh_bytes, write_mesh, write_mesh_with};
 pub use format::MeshFormat;
 pub use lines::{write_lines, write_multilines, CrsRef, LineFormat, LinePoint};
 pub use mesh::{Mesh, MeshRef};

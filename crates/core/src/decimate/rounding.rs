@@ -33,7 +33,8 @@ const RAISE_IN_SLACKS: f64 = 65536.0;
 /// data whose largest |value| is `max_abs_value`: 2^16 rounding slacks (2^-24 of
 /// `max_error + max_abs_value`), at most the enforced bound over [`RAISED_HEIGHT_SHARE`],
 /// and whatever the bound never more than the raise for a bound of `2 max_abs_value`: a
-/// hair relative to the data (2^-24 of three times its largest |value|).
+/// hair relative to the data (2^-24 of three times its largest |value|), nor than
+/// [`MAX_ABS_HEIGHT`].
 ///
 /// The raise only has to lift a sample exactly the bound above its triangle's plane (ties
 /// on integer heights) clear of the slack, which the rounding of any verifier stays far
@@ -48,7 +49,9 @@ const RAISE_IN_SLACKS: f64 = 65536.0;
 pub fn vertex_raise(max_error: f64, max_abs_value: f64) -> f64 {
     let bound = max_error.min(2.0 * max_abs_value);
     let slack = ROUNDING_SLACK * (bound + max_abs_value);
-    (RAISE_IN_SLACKS * slack).min(effective_limit(max_error, max_abs_value) / RAISED_HEIGHT_SHARE)
+    (RAISE_IN_SLACKS * slack)
+        .min(effective_limit(max_error, max_abs_value) / RAISED_HEIGHT_SHARE)
+        .min(MAX_ABS_HEIGHT)
 }
 
 /// The largest |height| decimation accepts: error bounds are stored as `f32`, and between

@@ -294,3 +294,42 @@ pub fn expected_orientation(placement: &Placement) -> Orientation {
         Orientation::CounterClockwise
     }
 }
+
+/// A mesh file read back onto the raster it was made from: the raster, each vertex's
+/// sample, its height as the file holds it, and the triangles wound as the grid expects.
+pub(crate) struct MeshOnRaster {
+    pub(crate) raster: Raster,
+    pub(crate) positions: Vec<[i64; 2]>,
+    pub(crate) heights: Vec<f64>,
+    pub(crate) triangles: Vec<[u32; 3]>,
+    /// The winding expected in grid coordinates.
+    pub(crate) orientation: Orientation,
+}
+
+/// Reads band `band` of `input` whole and the mesh file `mesh` (in `format`) onto it, as
+/// `verify` measures it: the transform checked, WGS84 transformed back, every vertex
+/// mapped to its sample, polygon triangles wound as the grid expects.
+pub(crate) fn read_onto_raster(
+    input: &Path,
+    band: usize,
+    mesh: &Path,
+    format: MeshFormat,
+    pixel_coords: bool,
+) -> Result<MeshOnRaster> {
+    let raster = tinsmith_raster::read_samples(input, band)?;
+    crate::transform_check::check_transform(&raster.info, pixel_coords)?;
+    let placement = Placement::new(raster.info.transform(), pixel_coords);
+    let read = read_mesh_file(mesh, format, &raster, placement)?;
+    let positions = sample_positions(mesh, &read, format, &raster, placement)?;
+    let heights: Vec<f64> = read.vertices.iter().map(|v| v[2]).collect();
+    let orientation = expected_orientation(&placement);
+    let mut triangles = read.triangles;
+    orient_polygon_triangles(format, &positions, &mut triangles, orientation);
+    Ok(MeshOnRaster {
+        raster,
+        positions,
+        heights,
+        triangles,
+        orientation,
+    })
+}

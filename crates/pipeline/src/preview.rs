@@ -1,13 +1,10 @@
 //! `tinsmith preview`: a picture of a raster and a TIN of it, as a PNG.
 
-use tinsmith_georef::Placement;
 use tinsmith_preview::{encode_png, render, Layers, Scene};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
 use crate::error::{bail, Context};
-use crate::mesh_file::{
-    expected_orientation, mesh_format, orient_polygon_triangles, read_mesh_file, sample_positions,
-};
+use crate::mesh_file::{mesh_format, read_onto_raster, MeshOnRaster};
 use crate::{Feedback, MeshJob, PreviewJob, Result};
 
 /// What [`preview`] drew.
@@ -42,15 +39,13 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
     check_picture_path(&job.output, job.size)?;
     crate::output_paths::check_writable_target(&job.output, &job.input)?;
     let format = check_fits(job)?;
-    let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
-    crate::transform_check::check_transform(&raster.info, job.pixel_coords)?;
-    let placement = Placement::new(raster.info.transform(), job.pixel_coords);
-    let mesh = read_mesh_file(&job.mesh, format, &raster, placement)?;
-    let positions = sample_positions(&job.mesh, &mesh, format, &raster, placement)?;
-    let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();
-    let orientation = expected_orientation(&placement);
-    let mut triangles = mesh.triangles;
-    orient_polygon_triangles(format, &positions, &mut triangles, orientation);
+    let MeshOnRaster {
+        raster,
+        positions,
+        heights,
+        triangles,
+        orientation,
+    } = read_onto_raster(&job.input, job.band, &job.mesh, format, job.pixel_coords)?;
     let grid = &raster.samples;
     let (width, height) = (grid.width(), grid.height());
     let tin = MeshRef::new(&positions, &heights, &triangles);

@@ -1,12 +1,9 @@
 //! `tinsmith verify`: measure a mesh file's true error against its raster.
 
-use tinsmith_georef::Placement;
 use tinsmith_verify::{GridRef, MeshRef, Report, VerifyOptions};
 
 use crate::error::{bail, Context};
-use crate::mesh_file::{
-    expected_orientation, mesh_format, orient_polygon_triangles, read_mesh_file, sample_positions,
-};
+use crate::mesh_file::{mesh_format, read_onto_raster, MeshOnRaster};
 use crate::{Result, VerifyJob};
 
 /// What [`verify`] measured, with what the caller needs to explain a failure.
@@ -36,15 +33,13 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
         "verify",
         "verification has no tiled mode; use a machine with more memory",
     )?;
-    let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
-    crate::transform_check::check_transform(&raster.info, job.pixel_coords)?;
-    let placement = Placement::new(raster.info.transform(), job.pixel_coords);
-    let mesh = read_mesh_file(&job.mesh, format, &raster, placement)?;
-    let positions = sample_positions(&job.mesh, &mesh, format, &raster, placement)?;
-    let heights: Vec<f64> = mesh.vertices.iter().map(|v| v[2]).collect();
-    let orientation = expected_orientation(&placement);
-    let mut triangles = mesh.triangles;
-    orient_polygon_triangles(format, &positions, &mut triangles, orientation);
+    let MeshOnRaster {
+        raster,
+        positions,
+        heights,
+        triangles,
+        orientation,
+    } = read_onto_raster(&job.input, job.band, &job.mesh, format, job.pixel_coords)?;
     let grid = &raster.samples;
     let mut options = VerifyOptions::new().with_orientation(orientation);
     if let Some(e) = job.max_error {

@@ -194,34 +194,28 @@ impl BucketStore {
         let bucket_url = format!("{scheme}://{bucket}");
         let store: Arc<dyn ObjectStore> = match provider {
             Provider::S3 => {
-                let mut builder = AmazonS3Builder::new();
-                for (key, value) in &settings {
-                    if let Ok(config_key) = key.parse() {
-                        builder = builder.with_config(config_key, value);
-                    }
-                }
-                let builder = builder.with_url(&bucket_url).with_retry(retry_config());
+                let builder = configured(AmazonS3Builder::new(), &settings, |b, k, v| {
+                    b.with_config(k, v)
+                })
+                .with_url(&bucket_url)
+                .with_retry(retry_config());
                 check_http_allowed(&builder).map_err(unusable)?;
                 Arc::new(builder.build().map_err(|e| unusable(e.to_string()))?)
             }
             Provider::Google => {
-                let mut builder = GoogleCloudStorageBuilder::new();
-                for (key, value) in &settings {
-                    if let Ok(config_key) = key.parse() {
-                        builder = builder.with_config(config_key, value);
-                    }
-                }
-                let builder = builder.with_url(&bucket_url).with_retry(retry_config());
+                let builder = configured(GoogleCloudStorageBuilder::new(), &settings, |b, k, v| {
+                    b.with_config(k, v)
+                })
+                .with_url(&bucket_url)
+                .with_retry(retry_config());
                 Arc::new(builder.build().map_err(|e| unusable(e.to_string()))?)
             }
             Provider::Azure => {
-                let mut builder = MicrosoftAzureBuilder::new();
-                for (key, value) in &settings {
-                    if let Ok(config_key) = key.parse() {
-                        builder = builder.with_config(config_key, value);
-                    }
-                }
-                let builder = builder.with_url(&bucket_url).with_retry(retry_config());
+                let builder = configured(MicrosoftAzureBuilder::new(), &settings, |b, k, v| {
+                    b.with_config(k, v)
+                })
+                .with_url(&bucket_url)
+                .with_retry(retry_config());
                 Arc::new(builder.build().map_err(|e| unusable(e.to_string()))?)
             }
         };
@@ -323,6 +317,21 @@ impl BucketStore {
             Err(e) => Err(self.failed(Some(relative), e)),
         }
     }
+}
+
+/// `builder` with each of `settings` (lower-case variable names) that parses as one of its
+/// configuration keys `K`, as the builders' `from_env` take them; others are ignored.
+fn configured<B, K: std::str::FromStr>(
+    mut builder: B,
+    settings: &[(String, String)],
+    with_config: impl Fn(B, K, &str) -> B,
+) -> B {
+    for (key, value) in settings {
+        if let Ok(key) = key.parse() {
+            builder = with_config(builder, key, value);
+        }
+    }
+    builder
 }
 
 /// Refuses an `http://` endpoint unless `AWS_ALLOW_HTTP` is true, with a message that says

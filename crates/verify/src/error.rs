@@ -27,6 +27,14 @@ pub enum VerifyError {
         /// Heights supplied.
         heights: usize,
     },
+    /// Samples picked along one side of the grid are not strictly increasing inside it.
+    #[error("the picked {what} must be strictly increasing and below {side}")]
+    Lattice {
+        /// `columns` or `rows`.
+        what: &'static str,
+        /// The grid's samples along that side.
+        side: u32,
+    },
 }
 
 /// Result of the verifier's fallible functions.

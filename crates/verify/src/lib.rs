@@ -60,5 +60,5 @@ pub use grid::GridRef;
 pub use mesh::MeshRef;
 pub use options::{Orientation, VerifyOptions};
 pub use report::{ErrorLocation, Report};
-pub use surface::surface;
+pub use surface::{surface, surface_at};
 pub use verify::verify;

@@ -22,6 +22,17 @@ pub(crate) fn rasterize(
     tri: [[i64; 2]; 3],
     width: u32,
     height: u32,
+    visit: impl FnMut(u32, u32, [i64; 3]),
+) {
+    rasterize_rows(tri, width, height, |_| true, visit);
+}
+
+/// [`rasterize`] over the rows `keep_row` accepts only: the others cost one call each.
+pub(crate) fn rasterize_rows(
+    tri: [[i64; 2]; 3],
+    width: u32,
+    height: u32,
+    keep_row: impl Fn(u32) -> bool,
     mut visit: impl FnMut(u32, u32, [i64; 3]),
 ) {
     let area_x2 = orient(tri[0], tri[1], tri[2]);
@@ -67,6 +78,10 @@ pub(crate) fn rasterize(
     let narrow = |v: i128| i64::try_from(v).expect("weights and slopes are checked to fit");
     let steps = slopes.map(narrow);
     for y in y_min..=y_max {
+        // In range: y lies within the grid, whose sides fit in u32.
+        if !keep_row(y as u32) {
+            continue;
+        }
         let offsets =
             edges.map(|(p, q)| sign * ((q[0] - p[0]) * (y - p[1]) + (q[1] - p[1]) * p[0]));
         let (mut lo, mut hi) = (x_min, x_max);

@@ -282,6 +282,13 @@ impl OpenBand {
         self.info.width as usize
     }
 
+    /// Drops the blocks GDAL has cached for this dataset (its cache is process-wide and
+    /// would otherwise keep every block read until it is full).
+    pub(crate) fn release_cached_blocks(&mut self) -> Result<()> {
+        let flushed = self.dataset.flush_cache();
+        flushed.map_err(|e| self.read_error(e))
+    }
+
     pub(crate) fn band(&self) -> Result<RasterBand<'_>> {
         self.dataset
             .rasterband(self.info.band)

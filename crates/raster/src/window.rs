@@ -131,6 +131,73 @@ impl WindowReader {
         })
     }
 
+    /// The samples at the given `columns` and `rows` (each strictly increasing, inside the
+    /// raster), row-major over `rows` x `columns`, decoded as [`WindowReader::read_window`]
+    /// decodes them: a sparse lattice of a raster too large to hold, such as the samples
+    /// a picture shows. The band is read block by block, each block once, and GDAL's cache
+    /// is emptied after each row of blocks, so memory is the result, one block and one
+    /// row of blocks in GDAL's cache, whatever the raster's size.
+    ///
+    /// # Errors
+    /// [`Error::WindowOutOfRange`] when `columns` or `rows` is not strictly increasing
+    /// inside the raster, [`Error::Read`] when GDAL fails.
+    pub fn read_lattice(&mut self, columns: &[u32], rows: &[u32]) -> Result<Vec<f64>> {
+        let (width, height) = (self.width(), self.height());
+        let increasing = |picked: &[u32], side: u32| {
+            picked.windows(2).all(|w| w[0] < w[1]) && picked.last().is_none_or(|&l| l < side)
+        };
+        if !increasing(columns, width) || !increasing(rows, height) {
+            return Err(Error::WindowOutOfRange {
+                path: self.opened.info.path.clone(),
+                x0: columns.first().copied().unwrap_or(0),
+                y0: rows.first().copied().unwrap_or(0),
+                width: columns.len() as u32,
+                height: rows.len() as u32,
+                raster_width: width,
+                raster_height: height,
+            });
+        }
+        let (block_width, block_height) = {
+            let (w, h) = self.opened.band()?.block_size();
+            (w.max(1) as u32, h.max(1) as u32)
+        };
+        let mut out = vec![f64::NAN; columns.len() * rows.len()];
+        // The picked indices in `picked` that fall in [start, start + len).
+        let within = |picked: &[u32], start: u32, len: u32| {
+            let lo = picked.partition_point(|&p| p < start);
+            let hi = picked.partition_point(|&p| p < start.saturating_add(len));
+            lo..hi
+        };
+        let mut block_row = 0;
+        while block_row < height {
+            let band_rows = within(rows, block_row, block_height);
+            if !band_rows.is_empty() {
+                let (y0, y1) = (rows[band_rows.start], rows[band_rows.end - 1]);
+                let mut block_column = 0;
+                while block_column < width {
+                    let band_columns = within(columns, block_column, block_width);
+                    if !band_columns.is_empty() {
+                        let (x0, x1) = (columns[band_columns.start], columns[band_columns.end - 1]);
+                        let window = self.read_window(x0, y0, x1 - x0 + 1, y1 - y0 + 1)?;
+                        let values = window.values();
+                        let stride = (x1 - x0 + 1) as usize;
+                        for j in band_rows.clone() {
+                            let from = (rows[j] - y0) as usize * stride;
+                            for i in band_columns.clone() {
+                                out[j * columns.len() + i] =
+                                    values[from + (columns[i] - x0) as usize];
+                            }
+                        }
+                    }
+                    block_column = block_column.saturating_add(block_width);
+                }
+                self.opened.release_cached_blocks()?;
+            }
+            block_row = block_row.saturating_add(block_height);
+        }
+        Ok(out)
+    }
+
     /// Whether the band has a 2x2 block of valid samples (a cell a TIN can cover).
     ///
     /// The band is scanned in bands of whole rows (about 2^20 samples, sharing a row),

@@ -223,3 +223,76 @@ fn a_valid_cell_is_found_wherever_it_is_and_only_if_there_is_one() {
         assert_eq!(reader.has_valid_cell().expect("read"), expected, "{name}");
     }
 }
+
+/// A Float32 GeoTIFF of `width` x `height` in 16 x 16 tiles, sample (x, y) = x + 1000 y,
+/// nodata -9999 on the diagonal.
+fn tiled_raster(dir: &Path, (width, height): (usize, usize)) -> PathBuf {
+    let path = dir.join("tiled.tif");
+    let driver = DriverManager::get_driver_by_name("GTiff").expect("GTiff");
+    let options = RasterCreationOptions::from_iter(["TILED=YES", "BLOCKXSIZE=16", "BLOCKYSIZE=16"]);
+    let ds = driver
+        .create_with_band_type_with_options::<f32, _>(&path, width, height, 1, &options)
+        .expect("create");
+    let mut band = ds.rasterband(1).expect("band");
+    band.set_no_data_value(Some(-9999.0)).expect("nodata");
+    let values = (0..width * height)
+        .map(|k| {
+            let (x, y) = (k % width, k / width);
+            if x == y {
+                -9999.0
+            } else {
+                (x + 1000 * y) as f32
+            }
+        })
+        .collect();
+    let mut buffer = Buffer::new((width, height), values);
+    band.write((0, 0), (width, height), &mut buffer)
+        .expect("write");
+    path
+}
+
+#[test]
+fn a_lattice_holds_the_samples_the_whole_band_read_has_there() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let tiled = tiled_raster(dir.path(), (70, 45));
+    for path in [tiled, fixture("landlab_hugo_site.asc")] {
+        let whole = read_samples(&path, 1).expect("read_samples");
+        let (width, height) = (whole.samples.width(), whole.samples.height());
+        let values = whole.samples.values();
+        let mut reader = WindowReader::open(&path, 1).expect("open");
+        let lattices: [(Vec<u32>, Vec<u32>); 4] = [
+            ((0..width).collect(), (0..height).collect()),
+            (
+                (0..width).step_by(7).collect(),
+                (3..height).step_by(5).collect(),
+            ),
+            (vec![width - 1], vec![0, height - 1]),
+            (vec![1, 15, 16, 17, width - 2], vec![15, 16, 31, 32]),
+        ];
+        for (columns, rows) in lattices {
+            let got = reader.read_lattice(&columns, &rows).expect("lattice");
+            let expected: Vec<f64> = rows
+                .iter()
+                .flat_map(|&y| {
+                    columns
+                        .iter()
+                        .map(move |&x| values[(y * width + x) as usize])
+                })
+                .collect();
+            assert_eq!(
+                bits(&got),
+                bits(&expected),
+                "{} {columns:?} {rows:?}",
+                path.display()
+            );
+        }
+        for (columns, rows) in [
+            (vec![2, 2], vec![0]),
+            (vec![width], vec![0]),
+            (vec![0], vec![3, 1]),
+        ] {
+            let err = reader.read_lattice(&columns, &rows).unwrap_err();
+            assert!(matches!(err, Error::WindowOutOfRange { .. }), "{err}");
+        }
+    }
+}

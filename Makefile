@@ -16,7 +16,7 @@ PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
   azure-storage-blob==12.27.1 dask[distributed]==2026.8.0 pyyaml==6.0.4 pillow==11.3.0
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps gdal oracles demo pictures test bench-results bench-contour bench-compare bench-tiles bench-shards
+.PHONY: deps gdal oracles demo pictures test bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview
 
 ## Everything the tests need: GDAL, then the independent oracles.
 deps: gdal
@@ -159,6 +159,12 @@ bench-compare: deps
 bench-tiles:
 	cargo build --release --quiet
 	python3 bench/tiles.py --out /tmp/tinsmith-bench/results.md
+
+## Peak memory of `preview` on rasters up to 16384^2 (docs/results.md, "Pictures"; about
+## 15 minutes, most of it meshing). Work files in /tmp/tinsmith-preview.
+bench-preview:
+	cargo build --release --quiet
+	python3 bench/preview_memory.py --shared ../shared --out /tmp/tinsmith-preview/results.md
 
 ## Sharded pyramids: ETOPO5 and a 16384 x 8192 resample in one process vs 4 shards on a
 ## Dask LocalCluster, and 1000 shards of a planet-size VRT (docs/results.md, "Sharded

@@ -299,3 +299,65 @@ fn mesh_preview_is_the_picture_preview_draws_of_the_written_mesh() {
     assert_fails_naming(&o, &["x.jpg", ".png"]);
     assert_eq!(dir.files(), before);
 }
+
+/// Runs `tinsmith args...` in `dir` as if every raster were larger than a preview reads
+/// whole: only the drawn samples are read.
+fn run_drawn_samples_only(dir: &Dir, args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+        .args(args)
+        .env("TINSMITH_TEST_WHOLE_READ_SAMPLES", "0")
+        .current_dir(dir.path("."))
+        .output()
+        .expect("run tinsmith")
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn a_raster_too_large_to_read_whole_gives_the_same_picture_from_its_drawn_samples() {
+    let dir = Dir::new();
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let o = dir.run(&["mesh", &dem, "--max-error", "5", "-o", "m.ply", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // Smaller than the raster (a sparse lattice), and larger (every sample).
+    for (size, layers) in [
+        ("150", &["--hillshade", "--wireframe", "--error"][..]),
+        ("333", &["--error"][..]),
+        ("2000", &["--hillshade", "--wireframe"][..]),
+    ] {
+        let mut args = vec!["preview", dem.as_str(), "m.ply", "--size", size];
+        args.extend(layers);
+        let whole = dir.run(&[&args[..], &["-o", "whole.png"]].concat());
+        assert!(whole.status.success(), "{}", stderr(&whole));
+        assert!(
+            !stderr(&whole).contains("not verified"),
+            "{}",
+            stderr(&whole)
+        );
+        let drawn = run_drawn_samples_only(&dir, &[&args[..], &["-o", "drawn.png"]].concat());
+        assert!(drawn.status.success(), "{}", stderr(&drawn));
+        assert!(
+            stderr(&drawn).contains("at the drawn samples")
+                && stderr(&drawn).contains("not verified at every sample"),
+            "{}",
+            stderr(&drawn)
+        );
+        let (a, b) = (
+            std::fs::read(dir.path("whole.png")).unwrap(),
+            std::fs::read(dir.path("drawn.png")).unwrap(),
+        );
+        assert!(a == b, "--size {size} {layers:?}: not the same picture");
+    }
+    // The error at the drawn samples is within the mesh's bound.
+    let seen = pillow(&dir.path("drawn.png"), &[]);
+    let value: f64 = seen["text"]["Max error at drawn samples"]
+        .as_str()
+        .and_then(|v| v.parse().ok())
+        .expect("a number");
+    assert!(value > 0.0 && value <= 5.0, "{value}");
+    // A mesh of another raster is still refused by name, and nothing is written.
+    let before = dir.files();
+    let other = fixture("etopo5_2deg_i16.tif");
+    let o = run_drawn_samples_only(&dir, &["preview", &other, "m.ply", "-o", "p.png"]);
+    assert_fails_naming(&o, &["m.ply"]);
+    assert_eq!(dir.files(), before, "no file left");
+}

@@ -78,16 +78,23 @@ pub fn preview(args: &PreviewArgs) -> Result<bool> {
         .error_scale
         .map(|e| format!("; error colours span +/-{}", tinsmith_pipeline::readable(e)))
         .unwrap_or_default();
+    let checked = match drawn.verified_max_error {
+        Some(e) => format!("max error {}", tinsmith_pipeline::readable(e)),
+        None => format!(
+            "max error at the drawn samples {}; the raster is larger than a preview reads \
+             whole, so the mesh was not verified at every sample",
+            tinsmith_pipeline::readable(drawn.max_error)
+        ),
+    };
     eprintln!(
-        "wrote {} ({} x {} pixels, {} samples per pixel; {} vertices, {} triangles, max error \
-         {}{scale})",
+        "wrote {} ({} x {} pixels, {} samples per pixel; {} vertices, {} triangles, \
+         {checked}{scale})",
         args.output.display(),
         drawn.width,
         drawn.height,
         tinsmith_pipeline::readable(drawn.samples_per_pixel),
         drawn.vertices,
         drawn.triangles,
-        tinsmith_pipeline::readable(drawn.max_error),
     );
     Ok(true)
 }

@@ -568,7 +568,7 @@ fn mesh_from_file(
     band: usize,
 ) -> Result<ContourMesh> {
     let grid: &Samples = &raster.samples;
-    let file = read_mesh_file(path, format, raster, placement)?;
+    let file = read_mesh_file(path, format, &raster.info, placement)?;
     let (lo, hi) = file
         .vertices
         .iter()
@@ -592,7 +592,7 @@ fn mesh_from_file(
     // Each file vertex's height: its sample's, or the file's where it is raised.
     let mut file_heights: Vec<f64> = Vec::with_capacity(file.vertices.len());
     let mut first_raise: Option<f64> = None;
-    let at = sample_positions(path, &file, format, raster, placement)?;
+    let at = sample_positions(path, &file, format, &raster.info, placement)?;
     let is_inner = |x: i64, y: i64| {
         (1..grid.width() as i64 - 1).contains(&x) && (1..grid.height() as i64 - 1).contains(&y)
     };

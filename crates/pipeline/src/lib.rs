@@ -53,7 +53,7 @@ pub use jobs::{
 };
 pub use memory::available_bytes;
 pub use mesh::mesh;
-pub use preview::{preview, preview_decimated, Previewed};
+pub use preview::{preview, preview_decimated, Previewed, WHOLE_READ_SAMPLES};
 pub use scan::scan_raster;
 pub use serve::{serve, ServeOptions};
 pub use tiles::{merge_tiles, tiles, tiles_shard};

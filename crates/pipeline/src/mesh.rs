@@ -155,14 +155,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     // Drawn before anything is written, so that a picture that cannot be made leaves the
     // old outputs alone.
     let picture = match &job.preview {
-        Some(_) => Some(draw_preview(
-            job,
-            output,
-            &raster.info,
-            grid,
-            tin,
-            check.max_error,
-        )?),
+        Some(_) => Some(draw_preview(job, output, &raster.info, grid, tin)?),
         None => None,
     };
 
@@ -224,7 +217,6 @@ fn draw_preview(
     info: &tinsmith_raster::RasterInfo,
     grid: &Grid,
     tin: &tinsmith_core::Tin,
-    max_error: f64,
 ) -> Result<Vec<u8>> {
     let positions: Vec<[i64; 2]> = tin
         .vertices()
@@ -232,15 +224,17 @@ fn draw_preview(
         .map(|v| [i64::from(v.x), i64::from(v.y)])
         .collect();
     let heights: Vec<f64> = tin.vertices().iter().map(|v| v.z).collect();
+    let drawn = tinsmith_preview::DrawnSamples::new(grid.width(), grid.height(), PREVIEW_SIZE)?;
+    let values = crate::preview::drawn_values(grid.values(), grid.width() as usize, &drawn);
     let drawing = crate::preview::Drawing {
         input: &job.input,
         info,
-        values: grid.values(),
+        drawn: &drawn,
+        values: &values,
         positions: &positions,
         heights: &heights,
         triangles: tin.triangles(),
         mesh_label: output.display().to_string(),
-        max_error,
     };
     let choices = crate::preview::PictureChoices {
         size: PREVIEW_SIZE,

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use tinsmith_formats::{Mesh, MeshFormat};
 use tinsmith_georef::{Placement, PositionError};
-use tinsmith_raster::Raster;
+use tinsmith_raster::{Raster, RasterInfo};
 use tinsmith_verify::Orientation;
 
 use crate::error::Context;
@@ -21,7 +21,7 @@ use crate::Result;
 pub fn read_mesh_file(
     path: &Path,
     format: MeshFormat,
-    raster: &Raster,
+    raster: &RasterInfo,
     placement: Placement,
 ) -> Result<Mesh> {
     let mut mesh = tinsmith_formats::read_mesh_as(path, format)?;
@@ -29,7 +29,7 @@ pub fn read_mesh_file(
     // A GIS rewrite may keep WGS84 as WKT alone (a shapefile's GCS_WGS_1984).
     if polygons
         && mesh.epsg.is_none()
-        && mesh.crs_wkt != raster.info.crs_wkt
+        && mesh.crs_wkt != raster.crs_wkt
         && mesh
             .crs_wkt
             .as_deref()
@@ -38,7 +38,7 @@ pub fn read_mesh_file(
         mesh.epsg = Some(4326);
     }
     if let (Some(4326), Placement::World(transform), Some(wkt)) =
-        (mesh.epsg, placement, raster.info.crs_wkt.as_deref())
+        (mesh.epsg, placement, raster.crs_wkt.as_deref())
     {
         if transformed_from_wgs84(&mesh, raster, placement) {
             tinsmith_raster::from_wgs84(wkt, &mut mesh.vertices).with_context(|| {
@@ -69,21 +69,21 @@ pub fn sample_positions(
     path: &Path,
     mesh: &Mesh,
     format: MeshFormat,
-    raster: &Raster,
+    raster: &RasterInfo,
     placement: Placement,
 ) -> Result<Vec<[i64; 2]>> {
     let tolerance = position_tolerance(format, mesh, raster, placement);
     // Other tools rewrite RFC 7946 GeoJSON with 7 decimals (ogr2ogr's default), about
     // 1 cm: too coarse for the mesh's vertices to name their samples on fine rasters.
     let wgs84 = transformed_from_wgs84(mesh, raster, placement);
-    let (width, height) = (raster.info.width, raster.info.height);
+    let (width, height) = (raster.width, raster.height);
     let outside = |i: usize, [x, y]: [i64; 2]| {
         crate::Error::Refused(format!(
             "{}: vertex {i} is at column {x}, row {y} of {}'s sample lattice, outside its \
              {width} x {height} samples: the mesh is not of this raster (another raster's \
              on the same lattice, or another extent) and cannot be measured against it",
             path.display(),
-            raster.info.path.display()
+            raster.path.display()
         ))
     };
     let inside = |[x, y]: [i64; 2]| {
@@ -127,7 +127,7 @@ pub fn sample_positions(
 pub fn position_tolerance(
     format: MeshFormat,
     mesh: &Mesh,
-    raster: &Raster,
+    raster: &RasterInfo,
     placement: Placement,
 ) -> f64 {
     use tinsmith_georef::{F32_SAMPLE_TOLERANCE, F64_SAMPLE_TOLERANCE, WGS84_SAMPLE_TOLERANCE};
@@ -143,11 +143,11 @@ pub fn position_tolerance(
 /// Whether [`read_mesh_file`] transforms `mesh`'s vertices from WGS84 into the raster's
 /// CRS: a WGS84 mesh, world coordinates, and a raster with a CRS of its own other than
 /// EPSG:4326.
-fn transformed_from_wgs84(mesh: &Mesh, raster: &Raster, placement: Placement) -> bool {
+fn transformed_from_wgs84(mesh: &Mesh, raster: &RasterInfo, placement: Placement) -> bool {
     mesh.epsg == Some(4326)
         && matches!(placement, Placement::World(_))
-        && raster.info.epsg != Some(4326)
-        && raster.info.crs_wkt.is_some()
+        && raster.epsg != Some(4326)
+        && raster.crs_wkt.is_some()
 }
 
 /// Moves longitudes read from RFC 7946 GeoJSON (in [-180, 180]) by whole turns into a
@@ -158,8 +158,12 @@ fn transformed_from_wgs84(mesh: &Mesh, raster: &Raster, placement: Placement) ->
 /// stays within the raster (the east edge of a grid whose first and last columns are the
 /// same meridian), the counter-clockwise one spanning the fewest degrees; corners are then
 /// welded again by position.
-fn into_raster_frame(mesh: &mut Mesh, raster: &Raster, transform: tinsmith_georef::GeoTransform) {
-    let (w, h) = (f64::from(raster.info.width), f64::from(raster.info.height));
+fn into_raster_frame(
+    mesh: &mut Mesh,
+    raster: &RasterInfo,
+    transform: tinsmith_georef::GeoTransform,
+) {
+    let (w, h) = (f64::from(raster.width), f64::from(raster.height));
     let xs: Vec<f64> = [
         (-0.5, -0.5),
         (w - 0.5, -0.5),
@@ -307,8 +311,7 @@ pub(crate) struct MeshOnRaster {
 }
 
 /// Reads band `band` of `input` whole and the mesh file `mesh` (in `format`) onto it, as
-/// `verify` measures it: the transform checked, WGS84 transformed back, every vertex
-/// mapped to its sample, polygon triangles wound as the grid expects.
+/// `verify` measures it: see [`read_onto_lattice`].
 pub(crate) fn read_onto_raster(
     input: &Path,
     band: usize,
@@ -317,16 +320,44 @@ pub(crate) fn read_onto_raster(
     pixel_coords: bool,
 ) -> Result<MeshOnRaster> {
     let raster = tinsmith_raster::read_samples(input, band)?;
-    crate::transform_check::check_transform(&raster.info, pixel_coords)?;
-    let placement = Placement::new(raster.info.transform(), pixel_coords);
-    let read = read_mesh_file(mesh, format, &raster, placement)?;
-    let positions = sample_positions(mesh, &read, format, &raster, placement)?;
+    let on = read_onto_lattice(&raster.info, mesh, format, pixel_coords)?;
+    Ok(MeshOnRaster {
+        raster,
+        positions: on.positions,
+        heights: on.heights,
+        triangles: on.triangles,
+        orientation: on.orientation,
+    })
+}
+
+/// A mesh file's vertices on a raster's sample lattice, without the samples.
+pub(crate) struct MeshOnLattice {
+    pub(crate) positions: Vec<[i64; 2]>,
+    pub(crate) heights: Vec<f64>,
+    pub(crate) triangles: Vec<[u32; 3]>,
+    /// The winding expected in grid coordinates.
+    pub(crate) orientation: Orientation,
+}
+
+/// Reads the mesh file `mesh` (in `format`) onto the lattice of the raster `info`
+/// describes, as `verify` measures it: the transform checked, WGS84 transformed back,
+/// every vertex mapped to its sample (a vertex off the lattice or outside the raster is
+/// refused), polygon triangles wound as the grid expects. Reads no sample.
+pub(crate) fn read_onto_lattice(
+    info: &RasterInfo,
+    mesh: &Path,
+    format: MeshFormat,
+    pixel_coords: bool,
+) -> Result<MeshOnLattice> {
+    crate::transform_check::check_transform(info, pixel_coords)?;
+    let placement = Placement::new(info.transform(), pixel_coords);
+    let read = read_mesh_file(mesh, format, info, placement)?;
+    let positions = sample_positions(mesh, &read, format, info, placement)?;
     let heights: Vec<f64> = read.vertices.iter().map(|v| v[2]).collect();
     let orientation = expected_orientation(&placement);
     let mut triangles = read.triangles;
     orient_polygon_triangles(format, &positions, &mut triangles, orientation);
-    Ok(MeshOnRaster {
-        raster,
+    Ok(MeshOnLattice {
         positions,
         heights,
         triangles,

@@ -1,11 +1,19 @@
 //! `tinsmith preview`: a picture of a raster and a TIN of it, as a PNG.
 
-use tinsmith_preview::{encode_png, render, Layers, Scene};
+use tinsmith_preview::{encode_png, render, DrawnSamples, Layers, Scene};
 use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
 
 use crate::error::{bail, Context};
-use crate::mesh_file::{mesh_format, read_onto_raster, MeshOnRaster};
+use crate::mesh_file::{
+    mesh_format, read_onto_lattice, read_onto_raster, MeshOnLattice, MeshOnRaster,
+};
 use crate::{Feedback, MeshJob, PreviewJob, Result};
+
+/// Rasters of up to this many samples (a 5792 x 5792 square) are read whole and the mesh
+/// verified at every sample before it is drawn, as `verify` would; larger ones are read
+/// only at the samples the picture shows, so that memory follows the picture and the
+/// mesh, not the raster. The picture is the same either way.
+pub const WHOLE_READ_SAMPLES: u64 = 1 << 25;
 
 /// What [`preview`] drew.
 #[derive(Debug, Clone, PartialEq)]
@@ -21,16 +29,25 @@ pub struct Previewed {
     pub vertices: usize,
     /// Triangles of the mesh.
     pub triangles: usize,
-    /// The largest error the verifier measured.
+    /// The largest error at the samples drawn.
     pub max_error: f64,
+    /// The largest error at every sample, when the raster was read whole and the mesh
+    /// verified ([`WHOLE_READ_SAMPLES`]); `None` when only the drawn samples were read.
+    pub verified_max_error: Option<f64>,
     /// The bound the error colours span, when drawn.
     pub error_scale: Option<f64>,
 }
 
-/// Reads the mesh back onto its raster as `verify` does, refuses one that is not a valid
-/// TIN of it (naming the verifier's first problem), draws the layers the job asks for and
-/// writes the PNG atomically (an existing file is replaced only by a complete one). The
-/// PNG's text chunks name the input, the mesh, the counts and the error bound.
+/// Reads the mesh back onto its raster's lattice as `verify` does (refusing a vertex that
+/// is not on a sample of this raster), draws the layers the job asks for and writes the
+/// PNG atomically (an existing file is replaced only by a complete one). The PNG's text
+/// chunks name the input, the mesh, the counts and the error at the drawn samples.
+///
+/// A raster of up to [`WHOLE_READ_SAMPLES`] is read whole and the mesh verified at every
+/// sample first: one that is not a valid TIN of it is refused, naming the verifier's
+/// first problem. A larger raster is read only at the samples drawn (a lattice about
+/// `samples_per_pixel` apart), its mesh checked only on the lattice; the bytes are the
+/// same either way.
 ///
 /// # Errors
 /// As `verify`, and when the output does not end in `.png`, is the input, cannot be
@@ -39,83 +56,135 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
     check_picture_path(&job.output, job.size)?;
     crate::output_paths::check_writable_target(&job.output, &job.input)?;
     let format = check_fits(job)?;
-    let MeshOnRaster {
-        raster,
-        positions,
-        heights,
-        triangles,
-        orientation,
-    } = read_onto_raster(&job.input, job.band, &job.mesh, format, job.pixel_coords)?;
-    let grid = &raster.samples;
-    let (width, height) = (grid.width(), grid.height());
-    let tin = MeshRef::new(&positions, &heights, &triangles);
-    let report = tinsmith_verify::verify(
-        GridRef::new(width, height, grid.values()),
-        tin,
-        &VerifyOptions::new().with_orientation(orientation),
-    )
-    .with_context(|| format!("{}: cannot verify", job.mesh.display()))?;
-    if !report.mesh_is_valid() {
-        bail!(
-            "{}: not a valid TIN of {} ({}); `tinsmith verify` says more",
-            job.mesh.display(),
-            job.input.display(),
-            report
-                .problems
-                .first()
-                .map_or("the verifier found problems", String::as_str)
-        );
-    }
+    let mut reader = tinsmith_raster::WindowReader::open(&job.input, job.band)?;
+    let drawn = DrawnSamples::new(reader.width(), reader.height(), job.size)?;
+    let (info, values, mesh, verified_max_error) = if reads_whole(&reader) {
+        let MeshOnRaster {
+            raster,
+            positions,
+            heights,
+            triangles,
+            orientation,
+        } = read_onto_raster(&job.input, job.band, &job.mesh, format, job.pixel_coords)?;
+        let grid = &raster.samples;
+        let report = tinsmith_verify::verify(
+            GridRef::new(grid.width(), grid.height(), grid.values()),
+            MeshRef::new(&positions, &heights, &triangles),
+            &VerifyOptions::new().with_orientation(orientation),
+        )
+        .with_context(|| format!("{}: cannot verify", job.mesh.display()))?;
+        if !report.mesh_is_valid() {
+            bail!(
+                "{}: not a valid TIN of {} ({}); `tinsmith verify` says more",
+                job.mesh.display(),
+                job.input.display(),
+                report
+                    .problems
+                    .first()
+                    .map_or("the verifier found problems", String::as_str)
+            );
+        }
+        let values = drawn_values(grid.values(), grid.width() as usize, &drawn);
+        let mesh = MeshOnLattice {
+            positions,
+            heights,
+            triangles,
+            orientation,
+        };
+        (raster.info, values, mesh, Some(report.max_error))
+    } else {
+        let info = reader.info().clone();
+        let mesh = read_onto_lattice(&info, &job.mesh, format, job.pixel_coords)?;
+        let values = reader.read_lattice(&drawn.columns, &drawn.rows)?;
+        (info, values, mesh, None)
+    };
     let label = job
         .mesh_label
         .clone()
         .unwrap_or_else(|| job.mesh.display().to_string());
     let drawing = Drawing {
         input: &job.input,
-        info: &raster.info,
-        values: grid.values(),
-        positions: &positions,
-        heights: &heights,
-        triangles: &triangles,
+        info: &info,
+        drawn: &drawn,
+        values: &values,
+        positions: &mesh.positions,
+        heights: &mesh.heights,
+        triangles: &mesh.triangles,
         mesh_label: label,
-        max_error: report.max_error,
     };
     let (picture, bytes) = drawing.png(&choices(job))?;
-    let error_scale = picture.error_scale;
     tinsmith_output::write_bytes_atomically(&job.output, &bytes)
         .with_context(|| format!("{}: cannot write", job.output.display()))?;
     Ok(Previewed {
         width: picture.width,
         height: picture.height,
         samples_per_pixel: picture.samples_per_pixel,
-        vertices: positions.len(),
-        triangles: triangles.len(),
-        max_error: report.max_error,
-        error_scale,
+        vertices: mesh.positions.len(),
+        triangles: mesh.triangles.len(),
+        max_error: picture.max_error,
+        verified_max_error,
+        error_scale: picture.error_scale,
     })
 }
 
-/// Fails when the whole raster and the mesh (or, before it exists, a mesh as large as the
-/// raster allows) would not fit in memory; returns the mesh's format.
+/// Whether [`preview`] reads the raster whole and verifies the mesh at every sample:
+/// rasters of up to [`WHOLE_READ_SAMPLES`] (or the `TINSMITH_TEST_WHOLE_READ_SAMPLES`
+/// the tests set, to take the other path on small rasters).
+fn reads_whole(reader: &tinsmith_raster::WindowReader) -> bool {
+    let limit = std::env::var("TINSMITH_TEST_WHOLE_READ_SAMPLES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(WHOLE_READ_SAMPLES);
+    u64::from(reader.width()) * u64::from(reader.height()) <= limit
+}
+
+/// The values of the samples `drawn` shows, picked from a whole grid `width` samples
+/// across.
+pub(crate) fn drawn_values(values: &[f64], width: usize, drawn: &DrawnSamples) -> Vec<f64> {
+    let mut out = Vec::with_capacity(drawn.len());
+    for &row in &drawn.rows {
+        let row = &values[row as usize * width..][..width];
+        out.extend(drawn.columns.iter().map(|&c| row[c as usize]));
+    }
+    out
+}
+
+/// Fails when what [`preview`] holds would not fit in memory: the whole raster and the
+/// mesh (or, before it exists, a mesh as large as the raster allows) for a raster read
+/// whole, else the mesh and the picture's samples; returns the mesh's format.
 pub(crate) fn check_fits(job: &PreviewJob) -> Result<tinsmith_formats::MeshFormat> {
     let format = mesh_format(&job.mesh, job.format)?;
-    let size = crate::memory::raster_size(&job.input, job.band)?;
+    let reader = tinsmith_raster::WindowReader::open(&job.input, job.band)?;
+    let size = (reader.width(), reader.height());
     // A mesh not written yet: at most a vertex and two triangles a sample, about 40 bytes.
     let mesh_bytes = match std::fs::metadata(&job.mesh) {
         Ok(_) => crate::memory::mesh_file_memory(&job.mesh, format),
         Err(_) => 0,
     };
-    let per_sample = if mesh_bytes == 0 { 80 } else { 40 };
-    crate::memory::check_whole_raster_fits(
-        &job.input,
-        size,
-        crate::memory::Need {
-            bytes_per_sample: per_sample,
-            extra_bytes: mesh_bytes,
-        },
-        "preview",
-        "a preview reads the whole raster; use a machine with more memory",
-    )?;
+    if reads_whole(&reader) {
+        let per_sample = if mesh_bytes == 0 { 80 } else { 40 };
+        crate::memory::check_whole_raster_fits(
+            &job.input,
+            size,
+            crate::memory::Need {
+                bytes_per_sample: per_sample,
+                extra_bytes: mesh_bytes,
+            },
+            "preview",
+            "a preview reads the whole raster; use a machine with more memory",
+        )?;
+    } else {
+        // Per pixel: a value, the surface, the shade, the colours.
+        let pixels = u64::from(job.size) * u64::from(job.size);
+        let needed = pixels * 28 + mesh_bytes;
+        crate::memory::check_fits(needed, |needed, available| {
+            format!(
+                "{}: drawing it needs about {needed:.1} GB (the mesh and the picture), and \
+                 {available:.1} GB is available; use a machine with more memory",
+                job.mesh.display()
+            )
+        })?;
+    }
     Ok(format)
 }
 
@@ -140,59 +209,60 @@ fn choices(job: &PreviewJob) -> PictureChoices {
     }
 }
 
-/// A raster and a valid TIN of it on its lattice, to draw.
+/// A raster seen at the samples a picture shows, and a TIN on its lattice, to draw.
 pub(crate) struct Drawing<'a> {
     pub(crate) input: &'a std::path::Path,
     pub(crate) info: &'a tinsmith_raster::RasterInfo,
-    /// The samples, row-major, NaN for nodata.
+    /// The samples the picture shows.
+    pub(crate) drawn: &'a DrawnSamples,
+    /// Their values, row-major, NaN for nodata ([`drawn_values`]).
     pub(crate) values: &'a [f64],
     pub(crate) positions: &'a [[i64; 2]],
     pub(crate) heights: &'a [f64],
     pub(crate) triangles: &'a [[u32; 3]],
     /// What the PNG's text calls the mesh.
     pub(crate) mesh_label: String,
-    /// The measured largest error.
-    pub(crate) max_error: f64,
 }
 
-/// A drawn picture's size and scale.
+/// A drawn picture's size and scale, and the error measured at its samples.
 pub(crate) struct Drawn {
     pub(crate) width: u32,
     pub(crate) height: u32,
     pub(crate) samples_per_pixel: f64,
+    /// The largest |TIN - raster| at the drawn samples both have.
+    pub(crate) max_error: f64,
     pub(crate) error_scale: Option<f64>,
 }
 
 impl Drawing<'_> {
     /// The picture `choices` ask for, as PNG bytes with text chunks naming the input, the
-    /// mesh, the counts and the error bound.
+    /// mesh, the counts and the largest error at the drawn samples.
     pub(crate) fn png(&self, choices: &PictureChoices) -> Result<(Drawn, Vec<u8>)> {
         let (width, height) = (self.info.width, self.info.height);
         let tin = MeshRef::new(self.positions, self.heights, self.triangles);
-        let surface = if choices.error {
-            Some(tinsmith_verify::surface(width, height, tin)?)
-        } else {
-            None
-        };
+        let drawn = self.drawn;
+        let surface = tinsmith_verify::surface_at(width, height, tin, &drawn.columns, &drawn.rows)?;
+        let max_error = surface
+            .iter()
+            .zip(self.values)
+            .map(|(t, v)| (t - v).abs())
+            .filter(|e| e.is_finite())
+            .fold(0.0, f64::max);
         let error_scale = choices.error.then(|| {
             choices
                 .max_error
                 .filter(|&e| e > 0.0)
-                .unwrap_or(if self.max_error > 0.0 {
-                    self.max_error
-                } else {
-                    1.0
-                })
+                .unwrap_or(if max_error > 0.0 { max_error } else { 1.0 })
         });
         let scene = Scene {
-            width,
-            height,
+            drawn,
             values: self.values,
-            resolution: resolution(self.info)
-                .unwrap_or_else(|| unit_free_resolution(self.values, width as usize)),
+            resolution: resolution(self.info).unwrap_or_else(|| {
+                unit_free_resolution(self.values, drawn.columns.len(), drawn.samples_per_pixel)
+            }),
             positions: self.positions,
             triangles: self.triangles,
-            surface: surface.as_deref(),
+            surface: Some(&surface),
         };
         let layers = Layers {
             hillshade: choices.hillshade,
@@ -203,7 +273,7 @@ impl Drawing<'_> {
                 None => "error, TIN - raster (to the largest)".into(),
             },
         };
-        let picture = render(&scene, &layers, choices.size)?;
+        let picture = render(&scene, &layers)?;
         let text = [
             (
                 "Software",
@@ -219,7 +289,10 @@ impl Drawing<'_> {
                     self.triangles.len()
                 ),
             ),
-            ("Max error", tinsmith_georef::readable(self.max_error)),
+            (
+                "Max error at drawn samples",
+                tinsmith_georef::readable(max_error),
+            ),
             (
                 "Error scale",
                 error_scale.map_or("none".into(), tinsmith_georef::readable),
@@ -234,6 +307,7 @@ impl Drawing<'_> {
             width: picture.width,
             height: picture.height,
             samples_per_pixel: picture.samples_per_pixel,
+            max_error,
             error_scale,
         };
         Ok((drawn, bytes))
@@ -278,9 +352,16 @@ fn resolution(info: &tinsmith_raster::RasterInfo) -> Option<[f64; 2]> {
 }
 
 /// A sample spacing for a raster whose spacing is unknown (no transform): the one that
-/// makes the steepest tenth of its steps between neighbours 45°, so that its relief reads
-/// whatever the heights' unit.
-fn unit_free_resolution(values: &[f64], width: usize) -> [f64; 2] {
+/// makes the steepest tenth of the steps between neighbouring drawn samples (`width`
+/// across, about `samples_per_pixel` samples apart, or 1 when fewer) 45°, so that its
+/// relief reads whatever the heights' unit.
+fn unit_free_resolution(values: &[f64], width: usize, samples_per_pixel: f64) -> [f64; 2] {
+    let spacing = unit_free_lattice_spacing(values, width) / samples_per_pixel.max(1.0);
+    [spacing, -spacing]
+}
+
+/// The drawn lattice's spacing [`unit_free_resolution`] picks.
+fn unit_free_lattice_spacing(values: &[f64], width: usize) -> f64 {
     let mut steps: Vec<f64> = values
         .windows(2)
         .enumerate()
@@ -289,12 +370,15 @@ fn unit_free_resolution(values: &[f64], width: usize) -> [f64; 2] {
         .filter(|d| d.is_finite())
         .collect();
     if steps.is_empty() {
-        return [1.0, -1.0];
+        return 1.0;
     }
     let k = steps.len() * 9 / 10;
     let (_, step, _) = steps.select_nth_unstable_by(k, f64::total_cmp);
-    let spacing = if *step > 0.0 { *step } else { 1.0 };
-    [spacing, -spacing]
+    if *step > 0.0 {
+        *step
+    } else {
+        1.0
+    }
 }
 
 /// [`preview`] of the TIN `decimate` makes (its `output` is ignored): the mesh is written to

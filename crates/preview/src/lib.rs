@@ -3,7 +3,7 @@
 //! with a legend that marks the bound.
 //!
 //! It takes plain slices (the raster's samples, the mesh on the raster's lattice, the
-//! TIN's height at each sample from [`tinsmith_verify`-style measurement](Scene::surface))
+//! TIN's height at each shown sample, [`Scene::surface`])
 //! and returns RGBA pixels ([`render`]) or PNG bytes ([`encode_png`]); it reads and writes
 //! no file.
 //!
@@ -12,7 +12,8 @@
 //!   time stamp; drawing in `f32` by `tiny-skia` and `ab_glyph`, whose results do not
 //!   depend on threads).
 //! - The picture's longer side is the size asked for; each pixel shows the sample nearest
-//!   its centre (the picture says how many samples a pixel spans).
+//!   its centre ([`DrawnSamples`]: only those samples are needed, so a huge raster is
+//!   drawn from a lattice of its samples in memory proportional to the picture).
 //! - The wireframe is drawn where the TIN's edges are: an edge from sample `a` to sample
 //!   `b` passes through the pixels of the points between them.
 
@@ -26,4 +27,4 @@ mod render;
 pub use error::PreviewError;
 pub use hillshade::hillshade;
 pub use png_file::encode_png;
-pub use render::{render, Layers, Picture, Scene};
+pub use render::{render, DrawnSamples, Layers, Picture, Scene};

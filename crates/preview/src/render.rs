@@ -17,24 +17,117 @@ const NODATA: [u8; 3] = [236, 236, 236];
 /// The TIN's edges: dark blue, mostly opaque.
 const EDGE: [u8; 4] = [16, 38, 92, 210];
 
-/// A raster and its TIN, as plain slices.
+/// The samples a picture of a `width x height` grid shows, `size` pixels on its longer
+/// side: each pixel shows the sample nearest its centre, so a picture smaller than the
+/// grid shows a sparse lattice of it (every `samples_per_pixel`-th sample or so) and a
+/// larger one every sample, several pixels each. Only these samples need to be read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DrawnSamples {
+    /// Samples across and down of the whole grid.
+    pub grid: [u32; 2],
+    /// Pixels across and down.
+    pub pixels: [u32; 2],
+    /// The grid columns shown, strictly increasing.
+    pub columns: Vec<u32>,
+    /// The grid rows shown, strictly increasing.
+    pub rows: Vec<u32>,
+    /// Grid samples per pixel along each axis (below 1 when the picture is larger).
+    pub samples_per_pixel: f64,
+    /// Pixels per grid sample spacing.
+    pixels_per_sample: f64,
+    /// For each pixel column, its place in `columns`.
+    pixel_columns: Vec<u32>,
+    /// For each pixel row, its place in `rows`.
+    pixel_rows: Vec<u32>,
+}
+
+impl DrawnSamples {
+    /// The samples a picture of `size` pixels on its longer side shows of a
+    /// `width x height` grid.
+    ///
+    /// # Errors
+    /// [`PreviewError::Size`] for a size below 16 or above 16,384; [`PreviewError::Scene`]
+    /// for an empty grid.
+    pub fn new(width: u32, height: u32, size: u32) -> Result<DrawnSamples, PreviewError> {
+        if !(16..=MAX_SIZE).contains(&size) {
+            return Err(PreviewError::Size {
+                size,
+                max: MAX_SIZE,
+            });
+        }
+        if width == 0 || height == 0 {
+            return Err(PreviewError::Scene(format!(
+                "a {width} x {height} grid has no sample to draw"
+            )));
+        }
+        // Pixels per sample spacing: the longer side of the grid becomes `size` pixels.
+        let scale = f64::from(size) / f64::from(width.max(height));
+        let pixels = |n: u32| ((f64::from(n) * scale).round() as u32).clamp(1, size);
+        let (pw, ph) = (pixels(width), pixels(height));
+        let sample_of = |p: u32, n: u32| (((f64::from(p) + 0.5) / scale) as u32).min(n - 1);
+        let lattice = |count: u32, n: u32| {
+            let mut picked: Vec<u32> = Vec::new();
+            let mut place = Vec::with_capacity(count as usize);
+            for p in 0..count {
+                let sample = sample_of(p, n);
+                if picked.last() != Some(&sample) {
+                    picked.push(sample);
+                }
+                place.push(picked.len() as u32 - 1);
+            }
+            (picked, place)
+        };
+        let (columns, pixel_columns) = lattice(pw, width);
+        let (rows, pixel_rows) = lattice(ph, height);
+        Ok(DrawnSamples {
+            grid: [width, height],
+            pixels: [pw, ph],
+            columns,
+            rows,
+            samples_per_pixel: 1.0 / scale,
+            pixels_per_sample: scale,
+            pixel_columns,
+            pixel_rows,
+        })
+    }
+
+    /// Samples shown: `columns.len() * rows.len()`.
+    pub fn len(&self) -> usize {
+        self.columns.len() * self.rows.len()
+    }
+
+    /// Whether no sample is shown (never, for a lattice [`DrawnSamples::new`] made).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The grid spacing between neighbouring shown samples, across and down, on average.
+    fn spacing(&self) -> [f64; 2] {
+        let mean = |picked: &[u32]| match picked {
+            [first, .., last] => f64::from(last - first) / (picked.len() - 1) as f64,
+            _ => 1.0,
+        };
+        [mean(&self.columns), mean(&self.rows)]
+    }
+}
+
+/// A raster, seen at the samples a picture shows, and its TIN.
 #[derive(Debug, Clone, Copy)]
 pub struct Scene<'a> {
-    /// Samples across and down.
-    pub width: u32,
-    /// Rows of samples.
-    pub height: u32,
-    /// The samples, row-major, row 0 first as the raster stores it; NaN for nodata.
+    /// The samples shown.
+    pub drawn: &'a DrawnSamples,
+    /// The shown samples' values, row-major over `drawn.rows` x `drawn.columns`; NaN for
+    /// nodata.
     pub values: &'a [f64],
-    /// Sample spacing `[east-west, north-south]` in the heights' unit (the second
-    /// negative for a north-up raster), for the hillshade.
+    /// Sample spacing `[east-west, north-south]` of the whole grid in the heights' unit
+    /// (the second negative for a north-up raster), for the hillshade.
     pub resolution: [f64; 2],
-    /// Each vertex's sample `[column, row]`.
+    /// Each vertex's sample `[column, row]` in the whole grid.
     pub positions: &'a [[i64; 2]],
     /// Vertex indices of each triangle.
     pub triangles: &'a [[u32; 3]],
-    /// The TIN's height at each sample (NaN where no triangle covers it), for the error
-    /// map: `tinsmith_verify::surface`.
+    /// The TIN's height at each shown sample (NaN where no triangle covers it), for the
+    /// error map: `tinsmith_verify::surface_at`.
     pub surface: Option<&'a [f64]>,
 }
 
@@ -66,24 +159,21 @@ pub struct Picture {
     pub rgba: Vec<u8>,
 }
 
-/// Draws `scene` with `layers`, the longer side `size` pixels.
+/// Draws `scene` with `layers` at the size its [`DrawnSamples`] were chosen for. The
+/// hillshade is computed over the shown samples (neighbours a lattice step apart), so it
+/// shows the relief at the picture's scale.
 ///
 /// # Errors
-/// [`PreviewError::Size`] for a size below 16 or above 16,384; [`PreviewError::Scene`]
-/// when the slices do not fit the grid (values, surface), a triangle names a missing
-/// vertex, or the error layer lacks the surface or a positive bound.
-pub fn render(scene: &Scene<'_>, layers: &Layers, size: u32) -> Result<Picture, PreviewError> {
-    if !(16..=MAX_SIZE).contains(&size) {
-        return Err(PreviewError::Size {
-            size,
-            max: MAX_SIZE,
-        });
-    }
-    let (w, h) = (scene.width as usize, scene.height as usize);
-    let samples = w * h;
-    if w == 0 || h == 0 || scene.values.len() != samples {
+/// [`PreviewError::Scene`] when the slices do not fit the shown samples (values,
+/// surface), a triangle names a missing vertex, or the error layer lacks the surface or a
+/// positive bound.
+pub fn render(scene: &Scene<'_>, layers: &Layers) -> Result<Picture, PreviewError> {
+    let drawn = scene.drawn;
+    let (w, h) = (drawn.columns.len(), drawn.rows.len());
+    let samples = drawn.len();
+    if scene.values.len() != samples {
         return Err(PreviewError::Scene(format!(
-            "{} values for a {w} x {h} grid",
+            "{} values for {w} x {h} shown samples",
             scene.values.len()
         )));
     }
@@ -105,42 +195,39 @@ pub fn render(scene: &Scene<'_>, layers: &Layers, size: u32) -> Result<Picture, 
         }
         (Some(bound), _) => {
             return Err(PreviewError::Scene(format!(
-                "the error map needs the TIN's height at each of the {samples} samples and a \
-                 positive bound (got {bound})"
+                "the error map needs the TIN's height at each of the {samples} shown samples \
+                 and a positive bound (got {bound})"
             )))
         }
     };
-    // Pixels per sample spacing: the longer side of the grid becomes `size` pixels.
-    let scale = f64::from(size) / w.max(h) as f64;
-    let (pw, ph) = (
-        ((w as f64 * scale).round() as u32).clamp(1, size),
-        ((h as f64 * scale).round() as u32).clamp(1, size),
-    );
-    let shade = layers
-        .hillshade
-        .then(|| hillshade(scene.values, w, h, scene.resolution));
+    let [pw, ph] = drawn.pixels;
+    let spacing = drawn.spacing();
+    let shade = layers.hillshade.then(|| {
+        let resolution = [
+            scene.resolution[0] * spacing[0],
+            scene.resolution[1] * spacing[1],
+        ];
+        hillshade(scene.values, w, h, resolution)
+    });
     let mut pixmap = Pixmap::new(pw, ph).expect("a picture of 1 to 16,384 pixels a side");
-    let sample_of = |p: u32, n: usize| (((f64::from(p) + 0.5) / scale) as usize).min(n - 1);
-    let columns: Vec<usize> = (0..pw).map(|x| sample_of(x, w)).collect();
     {
         let data = pixmap.data_mut();
-        for y in 0..ph {
-            let row = sample_of(y, h);
-            for (x, &column) in columns.iter().enumerate() {
-                let k = row * w + column;
+        for (y, &row) in drawn.pixel_rows.iter().enumerate() {
+            for (x, &column) in drawn.pixel_columns.iter().enumerate() {
+                let k = row as usize * w + column as usize;
                 let colour = base_colour(
                     scene.values[k],
                     shade.as_deref().map(|s| s[k]),
                     errors.map(|(b, s)| (b, s[k])),
                 );
-                let at = (y as usize * pw as usize + x) * 4;
+                let at = (y * pw as usize + x) * 4;
                 data[at..at + 3].copy_from_slice(&colour);
                 data[at + 3] = 255;
             }
         }
     }
     if layers.wireframe {
-        stroke_edges(&mut pixmap, scene, scale);
+        stroke_edges(&mut pixmap, scene, drawn.pixels_per_sample);
     }
     let mut rgba = pixmap.take();
     if let Some((bound, _)) = errors {
@@ -154,7 +241,7 @@ pub fn render(scene: &Scene<'_>, layers: &Layers, size: u32) -> Result<Picture, 
     Ok(Picture {
         width: pw,
         height: ph,
-        samples_per_pixel: 1.0 / scale,
+        samples_per_pixel: drawn.samples_per_pixel,
         rgba,
     })
 }
@@ -225,13 +312,13 @@ mod tests {
     use super::*;
 
     fn scene<'a>(
+        drawn: &'a DrawnSamples,
         values: &'a [f64],
         positions: &'a [[i64; 2]],
         triangles: &'a [[u32; 3]],
     ) -> Scene<'a> {
         Scene {
-            width: 10,
-            height: 10,
+            drawn,
             values,
             resolution: [1.0, -1.0],
             positions,
@@ -255,9 +342,11 @@ mod tests {
             wireframe: true,
             ..plain.clone()
         };
-        let s = scene(&values, &positions, &triangles);
-        let a = render(&s, &plain, 100).unwrap();
-        let b = render(&s, &wired, 100).unwrap();
+        let drawn = DrawnSamples::new(10, 10, 100).unwrap();
+        assert_eq!((drawn.columns.len(), drawn.rows.len()), (10, 10));
+        let s = scene(&drawn, &values, &positions, &triangles);
+        let a = render(&s, &plain).unwrap();
+        let b = render(&s, &wired).unwrap();
         assert_eq!((b.width, b.height, b.samples_per_pixel), (100, 100, 0.1));
         let px = |p: &Picture, x: u32, y: u32| {
             let k = ((y * p.width + x) * 4) as usize;
@@ -269,36 +358,53 @@ mod tests {
         // Inside a triangle, away from every edge.
         assert_eq!(px(&a, 70, 30), px(&b, 70, 30));
         // Same input, same pixels.
-        assert_eq!(render(&s, &wired, 100).unwrap(), b);
+        assert_eq!(render(&s, &wired).unwrap(), b);
     }
 
     #[test]
     fn bad_sizes_and_scenes_are_refused() {
         let values = vec![0.0; 100];
         let positions = [[0, 0], [9, 0], [9, 9]];
-        let s = scene(&values, &positions, &[[0, 1, 3]]);
+        for size in [8, 16_385] {
+            assert!(matches!(
+                DrawnSamples::new(10, 10, size),
+                Err(PreviewError::Size { .. })
+            ));
+        }
+        let drawn = DrawnSamples::new(10, 10, 100).unwrap();
+        let s = scene(&drawn, &values, &positions, &[[0, 1, 3]]);
         let layers = Layers {
             hillshade: true,
             wireframe: true,
             error: None,
             title: "error".into(),
         };
-        assert!(matches!(
-            render(&s, &layers, 8),
-            Err(PreviewError::Size { .. })
-        ));
-        assert!(matches!(
-            render(&s, &layers, 100),
-            Err(PreviewError::Scene(_))
-        ));
-        let s = scene(&values, &positions, &[[0, 1, 2]]);
+        assert!(matches!(render(&s, &layers), Err(PreviewError::Scene(_))));
+        let s = scene(&drawn, &values, &positions, &[[0, 1, 2]]);
         let error = Layers {
             error: Some(1.0),
-            ..layers
+            ..layers.clone()
         };
-        assert!(matches!(
-            render(&s, &error, 100),
-            Err(PreviewError::Scene(_))
-        ));
+        assert!(matches!(render(&s, &error), Err(PreviewError::Scene(_))));
+        let s = scene(&drawn, &values[..99], &positions, &[[0, 1, 2]]);
+        assert!(matches!(render(&s, &layers), Err(PreviewError::Scene(_))));
+    }
+
+    #[test]
+    fn a_smaller_picture_shows_the_sample_nearest_each_pixel_centre() {
+        // 1000 x 250 samples in 100 x 25 pixels: every tenth sample, from the fifth.
+        let drawn = DrawnSamples::new(1000, 250, 100).unwrap();
+        assert_eq!(drawn.pixels, [100, 25]);
+        assert_eq!(
+            drawn.columns,
+            (0..100).map(|i| i * 10 + 5).collect::<Vec<_>>()
+        );
+        assert_eq!(drawn.rows, (0..25).map(|i| i * 10 + 5).collect::<Vec<_>>());
+        assert_eq!(drawn.samples_per_pixel, 10.0);
+        // Larger than the grid: every sample, each on several pixels.
+        let drawn = DrawnSamples::new(7, 3, 70).unwrap();
+        assert_eq!(drawn.columns, (0..7).collect::<Vec<_>>());
+        assert_eq!(drawn.rows, (0..3).collect::<Vec<_>>());
+        assert_eq!(drawn.pixels, [70, 30]);
     }
 }

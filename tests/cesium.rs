@@ -1,7 +1,8 @@
 //! A real client: CesiumJS in headless Chromium loads a pyramid from `tinsmith serve`
 //! (`CesiumTerrainProvider.fromUrl`, `sampleTerrainMostDetailed`), from the directory
 //! `tinsmith tiles` wrote and from the same pyramid in an MBTiles file (served by a second
-//! server, so the page loads it across origins, through CORS). A missing CesiumJS or
+//! server, so the page loads it across origins, through CORS), and a pyramid of EGM96
+//! heights turned into ellipsoidal ones (`--vertical-datum egm96`). A missing CesiumJS or
 //! Chromium install, or a Chromium that cannot start, fails. `#[ignore]`d so that `cargo
 //! test` passes with only GDAL installed; `make test` runs it (`--include-ignored`).
 
@@ -10,7 +11,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
-use crate::tiles::gdal_samples;
+use crate::tiles::{egm96_undulations, gdal_samples};
 use crate::util::{fixture, serve, stderr, Dir};
 
 #[test]
@@ -48,8 +49,10 @@ fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
     let size = 180.0 / (1u64 << z) as f64;
     let d = size / 217.0;
     let (west, south) = (-180.0 + x as f64 * size, -90.0 + y as f64 * size);
+    let undulations = egm96_undulations(z, x, y);
     let mut points = Vec::new();
     let mut expected = Vec::new();
+    let mut above_geoid = Vec::new();
     let valid: Vec<(usize, usize)> = (3..215)
         .flat_map(|j| (3..215).map(move |i| (i, j)))
         .filter(|&(i, j)| samples[j][i].is_finite())
@@ -60,6 +63,7 @@ fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
         };
         points.push([west + i as f64 * d, south + j as f64 * d]);
         expected.push(samples[j][i]);
+        above_geoid.push(samples[j][i] + undulations[j][i]);
     }
     assert!(points.len() >= 3, "too few sample points with data");
     let points_file = dir.write("points.json", &serde_json::to_string(&points).unwrap());
@@ -68,11 +72,28 @@ fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
     let o = dir.run(&["tiles", &input, "-o", "terrain.mbtiles", "--normals", "-q"]);
     assert!(o.status.success(), "{}", stderr(&o));
 
+    // The DEM's heights taken as EGM96 heights: CesiumJS then samples H + N.
+    let o = dir.run(&[
+        "tiles",
+        &input,
+        "-o",
+        "site/geoid",
+        "--normals",
+        "--vertical-datum",
+        "egm96",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+
     let (_server, base) = serve(&dir, &["site"]);
     let (_mbtiles_server, mbtiles_base) = serve(&dir, &["terrain.mbtiles"]);
     let bound = 77_067.34 / (1u64 << z) as f64;
     let mut heights = Vec::new();
-    for terrain in [format!("{base}terrain/"), mbtiles_base] {
+    for (terrain, expected) in [
+        (format!("{base}terrain/"), &expected),
+        (mbtiles_base, &expected),
+        (format!("{base}geoid/"), &above_geoid),
+    ] {
         let out = Command::new("node")
             .arg(repo.join("tests/oracle/cesium_sample.cjs"))
             .arg(format!("{base}index.html"))
@@ -102,4 +123,5 @@ fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
     }
     // The same tiles, so the same heights, to the bit.
     assert_eq!(heights[0], heights[1]);
+    assert_ne!(heights[0], heights[2]);
 }

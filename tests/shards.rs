@@ -74,6 +74,19 @@ fn shards_and_their_merge_are_the_one_process_pyramid() {
 }
 
 #[test]
+fn shards_keep_the_vertical_datum_through_the_merge() {
+    let dir = Dir::new();
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    check_shards(&dir, &input, &["--vertical-datum", "egm96"], &[3]);
+    // And the datum shapes the tiles: a shard of another datum is another plan, which
+    // the merge refuses, naming the difference.
+    let o = dir.run(&["tiles", &input, "-o", "sharded-3", "--shard", "0/3", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = dir.run(&["tiles", "merge", "sharded-3"]);
+    assert_fails_naming(&o, &["different plans", "vertical_datum", "egm96"]);
+}
+
+#[test]
 fn shards_of_a_globe_meet_across_the_antimeridian() {
     let dir = Dir::new();
     let input = fixture("etopo5_2deg_i16.tif");

@@ -1310,3 +1310,126 @@ fn a_tile_does_not_depend_on_the_zoom_range_or_the_threads() {
     assert!(level_files(&dir.path("middle"), 0..=5).is_empty());
     assert!(!level_files(&dir.path("deep"), 13..=13).is_empty());
 }
+
+/// The geoid's height above the WGS84 ellipsoid at each point of a tile's lattice (row 0
+/// the southernmost), from the gdaltransform program: PROJ's own choice of operation from
+/// EPSG:4326 + EGM96 height to EPSG:4979.
+pub(crate) fn egm96_undulations(z: u32, x: u32, y: u32) -> Vec<Vec<f64>> {
+    use std::io::Write as _;
+    let size = 180.0 / (1u64 << z) as f64;
+    let d = size / CELLS as f64;
+    let (west, south) = (-180.0 + x as f64 * size, -90.0 + y as f64 * size);
+    let mut points = String::new();
+    for j in 0..=CELLS {
+        for i in 0..=CELLS {
+            points += &format!(
+                "{:.12} {:.12} 0\n",
+                west + i as f64 * d,
+                south + j as f64 * d
+            );
+        }
+    }
+    let mut child = Command::new("gdaltransform")
+        .args(["-s_srs", "EPSG:4326+5773", "-t_srs", "EPSG:4979"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("gdaltransform runs");
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || stdin.write_all(points.as_bytes()).unwrap());
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    assert!(out.status.success());
+    let n: Vec<f64> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| l.split_whitespace().nth(2).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(n.len(), ((CELLS + 1) * (CELLS + 1)) as usize);
+    n.chunks((CELLS + 1) as usize).map(|r| r.to_vec()).collect()
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn a_geoid_datum_writes_the_ellipsoidal_heights_proj_gives() {
+    let dir = Dir::new();
+    let input = fixture("tintn_valid_raster_3857.tif");
+    let o = dir.run(&["tiles", &input, "-o", "plain"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("no vertical CRS") && stderr(&o).contains("--vertical-datum"),
+        "{}",
+        stderr(&o)
+    );
+    pyramid(&dir, &input, "egm96", &["--vertical-datum", "egm96"]);
+    let (layer, _) = layer_json(&dir.path("egm96"));
+    let max_zoom = layer["maxzoom"].as_u64().unwrap() as u32;
+    let (plain, tiles) = (
+        decode_pyramid(&dir.path("plain")),
+        decode_pyramid(&dir.path("egm96")),
+    );
+    assert!(check_shared_edges(&tiles) > 0);
+    let mut checked = 0;
+    for (&(z, x, y), t) in tiles.range((max_zoom, 0, 0)..) {
+        check_tile((z, x, y), t);
+        let bound = E0 / (1u64 << z) as f64;
+        let mut samples = gdal_samples(&dir, &input, z, x, y);
+        let n = egm96_undulations(z, x, y);
+        let shift = n
+            .iter()
+            .flatten()
+            .fold(f64::INFINITY, |m, v| m.min(v.abs()));
+        assert!(
+            shift > 2.0 * bound,
+            "{z}/{x}/{y}: the geoid ({shift} m) must matter"
+        );
+        for (row, n_row) in samples.iter_mut().zip(&n) {
+            for (s, n) in row.iter_mut().zip(n_row) {
+                *s += n;
+            }
+        }
+        let e = max_error(t, &samples);
+        assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
+        // The ellipsoid pyramid's tile is that far from the geoid one's samples.
+        let e = max_error(&plain[&(z, x, y)], &samples);
+        assert!(e > bound, "{z}/{x}/{y}: heights not shifted");
+        checked += 1;
+    }
+    assert!(checked > 0);
+
+    // A raster that declares EGM96 heights gets them without the option.
+    let declared = dir.path("declared.tif").to_string_lossy().into_owned();
+    let status = Command::new("gdal_translate")
+        .args(["-q", "-a_srs", "EPSG:3857+5773", &input, &declared])
+        .status()
+        .expect("gdal_translate runs");
+    assert!(status.success());
+    let o = dir.run(&["tiles", &declared, "-o", "declared"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("egm96"), "{}", stderr(&o));
+    assert!(
+        terrain_files(&dir.path("declared")) == terrain_files(&dir.path("egm96")),
+        "a declared EGM96 raster must give the tiles --vertical-datum egm96 gives"
+    );
+
+    // A vertical CRS tinsmith cannot shift by itself, and a missing grid: refused by
+    // name, nothing written.
+    let navd = dir.path("navd88.tif").to_string_lossy().into_owned();
+    let status = Command::new("gdal_translate")
+        .args(["-q", "-a_srs", "EPSG:3857+5703", &input, &navd])
+        .status()
+        .expect("gdal_translate runs");
+    assert!(status.success());
+    let o = dir.run(&["tiles", &navd, "-o", "navd"]);
+    assert_fails_naming(&o, &["navd88.tif", "NAVD88", "--vertical-datum"]);
+    let o = dir.run(&[
+        "tiles",
+        &input,
+        "-o",
+        "nogrid",
+        "--vertical-datum",
+        "nogrid.gtx",
+    ]);
+    assert_fails_naming(&o, &["nogrid.gtx"]);
+    assert!(!dir.path("navd").exists() && !dir.path("nogrid").exists());
+}

@@ -134,6 +134,12 @@ pub struct TilesArgs {
     /// Band to read (1-based).
     #[arg(long, default_value_t = 1)]
     pub band: usize,
+    /// What INPUT's heights are above: egm96, egm2008 or a geoid grid file (heights are
+    /// turned into the ellipsoidal heights CesiumJS draws, through PROJ), or ellipsoid
+    /// (used as they are). Default: INPUT's own vertical CRS, else the ellipsoid, with a
+    /// note.
+    #[arg(long, value_name = "DATUM")]
+    pub vertical_datum: Option<String>,
     /// Coarsest level written.
     #[arg(long, default_value_t = 0)]
     pub min_zoom: u8,
@@ -267,6 +273,7 @@ impl TilesArgs {
             threads: self.threads,
             memory_limit,
             update: self.update,
+            vertical_datum: tinsmith_raster::VerticalDatum::Ellipsoid,
         }
     }
 }

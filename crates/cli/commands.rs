@@ -29,8 +29,14 @@ pub fn tiles(args: &TilesArgs) -> Result<bool> {
     let (Some(input), Some(output)) = (&args.input, &args.output) else {
         unreachable!("clap requires INPUT and --output without a subcommand");
     };
-    let options = args.options(tinsmith_pipeline::available_bytes());
+    let mut options = args.options(tinsmith_pipeline::available_bytes());
     let feedback = Stderr::new(args.quiet);
+    options.vertical_datum = tinsmith_pipeline::vertical_datum(
+        input,
+        args.band,
+        args.vertical_datum.as_deref(),
+        &feedback,
+    )?;
     let report = args.report.as_deref();
     match args.shard {
         Some(shard) => {

@@ -75,6 +75,49 @@ pub fn tiles(
     Ok(built)
 }
 
+/// The vertical datum of `input`'s heights: `choice` (`egm96`, `egm2008`, `ellipsoid` or
+/// a geoid grid file) when given, else the vertical CRS `input` declares, else the
+/// ellipsoid with a note saying so and how to choose. Checks that PROJ can use the
+/// geoid's grid before any work.
+///
+/// # Errors
+/// When the raster declares a vertical CRS tinsmith does not know (and no `choice`), or
+/// PROJ cannot find or read the geoid's grid.
+pub fn vertical_datum(
+    input: &Path,
+    band: usize,
+    choice: Option<&str>,
+    feedback: &dyn Feedback,
+) -> Result<tinsmith_raster::VerticalDatum> {
+    use tinsmith_raster::VerticalDatum;
+    let datum = match choice {
+        Some(text) => VerticalDatum::parse(text),
+        None => match tinsmith_raster::declared_vertical_datum(input, band)? {
+            Some(declared) => {
+                feedback.note(&format!(
+                    "{}: heights above {} (its vertical CRS), written as heights above the \
+                     WGS84 ellipsoid",
+                    input.display(),
+                    declared.label()
+                ));
+                declared
+            }
+            None => {
+                feedback.note(&format!(
+                    "{}: no vertical CRS; heights are taken as metres above the WGS84 \
+                     ellipsoid. Most DEMs (SRTM, Copernicus, national grids) are above a \
+                     geoid, tens of metres off: give --vertical-datum egm96, egm2008 or a \
+                     geoid grid file (or ellipsoid to keep them as they are)",
+                    input.display()
+                ));
+                VerticalDatum::Ellipsoid
+            }
+        },
+    };
+    tinsmith_raster::Geoid::new(&datum)?;
+    Ok(datum)
+}
+
 /// Shows a build's progress: a status line of blocks, a note per finished level.
 fn show(feedback: &dyn Feedback, progress: Progress<'_>) {
     match progress {

@@ -168,6 +168,15 @@ pub enum Error {
         /// How to give it.
         hint: &'static str,
     },
+    /// Heights cannot be turned into heights above the WGS84 ellipsoid: the raster's
+    /// vertical CRS is not one tinsmith knows, or PROJ cannot use the geoid grid.
+    #[error("{}: {reason}", path.display())]
+    VerticalDatum {
+        /// The raster, or the geoid grid.
+        path: PathBuf,
+        /// What is wrong and what to do.
+        reason: String,
+    },
     /// GDAL failed to reproject the raster to EPSG:4326.
     #[error("{}: reprojecting to EPSG:4326 failed ({reason})", path.display())]
     Warp {

@@ -58,6 +58,7 @@
 mod bilinear;
 mod cache;
 mod coverage;
+mod datum;
 mod decode;
 mod error;
 mod files;
@@ -71,6 +72,7 @@ mod window;
 
 pub use cache::limit_block_cache;
 pub use coverage::{coverage, Coverage};
+pub use datum::{declared_vertical_datum, Geoid, VerticalDatum};
 pub use error::{Error, Result};
 pub use files::input_files;
 pub use geographic::{geographic_bounds, heights_may_exceed_f32, GeoBounds, GeoLattice};

@@ -9,6 +9,7 @@ use gdal::raster::RasterBand;
 use gdal::spatial_ref::{CoordTransform, CoordTransformOptions};
 
 use crate::bilinear::{Footprint, PixelGrid, Window};
+use crate::datum::{Geoid, VerticalDatum};
 use crate::error::Result;
 use crate::geographic::{
     area_of_interest, corner_box, geo_transform, source_crs, warp_error, wgs84, GeoLattice,
@@ -41,6 +42,11 @@ const PIXELS_PER_POINT: usize = 16;
 /// is NaN when no pixel of nonzero weight is valid, and when the position is outside the
 /// raster's pixel edges (or PROJ cannot transform it).
 ///
+/// With a `datum` other than the ellipsoid, each valid sample `H` becomes `H + N`, the
+/// geoid's height above the WGS84 ellipsoid at the point as PROJ's `vgridshift`
+/// interpolates its grid ([`Geoid`]), added in `f64` before the sample is rounded to
+/// `f32`.
+///
 /// A raster in a geographic CRS is sampled at its longitude moved by whole turns into its
 /// own range (a raster in 0..360° or east of 180° is sampled at -170° too); one whose first
 /// columns make exactly one turn of longitude wraps round, its pixels either side of the
@@ -53,10 +59,18 @@ const PIXELS_PER_POINT: usize = 16;
 ///
 /// # Errors
 /// As [`crate::geographic_bounds`]; [`crate::Error::Read`] when GDAL fails to read the
-/// band.
-pub fn sample_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Result<Vec<f32>> {
+/// band; [`crate::Error::VerticalDatum`] when the geoid's grid is missing or does not
+/// cover a point with data.
+pub fn sample_geographic(
+    path: &Path,
+    band: usize,
+    lattice: &GeoLattice,
+    datum: &VerticalDatum,
+) -> Result<Vec<f32>> {
     let opened = OpenBand::open(path, band)?;
     let locator = Locator::new(path, &opened)?;
+    let geoid = Geoid::new(datum)?;
+    let (mut lons, mut lats) = (Vec::new(), Vec::new());
     let rb = opened.band()?;
     let (width, height) = (lattice.width as usize, lattice.height as usize);
     let mut out = vec![f32::NAN; width * height];
@@ -85,6 +99,16 @@ pub fn sample_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Resu
             values.clear();
             values.resize(footprints.len(), f64::NAN);
             sample_points(&opened, &rb, &locator.grid, &footprints, &mut values)?;
+            if let Some(geoid) = &geoid {
+                add_undulations(
+                    geoid,
+                    lattice,
+                    (i0..i1, j0..j1),
+                    &mut values,
+                    &mut lons,
+                    &mut lats,
+                )?;
+            }
             let block_width = (i1 - i0) as usize;
             for (k, row) in values.chunks_exact(block_width).enumerate() {
                 let start = (j0 as usize + k) * width + i0 as usize;
@@ -95,6 +119,32 @@ pub fn sample_geographic(path: &Path, band: usize, lattice: &GeoLattice) -> Resu
         }
     }
     Ok(out)
+}
+
+/// Adds the geoid's height above the ellipsoid to each valid value of the block of the
+/// lattice `columns` x `rows` (row-major in `values`); `lons`, `lats` are scratch.
+fn add_undulations(
+    geoid: &Geoid,
+    lattice: &GeoLattice,
+    (columns, rows): (std::ops::Range<u32>, std::ops::Range<u32>),
+    values: &mut [f64],
+    lons: &mut Vec<f64>,
+    lats: &mut Vec<f64>,
+) -> Result<()> {
+    lons.clear();
+    lats.clear();
+    let points = rows.flat_map(|j| columns.clone().map(move |i| (i, j)));
+    for ((i, j), v) in points.zip(values.iter()) {
+        if v.is_finite() {
+            lons.push(lattice.lon(i));
+            lats.push(lattice.lat(j));
+        }
+    }
+    let undulations = geoid.undulations(lons, lats)?;
+    for (v, n) in values.iter_mut().filter(|v| v.is_finite()).zip(undulations) {
+        *v += n;
+    }
+    Ok(())
 }
 
 /// Interpolates the points of `footprints` (`None`: no sample) into `values`, reading the

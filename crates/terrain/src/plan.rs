@@ -63,6 +63,10 @@ pub(super) struct TileOptions {
     pub(super) normals: bool,
     pub(super) metadata: bool,
     pub(super) gzip: bool,
+    /// The vertical datum as [`tinsmith_raster::VerticalDatum::parse`] reads it; absent
+    /// for the ellipsoid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) vertical_datum: Option<String>,
 }
 
 impl TileOptions {
@@ -76,6 +80,8 @@ impl TileOptions {
             normals: options.normals,
             metadata: options.metadata,
             gzip: options.gzip,
+            vertical_datum: (options.vertical_datum != tinsmith_raster::VerticalDatum::Ellipsoid)
+                .then(|| options.vertical_datum.spec()),
         }
     }
 
@@ -92,6 +98,10 @@ impl TileOptions {
             threads,
             memory_limit: None,
             update: false,
+            vertical_datum: self.vertical_datum.as_deref().map_or(
+                tinsmith_raster::VerticalDatum::Ellipsoid,
+                tinsmith_raster::VerticalDatum::parse,
+            ),
         }
     }
 }

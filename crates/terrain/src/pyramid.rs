@@ -54,6 +54,10 @@ pub struct TerrainOptions {
     /// Update the pyramid in `out_dir` in place: rebuild only the tiles whose data (or
     /// metadata) changed since its records, remove those that no longer have data.
     pub update: bool,
+    /// What the band's heights are measured from: each sample `H` is written as the
+    /// ellipsoidal height `H + N` (the geoid's height `N` from PROJ), which is what
+    /// CesiumJS draws. Part of every tile's identity (a change rebuilds every tile).
+    pub vertical_datum: tinsmith_raster::VerticalDatum,
 }
 
 impl Default for TerrainOptions {
@@ -69,6 +73,7 @@ impl Default for TerrainOptions {
             threads: 0,
             memory_limit: None,
             update: false,
+            vertical_datum: tinsmith_raster::VerticalDatum::Ellipsoid,
         }
     }
 }
@@ -309,6 +314,7 @@ fn build_into(
     let source = Warp {
         path: input,
         band: options.band,
+        datum: &options.vertical_datum,
     };
     let cut = Cut::coarsest(own_level);
     let pool = worker_pool(&bounds, max_zoom.max(cut.anchor), options.threads)?;
@@ -1090,6 +1096,7 @@ mod tests {
             let source = Warp {
                 path: &input,
                 band: 1,
+                datum: &tinsmith_raster::VerticalDatum::Ellipsoid,
             };
             let options = TerrainOptions {
                 max_zoom: Some(max_zoom),
@@ -1142,6 +1149,7 @@ mod tests {
         let source = Warp {
             path: &input,
             band: 1,
+            datum: &tinsmith_raster::VerticalDatum::Ellipsoid,
         };
         let options = TerrainOptions {
             max_zoom: Some(2),

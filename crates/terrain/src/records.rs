@@ -65,10 +65,15 @@ pub(super) fn tile_sum(
 
 /// The key of the options that shape tiles' bytes (not the zoom range).
 pub(super) fn options_key(options: &TerrainOptions) -> String {
-    let text = serde_json::json!({
+    let mut text = serde_json::json!({
         "band": options.band, "quality": options.quality, "normals": options.normals,
         "metadata": options.metadata, "gzip": options.gzip, "format": 1,
     });
+    // Absent for the ellipsoid, so that pyramids built before datums were chosen keep
+    // their key.
+    if options.vertical_datum != tinsmith_raster::VerticalDatum::Ellipsoid {
+        text["vertical_datum"] = options.vertical_datum.label().into();
+    }
     hex(&Sha256::digest(text.to_string().as_bytes()))
 }
 

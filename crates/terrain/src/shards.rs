@@ -102,6 +102,7 @@ pub fn build_shard(
     let source = Warp {
         path: input,
         band: options.band,
+        datum: &options.vertical_datum,
     };
     let key = options_key(options);
     let mut known = Entries::new();
@@ -167,6 +168,43 @@ fn shard_records(dest: &dyn TileStore) -> TerrainResult<Vec<(String, ShardRecord
     Ok(out)
 }
 
+/// What differs between two plans, for a message: the input, the shard count, the
+/// input's data, each option that differs.
+fn plan_differences(a: &Plan, b: &Plan) -> String {
+    let mut differences = Vec::new();
+    if a.input != b.input {
+        differences.push(format!("input {} vs {}", a.input, b.input));
+    }
+    if a.shards != b.shards {
+        differences.push(format!("{} vs {} shards", a.shards, b.shards));
+    }
+    if a.fingerprint != b.fingerprint {
+        differences.push("the input's data changed between them".to_owned());
+    }
+    let options = |p: &Plan| serde_json::to_value(&p.options).unwrap_or_default();
+    let (oa, ob) = (options(a), options(b));
+    if let (Some(oa), Some(ob)) = (oa.as_object(), ob.as_object()) {
+        let mut keys: Vec<&String> = oa.keys().chain(ob.keys()).collect();
+        keys.sort();
+        keys.dedup();
+        for key in keys {
+            let shown =
+                |v: Option<&serde_json::Value>| v.map_or("none".to_owned(), |v| v.to_string());
+            if oa.get(key) != ob.get(key) {
+                differences.push(format!(
+                    "{key} {} vs {}",
+                    shown(oa.get(key)),
+                    shown(ob.get(key))
+                ));
+            }
+        }
+    }
+    if differences.is_empty() {
+        differences.push("their plans were cut differently".to_owned());
+    }
+    differences.join(", ")
+}
+
 /// Finishes a sharded pyramid in `dest`: checks that every shard of one plan is recorded,
 /// builds the levels above the blocks and (with `--metadata`) the flat roots, and writes
 /// `layer.json` last. Refuses, naming them, shards of different plans, missing shards, or
@@ -181,15 +219,12 @@ pub fn merge_shards(
     for (path, record) in &records {
         if record.plan_id != first.plan_id || record.plan_id != record.plan.id() {
             return Err(TerrainError::Options(format!(
-                "{} and {} in {} belong to different plans (input {} vs {}, {} vs {} shards, \
-                 or other options): keep the shards of one run only",
+                "{} and {} in {} belong to different plans ({}): keep the shards of one run \
+                 only",
                 first_path,
                 path,
                 dest.location(),
-                first.plan.input,
-                record.plan.input,
-                first.plan.shards,
-                record.plan.shards
+                plan_differences(&first.plan, &record.plan)
             )));
         }
     }

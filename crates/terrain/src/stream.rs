@@ -59,6 +59,8 @@ fn sample_reach(
 pub(super) struct Warp<'a> {
     pub(super) path: &'a Path,
     pub(super) band: usize,
+    /// What the band's heights are above; they are turned into ellipsoidal heights.
+    pub(super) datum: &'a tinsmith_raster::VerticalDatum,
 }
 
 impl RowSource for Warp<'_> {
@@ -69,7 +71,9 @@ impl RowSource for Warp<'_> {
         columns: Range<usize>,
     ) -> TerrainResult<Vec<f32>> {
         let lattice = level.lattice(rows, columns);
-        Ok(sample_geographic(self.path, self.band, &lattice)?)
+        Ok(sample_geographic(
+            self.path, self.band, &lattice, self.datum,
+        )?)
     }
 }
 

@@ -11,7 +11,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
-use crate::tiles::{egm96_undulations, gdal_samples};
+use crate::tiles::{ascii_grid, decode_pyramid, egm96_undulations, gdal_samples};
 use crate::util::{fixture, serve, stderr, Dir};
 
 #[test]
@@ -124,4 +124,76 @@ fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
     // The same tiles, so the same heights, to the bit.
     assert_eq!(heights[0], heights[1]);
     assert_ne!(heights[0], heights[2]);
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn cesiumjs_receives_the_water_masks() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let cesium = repo.join(".tools/node_modules/cesium/Build/Cesium");
+    assert!(
+        cesium.join("Cesium.js").exists() && Path::new("/usr/bin/chromium").exists(),
+        "CesiumJS or Chromium is missing: run `make oracles`"
+    );
+    let dir = Dir::new();
+    // Land west of 10.6°E, nodata sea east of it.
+    let dem = ascii_grid(
+        &dir,
+        "coast.asc",
+        (10.0, 45.0, 0.01),
+        (100, 100),
+        |lon, _| {
+            if lon > 10.6 {
+                f64::NAN
+            } else {
+                50.0 + 100.0 * (lon - 10.0)
+            }
+        },
+    );
+    let o = dir.run(&[
+        "tiles",
+        &dem,
+        "-o",
+        "site/terrain",
+        "--water",
+        "sea-level",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::os::unix::fs::symlink(&cesium, dir.path("site/cesium")).unwrap();
+    dir.write(
+        "site/index.html",
+        "<!doctype html><html><head><link rel=\"icon\" href=\"data:,\"><script>window.CESIUM_BASE_URL = '/cesium/';</script>\
+         <script src=\"/cesium/Cesium.js\"></script></head><body></body></html>\n",
+    );
+    let tiles = decode_pyramid(&dir.path("site/terrain"));
+    let (&(z, x, y), finest) = tiles.iter().next_back().expect("tiles");
+    let ours = finest.water_mask.clone().expect("a water mask");
+    assert_eq!(ours.len(), 65536, "a tile with land and water");
+    let points_file = dir.write("points.json", "[[10.3, 45.5]]");
+    let (_server, base) = serve(&dir, &["site"]);
+    let out = Command::new("node")
+        .arg(repo.join("tests/oracle/cesium_sample.cjs"))
+        .arg(format!("{base}index.html"))
+        .arg(format!("{base}terrain/"))
+        .arg(&points_file)
+        .arg(format!("{z}/{x}/{y}"))
+        .output()
+        .expect("node runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let result: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
+    assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
+    assert_eq!(result["hasWaterMask"], true);
+    let theirs: Vec<u64> = result["waterMask"]
+        .as_array()
+        .expect("CesiumJS has the tile's water mask")
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .collect();
+    assert!(theirs == ours, "CesiumJS decoded another water mask");
 }

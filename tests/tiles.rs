@@ -14,7 +14,7 @@ const CELLS: i64 = 217;
 const U_STEP: i64 = 151;
 const E0: f64 = 77_067.34;
 
-struct Tile {
+pub(crate) struct Tile {
     u: Vec<i64>,
     v: Vec<i64>,
     /// Decoded heights.
@@ -24,6 +24,8 @@ struct Tile {
     triangles: Vec<[usize; 3]>,
     edges: [Vec<usize>; 4],
     normals: Option<Vec<u64>>,
+    /// The water mask extension's bytes, as decoded.
+    pub(crate) water_mask: Option<Vec<u64>>,
     metadata: Value,
 }
 
@@ -36,7 +38,7 @@ fn numbers(v: &Value) -> Vec<i64> {
 }
 
 /// Every `z/x/y.terrain` under `dir`, decoded by the oracle.
-fn decode_pyramid(dir: &Path) -> BTreeMap<(u32, u32, u32), Tile> {
+pub(crate) fn decode_pyramid(dir: &Path) -> BTreeMap<(u32, u32, u32), Tile> {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     assert!(
         repo.join(".tools/node_modules/@here/quantized-mesh-decoder/package.json")
@@ -97,6 +99,9 @@ fn decode_pyramid(dir: &Path) -> BTreeMap<(u32, u32, u32), Tile> {
             edges: ["west", "south", "east", "north"]
                 .map(|k| numbers(&t[k]).iter().map(|&i| i as usize).collect()),
             normals: t["normals"]
+                .as_array()
+                .map(|a| a.iter().map(|x| x.as_u64().unwrap()).collect()),
+            water_mask: t["waterMask"]
                 .as_array()
                 .map(|a| a.iter().map(|x| x.as_u64().unwrap()).collect()),
             metadata: t["metadata"].clone(),
@@ -1432,4 +1437,182 @@ fn a_geoid_datum_writes_the_ellipsoidal_heights_proj_gives() {
     ]);
     assert_fails_naming(&o, &["nogrid.gtx"]);
     assert!(!dir.path("navd").exists() && !dir.path("nogrid").exists());
+}
+
+/// An ESRI ASCII grid in EPSG:4326 of `width` x `height` cells of `cell` degrees from
+/// (`west`, `south`), each cell's value `value(lon, lat)` at its centre (NaN: nodata).
+pub(crate) fn ascii_grid(
+    dir: &Dir,
+    name: &str,
+    (west, south, cell): (f64, f64, f64),
+    (width, height): (usize, usize),
+    value: impl Fn(f64, f64) -> f64,
+) -> String {
+    let mut text = format!(
+        "ncols {width}\nnrows {height}\nxllcorner {west}\nyllcorner {south}\ncellsize {cell}\n\
+         NODATA_value -9999\n"
+    );
+    for j in (0..height).rev() {
+        let row: Vec<String> = (0..width)
+            .map(|i| {
+                let v = value(
+                    west + (i as f64 + 0.5) * cell,
+                    south + (j as f64 + 0.5) * cell,
+                );
+                if v.is_nan() {
+                    "-9999".to_owned()
+                } else {
+                    v.to_string()
+                }
+            })
+            .collect();
+        text += &row.join(" ");
+        text += "\n";
+    }
+    dir.write(name, &text);
+    dir.write(
+        &name.replace(".asc", ".prj"),
+        "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],\
+         PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]",
+    );
+    dir.path(name).to_string_lossy().into_owned()
+}
+
+/// Every mask cell of every tile whose centre is clearly on one side of `is_water` (as
+/// `clear(lon, lat)` says) has that side's value; returns how many were checked.
+fn check_water_masks<'a>(
+    tiles: impl IntoIterator<Item = (&'a (u32, u32, u32), &'a Tile)>,
+    is_water: impl Fn(f64, f64) -> Option<bool>,
+) -> (usize, usize) {
+    let (mut water, mut land) = (0, 0);
+    for (&(z, x, y), t) in tiles {
+        let mask = t.water_mask.as_ref().expect("every tile has a water mask");
+        let size = 180.0 / (1u64 << z) as f64;
+        let (west, north) = (-180.0 + x as f64 * size, -90.0 + (y + 1) as f64 * size);
+        let cell = size / 256.0;
+        for j in 0..256 {
+            for i in 0..256 {
+                let (lon, lat) = (
+                    west + (i as f64 + 0.5) * cell,
+                    north - (j as f64 + 0.5) * cell,
+                );
+                let Some(expected) = is_water(lon, lat) else {
+                    continue;
+                };
+                let got = match mask.len() {
+                    1 => mask[0],
+                    65536 => mask[j * 256 + i],
+                    n => panic!("{z}/{x}/{y}: a water mask of {n} bytes"),
+                };
+                assert_eq!(
+                    got,
+                    if expected { 255 } else { 0 },
+                    "{z}/{x}/{y}: cell {i}, {j} at {lon}, {lat}"
+                );
+                if expected {
+                    water += 1;
+                } else {
+                    land += 1;
+                }
+            }
+        }
+    }
+    (water, land)
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn water_masks_mark_the_sea_a_mask_or_the_dem_itself_says() {
+    let dir = Dir::new();
+    // Land west of 10.6°E (a 5 m deep polder round 10.3°E, 45.5°N), then a strip 0.02°
+    // wide at -1 m, then nodata sea.
+    let dem = ascii_grid(
+        &dir,
+        "coast.asc",
+        (10.0, 45.0, 0.01),
+        (100, 100),
+        |lon, lat| {
+            if lon > 10.62 {
+                f64::NAN
+            } else if lon > 10.6 {
+                -1.0
+            } else if (lon - 10.3).abs() < 0.05 && (lat - 45.5).abs() < 0.05 {
+                -5.0
+            } else {
+                50.0 + 100.0 * (lon - 10.0)
+            }
+        },
+    );
+    let o = dir.run(&["tiles", &dem, "-o", "sea", "--water", "sea-level", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (layer, _) = layer_json(&dir.path("sea"));
+    assert!(layer["extensions"]
+        .as_array()
+        .unwrap()
+        .contains(&"watermask".into()));
+    let tiles = decode_pyramid(&dir.path("sea"));
+    let max_zoom = layer["maxzoom"].as_u64().unwrap() as u32;
+    let finest = tiles.range((max_zoom, 0, 0)..);
+    let inside = |lon: f64, lat: f64| (10.0..11.0).contains(&lon) && (45.0..46.0).contains(&lat);
+    let (water, land) = check_water_masks(finest, |lon, lat| {
+        let margin = 0.02;
+        if !inside(lon, lat) {
+            // Outside the DEM: no data, so sea, away from its edges.
+            return (lon > 11.0 + margin
+                || lon < 10.0 - margin
+                || lat > 46.0 + margin
+                || lat < 45.0 - margin)
+                .then_some(true);
+        }
+        if lon > 10.62 + margin {
+            Some(true)
+        } else if lon < 10.6 - margin {
+            // Land, the polder too: below 0 but away from the sea.
+            (lon > 10.0 + margin && lat > 45.0 + margin && lat < 46.0 - margin).then_some(false)
+        } else {
+            None
+        }
+    });
+    assert!(
+        water > 1000 && land > 1000,
+        "{water} water, {land} land cells checked"
+    );
+
+    // A mask raster: water south of 45.5°N.
+    let mask = ascii_grid(&dir, "mask.asc", (9.5, 44.5, 0.02), (100, 100), |_, lat| {
+        f64::from(u8::from(lat < 45.5))
+    });
+    let o = dir.run(&["tiles", &dem, "-o", "masked", "--water", &mask, "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let tiles = decode_pyramid(&dir.path("masked"));
+    let (water, land) = check_water_masks(&tiles, |lon, lat| {
+        let inside = (9.5..11.5).contains(&lon) && (44.5..46.5).contains(&lat);
+        let margin = 0.03;
+        if !inside {
+            (lon > 11.5 + margin
+                || lon < 9.5 - margin
+                || lat > 46.5 + margin
+                || lat < 44.5 - margin)
+                .then_some(false)
+        } else if lat < 45.5 - margin {
+            Some(true)
+        } else if lat > 45.5 + margin {
+            Some(false)
+        } else {
+            None
+        }
+    });
+    assert!(
+        water > 1000 && land > 1000,
+        "{water} water, {land} land cells checked"
+    );
+
+    // Not a raster: refused, saying what to do.
+    dir.write(
+        "water.geojson",
+        "{\"type\":\"FeatureCollection\",\"features\":[]}",
+    );
+    let o = dir.run(&["tiles", &dem, "-o", "bad", "--water", "water.geojson"]);
+    assert_fails_naming(&o, &["water.geojson", "gdal_rasterize"]);
+    assert!(!dir.path("bad").exists());
 }

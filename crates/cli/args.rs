@@ -140,6 +140,11 @@ pub struct TilesArgs {
     /// note.
     #[arg(long, value_name = "DATUM")]
     pub vertical_datum: Option<String>,
+    /// Add the water mask extension (CesiumJS's requestWaterMask): `sea-level` (INPUT's
+    /// nodata is sea, and heights at or below 0 beside it), or a raster of water (1) and
+    /// land (0).
+    #[arg(long, value_name = "SOURCE")]
+    pub water: Option<String>,
     /// Coarsest level written.
     #[arg(long, default_value_t = 0)]
     pub min_zoom: u8,
@@ -274,6 +279,7 @@ impl TilesArgs {
             memory_limit,
             update: self.update,
             vertical_datum: tinsmith_raster::VerticalDatum::Ellipsoid,
+            water: None,
         }
     }
 }

@@ -37,6 +37,7 @@ pub fn tiles(args: &TilesArgs) -> Result<bool> {
         args.vertical_datum.as_deref(),
         &feedback,
     )?;
+    options.water = tinsmith_pipeline::water_source(input, args.band, args.water.as_deref())?;
     let report = args.report.as_deref();
     match args.shard {
         Some(shard) => {

@@ -1,8 +1,10 @@
 // Loads a terrain pyramid in CesiumJS (npm `cesium`, in .tools) inside headless Debian
 // Chromium (driven by playwright-core), through CesiumTerrainProvider.fromUrl, and samples
 // it with sampleTerrainMostDetailed.
-// Usage: node cesium_sample.cjs PAGE_URL TERRAIN_URL POINTS_JSON_FILE
-// Prints {heights, consoleErrors, failedRequests, levels}. Exit code 3: Chromium cannot
+// Usage: node cesium_sample.cjs PAGE_URL TERRAIN_URL POINTS_JSON_FILE [Z/X/Y]
+// Prints {heights, consoleErrors, failedRequests, levels}; with Z/X/Y, the provider asks
+// for water masks too and the result adds that tile's (TMS numbering) {hasWaterMask,
+// waterMask} as CesiumJS decoded it. Exit code 3: Chromium cannot
 // start (the caller may skip); any other non-zero code is a failure.
 'use strict';
 const fs = require('fs');
@@ -12,7 +14,7 @@ const root = path.resolve(__dirname, '..', '..');
 const { chromium } = require(path.join(root, '.tools', 'node_modules', 'playwright-core'));
 
 (async () => {
-  const [pageUrl, terrainUrl, pointsFile] = process.argv.slice(2);
+  const [pageUrl, terrainUrl, pointsFile, waterTile] = process.argv.slice(2);
   const points = JSON.parse(fs.readFileSync(pointsFile, 'utf8'));
   const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'tinsmith-chromium-'));
   let context;
@@ -36,13 +38,24 @@ const { chromium } = require(path.join(root, '.tools', 'node_modules', 'playwrig
     page.on('requestfailed', (r) => failedRequests.push(r.url() + ' ' + (r.failure() || {}).errorText));
     page.on('response', (r) => { if (r.status() >= 400) failedRequests.push(r.url() + ' ' + r.status()); });
     await page.goto(pageUrl, { waitUntil: 'load', timeout: 60000 });
-    const result = await page.evaluate(async ({ terrainUrl, points }) => {
-      const provider = await Cesium.CesiumTerrainProvider.fromUrl(terrainUrl, { requestVertexNormals: true });
+    const result = await page.evaluate(async ({ terrainUrl, points, waterTile }) => {
+      const provider = await Cesium.CesiumTerrainProvider.fromUrl(terrainUrl, {
+        requestVertexNormals: true, requestWaterMask: Boolean(waterTile),
+      });
       const positions = points.map((p) => Cesium.Cartographic.fromDegrees(p[0], p[1], NaN));
       const levels = positions.map((c) => provider.availability.computeMaximumLevelAtPosition(c));
       await Cesium.sampleTerrainMostDetailed(provider, positions);
-      return { heights: positions.map((c) => c.height), levels };
-    }, { terrainUrl, points });
+      const out = { heights: positions.map((c) => c.height), levels };
+      if (waterTile) {
+        const [z, x, y] = waterTile.split('/').map(Number);
+        // Z/X/Y as the pyramid names it (TMS, y = 0 in the south); CesiumJS counts rows
+        // from the north.
+        const data = await provider.requestTileGeometry(x, (1 << z) - 1 - y, z);
+        out.hasWaterMask = provider.hasWaterMask;
+        out.waterMask = data.waterMask ? Array.from(data.waterMask) : null;
+      }
+      return out;
+    }, { terrainUrl, points, waterTile });
     console.log(JSON.stringify({ ...result, consoleErrors, failedRequests }));
   } finally {
     await context.close();

@@ -1,7 +1,7 @@
 // Decodes quantized-mesh tiles with the independent HERE decoder (npm
 // @here/quantized-mesh-decoder, installed into .tools by `make oracles`) and prints one
 // JSON object per line: header, u/v/height, triangle indices, W/S/E/N edge lists, normals
-// (oct bytes) and metadata. Arguments: tile files (gzipped or not).
+// (oct bytes), the water mask's bytes and metadata. Arguments: tile files (gzipped or not).
 'use strict';
 const fs = require('fs');
 const path = require('path');
@@ -33,6 +33,7 @@ for (const file of process.argv.slice(2)) {
     east: Array.from(t.eastIndices),
     north: Array.from(t.northIndices),
     normals: ext.vertexNormals ? Array.from(ext.vertexNormals) : null,
+    waterMask: ext.waterMask ? Array.from(new Uint8Array(ext.waterMask)) : null,
     metadata: ext.metadata === undefined ? null : ext.metadata,
   }));
 }

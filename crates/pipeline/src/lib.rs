@@ -56,6 +56,6 @@ pub use mesh::mesh;
 pub use preview::{preview, preview_decimated, Previewed, WHOLE_READ_SAMPLES};
 pub use scan::scan_raster;
 pub use serve::{serve, ServeOptions};
-pub use tiles::{merge_tiles, tiles, tiles_shard, vertical_datum};
+pub use tiles::{merge_tiles, tiles, tiles_shard, vertical_datum, water_source};
 pub use tinsmith_georef::readable;
 pub use verify::{verify, Verified};

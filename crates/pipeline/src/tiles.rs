@@ -118,6 +118,41 @@ pub fn vertical_datum(
     Ok(datum)
 }
 
+/// Where the water mask of `input`'s pyramid comes from: `sea-level` (`input` itself,
+/// band `band`) or a mask raster, checked to open; `None` without `choice`.
+///
+/// # Errors
+/// When the mask is not a raster GDAL opens (a polygon layer: rasterize it first).
+pub fn water_source(
+    input: &Path,
+    band: usize,
+    choice: Option<&str>,
+) -> Result<Option<tinsmith_terrain::Water>> {
+    let Some(choice) = choice else {
+        return Ok(None);
+    };
+    if choice.eq_ignore_ascii_case("sea-level") {
+        return Ok(Some(tinsmith_terrain::Water::SeaLevel {
+            path: input.to_path_buf(),
+            band,
+        }));
+    }
+    let path = Path::new(choice);
+    match tinsmith_raster::WindowReader::open(path, 1) {
+        Ok(_) => Ok(Some(tinsmith_terrain::Water::Raster {
+            path: path.to_path_buf(),
+            band: 1,
+        })),
+        Err(tinsmith_raster::Error::NotARaster { .. }) => bail!(
+            "{}: --water takes `sea-level` or a raster of water (1) and land (0); for a \
+             polygon layer, rasterize it first (e.g. `gdal_rasterize -burn 1 -init 0 -ot Byte \
+             -tr 0.001 0.001 WATER.gpkg water.tif`)",
+            path.display()
+        ),
+        Err(e) => Err(e.into()),
+    }
+}
+
 /// Shows a build's progress: a status line of blocks, a note per finished level.
 fn show(feedback: &dyn Feedback, progress: Progress<'_>) {
     match progress {

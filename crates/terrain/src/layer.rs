@@ -128,6 +128,9 @@ pub(super) fn layer_json(
     if options.normals {
         extensions.push(serde_json::json!("octvertexnormals"));
     }
+    if options.water.is_some() {
+        extensions.push(serde_json::json!("watermask"));
+    }
     if options.metadata {
         extensions.push(serde_json::json!("metadata"));
     }

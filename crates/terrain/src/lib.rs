@@ -18,6 +18,7 @@ mod shards;
 mod stream;
 mod tile;
 mod tms;
+mod water;
 mod writer;
 
 pub use budget::LEVEL_ZERO_ERROR;
@@ -35,3 +36,4 @@ pub use quantized_mesh::{
 };
 pub use shards::{build_shard, merge_shards, ShardReport};
 pub use tms::{tile_rectangle, TILE_CELLS};
+pub use water::{Water, MASK_CELLS};

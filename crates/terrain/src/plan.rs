@@ -67,6 +67,9 @@ pub(super) struct TileOptions {
     /// for the ellipsoid.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(super) vertical_datum: Option<String>,
+    /// Where the water mask comes from; absent without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) water: Option<crate::Water>,
 }
 
 impl TileOptions {
@@ -82,6 +85,7 @@ impl TileOptions {
             gzip: options.gzip,
             vertical_datum: (options.vertical_datum != tinsmith_raster::VerticalDatum::Ellipsoid)
                 .then(|| options.vertical_datum.spec()),
+            water: options.water.clone(),
         }
     }
 
@@ -102,6 +106,7 @@ impl TileOptions {
                 tinsmith_raster::VerticalDatum::Ellipsoid,
                 tinsmith_raster::VerticalDatum::parse,
             ),
+            water: self.water.clone(),
         }
     }
 }

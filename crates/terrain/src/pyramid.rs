@@ -58,6 +58,8 @@ pub struct TerrainOptions {
     /// ellipsoidal height `H + N` (the geoid's height `N` from PROJ), which is what
     /// CesiumJS draws. Part of every tile's identity (a change rebuilds every tile).
     pub vertical_datum: tinsmith_raster::VerticalDatum,
+    /// Add the water mask extension (2) from this source.
+    pub water: Option<crate::Water>,
 }
 
 impl Default for TerrainOptions {
@@ -74,6 +76,7 @@ impl Default for TerrainOptions {
             memory_limit: None,
             update: false,
             vertical_datum: tinsmith_raster::VerticalDatum::Ellipsoid,
+            water: None,
         }
     }
 }

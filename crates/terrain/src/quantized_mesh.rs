@@ -24,6 +24,8 @@ pub const HEADER_BYTES: usize = 88;
 
 /// Extension id of oct-encoded per-vertex normals (`octvertexnormals`).
 pub const EXTENSION_NORMALS: u8 = 1;
+/// Extension id of the water mask (`watermask`).
+pub const EXTENSION_WATER_MASK: u8 = 2;
 /// Extension id of the JSON metadata (`metadata`).
 pub const EXTENSION_METADATA: u8 = 4;
 
@@ -57,6 +59,9 @@ pub enum EncodeError {
         /// Maximum height.
         max: f32,
     },
+    /// A water mask is neither 1 byte nor 256 x 256.
+    #[error("a water mask of {0} bytes: it is 1 or 65536")]
+    WaterMaskSize(usize),
     /// The normals are not one per vertex.
     #[error("{got} normals for {expected} vertices")]
     NormalCount {
@@ -97,6 +102,7 @@ pub struct QuantizedMeshTile<'a> {
     vertices: &'a [[u16; 3]],
     triangles: &'a [[u32; 3]],
     normals: Option<&'a [[f64; 3]]>,
+    water_mask: Option<&'a [u8]>,
     metadata: Option<&'a str>,
 }
 
@@ -116,6 +122,7 @@ impl<'a> QuantizedMeshTile<'a> {
             vertices,
             triangles,
             normals: None,
+            water_mask: None,
             metadata: None,
         }
     }
@@ -124,6 +131,13 @@ impl<'a> QuantizedMeshTile<'a> {
     /// the input vertex order.
     pub fn with_normals(mut self, normals: &'a [[f64; 3]]) -> Self {
         self.normals = Some(normals);
+        self
+    }
+
+    /// Adds the `watermask` extension (id 2): 1 byte (0 all land, 255 all water) or
+    /// 256 x 256 bytes, north to south, west to east.
+    pub fn with_water_mask(mut self, mask: &'a [u8]) -> Self {
+        self.water_mask = Some(mask);
         self
     }
 
@@ -204,6 +218,11 @@ impl<'a> QuantizedMeshTile<'a> {
                 out.extend_from_slice(&oct_encode(normals[i]));
             }
         }
+        if let Some(mask) = self.water_mask {
+            out.push(EXTENSION_WATER_MASK);
+            out.extend_from_slice(&(mask.len() as u32).to_le_bytes());
+            out.extend_from_slice(mask);
+        }
         if let Some(json) = self.metadata {
             out.push(EXTENSION_METADATA);
             out.extend_from_slice(&(4 + json.len() as u32).to_le_bytes());
@@ -244,6 +263,11 @@ impl<'a> QuantizedMeshTile<'a> {
                     expected: vertex_count,
                     got: normals.len(),
                 });
+            }
+        }
+        if let Some(mask) = self.water_mask {
+            if mask.len() != 1 && mask.len() != 256 * 256 {
+                return Err(EncodeError::WaterMaskSize(mask.len()));
             }
         }
         Ok(())
@@ -495,6 +519,33 @@ mod tests {
             QuantizedMeshTile::new(rect(), 2.0, 1.0, &v, &t).encode(),
             Err(EncodeError::HeightRange { .. })
         ));
+        assert!(matches!(
+            QuantizedMeshTile::new(rect(), 0.0, 1.0, &v, &t)
+                .with_water_mask(&[0, 255])
+                .encode(),
+            Err(EncodeError::WaterMaskSize(2))
+        ));
+    }
+
+    #[test]
+    fn the_water_mask_comes_after_the_normals_with_its_length() {
+        let vertices = [[0, 0, 0], [32767, 0, 0], [0, 32767, 0]];
+        let triangles = [[0, 1, 2]];
+        let normals = [[0.0, 0.0, 1.0]; 3];
+        let plain = QuantizedMeshTile::new(rect(), 0.0, 1.0, &vertices, &triangles)
+            .with_normals(&normals)
+            .encode()
+            .unwrap();
+        let masked = QuantizedMeshTile::new(rect(), 0.0, 1.0, &vertices, &triangles)
+            .with_normals(&normals)
+            .with_water_mask(&[255])
+            .encode()
+            .unwrap();
+        assert_eq!(masked[..plain.len()], plain[..]);
+        assert_eq!(
+            masked[plain.len()..],
+            [EXTENSION_WATER_MASK, 1, 0, 0, 0, 255]
+        );
     }
 
     #[test]

@@ -74,6 +74,9 @@ pub(super) fn options_key(options: &TerrainOptions) -> String {
     if options.vertical_datum != tinsmith_raster::VerticalDatum::Ellipsoid {
         text["vertical_datum"] = options.vertical_datum.label().into();
     }
+    if let Some(water) = &options.water {
+        text["water"] = water.label().into();
+    }
     hex(&Sha256::digest(text.to_string().as_bytes()))
 }
 

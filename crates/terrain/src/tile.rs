@@ -176,6 +176,10 @@ pub(super) fn build_tile(
             .collect()
     });
     let metadata = metadata_available.map(|available| metadata_json(available, z, column, y));
+    let water = match &options.water {
+        Some(water) => Some(crate::water::mask(water, rect)?),
+        None => None,
+    };
     let mut tile = QuantizedMeshTile::new(
         rect,
         min_height as f32,
@@ -185,6 +189,9 @@ pub(super) fn build_tile(
     );
     if let Some(normals) = &normals {
         tile = tile.with_normals(normals);
+    }
+    if let Some(water) = &water {
+        tile = tile.with_water_mask(water.bytes());
     }
     if let Some(metadata) = &metadata {
         tile = tile.with_metadata(metadata);

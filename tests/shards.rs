@@ -78,12 +78,12 @@ fn shards_keep_the_vertical_datum_through_the_merge() {
     let dir = Dir::new();
     let input = fixture("becmodel_dem_bc_albers_50m.tif");
     check_shards(&dir, &input, &["--vertical-datum", "egm96"], &[3]);
-    // And the datum shapes the tiles: a shard of another datum is another plan, which
-    // the merge refuses, naming the difference.
+    // And the datum shapes the tiles: a shard of another datum is another plan, refused
+    // before it overwrites the finished pyramid's tiles.
+    let before = pyramid_files(&dir.path("sharded-3"));
     let o = dir.run(&["tiles", &input, "-o", "sharded-3", "--shard", "0/3", "-q"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = dir.run(&["tiles", "merge", "sharded-3"]);
-    assert_fails_naming(&o, &["different plans", "vertical_datum", "egm96"]);
+    assert_fails_naming(&o, &["another plan", "vertical_datum", "egm96"]);
+    assert!(pyramid_files(&dir.path("sharded-3")) == before);
 }
 
 #[test]
@@ -146,8 +146,21 @@ fn a_merge_names_missing_and_foreign_shards_and_writes_no_layer_json() {
     let o = dir.run(&["tiles", "merge", "p"]);
     assert_fails_naming(&o, &["1/3", "missing", "no layer.json"]);
     assert!(!dir.path("p/layer.json").exists());
-    // A shard of another plan (another count) in the same directory.
-    run_ok(&dir, &["tiles", &input, "-o", "p", "--shard", "1/2", "-q"]);
+    // A shard of another plan (another count) in the same directory is refused before it
+    // writes a tile; one that got there anyway (a copy) is refused by the merge.
+    let before = pyramid_files(&dir.path("p"));
+    let o = dir.run(&["tiles", &input, "-o", "p", "--shard", "1/2", "-q"]);
+    assert_fails_naming(&o, &["0-of-3.json", "another plan", "3 vs 2 shards"]);
+    assert!(
+        pyramid_files(&dir.path("p")) == before,
+        "the refused shard wrote files"
+    );
+    run_ok(&dir, &["tiles", &input, "-o", "q", "--shard", "1/2", "-q"]);
+    std::fs::copy(
+        dir.path("q/tinsmith/shards/1-of-2.json"),
+        dir.path("p/tinsmith/shards/1-of-2.json"),
+    )
+    .unwrap();
     let o = dir.run(&["tiles", "merge", "p"]);
     assert_fails_naming(&o, &["1-of-2.json", "different plans"]);
     assert!(!dir.path("p/layer.json").exists());

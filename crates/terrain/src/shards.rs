@@ -86,6 +86,7 @@ pub fn build_shard(
         TileOptions::new(options, max_zoom),
         shard.count,
     )?;
+    refuse_other_plans(dest, &plan)?;
     let cut = plan.cut();
     let mine = plan.shard_blocks(shard.index);
     let blocks = plan.blocks()[mine.clone()].to_vec();
@@ -166,6 +167,29 @@ fn shard_records(dest: &dyn TileStore) -> TerrainResult<Vec<(String, ShardRecord
     }
     out.sort_by_key(|(_, r)| r.shard.index);
     Ok(out)
+}
+
+/// Fails, before any tile is written, when `dest` already records a shard of another
+/// plan (other options, another shard count, changed data): its tiles would be
+/// overwritten by this plan's, leaving neither pyramid whole.
+fn refuse_other_plans(dest: &dyn TileStore, plan: &Plan) -> TerrainResult<()> {
+    for name in dest.list_files(&format!("{RECORDS_DIR}/shards/"))? {
+        if !(name.contains("-of-") && name.ends_with(".json")) {
+            continue;
+        }
+        let Some(record): Option<ShardRecord> = read_record(dest, &name)? else {
+            continue;
+        };
+        if record.plan_id != plan.id() {
+            return Err(TerrainError::Options(format!(
+                "{}: {name} is a shard of another plan ({}); this run would overwrite its \
+                 tiles: write to another destination, or remove that one first",
+                dest.location(),
+                plan_differences(&record.plan, plan)
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// What differs between two plans, for a message: the input, the shard count, the

@@ -3,7 +3,9 @@
 // base colour lit from over the viewer's left shoulder, so the relief shows by the
 // pyramid's own normals. Used by bench/pictures.py (make pictures).
 // Usage: node bench/cesium_shot.cjs PAGE_URL TERRAIN_URL OUT.png LON LAT HEIGHT_M
-//        HEADING_DEG PITCH_DEG EXAGGERATION
+//        HEADING_DEG PITCH_DEG EXAGGERATION [water]
+// With `water`, the provider asks for the pyramid's water masks and the globe draws
+// water (CesiumJS's animated specular water) where they say.
 'use strict';
 const fs = require('fs');
 const os = require('os');
@@ -11,7 +13,7 @@ const path = require('path');
 const root = path.resolve(__dirname, "..");
 const { chromium } = require(path.join(root, '.tools', 'node_modules', 'playwright-core'));
 (async () => {
-  const [pageUrl, terrainUrl, out, lon, lat, height, heading, pitch, exaggeration] = process.argv.slice(2);
+  const [pageUrl, terrainUrl, out, lon, lat, height, heading, pitch, exaggeration, water] = process.argv.slice(2);
   const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'tinsmith-chromium-'));
   const context = await chromium.launchPersistentContext(userDataDir, {
     executablePath: '/usr/bin/chromium', headless: true,
@@ -24,8 +26,10 @@ const { chromium } = require(path.join(root, '.tools', 'node_modules', 'playwrig
     page.on('console', (m) => console.error('console: ' + m.text()));
     page.on('pageerror', (e) => console.error('pageerror: ' + e));
     await page.goto(pageUrl, { waitUntil: 'load', timeout: 60000 });
-    await page.evaluate(async ({ terrainUrl, view }) => {
-      const terrainProvider = await Cesium.CesiumTerrainProvider.fromUrl(terrainUrl, { requestVertexNormals: true });
+    await page.evaluate(async ({ terrainUrl, view, water }) => {
+      const terrainProvider = await Cesium.CesiumTerrainProvider.fromUrl(terrainUrl, {
+        requestVertexNormals: true, requestWaterMask: water,
+      });
       const viewer = new Cesium.Viewer('v', {
         terrainProvider, baseLayer: false, baseLayerPicker: false, geocoder: false, homeButton: false,
         sceneModePicker: false, navigationHelpButton: false, animation: false, timeline: false,
@@ -55,7 +59,7 @@ const { chromium } = require(path.join(root, '.tools', 'node_modules', 'playwrig
       });
       await new Promise((r) => setTimeout(r, 1000));
       window.__viewer = viewer;
-    }, { terrainUrl, view: [lon, lat, height, heading, pitch, exaggeration].map(Number) });
+    }, { terrainUrl, view: [lon, lat, height, heading, pitch, exaggeration].map(Number), water: water === 'water' });
     await page.screenshot({ path: out });
   } finally {
     await context.close();

@@ -26,12 +26,15 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 # (case of bench/compare.py, epsilon, picture size)
 PICTURES = [("bigtujunga", 30.0, 800), ("fuji", 20.0, 560)]
 # (name, DEM under ../shared/data, terrain directory, camera: lon, lat, height m, heading,
-# pitch, vertical exaggeration)
+# pitch, vertical exaggeration; water mask: none, or "below-0" for a mask of the DEM's
+# samples below 0 m)
 CESIUM = [
     ("cesium-global", "dem/etopo5_global_5arcmin.tif", "etopo5",
-     (85, 25, 11_000_000, 0, -90, 20)),
+     (85, 25, 11_000_000, 0, -90, 20), None),
     ("cesium-close", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga",
-     (-118.19, 34.16, 9_000, 20, -30, 1)),
+     (-118.19, 34.16, 9_000, 20, -30, 1), None),
+    ("cesium-water", "dem/etopo5_global_5arcmin.tif", "etopo5-water",
+     (15, 38, 4_000_000, 0, -90, 20), "below-0"),
 ]
 PAGE = ("<!doctype html><html><head><link rel=\"icon\" href=\"data:,\">"
         "<script>window.CESIUM_BASE_URL = '/cesium/';</script>"
@@ -109,15 +112,25 @@ def cesium_pictures(args, data, out, tmp):
     site.mkdir()
     (site / "index.html").write_text(PAGE)
     os.symlink(ROOT / ".tools/node_modules/cesium/Build/Cesium", site / "cesium")
-    for _, dem, terrain, _ in CESIUM:
-        run([args.bin, "tiles", data / dem, "-o", site / terrain, "--normals", "-q"])
+    for _, dem, terrain, _, water in CESIUM:
+        extra = []
+        if water == "below-0":
+            # 255 (water) where the DEM is below 0 m, 0 elsewhere: -scale maps 0 m to 0
+            # and -1 m to 255, and Byte clips the rest.
+            mask = tmp / f"{terrain}-mask.tif"
+            run(["gdal_translate", "-q", "-ot", "Byte", "-scale", "0", "-1", "0", "255",
+                 data / dem, mask])
+            extra = ["--water", mask, "--max-zoom", "4"]
+        run([args.bin, "tiles", data / dem, "-o", site / terrain, "--normals",
+             "--vertical-datum", "ellipsoid", "-q", *extra])
     server = subprocess.Popen([args.bin, "serve", site, "--port", "0"], stdout=subprocess.PIPE,
                               text=True)
     try:
         base = server.stdout.readline().strip().rsplit(" ", 1)[-1]
-        for name, _, terrain, view in CESIUM:
+        for name, _, terrain, view, water in CESIUM:
             run(["node", ROOT / "bench/cesium_shot.cjs", f"{base}index.html",
-                 f"{base}{terrain}/", out / f"{name}.png", *view])
+                 f"{base}{terrain}/", out / f"{name}.png", *view,
+                 *(["water"] if water else [])])
     finally:
         server.kill()
         server.wait()
@@ -130,6 +143,13 @@ def cesium_pictures(args, data, out, tmp):
         "|---|---|",
         "| ![ETOPO5 in CesiumJS](images/cesium-global.png) "
         "| ![Big Tujunga in CesiumJS](images/cesium-close.png) |",
+        "",
+        "Water masks: ETOPO5 (levels 0–4) with `--water MASK`, the mask 1 where ETOPO5 is "
+        "below 0 m, loaded with `requestWaterMask`: CesiumJS draws its specular water over "
+        "the Mediterranean, the Black Sea and the Red Sea (each tile's mask is 256 x 256 "
+        "cells, about 5 km at level 4, which shows as the coasts' steps).",
+        "",
+        "![ETOPO5 with water masks in CesiumJS](images/cesium-water.png)",
         "",
     ]
 

@@ -1607,12 +1607,53 @@ fn water_masks_mark_the_sea_a_mask_or_the_dem_itself_says() {
         "{water} water, {land} land cells checked"
     );
 
-    // Not a raster: refused, saying what to do.
+    // The same water as a polygon layer, in another CRS (Web Mercator): the same cells.
     dir.write(
         "water.geojson",
-        "{\"type\":\"FeatureCollection\",\"features\":[]}",
+        r#"{"type":"FeatureCollection","features":[{"type":"Feature","properties":{},
+        "geometry":{"type":"Polygon","coordinates":[[[9.5,44.5],[11.5,44.5],[11.5,45.5],
+        [9.5,45.5],[9.5,44.5]]]}}]}"#,
     );
-    let o = dir.run(&["tiles", &dem, "-o", "bad", "--water", "water.geojson"]);
-    assert_fails_naming(&o, &["water.geojson", "gdal_rasterize"]);
+    let status = Command::new("ogr2ogr")
+        .args(["-t_srs", "EPSG:3857", "-f", "GPKG"])
+        .arg(dir.path("water.gpkg"))
+        .arg(dir.path("water.geojson"))
+        .status()
+        .expect("ogr2ogr runs");
+    assert!(status.success());
+    let o = dir.run(&[
+        "tiles",
+        &dem,
+        "-o",
+        "polygons",
+        "--water",
+        "water.gpkg",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let polygons = decode_pyramid(&dir.path("polygons"));
+    let (water, land) = check_water_masks(&polygons, |lon, lat| {
+        let margin = 0.03;
+        let inside = (9.5 + margin..11.5 - margin).contains(&lon)
+            && (44.5 + margin..45.5 - margin).contains(&lat);
+        let outside = !(9.5 - margin..11.5 + margin).contains(&lon)
+            || !(44.5 - margin..45.5 + margin).contains(&lat);
+        if inside {
+            Some(true)
+        } else if outside {
+            Some(false)
+        } else {
+            None
+        }
+    });
+    assert!(
+        water > 1000 && land > 1000,
+        "{water} water, {land} land cells checked"
+    );
+
+    // Neither a raster nor a vector dataset: refused by name, nothing written.
+    dir.write("water.txt", "not water");
+    let o = dir.run(&["tiles", &dem, "-o", "bad", "--water", "water.txt"]);
+    assert_fails_naming(&o, &["water.txt", "--water"]);
     assert!(!dir.path("bad").exists());
 }

@@ -141,8 +141,8 @@ pub struct TilesArgs {
     #[arg(long, value_name = "DATUM")]
     pub vertical_datum: Option<String>,
     /// Add the water mask extension (CesiumJS's requestWaterMask): `sea-level` (INPUT's
-    /// nodata is sea, and heights at or below 0 beside it), or a raster of water (1) and
-    /// land (0).
+    /// nodata is sea, and heights at or below 0 beside it), a raster of water (1) and land
+    /// (0), or a polygon layer of water.
     #[arg(long, value_name = "SOURCE")]
     pub water: Option<String>,
     /// Coarsest level written.

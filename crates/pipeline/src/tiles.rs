@@ -119,10 +119,11 @@ pub fn vertical_datum(
 }
 
 /// Where the water mask of `input`'s pyramid comes from: `sea-level` (`input` itself,
-/// band `band`) or a mask raster, checked to open; `None` without `choice`.
+/// band `band`), a mask raster or a polygon layer, checked to open; `None` without
+/// `choice`.
 ///
 /// # Errors
-/// When the mask is not a raster GDAL opens (a polygon layer: rasterize it first).
+/// When GDAL opens `choice` as neither a raster nor a vector dataset.
 pub fn water_source(
     input: &Path,
     band: usize,
@@ -143,10 +144,14 @@ pub fn water_source(
             path: path.to_path_buf(),
             band: 1,
         })),
+        Err(tinsmith_raster::Error::NotARaster { .. }) if tinsmith_raster::is_vector(path) => {
+            Ok(Some(tinsmith_terrain::Water::Polygons {
+                path: path.to_path_buf(),
+            }))
+        }
         Err(tinsmith_raster::Error::NotARaster { .. }) => bail!(
-            "{}: --water takes `sea-level` or a raster of water (1) and land (0); for a \
-             polygon layer, rasterize it first (e.g. `gdal_rasterize -burn 1 -init 0 -ot Byte \
-             -tr 0.001 0.001 WATER.gpkg water.tif`)",
+            "{}: --water takes `sea-level`, a raster of water (1) and land (0), or a polygon \
+             layer of water; GDAL opens this as neither",
             path.display()
         ),
         Err(e) => Err(e.into()),

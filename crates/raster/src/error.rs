@@ -177,6 +177,14 @@ pub enum Error {
         /// What is wrong and what to do.
         reason: String,
     },
+    /// A polygon layer could not be read or burnt onto a grid.
+    #[error("{}: cannot burn its polygons onto a grid ({reason})", path.display())]
+    Polygons {
+        /// The vector file.
+        path: PathBuf,
+        /// GDAL's or PROJ's explanation.
+        reason: String,
+    },
     /// GDAL failed to reproject the raster to EPSG:4326.
     #[error("{}: reprojecting to EPSG:4326 failed ({reason})", path.display())]
     Warp {

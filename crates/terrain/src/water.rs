@@ -25,6 +25,12 @@ pub enum Water {
         /// Its band, 1-based.
         band: usize,
     },
+    /// A polygon layer GDAL reads (seas, lakes, a coastline's land polygons inverted): a
+    /// cell is water where its centre lies inside a polygon of any of the file's layers.
+    Polygons {
+        /// The vector file, any CRS PROJ transforms.
+        path: PathBuf,
+    },
     /// The pyramid's own DEM: a cell is water where the DEM has no data at its centre
     /// (nodata sea), or where its height is at or below 0 and one of the 8 cells around it
     /// has no data (the shore of that sea). Valid samples below 0 away from nodata (a
@@ -47,6 +53,7 @@ impl Water {
         };
         match self {
             Water::Raster { path, band } => format!("raster:{}:{band}", name(path)),
+            Water::Polygons { path } => format!("polygons:{}", name(path)),
             Water::SeaLevel { band, .. } => format!("sea-level:{band}"),
         }
     }
@@ -98,6 +105,13 @@ pub(crate) fn mask(water: &Water, rect: GeoRectangle) -> TerrainResult<Mask> {
                     cells[(n - 1 - j) * n + i] = 255;
                 }
             }
+        }
+        Water::Polygons { path } => {
+            cells = tinsmith_raster::burn_polygons(
+                path,
+                [rect.west, rect.south, rect.east, rect.north],
+                MASK_CELLS,
+            )?;
         }
         Water::SeaLevel { path, band } => {
             let wide = n + 2;

@@ -67,6 +67,10 @@ pub enum InitialMeshArg {
     Rtin,
     /// Rows or columns simplified as 1-D lines within the bound, zipped into triangles.
     Strips,
+    /// Greedy insertion: the sample of largest error inserted into a Delaunay
+    /// triangulation until all are within the bound (grids without nodata; others take
+    /// auto's start).
+    Insert,
     /// Strips, or the RTIN where it is cheap to build and has fewer triangles; the RTIN
     /// with contour levels.
     Auto,
@@ -78,6 +82,7 @@ impl From<InitialMeshArg> for InitialMesh {
             InitialMeshArg::Full => InitialMesh::Full,
             InitialMeshArg::Rtin => InitialMesh::Rtin,
             InitialMeshArg::Strips => InitialMesh::Strips,
+            InitialMeshArg::Insert => InitialMesh::Insert,
             InitialMeshArg::Auto => InitialMesh::Auto,
         }
     }

@@ -183,10 +183,11 @@ fn run(
     let exact_zero = options.error_model == ErrorModel::Exact && grid.integral_heights();
     let rtin_ok = limit > 0.0 || exact_zero;
     let mut count_start_bound = None;
+    let mut border_decided = false;
     let mut mesh = match options.initial_mesh {
         // A count target starts from an RTIN refined to a multiple of the count, whatever
         // coarse start was chosen (the strips have no such knob).
-        InitialMesh::Rtin | InitialMesh::Strips | InitialMesh::Auto
+        InitialMesh::Rtin | InitialMesh::Strips | InitialMesh::Insert | InitialMesh::Auto
             if count_target && limit > 0.0 =>
         {
             let (corners, bounds, start_bound) = rtin_for_count(
@@ -207,15 +208,18 @@ fn run(
                 Mesh::from_triangles(grid, corners, bounds)
             }
         }
-        InitialMesh::Rtin | InitialMesh::Strips | InitialMesh::Auto if rtin_ok => {
-            let (corners, bounds) = coarse_start(
+        InitialMesh::Rtin | InitialMesh::Strips | InitialMesh::Insert | InitialMesh::Auto
+            if rtin_ok =>
+        {
+            let start = coarse_start(
                 grid,
                 resolved_start(options),
                 limit,
                 max_edge_squared(options),
-                keep_border.is_some(),
+                keep_border,
             );
-            Mesh::from_triangles(grid, corners, bounds)
+            border_decided = start.border_decided;
+            Mesh::from_triangles(grid, start.corners, start.bounds)
         }
         _ => Mesh::from_grid(grid),
     };
@@ -241,7 +245,9 @@ fn run(
     remover.segments_may_not_grow = rules.levels.is_some() && !count_target;
     let mut stats = Stats::default();
     if let Some(keep) = keep_border {
-        remove_border(&mut mesh, &mut remover, keep)?;
+        if !border_decided {
+            remove_border(&mut mesh, &mut remover, keep)?;
+        }
         remover.locked_border = Some((grid.width(), grid.height()));
     }
     match options.order {

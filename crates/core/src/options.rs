@@ -41,6 +41,12 @@ pub enum InitialMesh {
     /// grid, and fewer samples than the RTIN keeps where the bound is small for the
     /// ground's roughness.
     Strips,
+    /// Greedy insertion (Garland & Heckbert): from the domain's corners, the sample of
+    /// largest exact error is inserted into a Delaunay triangulation until every triangle
+    /// is within the bound; far fewer vertices than the other starts where the result
+    /// keeps a small share of the samples. Grids with nodata use [`InitialMesh::Auto`]'s
+    /// start instead.
+    Insert,
     /// [`InitialMesh::Strips`], or the RTIN where its probe finds it cheap (few of the
     /// finest squares split) and it has fewer triangles; the RTIN when contour levels
     /// are given ([`DecimationOptions::with_contour_levels`]), which keep fewer segments
@@ -141,6 +147,7 @@ impl InitialMesh {
             Self::Full => "full",
             Self::Rtin => "rtin",
             Self::Strips => "strips",
+            Self::Insert => "insert",
             Self::Auto => "auto",
         }
     }

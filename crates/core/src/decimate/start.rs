@@ -1,5 +1,6 @@
 //! The mesh decimation starts from: which start, and the bound or count it is built to.
 
+use crate::insert::insertion_triangles;
 use crate::mesh::CompactBound;
 use crate::rtin::{cheap_rtin_with_fewer_triangles, rtin_triangles};
 use crate::strips::StripPlan;
@@ -17,11 +18,70 @@ pub(super) fn resolved_start(options: &DecimationOptions) -> InitialMesh {
     }
 }
 
-/// The triangles and exact errors of a coarse start within `limit`: the RTIN, the strips,
-/// or (for [`InitialMesh::Auto`]) the strips unless the RTIN is cheap and has fewer
-/// triangles. The strips need edges of any length, so a maximum edge length, or strips
+/// A coarse start: its triangles and exact errors, and whether its outline is already the
+/// decided border of a tile (insertion starts from it; the other starts keep half cells
+/// along the border, whose skipped samples removal takes out first).
+pub(super) struct Start {
+    pub corners: Vec<[u32; 3]>,
+    pub bounds: Vec<CompactBound>,
+    pub border_decided: bool,
+}
+
+/// [`InitialMesh::Auto`] inserts (when the grid has no nodata) only while insertion keeps
+/// at most one sample in this many; past that it stops and the strips or the RTIN start
+/// instead. Decided by the input and the options alone, never by time.
+pub(super) const AUTO_INSERT_SHARE: usize = 128;
+
+/// The fewest vertices [`InitialMesh::Auto`]'s insertion may place, however small the grid.
+const AUTO_INSERT_MIN: usize = 64;
+
+/// The triangles and exact errors of a coarse start within `limit`: greedy insertion
+/// ([`InitialMesh::Insert`], and for [`InitialMesh::Auto`] when it keeps few samples, see
+/// [`AUTO_INSERT_SHARE`]), the RTIN, the strips, or (for [`InitialMesh::Auto`]) the strips
+/// unless the RTIN is cheap and has fewer triangles. Insertion needs a grid without
+/// nodata; the strips need edges of any length, so a maximum edge length, or strips
 /// refused by their exact measurement (rounding in their 1-D pass), give the RTIN.
 pub(super) fn coarse_start(
+    grid: &Grid,
+    initial_mesh: InitialMesh,
+    limit: f64,
+    max_edge_squared: i64,
+    keep_border: Option<&dyn Fn(u32, u32) -> bool>,
+) -> Start {
+    let budget = match initial_mesh {
+        InitialMesh::Insert => Some(usize::MAX),
+        InitialMesh::Auto => {
+            Some((grid.domain_sample_count() / AUTO_INSERT_SHARE).max(AUTO_INSERT_MIN))
+        }
+        _ => None,
+    };
+    if let Some(budget) = budget {
+        if let Some((corners, bounds)) =
+            insertion_triangles(grid, limit, max_edge_squared, keep_border, budget)
+        {
+            return Start {
+                corners,
+                bounds,
+                border_decided: keep_border.is_some(),
+            };
+        }
+    }
+    let (corners, bounds) = bottom_up_start(
+        grid,
+        initial_mesh,
+        limit,
+        max_edge_squared,
+        keep_border.is_some(),
+    );
+    Start {
+        corners,
+        bounds,
+        border_decided: false,
+    }
+}
+
+/// The RTIN or the strips (see [`coarse_start`]).
+fn bottom_up_start(
     grid: &Grid,
     initial_mesh: InitialMesh,
     limit: f64,
@@ -35,7 +95,7 @@ pub(super) fn coarse_start(
     let Some(strips) = StripPlan::new(grid, limit, full_border) else {
         return rtin();
     };
-    let cheap_rtin = if initial_mesh == InitialMesh::Auto {
+    let cheap_rtin = if initial_mesh != InitialMesh::Strips {
         cheap_rtin_with_fewer_triangles(
             grid,
             limit,

@@ -71,8 +71,9 @@ pub enum InitialMeshArg {
     /// triangulation until all are within the bound (grids without nodata; others take
     /// auto's start).
     Insert,
-    /// Strips, or the RTIN where it is cheap to build and has fewer triangles; the RTIN
-    /// with contour levels.
+    /// Insert where the grid has no nodata and the strips would keep at most 1 sample in
+    /// 12; else strips, or the RTIN where it is cheap to build and has fewer triangles; the
+    /// RTIN with contour levels.
     Auto,
 }
 

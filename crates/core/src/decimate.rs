@@ -64,7 +64,8 @@ pub struct DecimationReport {
 /// `options.max_error` of every domain sample.
 ///
 /// Decimation starts from `options.initial_mesh`: by default a coarse start already within
-/// the bound (strips, or the RTIN where it is cheap); the paper's start,
+/// the bound (greedy insertion where few samples stay, else strips, or the RTIN where it
+/// is cheap); the paper's start,
 /// [`crate::InitialMesh::Full`], splits every valid cell into two triangles. Vertices are
 /// then removed as in the paper: classify (§3.2); bound the new triangles' errors
 /// (`options.error_model`: by default the exact error over the samples each covers; the

@@ -66,6 +66,11 @@ impl<'g> StripPlan<'g> {
         Some(plan)
     }
 
+    /// How many samples the simplified lines keep.
+    pub(crate) fn kept_count(&self) -> usize {
+        self.kept.positions.len()
+    }
+
     /// How many triangles [`StripPlan::triangles`] makes.
     pub(crate) fn triangle_count(&self) -> usize {
         self.triangle_count

@@ -27,20 +27,23 @@ pub(super) struct Start {
     pub border_decided: bool,
 }
 
-/// [`InitialMesh::Auto`] inserts (when the grid has no nodata) only while insertion keeps
-/// at most one sample in this many; past that it stops and the strips or the RTIN start
-/// instead. Decided by the input and the options alone, never by time.
-pub(super) const AUTO_INSERT_SHARE: usize = 128;
-
-/// The fewest vertices [`InitialMesh::Auto`]'s insertion may place, however small the grid.
-const AUTO_INSERT_MIN: usize = 64;
+/// [`InitialMesh::Auto`] inserts (on a grid without nodata) where the strips keep at most
+/// one domain sample in this many, and then only while insertion places fewer vertices
+/// than the strips keep; otherwise the strips or the RTIN start. Decided by the input and
+/// the options alone, never by time. Measured (one thread, interleaved runs, 2026-12-04;
+/// docs/notes/2026-12-04-greedy-insertion-start.md): at ε = 30 insertion then removal took
+/// 0.5 x the strips' time on Big Tujunga (strips keep 1-5 %) and 0.8 x on Fuji (5 %), but
+/// 1.7 x on a CT slice (11 %, long flat runs the strips pass cheaply); at ε = 5 (a quarter
+/// of the samples kept) 2-2.5 x; and ETOPO5's pyramid tiles 0.32 x.
+pub(super) const AUTO_INSERT_SHARE: usize = 12;
 
 /// The triangles and exact errors of a coarse start within `limit`: greedy insertion
-/// ([`InitialMesh::Insert`], and for [`InitialMesh::Auto`] when it keeps few samples, see
-/// [`AUTO_INSERT_SHARE`]), the RTIN, the strips, or (for [`InitialMesh::Auto`]) the strips
-/// unless the RTIN is cheap and has fewer triangles. Insertion needs a grid without
-/// nodata; the strips need edges of any length, so a maximum edge length, or strips
-/// refused by their exact measurement (rounding in their 1-D pass), give the RTIN.
+/// ([`InitialMesh::Insert`], and for [`InitialMesh::Auto`] where the strips keep few
+/// samples, see [`AUTO_INSERT_SHARE`]), the RTIN, the strips, or (for
+/// [`InitialMesh::Auto`]) the strips unless the RTIN is cheap and has fewer triangles.
+/// Insertion needs a grid without nodata; the strips need edges of any length, so a
+/// maximum edge length, or strips refused by their exact measurement (rounding in their
+/// 1-D pass), give the RTIN.
 pub(super) fn coarse_start(
     grid: &Grid,
     initial_mesh: InitialMesh,
@@ -48,10 +51,17 @@ pub(super) fn coarse_start(
     max_edge_squared: i64,
     keep_border: Option<&dyn Fn(u32, u32) -> bool>,
 ) -> Start {
+    let full_border = keep_border.is_some();
+    let no_nodata = grid.valid_cell_count()
+        == (grid.width() as usize).saturating_sub(1) * (grid.height() as usize).saturating_sub(1);
+    let mut strips = None;
     let budget = match initial_mesh {
         InitialMesh::Insert => Some(usize::MAX),
-        InitialMesh::Auto => {
-            Some((grid.domain_sample_count() / AUTO_INSERT_SHARE).max(AUTO_INSERT_MIN))
+        InitialMesh::Auto if no_nodata && limit > 0.0 => {
+            strips = StripPlan::new(grid, limit, full_border);
+            strips.as_ref().map(|s| s.kept_count()).filter(|&kept| {
+                kept.saturating_mul(AUTO_INSERT_SHARE) <= grid.domain_sample_count()
+            })
         }
         _ => None,
     };
@@ -62,7 +72,7 @@ pub(super) fn coarse_start(
             return Start {
                 corners,
                 bounds,
-                border_decided: keep_border.is_some(),
+                border_decided: full_border,
             };
         }
     }
@@ -71,7 +81,8 @@ pub(super) fn coarse_start(
         initial_mesh,
         limit,
         max_edge_squared,
-        keep_border.is_some(),
+        full_border,
+        strips,
     );
     Start {
         corners,
@@ -87,12 +98,13 @@ fn bottom_up_start(
     limit: f64,
     max_edge_squared: i64,
     full_border: bool,
+    strips: Option<StripPlan<'_>>,
 ) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
     let rtin = || rtin_triangles(grid, limit, max_edge_squared, full_border);
     if initial_mesh == InitialMesh::Rtin || max_edge_squared != i64::MAX {
         return rtin();
     }
-    let Some(strips) = StripPlan::new(grid, limit, full_border) else {
+    let Some(strips) = strips.or_else(|| StripPlan::new(grid, limit, full_border)) else {
         return rtin();
     };
     let cheap_rtin = if initial_mesh != InitialMesh::Strips {

@@ -354,9 +354,7 @@ impl<'g> Triangulation<'g> {
             }
             let (a, b) = (tc[e], tc[(e + 1) % 3]);
             let uc = self.corners[u as usize];
-            let Some(j) = (0..3).find(|&j| uc[j] == b && uc[(j + 1) % 3] == a) else {
-                return None;
-            };
+            let j = (0..3).find(|&j| uc[j] == b && uc[(j + 1) % 3] == a)?;
             let d = uc[(j + 2) % 3];
             let [pv, pa, pb, pd] = [v, a, b, d].map(|x| self.point(x));
             if in_circle(&pv, &pa, &pb, &pd) <= 0 {
@@ -445,14 +443,14 @@ mod tests {
     #[test]
     fn a_decided_border_is_the_outline() {
         let g = grid(41, 29, |x, y| if y == 0 { 0.0 } else { bumpy(x, y) });
-        let keep = |x: u32, y: u32| y != 0 || x % 10 == 0;
+        let keep = |x: u32, y: u32| y != 0 || x.is_multiple_of(10);
         let (c, b) = insertion_triangles(&g, 0.5, i64::MAX, Some(&keep), usize::MAX).unwrap();
         check(&g, 0.5, &c, &b);
         for t in &c {
             for &v in t {
                 let (x, y) = (v % 41, v / 41);
                 if x == 0 || y == 0 || x == 40 || y == 28 {
-                    assert!(keep(x, y) || (x % 40 == 0 && y % 28 == 0));
+                    assert!(keep(x, y) || (x.is_multiple_of(40) && y.is_multiple_of(28)));
                 }
             }
         }

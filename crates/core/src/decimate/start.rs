@@ -32,9 +32,9 @@ pub(super) struct Start {
 /// than the strips keep; otherwise the strips or the RTIN start. Decided by the input and
 /// the options alone, never by time. Measured (one thread, interleaved runs, 2026-12-04;
 /// docs/notes/2026-12-04-greedy-insertion-start.md): at ε = 30 insertion then removal took
-/// 0.5 x the strips' time on Big Tujunga (strips keep 1-5 %) and 0.8 x on Fuji (5 %), but
-/// 1.7 x on a CT slice (11 %, long flat runs the strips pass cheaply); at ε = 5 (a quarter
-/// of the samples kept) 2-2.5 x; and ETOPO5's pyramid tiles 0.32 x.
+/// about 0.5 x the strips' time on Big Tujunga's tiles and 0.7 x on Fuji (the strips keep
+/// 5 %), but 1-1.7 x on a CT slice (11 %, long flat runs the strips pass cheaply); at ε = 5
+/// (a quarter of the samples kept) 1.3-2.5 x; ETOPO5's pyramid 0.32-0.45 x.
 pub(super) const AUTO_INSERT_SHARE: usize = 12;
 
 /// The triangles and exact errors of a coarse start within `limit`: greedy insertion

@@ -231,6 +231,17 @@ impl Kept {
     }
 }
 
+/// How many samples the strips along rows keep (one of the two passes of
+/// [`StripPlan::new`]).
+pub(crate) fn kept_along_rows(grid: &Grid, limit: f64, full_border: bool) -> usize {
+    if grid.width() < 2 || grid.height() < 2 {
+        return grid.values().len();
+    }
+    kept_samples(grid, Lines::new(grid, true), limit, full_border)
+        .positions
+        .len()
+}
+
 /// Simplifies every line: the positions where a strip's run of valid cells begins or ends
 /// (and, with `full_border`, every position of the two outer lines on each side and the
 /// two outer positions at each end of every line) are kept, and each stretch between two

@@ -3,7 +3,7 @@
 use crate::insert::insertion_triangles;
 use crate::mesh::CompactBound;
 use crate::rtin::{cheap_rtin_with_fewer_triangles, rtin_triangles};
-use crate::strips::StripPlan;
+use crate::strips::{kept_along_rows, StripPlan};
 use crate::{DecimationOptions, Grid, InitialMesh};
 
 /// The start [`InitialMesh::Auto`] stands for given the other options: with contour
@@ -28,7 +28,7 @@ pub(super) struct Start {
 }
 
 /// [`InitialMesh::Auto`] inserts (on a grid without nodata) where the strips keep at most
-/// one domain sample in this many, and then only while insertion places fewer vertices
+/// one sample in this many (the strips along rows, where an edge cap rules the strips out), and then only while insertion places fewer vertices
 /// than the strips keep; otherwise the strips or the RTIN start. Decided by the input and
 /// the options alone, never by time. Measured (one thread, interleaved runs, 2026-12-04;
 /// docs/notes/2026-12-04-greedy-insertion-start.md): at ε = 30 insertion then removal took
@@ -52,16 +52,24 @@ pub(super) fn coarse_start(
     keep_border: Option<&dyn Fn(u32, u32) -> bool>,
 ) -> Start {
     let full_border = keep_border.is_some();
-    let no_nodata = grid.valid_cell_count()
-        == (grid.width() as usize).saturating_sub(1) * (grid.height() as usize).saturating_sub(1);
+    let (w, h) = (grid.width() as usize, grid.height() as usize);
+    let no_nodata = limit > 0.0
+        && matches!(initial_mesh, InitialMesh::Insert | InitialMesh::Auto)
+        && grid.valid_cell_count() == w.saturating_sub(1) * h.saturating_sub(1);
     let mut strips = None;
     let budget = match initial_mesh {
+        _ if !no_nodata => None,
         InitialMesh::Insert => Some(usize::MAX),
-        InitialMesh::Auto if no_nodata && limit > 0.0 => {
-            strips = StripPlan::new(grid, limit, full_border);
-            strips.as_ref().map(|s| s.kept_count()).filter(|&kept| {
-                kept.saturating_mul(AUTO_INSERT_SHARE) <= grid.domain_sample_count()
-            })
+        InitialMesh::Auto => {
+            // With an edge cap the strips cannot start, so only their rows are planned
+            // (half the pass) to count what they keep.
+            let kept = if max_edge_squared != i64::MAX {
+                Some(kept_along_rows(grid, limit, full_border))
+            } else {
+                strips = StripPlan::new(grid, limit, full_border);
+                strips.as_ref().map(|s| s.kept_count())
+            };
+            kept.filter(|&kept| kept.saturating_mul(AUTO_INSERT_SHARE) <= w * h)
         }
         _ => None,
     };

@@ -12,6 +12,10 @@ Setup (done by `make bench-compare`): a venv with pydelatin, numpy and rasterio:
 Usage:
     .venv/bin/python bench/compare.py [--shared ../shared] [--eps 0.5,1,5,30] [--out FILE.md]
         [--tinsmith-args "--error-model exact"] [--cases bigtujunga,fuji]
+        [--baseline OLD_BINARY] [--repeat 5]
+With --baseline, an older tinsmith binary runs too, interleaved with the new one and hmm
+in every repeat, and its time ratio to hmm is printed beside the new one's (the machine is
+shared: compare ratios within one run, not seconds across runs).
 Times: tinsmith's is its decimation time from --report (initial mesh + decimation, not
 file reading or writing); hmm's is the Delatin() call on an in-memory array. Each is the
 best of --repeat runs.
@@ -87,6 +91,7 @@ def main():
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--tinsmith-args", default="")
     ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--baseline", help="an older tinsmith binary to run interleaved")
     ap.add_argument("--out")
     args = ap.parse_args()
     data = pathlib.Path(args.shared) / "data"
@@ -104,27 +109,31 @@ def main():
             full = 2 * (w - 1) * (h - 1)
             hmm_in = grid.astype(np.float32)
             for eps in [float(e) for e in args.eps.split(",")]:
-                # tinsmith
-                best_t = None
+                # tinsmith (and the baseline), then hmm, alternately in each repeat
+                best_t = best_b = best_h = None
                 for _ in range(args.repeat):
-                    out, rep = tmp / "t.ply", tmp / "t.json"
-                    cmd = [args.bin, "mesh", str(raster), "-o", str(out), "--max-error", str(eps),
-                           "--pixel-coords", "-q", "--threads", "1", "--report", str(rep)] + shlex.split(args.tinsmith_args)
-                    p = subprocess.run(cmd, capture_output=True, text=True)
-                    if p.returncode != 0:
-                        sys.exit(f"tinsmith failed: {p.stderr}")
-                    r = json.loads(rep.read_text())
-                    s = r["seconds"]["initial_mesh"] + r["seconds"]["decimate"]
-                    best_t = s if best_t is None else min(best_t, s)
-                t_tris = r["triangles_after"]
-                t_err = verify(args.bin, raster, out, eps)
-                # hmm
-                best_h = None
-                for _ in range(args.repeat):
+                    for which in ([args.bin] + ([args.baseline] if args.baseline else [])):
+                        out = tmp / ("t.ply" if which == args.bin else "b.ply")
+                        rep = tmp / "t.json"
+                        cmd = [which, "mesh", str(raster), "-o", str(out), "--max-error", str(eps),
+                               "--pixel-coords", "-q", "--threads", "1", "--report", str(rep)] + shlex.split(args.tinsmith_args)
+                        p = subprocess.run(cmd, capture_output=True, text=True)
+                        if p.returncode != 0:
+                            sys.exit(f"tinsmith failed: {p.stderr}")
+                        rr = json.loads(rep.read_text())
+                        s = rr["seconds"]["initial_mesh"] + rr["seconds"]["decimate"]
+                        if which == args.bin:
+                            best_t = s if best_t is None else min(best_t, s)
+                            r = rr
+                        else:
+                            best_b = s if best_b is None else min(best_b, s)
+                            b_tris = rr["triangles_after"]
                     t0 = time.perf_counter()
                     tin = Delatin(hmm_in, width=w, height=h, max_error=eps)
                     s = time.perf_counter() - t0
                     best_h = s if best_h is None else min(best_h, s)
+                t_tris = r["triangles_after"]
+                t_err = verify(args.bin, raster, tmp / "t.ply", eps)
                 h_tris = len(tin.triangles)
                 hobj = tmp / "h.obj"
                 write_obj(hobj, tin.vertices, tin.triangles, h)
@@ -137,12 +146,14 @@ def main():
                 ok_time = time_ratio <= time_target
                 ok_err = t_err["max_error"] <= eps and t_err["mesh_is_valid"] if "mesh_is_valid" in t_err else t_err["max_error"] <= eps
                 ok = ok_tri and ok_time and ok_err
+                base = (f" baseline {b_tris} triangles, {best_b:.3f} s = {best_b / best_h:.2f} x hmm;"
+                        if args.baseline else "")
                 all_ok &= ok
                 rows.append(
                     f"| {name} {w}x{h} | {eps:g} | {t_tris} / {h_tris} | {tri_ratio:.2f} | "
                     f"{best_t:.3f} / {best_h:.3f} | {time_ratio:.2f} (≤ {time_target}) | {100 * keeps:.0f} % | "
                     f"{t_err['max_error']:.6g} / {h_err['max_error']:.6g} | "
-                    f"{'tri ' + ('ok' if ok_tri else 'MISS')}, {'time ' + ('ok' if ok_time else 'MISS')}, {'err ' + ('ok' if ok_err else 'MISS')} |")
+                    f"{'tri ' + ('ok' if ok_tri else 'MISS')}, {'time ' + ('ok' if ok_time else 'MISS')}, {'err ' + ('ok' if ok_err else 'MISS')};{base} |")
                 print(rows[-1], flush=True)
     table = "\n".join(rows) + "\n"
     if args.out:

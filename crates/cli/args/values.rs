@@ -67,8 +67,13 @@ pub enum InitialMeshArg {
     Rtin,
     /// Rows or columns simplified as 1-D lines within the bound, zipped into triangles.
     Strips,
-    /// Strips, or the RTIN where it is cheap to build and has fewer triangles; the RTIN
-    /// with contour levels.
+    /// Greedy insertion: the sample of largest error inserted into a Delaunay
+    /// triangulation until all are within the bound (grids without nodata; others take
+    /// auto's start).
+    Insert,
+    /// Insert where the grid has no nodata and the strips would keep at most 1 sample in
+    /// 12; else strips, or the RTIN where it is cheap to build and has fewer triangles; the
+    /// RTIN with contour levels.
     Auto,
 }
 
@@ -78,6 +83,7 @@ impl From<InitialMeshArg> for InitialMesh {
             InitialMeshArg::Full => InitialMesh::Full,
             InitialMeshArg::Rtin => InitialMesh::Rtin,
             InitialMeshArg::Strips => InitialMesh::Strips,
+            InitialMeshArg::Insert => InitialMesh::Insert,
             InitialMeshArg::Auto => InitialMesh::Auto,
         }
     }

@@ -64,7 +64,8 @@ pub struct DecimationReport {
 /// `options.max_error` of every domain sample.
 ///
 /// Decimation starts from `options.initial_mesh`: by default a coarse start already within
-/// the bound (strips, or the RTIN where it is cheap); the paper's start,
+/// the bound (greedy insertion where few samples stay, else strips, or the RTIN where it
+/// is cheap); the paper's start,
 /// [`crate::InitialMesh::Full`], splits every valid cell into two triangles. Vertices are
 /// then removed as in the paper: classify (§3.2); bound the new triangles' errors
 /// (`options.error_model`: by default the exact error over the samples each covers; the
@@ -183,10 +184,11 @@ fn run(
     let exact_zero = options.error_model == ErrorModel::Exact && grid.integral_heights();
     let rtin_ok = limit > 0.0 || exact_zero;
     let mut count_start_bound = None;
+    let mut border_decided = false;
     let mut mesh = match options.initial_mesh {
         // A count target starts from an RTIN refined to a multiple of the count, whatever
         // coarse start was chosen (the strips have no such knob).
-        InitialMesh::Rtin | InitialMesh::Strips | InitialMesh::Auto
+        InitialMesh::Rtin | InitialMesh::Strips | InitialMesh::Insert | InitialMesh::Auto
             if count_target && limit > 0.0 =>
         {
             let (corners, bounds, start_bound) = rtin_for_count(
@@ -207,15 +209,18 @@ fn run(
                 Mesh::from_triangles(grid, corners, bounds)
             }
         }
-        InitialMesh::Rtin | InitialMesh::Strips | InitialMesh::Auto if rtin_ok => {
-            let (corners, bounds) = coarse_start(
+        InitialMesh::Rtin | InitialMesh::Strips | InitialMesh::Insert | InitialMesh::Auto
+            if rtin_ok =>
+        {
+            let start = coarse_start(
                 grid,
                 resolved_start(options),
                 limit,
                 max_edge_squared(options),
-                keep_border.is_some(),
+                keep_border,
             );
-            Mesh::from_triangles(grid, corners, bounds)
+            border_decided = start.border_decided;
+            Mesh::from_triangles(grid, start.corners, start.bounds)
         }
         _ => Mesh::from_grid(grid),
     };
@@ -241,7 +246,9 @@ fn run(
     remover.segments_may_not_grow = rules.levels.is_some() && !count_target;
     let mut stats = Stats::default();
     if let Some(keep) = keep_border {
-        remove_border(&mut mesh, &mut remover, keep)?;
+        if !border_decided {
+            remove_border(&mut mesh, &mut remover, keep)?;
+        }
         remover.locked_border = Some((grid.width(), grid.height()));
     }
     match options.order {

@@ -90,6 +90,74 @@ pub(crate) fn triangle_error(
     Some(ErrorBound { above, below })
 }
 
+/// The exact above/below error of the plane through counter-clockwise triangle `abc` over
+/// every grid sample in the closed triangle (no early stop), with the sample (row-major
+/// index) of largest |sample - plane| among those that are not yet vertices
+/// (`is_vertex`) with that error, `None` when every sample is one. The arithmetic is
+/// [`triangle_error`]'s, so the bound is bit for bit the one it gives.
+pub(crate) fn triangle_worst(
+    grid: &Grid,
+    a: &Point,
+    b: &Point,
+    c: &Point,
+    is_vertex: &[bool],
+) -> (ErrorBound, Option<(usize, f64)>) {
+    debug_assert!(orient(a, b, c) > 0);
+    let g = plane_gradient(a, b, c);
+    let width = grid.width() as usize;
+    let values = grid.values();
+    let (mut above, mut below) = (0.0f64, 0.0f64);
+    let mut worst = (-1.0f64, None);
+    let mut spans = RowSpans::new(a, b, c);
+    for y in spans.rows() {
+        let (lo, hi) = spans.next_span();
+        if lo > hi {
+            continue;
+        }
+        let start = y as usize * width;
+        let row = &values[start..][..width];
+        let base = a.z + g[1] * (y - a.y) as f64;
+        // Returns |d| at `x`, recording the bound and the worst non-vertex sample.
+        let mut measure = |x: i64| {
+            let plane = base + g[0] * (x - a.x) as f64;
+            let d = row[x as usize] - plane;
+            above = if d > above { d } else { above };
+            below = if -d > below { -d } else { below };
+            let e = d.abs();
+            if e > worst.0 && !is_vertex[start + x as usize] {
+                worst = (e, Some((start + x as usize, e)));
+            }
+        };
+        match grid.equal_runs() {
+            None => (lo..=hi).for_each(&mut measure),
+            Some(runs) => {
+                // Along a run of equal samples |d| is largest at one of its ends (see
+                // `triangle_error`); a vertex at an end hands that end to its neighbour.
+                let runs = &runs[start..][..width];
+                let mut x = lo;
+                while x <= hi {
+                    let run = runs[x as usize];
+                    let end = if run >= MIN_EQUAL_RUN {
+                        let end = (x + i64::from(run) - 1).min(hi);
+                        for e in [x, x + 1, end - 1, end] {
+                            if e >= x && e <= end {
+                                measure(e);
+                            }
+                        }
+                        end
+                    } else {
+                        let end = (x + i64::from(MIN_EQUAL_RUN) - 1).min(hi);
+                        (x..=end).for_each(&mut measure);
+                        end
+                    };
+                    x = end + 1;
+                }
+            }
+        }
+    }
+    (ErrorBound { above, below }, worst.1)
+}
+
 /// The samples at the given vertices' positions, as points (their heights may differ, see
 /// [`Grid::vertex_height`]).
 pub(crate) fn corner_samples<const N: usize>(grid: &Grid, corners: [&Point; N]) -> [Point; N] {

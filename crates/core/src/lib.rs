@@ -31,6 +31,7 @@ mod extend;
 mod flips;
 mod grid;
 mod hole;
+mod insert;
 mod levels;
 mod mesh;
 mod options;

@@ -41,10 +41,18 @@ pub enum InitialMesh {
     /// grid, and fewer samples than the RTIN keeps where the bound is small for the
     /// ground's roughness.
     Strips,
-    /// [`InitialMesh::Strips`], or the RTIN where its probe finds it cheap (few of the
-    /// finest squares split) and it has fewer triangles; the RTIN when contour levels
-    /// are given ([`DecimationOptions::with_contour_levels`]), which keep fewer segments
-    /// from it.
+    /// Greedy insertion (Garland & Heckbert): from the domain's corners, the sample of
+    /// largest exact error is inserted into a Delaunay triangulation until every triangle
+    /// is within the bound; far fewer vertices than the other starts where the result
+    /// keeps a small share of the samples. Grids with nodata use [`InitialMesh::Auto`]'s
+    /// start instead.
+    Insert,
+    /// [`InitialMesh::Insert`] where the grid has no nodata and the strips would keep at
+    /// most one sample in 12 (and insertion places fewer vertices than they keep);
+    /// otherwise [`InitialMesh::Strips`], or the RTIN where its probe finds it cheap (few
+    /// of the finest squares split) and it has fewer triangles; the RTIN when contour
+    /// levels are given ([`DecimationOptions::with_contour_levels`]), which keep fewer
+    /// segments from it. The choice depends only on the grid and the options.
     #[default]
     Auto,
 }
@@ -141,6 +149,7 @@ impl InitialMesh {
             Self::Full => "full",
             Self::Rtin => "rtin",
             Self::Strips => "strips",
+            Self::Insert => "insert",
             Self::Auto => "auto",
         }
     }
@@ -203,8 +212,8 @@ pub struct DecimationOptions {
 
 impl DecimationOptions {
     /// Options with the given error bound and the defaults chosen by measurement
-    /// (docs/results.md): exact error, the `auto` start (strips, or the RTIN where it is
-    /// cheap), row-major sweeps, DP holes. [`DecimationOptions::paper`] gives the paper's
+    /// (docs/results.md): exact error, the `auto` start (greedy insertion where few samples
+    /// stay, else strips, or the RTIN where it is cheap), row-major sweeps, DP holes. [`DecimationOptions::paper`] gives the paper's
     /// configuration.
     pub fn new(max_error: f64) -> DecimationOptions {
         DecimationOptions {

@@ -66,6 +66,11 @@ impl<'g> StripPlan<'g> {
         Some(plan)
     }
 
+    /// How many samples the simplified lines keep.
+    pub(crate) fn kept_count(&self) -> usize {
+        self.kept.positions.len()
+    }
+
     /// How many triangles [`StripPlan::triangles`] makes.
     pub(crate) fn triangle_count(&self) -> usize {
         self.triangle_count
@@ -224,6 +229,17 @@ impl Kept {
     fn line(&self, line: usize) -> &[u32] {
         &self.positions[self.starts[line]..self.starts[line + 1]]
     }
+}
+
+/// How many samples the strips along rows keep (one of the two passes of
+/// [`StripPlan::new`]).
+pub(crate) fn kept_along_rows(grid: &Grid, limit: f64, full_border: bool) -> usize {
+    if grid.width() < 2 || grid.height() < 2 {
+        return grid.values().len();
+    }
+    kept_samples(grid, Lines::new(grid, true), limit, full_border)
+        .positions
+        .len()
 }
 
 /// Simplifies every line: the positions where a strip's run of valid cells begins or ends

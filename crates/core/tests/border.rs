@@ -179,6 +179,7 @@ fn two_tiles_weld_within_the_bound() {
             InitialMesh::Full,
             InitialMesh::Rtin,
             InitialMesh::Strips,
+            InitialMesh::Insert,
             InitialMesh::Auto,
         ] {
             for bound in [0.5, 3.0, 20.0] {
@@ -198,6 +199,7 @@ fn nodata_across_the_shared_border() {
             InitialMesh::Full,
             InitialMesh::Rtin,
             InitialMesh::Strips,
+            InitialMesh::Insert,
             InitialMesh::Auto,
         ] {
             check_two_tiles(&spec, 2.0, model, initial);
@@ -212,6 +214,7 @@ fn narrow_tiles() {
             InitialMesh::Full,
             InitialMesh::Rtin,
             InitialMesh::Strips,
+            InitialMesh::Insert,
             InitialMesh::Auto,
         ] {
             check_two_tiles(
@@ -304,4 +307,33 @@ fn a_skipped_sample_that_breaks_the_bound_is_an_error() {
     let options = DecimationOptions::new(1.0);
     let err = decimate_with_border(&grid, &options, &|_, _| false, &mut |_| {}).unwrap_err();
     assert!(err.to_string().contains("border sample (13, 19)"), "{err}");
+}
+
+#[test]
+fn insertion_starts_from_the_decided_border_on_seeded_terrain() {
+    for (seed, bound) in [(11, 0.5), (12, 4.0), (13, 30.0)] {
+        for initial in [InitialMesh::Insert, InitialMesh::Auto] {
+            check_two_tiles(
+                &terrain(65, 48, 4.0, seed),
+                bound,
+                ErrorModel::Exact,
+                initial,
+            );
+        }
+    }
+}
+
+#[test]
+fn insertion_from_a_skipped_border_keeps_a_plane_at_two_triangles() {
+    let n = 120u32;
+    let values: Vec<f64> = (0..n * n)
+        .map(|i| 0.5 * (i % n) as f64 - 0.25 * (i / n) as f64)
+        .collect();
+    let grid = Grid::new(n, n, values.clone()).unwrap();
+    let options = DecimationOptions::new(0.01).with_initial_mesh(InitialMesh::Insert);
+    let tin = decimate_with_border(&grid, &options, &|_, _| false, &mut |_| {})
+        .unwrap()
+        .tin;
+    assert_eq!(tin.triangles().len(), 2);
+    assert_within(n, n, &values, &tin, 0.01);
 }

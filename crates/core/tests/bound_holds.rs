@@ -27,6 +27,7 @@ fn all_options(bound: f64) -> Vec<DecimationOptions> {
                 InitialMesh::Full,
                 InitialMesh::Rtin,
                 InitialMesh::Strips,
+                InitialMesh::Insert,
                 InitialMesh::Auto,
             ] {
                 let base = DecimationOptions::paper(bound)
@@ -178,7 +179,13 @@ proptest! {
         length in 2u32..7,
     ) {
         for model in [ErrorModel::Bounds, ErrorModel::Exact] {
-            for start in [InitialMesh::Full, InitialMesh::Rtin, InitialMesh::Strips, InitialMesh::Auto] {
+            for start in [
+                InitialMesh::Full,
+                InitialMesh::Rtin,
+                InitialMesh::Strips,
+                InitialMesh::Insert,
+                InitialMesh::Auto,
+            ] {
                 let options = DecimationOptions::new(bound)
                     .with_error_model(model)
                     .with_initial_mesh(start)
@@ -702,4 +709,25 @@ fn the_reported_bound_covers_the_raise_of_vertices_no_removal_measured() {
     options.dp_max_ring = 3;
     options.max_abs_value = Some(6.194_999_670_005_428e-268);
     check_with(&spec, &options).unwrap();
+}
+
+#[test]
+fn insertion_keeps_the_bound_on_seeded_terrain_and_count_targets() {
+    let spec = tinsmith_testkit::terrain(97, 70, 4.0, 21);
+    for bound in [0.25, 1.0, 5.0, 40.0] {
+        for options in [
+            DecimationOptions::new(bound).with_initial_mesh(InitialMesh::Insert),
+            DecimationOptions::new(bound)
+                .with_initial_mesh(InitialMesh::Insert)
+                .with_max_edge_length(5),
+            DecimationOptions::new(bound),
+        ] {
+            check_with(&spec, &options).unwrap();
+        }
+    }
+    let options = DecimationOptions::new(f64::INFINITY)
+        .with_initial_mesh(InitialMesh::Insert)
+        .with_max_triangles(300);
+    let tin = check_with(&spec, &options).unwrap();
+    assert!(tin.triangles().len() <= 300);
 }

@@ -33,8 +33,9 @@ pub const DEFAULT_TILE_SIZE: u32 = 512;
 pub struct TileOptions {
     /// How each tile is decimated. The bound must be finite; count targets
     /// (`max_triangles`, `max_vertices`) are not supported; `max_abs_value` is replaced by
-    /// the raster's; `initial_mesh` is honoured (the RTIN refined to half cells along the
-    /// tile's border, which the edge stitching needs).
+    /// the raster's; `initial_mesh` is honoured (the RTIN or strips refined to half cells
+    /// along the tile's border, which the edge stitching needs; insertion starts from the
+    /// border samples the stitching kept).
     pub decimation: DecimationOptions,
     /// Samples per tile side, shared row and column included (at least 2).
     pub tile_size: u32,

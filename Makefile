@@ -120,12 +120,15 @@ test: deps
 ## The Python package (crates/python, docs/python.md): built from this tree into .venv
 ## (maturin, through pip), then its pytest suite and docstring examples; the tests compare
 ## files with the release CLI's (built here) and read them back with trimesh and ogr2ogr.
-.PHONY: python-test
-python-test: gdal py-oracles
+.PHONY: python-test python-package
+python-test: gdal python-package
 	cargo build --release --quiet --bin tinsmith
+	$(VENV)/bin/python -m pytest -q -p no:cacheprovider crates/python/tests
+
+## The Python package built from this tree (release) and installed into .venv.
+python-package: py-oracles
 	PATH="$(abspath $(VENV))/bin:$$PATH" $(VENV)/bin/pip install --quiet \
 	  --disable-pip-version-check --no-build-isolation --no-deps --force-reinstall ./crates/python
-	$(VENV)/bin/python -m pytest -q -p no:cacheprovider crates/python/tests
 
 ## The fuzz targets (fuzz/, docs/fuzzing.md) build, and each runs for a few seconds from its
 ## seeds without a finding. Installs the nightly toolchain (minimal) and cargo-fuzz when
@@ -167,6 +170,13 @@ bench-compare: deps
 	cargo build --release --quiet
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check pydelatin rasterio
 	$(VENV)/bin/python bench/compare.py --shared ../shared
+
+## tinsmith.mesh vs pydelatin in one Python process, one thread each, on the DEMs of
+## bench-compare: triangles, seconds, errors, peak memory, and the binding's per-call
+## overhead (docs/results.md, "Python package"; about 5 minutes).
+bench-python: python-package
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check pydelatin==0.4.0 rasterio
+	$(VENV)/bin/python bench/python_vs_pydelatin.py --shared ../shared
 
 ## Benchmark the tiled engine on a 16384^2 DEM built from ../shared/data (about an hour).
 bench-tiles:

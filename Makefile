@@ -11,11 +11,12 @@ TOOLS := .tools
 # and boto3 are a local S3 and an independent client (tests/object_storage.rs), and
 # azure-storage-blob the client for Azurite (npm, below); Dask runs the shards of a
 # pyramid (tools/dask_tiles.py, tests/dask.rs); PyYAML reads deploy/; Pillow reads the
-# previews back (tests/preview.rs); maturin builds the Python package (crates/python) and
-# pytest runs its tests (make python-test).
+# previews back (tests/preview.rs); maturin builds the Python package (crates/python),
+# pytest runs its tests (make python-test), which hand it affine's transforms and ask it
+# for shapely's lines.
 PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
   azure-storage-blob==12.27.1 dask[distributed]==2026.8.0 pyyaml==6.0.4 pillow==11.3.0 \
-  maturin==1.16.0 pytest==9.2.0
+  maturin==1.16.0 pytest==9.2.0 affine==3.0.1 shapely==2.2.0
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
 .PHONY: deps gdal oracles demo pictures test python-test bench-python bench-results bench-contour bench-compare bench-tiles bench-shards

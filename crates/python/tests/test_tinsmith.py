@@ -11,8 +11,10 @@ import threading
 import time
 import xml.etree.ElementTree as ET
 
+import affine
 import numpy as np
 import pytest
+import shapely
 import trimesh
 
 import tinsmith
@@ -195,12 +197,11 @@ def test_count_targets():
 
 
 def test_affine_objects_and_gdal_tuples_place_sample_centres():
-    class Affine:  # affine.Affine's attributes: x = a*col + b*row + c, y = d*col + e*row + f
-        a, b, c, d, e, f = 30.0, 0.0, 500000.0, 0.0, -30.0, 4100000.0
-
     z = bumps(20, 30)
     by_tuple = tinsmith.mesh(z, 1.0, transform=(500000.0, 30.0, 0.0, 4100000.0, 0.0, -30.0))
-    by_affine = tinsmith.mesh(z, 1.0, transform=Affine())
+    by_affine = tinsmith.mesh(z, 1.0, transform=affine.Affine(30.0, 0.0, 500000.0, 0.0, -30.0, 4100000.0))
+    assert np.array_equal(by_affine.vertices, tinsmith.mesh(
+        z, 1.0, transform=affine.Affine.from_gdal(500000.0, 30.0, 0.0, 4100000.0, 0.0, -30.0)).vertices)
     pixel = tinsmith.mesh(z, 1.0)
     assert np.array_equal(by_tuple.vertices, by_affine.vertices)
     assert np.array_equal(by_tuple.vertices[:, 0], 500000.0 + 30.0 * (pixel.vertices[:, 0] + 0.5))
@@ -256,6 +257,11 @@ def test_contour_lines_as_geojson_features():
     assert np.abs(r - 10).max() < 0.25
     decimated = tinsmith.contour(cone, 5.0, max_error=0.5)
     assert {f["properties"]["level"] for f in decimated} == set(levels)
+    shapes = tinsmith.contour(cone, 5.0, transform=(0, 1, 0, 0, 0, -1), geometry="shapely")
+    assert [level for level, _ in shapes] == [f["properties"]["level"] for f in lines]
+    level, line = shapes[1]
+    assert isinstance(line, shapely.LineString) and line.is_ring
+    assert np.array_equal(np.asarray(line.coords), np.array(lines[1]["geometry"]["coordinates"]))
 
 
 # -- files: every writer, read back by others ----------------------------------------------

@@ -233,6 +233,26 @@ impl Tin {
                 )));
             }
         }
+        if let Some(origin) = origin {
+            // As the CLI's last gate for float32 files: every stored position maps back to
+            // its sample as `tinsmith verify` will map it.
+            let placement = self.georef.placement();
+            for (i, v) in vertices.iter().enumerate() {
+                let q = origin.quantize(*v);
+                if placement
+                    .sample_at([q[0], q[1]], tinsmith_georef::F32_SAMPLE_TOLERANCE)
+                    .is_err()
+                {
+                    return Err(PyValueError::new_err(format!(
+                        "{}: vertex {i} would not map back to its sample in float32 (the \
+                         array is too large for float32 positions relative to one origin); \
+                         nothing written; use a double-precision format (ply, obj, fgb, \
+                         geojson, landxml)",
+                        path.display()
+                    )));
+                }
+            }
+        }
         let options = WriteOptions::new().with_origin(origin);
         let mesh = MeshRef::new(vertices, triangles)
             .with_crs_wkt(wkt.as_deref())

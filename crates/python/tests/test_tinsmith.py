@@ -310,6 +310,23 @@ def test_every_writer_round_trips(tmp_path, becmodel, fmt):
         assert (tmp_path / "mesh.prj").read_text() == "EPSG:3005"
 
 
+def test_float32_formats_refuse_what_would_break_the_bound(tmp_path):
+    # Heights 1e6..1.3e6 are stored as float32 offsets of up to 1.5e5 from a mid-range
+    # origin, in steps of 1/64: the corners (off the steps by 0.0015) cannot keep 0.001.
+    z = 1e6 + 0.123456 + np.linspace(0, 3e5, 400).reshape(20, 20)
+    tin = tinsmith.mesh(z, 0.001)
+    with pytest.raises(tinsmith.BoundError, match="float32 heights round by up to"):
+        tin.write(tmp_path / "m.stl")
+    assert not (tmp_path / "m.stl").exists()
+    tin.write(tmp_path / "m.ply")  # double precision keeps it
+    # Positions: 60,000 samples across (0.3 apart) cannot all be placed in float32 within
+    # the verifier's 1e-3 pixel of their sample.
+    wide = tinsmith.mesh(np.zeros((2, 60000)), 0.0, max_edge_length=2,
+                         transform=(0.0, 0.3, 0.0, 0.0, 0.0, -0.3))
+    with pytest.raises(ValueError, match="would not map back to its sample in float32"):
+        wide.write(tmp_path / "w.glb")
+
+
 def test_unknown_format_names_the_choices(tmp_path):
     tin = tinsmith.mesh(bumps(10, 10), 1.0)
     with pytest.raises(ValueError, match="mesh.xyz"):

@@ -239,16 +239,8 @@ pub fn check_float32_positions(format: MeshFormat, info: &RasterInfo, job: &Mesh
 
 /// Min and max of the raster's file coordinates (sample centres) and valid heights.
 fn extent(info: &RasterInfo, placement: &Placement) -> ([f64; 3], [f64; 3]) {
-    let (w, h) = (info.width.saturating_sub(1), info.height.saturating_sub(1));
-    let mut min = [f64::INFINITY; 3];
-    let mut max = [f64::NEG_INFINITY; 3];
-    for (x, y) in [(0, 0), (w, 0), (0, h), (w, h)] {
-        let p = placement.file_position(x, y);
-        for axis in 0..2 {
-            min[axis] = min[axis].min(p[axis]);
-            max[axis] = max[axis].max(p[axis]);
-        }
-    }
+    let ([x0, y0], [x1, y1]) = placement.extent(info.width, info.height);
+    let (mut min, mut max) = ([x0, y0, 0.0], [x1, y1, 0.0]);
     // The statistics of the heights decimation sees (after scale and offset).
     min[2] = info.min.unwrap_or(0.0);
     max[2] = info.max.unwrap_or(0.0);

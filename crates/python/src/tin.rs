@@ -8,7 +8,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyInt, PyString};
 use tinsmith_formats::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
-use tinsmith_georef::{GeoTransform, Placement, F64_SAMPLE_TOLERANCE};
+use tinsmith_georef::{GeoTransform, Placement, PlacementProblem};
 
 use crate::BoundError;
 
@@ -36,31 +36,23 @@ impl Georef {
         let Some(t) = georef.transform else {
             return Ok(georef);
         };
-        if t.0.iter().any(|c| !c.is_finite()) {
-            return Err(PyValueError::new_err(format!(
-                "transform {:?} has a coefficient that is not a finite number",
-                t.0
-            )));
-        }
-        if t.is_singular() {
-            return Err(PyValueError::new_err(format!(
-                "transform {:?} is singular (a pixel size of 0: samples have no distinct \
-                 positions)",
-                t.0
-            )));
-        }
-        let (w, h) = (f64::from(width - 1), f64::from(height - 1));
-        for (x, y) in [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)] {
-            let back = Placement::World(t).sample_at(t.sample_centre(x, y), F64_SAMPLE_TOLERANCE);
-            if back.ok() != Some([x as i64, y as i64]) {
-                return Err(PyValueError::new_err(format!(
-                    "transform {:?} has pixels too small for its origin: in f64 the position \
-                     of sample ({x}, {y}) does not map back to it",
-                    t.0
-                )));
+        let problem = match georef.placement().check_places_samples(width, height) {
+            Ok(()) => return Ok(georef),
+            Err(PlacementProblem::NotFinite) => {
+                "has a coefficient that is not a finite number".into()
             }
-        }
-        Ok(georef)
+            Err(PlacementProblem::Singular) => {
+                "is singular (a pixel size of 0: samples have no distinct positions)".into()
+            }
+            Err(PlacementProblem::PixelsTooSmall { x, y }) => format!(
+                "has pixels too small for its origin: in f64 the position of sample ({x}, {y}) \
+                 does not map back to it"
+            ),
+        };
+        Err(PyValueError::new_err(format!(
+            "transform {:?} {problem}",
+            t.0
+        )))
     }
 
     pub fn with_heights(mut self, heights: Option<(f64, f64)>) -> Georef {
@@ -75,17 +67,8 @@ impl Georef {
     /// The float32 formats' origin, as the CLI chooses it: the middle of the sample
     /// centres' extent and of the valid heights.
     fn origin(&self) -> LocalOrigin {
-        let placement = self.placement();
-        let (w, h) = (self.width - 1, self.height - 1);
-        let mut min = [f64::INFINITY; 3];
-        let mut max = [f64::NEG_INFINITY; 3];
-        for (x, y) in [(0, 0), (w, 0), (0, h), (w, h)] {
-            let p = placement.file_position(x, y);
-            for axis in 0..2 {
-                min[axis] = min[axis].min(p[axis]);
-                max[axis] = max[axis].max(p[axis]);
-            }
-        }
+        let ([x0, y0], [x1, y1]) = self.placement().extent(self.width, self.height);
+        let (mut min, mut max) = ([x0, y0, 0.0], [x1, y1, 0.0]);
         let (lo, hi) = self.heights.unwrap_or((0.0, 0.0));
         min[2] = lo;
         max[2] = hi;

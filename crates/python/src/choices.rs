@@ -29,6 +29,8 @@ pub struct MeshChoices {
     pub contour_levels: Vec<f64>,
     pub tile_size: u32,
     pub threads: Option<u32>,
+    /// The format the mesh is for (`--format`): STL and glTF get the CLI's tighter bound.
+    pub format: Option<tinsmith_formats::MeshFormat>,
 }
 
 /// `value` among `all` by the name the CLI gives it; a ValueError listing the names
@@ -100,15 +102,20 @@ impl MeshChoices {
     }
 
     /// The decimation options asked for, as the CLI builds them
-    /// (`tinsmith_pipeline::MeshJob::decimation_options`): contour levels from
+    /// (`tinsmith_pipeline::MeshJob::decimation_options`), with `bound` as the bound (the
+    /// asked one less a float32 format's height rounding): contour levels from
     /// `contour_interval` run over `heights`, the array's valid range.
-    pub fn decimation_options(&self, heights: Option<(f64, f64)>) -> PyResult<DecimationOptions> {
+    pub fn decimation_options(
+        &self,
+        bound: f64,
+        heights: Option<(f64, f64)>,
+    ) -> PyResult<DecimationOptions> {
         if self.max_error.is_none() && !self.has_count_target() {
             return Err(PyValueError::new_err(
                 "give max_error, or a count target (max_triangles or max_vertices)",
             ));
         }
-        let mut options = DecimationOptions::new(self.max_error.unwrap_or(f64::INFINITY))
+        let mut options = DecimationOptions::new(bound)
             .with_selection(self.selection)
             .with_error_model(self.error_model)
             .with_order(self.order)

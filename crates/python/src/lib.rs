@@ -83,6 +83,13 @@ fn choices_from_dict(d: &Bound<'_, PyDict>) -> PyResult<choices::MeshChoices> {
         contour_levels: get::<Option<Vec<f64>>>(d, "contour_levels")?.unwrap_or_default(),
         tile_size: get(d, "tile_size")?,
         threads: get(d, "threads")?,
+        format: match get::<Option<String>>(d, "format")? {
+            Some(name) => Some(
+                tinsmith_formats::MeshFormat::from_name(&name)
+                    .map_err(|e| PyValueError::new_err(e.to_string()))?,
+            ),
+            None => None,
+        },
     })
 }
 

@@ -124,7 +124,15 @@ pub fn mesh<'py>(
     let grid = Grid::new(read.width, read.height, read.values)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     let heights_range = valid_range(&grid);
-    let options = choices.decimation_options(heights_range)?;
+    let georef = georef.with_heights(heights_range);
+    let bound = decimation_bound(
+        &grid,
+        &choices,
+        &georef,
+        heights_range,
+        fits || count_target,
+    )?;
+    let options = choices.decimation_options(bound, heights_range)?;
     let placement = georef.placement();
 
     let interrupt = Interruptible::new();
@@ -136,7 +144,6 @@ pub fn mesh<'py>(
         }
     });
     let meshed = interrupt.finish(py, meshed)?;
-    let georef = georef.with_heights(heights_range);
     let report = dict(py, meshed.report)?;
     Tin::new(
         py,
@@ -147,6 +154,47 @@ pub fn mesh<'py>(
         report,
         georef,
     )
+}
+
+/// The bound given to the decimator, as the CLI's `FormatPlan` sets it: `max_error`, less
+/// the float32 rounding of the heights when the mesh is for STL or glTF (`format`), so that
+/// the file keeps `max_error` (measured at every valid sample when the grid is meshed
+/// `whole` with vertices on their samples; bounded from the height range when tiled or
+/// when decimation raises the vertices).
+fn decimation_bound(
+    grid: &Grid,
+    choices: &MeshChoices,
+    georef: &Georef,
+    heights: Option<(f64, f64)>,
+    whole: bool,
+) -> PyResult<f64> {
+    let max_error = choices.max_error.unwrap_or(f64::INFINITY);
+    let Some(format) = choices.format.filter(|f| f.is_float32()) else {
+        return Ok(max_error);
+    };
+    let origin = georef.origin();
+    let max_abs = grid.max_abs_value();
+    let samples_only = !choices
+        .decimation_options(max_error, heights)?
+        .raises_vertex_heights(max_abs);
+    let rounding = if samples_only && whole {
+        origin.height_rounding(grid.values())
+    } else {
+        let (lo, hi) = heights.unwrap_or((0.0, 0.0));
+        let raise = tinsmith_core::vertex_raise(max_error, max_abs);
+        origin.height_rounding_bound(lo, hi + raise)
+    };
+    let bound = max_error - rounding;
+    if bound < 0.0 {
+        return Err(PyValueError::new_err(format!(
+            "max_error {} is smaller than the float32 rounding of the heights ({}) in \
+             {format}; use a larger bound or a double-precision format (ply, obj, fgb, \
+             geojson, landxml)",
+            tinsmith_georef::readable(max_error),
+            tinsmith_georef::readable(rounding)
+        )));
+    }
+    Ok(bound)
 }
 
 /// The least and largest valid sample, `None` when there is none.

@@ -66,7 +66,7 @@ impl Georef {
 
     /// The float32 formats' origin, as the CLI chooses it: the middle of the sample
     /// centres' extent and of the valid heights.
-    fn origin(&self) -> LocalOrigin {
+    pub fn origin(&self) -> LocalOrigin {
         let ([x0, y0], [x1, y1]) = self.placement().extent(self.width, self.height);
         let (mut min, mut max) = ([x0, y0, 0.0], [x1, y1, 0.0]);
         let (lo, hi) = self.heights.unwrap_or((0.0, 0.0));
@@ -179,7 +179,8 @@ impl Tin {
     /// code), as `tinsmith mesh -o` writes it: atomically (a temporary file renamed into
     /// place), a `.prj` sidecar beside OBJ, STL and glTF. GeoJSON keeps the array's CRS
     /// (the CLI's `--geojson-source-crs`). STL and glTF store float32 offsets from a local
-    /// origin: the file is refused (`BoundError`) when that rounding could take it past
+    /// origin: mesh with `format="stl"` or `"glb"` to leave room for that rounding, as the
+    /// CLI does; the file is refused (`BoundError`) when the rounding could take it past
     /// `max_error`.
     #[pyo3(signature = (path, format=None, crs=None))]
     fn write(

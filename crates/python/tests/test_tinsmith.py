@@ -350,6 +350,11 @@ def test_trimesh_view():
         ("count.obj", ["--max-triangles", "5000"], dict(max_triangles=5000)),
         ("tiled.fgb", ["--max-error", "10", "--threads", "1", "--tile-size", "300"],
          dict(max_error=10.0, threads=1, tile_size=300)),
+        ("whole.stl", ["--max-error", "3", "--tile-size", "1024"],
+         dict(max_error=3.0, tile_size=1024, format="stl")),
+        ("samples.glb", ["--max-error", "0.5", "--tile-size", "1024", "--vertex-heights", "samples"],
+         dict(max_error=0.5, tile_size=1024, format="glb", vertex_heights="samples")),
+        ("tiled.glb", ["--max-error", "1"], dict(max_error=1.0, format="glb")),
     ],
 )
 def test_same_bytes_as_the_cli(tmp_path, becmodel, cli, name, args, kwargs):

@@ -116,6 +116,7 @@ def mesh(
     contour_levels: Optional[Iterable[float]] = None,
     tile_size: int = DEFAULT_TILE_SIZE,
     threads: Optional[int] = None,
+    format: Optional[str] = None,
 ) -> Tin:
     """Decimate ``heights`` into a TIN within ``max_error`` of every valid sample.
 
@@ -145,6 +146,10 @@ def mesh(
     tile_size, threads
         Arrays larger than ``tile_size`` a side are meshed tile by tile on ``threads``
         workers (``None``/0: one per core) into one welded mesh, as the CLI does.
+    format
+        The format the mesh will be written in (``--format``): for ``stl`` and ``glb``,
+        whose float32 heights round, decimation keeps ``max_error`` less that rounding, as
+        the CLI does, so that the file keeps ``max_error``.
 
     Returns a :class:`Tin`. Raises ``ValueError`` for bad arguments (the CLI's messages),
     ``MemoryError`` before allocating when the array cannot fit, ``BoundError`` if the
@@ -180,6 +185,7 @@ def mesh(
         "contour_levels": None if contour_levels is None else [float(v) for v in contour_levels],
         "tile_size": tile_size,
         "threads": threads,
+        "format": format,
     }
     return _tinsmith.mesh(array, choices, _nodata(nodata), mask, _transform(transform))
 

@@ -96,8 +96,10 @@ pub fn mesh<'py>(
     if !fits && !count_target && choices.max_error.is_none() {
         return Err(PyValueError::new_err("tiles need max_error"));
     }
-    // Refused before the grid is allocated: the whole-grid run's measured need, or the
-    // grid alone (8 bytes a sample) and its tiles for the tiled engine.
+    // Refused before the grid is allocated: the CLI's measured need of a whole-grid run or
+    // a count target; for the tiled engine the grid itself (8 bytes a sample) and as much
+    // again for its caches and the welded mesh (an allowance, not a measurement: the
+    // tiles' own working memory is bounded by the tile size).
     let (per_sample, extra) = if count_target {
         let by_vertices = choices
             .max_vertices

@@ -11,12 +11,15 @@ TOOLS := .tools
 # and boto3 are a local S3 and an independent client (tests/object_storage.rs), and
 # azure-storage-blob the client for Azurite (npm, below); Dask runs the shards of a
 # pyramid (tools/dask_tiles.py, tests/dask.rs); PyYAML reads deploy/; Pillow reads the
-# previews back (tests/preview.rs).
+# previews back (tests/preview.rs); maturin builds the Python package (crates/python),
+# pytest runs its tests (make python-test), which hand it affine's transforms and ask it
+# for shapely's lines.
 PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
-  azure-storage-blob==12.27.1 dask[distributed]==2026.8.0 pyyaml==6.0.4 pillow==11.3.0
+  azure-storage-blob==12.27.1 dask[distributed]==2026.8.0 pyyaml==6.0.4 pillow==11.3.0 \
+  maturin==1.16.0 pytest==9.2.0 affine==3.0.1 shapely==2.2.0
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps gdal oracles demo pictures test bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview
+.PHONY: deps gdal oracles demo pictures test python-test bench-python bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview
 
 ## Everything the tests need: GDAL, then the independent oracles.
 deps: gdal
@@ -112,7 +115,21 @@ test: deps
 	cargo clippy --workspace --all-targets -- -D warnings
 	RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 	cargo test --workspace -- --include-ignored
+	@$(MAKE) --no-print-directory python-test
 	@$(MAKE) --no-print-directory fuzz-smoke
+
+## The Python package (crates/python, docs/python.md): built from this tree into .venv
+## (maturin, through pip), then its pytest suite and docstring examples; the tests compare
+## files with the release CLI's (built here) and read them back with trimesh and ogr2ogr.
+.PHONY: python-test python-package
+python-test: gdal python-package
+	cargo build --release --quiet --bin tinsmith
+	$(VENV)/bin/python -m pytest -q -p no:cacheprovider crates/python/tests
+
+## The Python package built from this tree (release) and installed into .venv.
+python-package: py-oracles
+	PATH="$(abspath $(VENV))/bin:$$PATH" $(VENV)/bin/pip install --quiet \
+	  --disable-pip-version-check --no-build-isolation --no-deps --force-reinstall ./crates/python
 
 ## The fuzz targets (fuzz/, docs/fuzzing.md) build, and each runs for a few seconds from its
 ## seeds without a finding. Installs the nightly toolchain (minimal) and cargo-fuzz when
@@ -154,6 +171,13 @@ bench-compare: deps
 	cargo build --release --quiet
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check pydelatin rasterio
 	$(VENV)/bin/python bench/compare.py --shared ../shared
+
+## tinsmith.mesh vs pydelatin in one Python process, one thread each, on the DEMs of
+## bench-compare: triangles, seconds, errors, peak memory, and the binding's per-call
+## overhead (docs/results.md, "Python package"; about 5 minutes).
+bench-python: python-package
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check pydelatin==0.4.0 rasterio
+	$(VENV)/bin/python bench/python_vs_pydelatin.py --shared ../shared
 
 ## Benchmark the tiled engine on a 16384^2 DEM built from ../shared/data (about an hour).
 bench-tiles:

@@ -84,6 +84,27 @@ impl LocalOrigin {
     pub fn quantize(&self, p: [f64; 3]) -> [f64; 3] {
         self.to_world(self.to_local(p))
     }
+
+    /// The largest |stored - z| over the finite `heights`, each stored as the file stores
+    /// it ([`LocalOrigin::quantize`]): the exact height rounding of a mesh whose vertices
+    /// are among those heights.
+    pub fn height_rounding(&self, heights: &[f64]) -> f64 {
+        heights
+            .iter()
+            .filter(|z| z.is_finite())
+            .map(|&z| (self.quantize([0.0, 0.0, z])[2] - z).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// An upper bound on |stored - z| for every height `z` in `[min, max]`: half a float32
+    /// step of the largest offset (2^-24 of it), plus the `f64` roundings of the
+    /// subtraction and the addition back, with a factor 2 to spare.
+    pub fn height_rounding_bound(&self, min: f64, max: f64) -> f64 {
+        let oz = self.offset[2];
+        let offset = (max - oz).abs().max((min - oz).abs());
+        let magnitude = max.abs().max(min.abs());
+        2.0 * (offset * 2f64.powi(-24) + (offset + magnitude) * 2f64.powi(-52))
+    }
 }
 
 /// `value` rounded to `digits` significant decimal digits (through its decimal text, so

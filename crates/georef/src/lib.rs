@@ -38,6 +38,7 @@ mod samples;
 pub use geo_transform::GeoTransform;
 pub use number::readable;
 pub use placement::{
-    Placement, PositionError, F32_SAMPLE_TOLERANCE, F64_SAMPLE_TOLERANCE, WGS84_SAMPLE_TOLERANCE,
+    Placement, PlacementProblem, PositionError, F32_SAMPLE_TOLERANCE, F64_SAMPLE_TOLERANCE,
+    WGS84_SAMPLE_TOLERANCE,
 };
 pub use samples::{Samples, SamplesError};

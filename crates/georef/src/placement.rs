@@ -119,6 +119,24 @@ impl fmt::Display for PositionError {
 
 impl std::error::Error for PositionError {}
 
+/// Why a geotransform cannot give every sample of a grid its own position
+/// ([`Placement::check_places_samples`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PlacementProblem {
+    /// A coefficient is NaN or infinite.
+    NotFinite,
+    /// The map is singular (a pixel size of 0): samples have no distinct positions.
+    Singular,
+    /// In `f64` the position of sample `(x, y)` (a corner of the grid) does not map back
+    /// to it: pixels too small for the origin.
+    PixelsTooSmall {
+        /// Column of the sample.
+        x: f64,
+        /// Row of the sample.
+        y: f64,
+    },
+}
+
 impl Placement {
     /// World coordinates when there is a geotransform and pixel coordinates are not asked
     /// for; pixel coordinates otherwise.
@@ -146,6 +164,47 @@ impl Placement {
             .collect();
         let triangles = triangles.into_iter().map(|t| self.orient(t)).collect();
         (vertices, triangles)
+    }
+
+    /// The least and largest file coordinates of the samples of a `width` x `height` grid
+    /// (its corner samples' positions: the map is affine), as `(min, max)`.
+    pub fn extent(self, width: u32, height: u32) -> ([f64; 2], [f64; 2]) {
+        let (w, h) = (width.saturating_sub(1), height.saturating_sub(1));
+        let mut min = [f64::INFINITY; 2];
+        let mut max = [f64::NEG_INFINITY; 2];
+        for (x, y) in [(0, 0), (w, 0), (0, h), (w, h)] {
+            let p = self.file_position(x, y);
+            for axis in 0..2 {
+                min[axis] = min[axis].min(p[axis]);
+                max[axis] = max[axis].max(p[axis]);
+            }
+        }
+        (min, max)
+    }
+
+    /// Checks that a `width` x `height` grid written through this placement gives every
+    /// sample its own position that maps back to it in `f64` (within
+    /// [`F64_SAMPLE_TOLERANCE`]): finite coefficients, a regular map, and pixels not so
+    /// small against the origin that positions merge (checked at the corners, where
+    /// positions are largest). Pixel coordinates always pass.
+    pub fn check_places_samples(self, width: u32, height: u32) -> Result<(), PlacementProblem> {
+        let Placement::World(t) = self else {
+            return Ok(());
+        };
+        if t.0.iter().any(|c| !c.is_finite()) {
+            return Err(PlacementProblem::NotFinite);
+        }
+        if t.is_singular() {
+            return Err(PlacementProblem::Singular);
+        }
+        let (w, h) = (f64::from(width.max(1) - 1), f64::from(height.max(1) - 1));
+        for (x, y) in [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)] {
+            let back = self.sample_at(t.sample_centre(x, y), F64_SAMPLE_TOLERANCE);
+            if back.ok() != Some([x as i64, y as i64]) {
+                return Err(PlacementProblem::PixelsTooSmall { x, y });
+            }
+        }
+        Ok(())
     }
 
     /// File coordinates of sample `(x, y)`.
@@ -335,5 +394,30 @@ mod tests {
                 .to_string(),
             "the raster's geotransform is singular"
         );
+    }
+
+    #[test]
+    fn a_transform_places_samples_apart_or_says_why() {
+        let world = |c| Placement::World(GeoTransform(c));
+        assert_eq!(
+            world([5e5, 30.0, 0.0, 4e6, 0.0, -30.0]).check_places_samples(100, 50),
+            Ok(())
+        );
+        assert_eq!(Placement::Pixel.check_places_samples(100, 50), Ok(()));
+        assert_eq!(
+            world([0.0, f64::NAN, 0.0, 0.0, 0.0, -1.0]).check_places_samples(3, 3),
+            Err(PlacementProblem::NotFinite)
+        );
+        assert_eq!(
+            world([0.0, 1.0, 2.0, 0.0, 0.5, 1.0]).check_places_samples(3, 3),
+            Err(PlacementProblem::Singular)
+        );
+        // Pixels of 1e-12 at an origin of 1e6: positions merge in f64.
+        assert!(matches!(
+            world([1e6, 1e-12, 0.0, 1e6, 0.0, -1e-12]).check_places_samples(3, 3),
+            Err(PlacementProblem::PixelsTooSmall { .. })
+        ));
+        let (min, max) = world([10.0, 2.0, 0.0, 20.0, 0.0, -2.0]).extent(4, 3);
+        assert_eq!((min, max), ([11.0, 15.0], [17.0, 19.0]));
     }
 }

@@ -501,7 +501,7 @@ impl StitchingSink<'_> {
         let segments = held + mesh.segment_count(self.levels);
         let needed = segments.saturating_mul(BYTES_PER_SEGMENT);
         let in_use = held * BYTES_PER_HELD_CROSSING;
-        if let Some(available) = crate::memory::available_bytes() {
+        if let Some(available) = tinsmith_tiling::available_bytes() {
             if needed > available.saturating_add(in_use) {
                 bail!(
                     "{}",

@@ -166,15 +166,8 @@ impl FormatPlan {
             tinsmith_core::vertex_raise(max_error, info.max_abs_value().unwrap_or(0.0))
         };
         let height_rounding = match grid.filter(|_| samples_only) {
-            Some(grid) => {
-                let mut rounding = 0.0f64;
-                for &z in grid.values().iter().filter(|z| z.is_finite()) {
-                    let stored = origin.quantize([0.0, 0.0, z])[2];
-                    rounding = rounding.max((stored - z).abs());
-                }
-                rounding
-            }
-            None => height_rounding_bound(origin, min[2], max[2] + raise),
+            Some(grid) => origin.height_rounding(grid.values()),
+            None => origin.height_rounding_bound(min[2], max[2] + raise),
         };
         let decimation_bound = max_error - height_rounding;
         if decimation_bound < 0.0 {
@@ -214,16 +207,6 @@ impl FormatPlan {
     }
 }
 
-/// An upper bound on |stored - z| for every height `z` in `[min, max]` stored as float32
-/// relative to `origin`: half a float32 step of the largest offset (2^-24 of it), plus the
-/// `f64` roundings of the subtraction and the addition back, with a factor 2 to spare.
-fn height_rounding_bound(origin: LocalOrigin, min: f64, max: f64) -> f64 {
-    let oz = origin.offset()[2];
-    let offset = (max - oz).abs().max((min - oz).abs());
-    let magnitude = max.abs().max(min.abs());
-    2.0 * (offset * 2f64.powi(-24) + (offset + magnitude) * 2f64.powi(-52))
-}
-
 /// For STL and glTF, before reading any sample: fails when the raster is too wide for
 /// float32 positions (see [`FormatPlan::new`]; the positions depend only on the size and the
 /// geotransform, so a huge raster is refused before its statistics scan).
@@ -239,16 +222,8 @@ pub fn check_float32_positions(format: MeshFormat, info: &RasterInfo, job: &Mesh
 
 /// Min and max of the raster's file coordinates (sample centres) and valid heights.
 fn extent(info: &RasterInfo, placement: &Placement) -> ([f64; 3], [f64; 3]) {
-    let (w, h) = (info.width.saturating_sub(1), info.height.saturating_sub(1));
-    let mut min = [f64::INFINITY; 3];
-    let mut max = [f64::NEG_INFINITY; 3];
-    for (x, y) in [(0, 0), (w, 0), (0, h), (w, h)] {
-        let p = placement.file_position(x, y);
-        for axis in 0..2 {
-            min[axis] = min[axis].min(p[axis]);
-            max[axis] = max[axis].max(p[axis]);
-        }
-    }
+    let ([x0, y0], [x1, y1]) = placement.extent(info.width, info.height);
+    let (mut min, mut max) = ([x0, y0, 0.0], [x1, y1, 0.0]);
     // The statistics of the heights decimation sees (after scale and offset).
     min[2] = info.min.unwrap_or(0.0);
     max[2] = info.max.unwrap_or(0.0);

@@ -51,11 +51,11 @@ pub use format_plan::{parse_format, FormatPlan};
 pub use jobs::{
     ContourJob, ExportChoices, MeshJob, PreviewJob, TileFormat, VerifyJob, DEFAULT_TILE_SIZE,
 };
-pub use memory::available_bytes;
 pub use mesh::mesh;
 pub use preview::{preview, preview_decimated, Previewed, WHOLE_READ_SAMPLES};
 pub use scan::scan_raster;
 pub use serve::{serve, ServeOptions};
 pub use tiles::{merge_tiles, tiles, tiles_shard, vertical_datum, water_source};
 pub use tinsmith_georef::readable;
+pub use tinsmith_tiling::available_bytes;
 pub use verify::{verify, Verified};

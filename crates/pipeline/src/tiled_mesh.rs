@@ -59,7 +59,7 @@ pub fn untiled_output(job: &MeshJob) -> Result<Option<&Path>> {
             &job.input,
             (reader.width(), reader.height()),
             crate::memory::Need {
-                bytes_per_sample: 50,
+                bytes_per_sample: tinsmith_tiling::COUNT_TARGET_BYTES_PER_SAMPLE,
                 extra_bytes: start_triangles
                     .saturating_mul(crate::memory::BYTES_PER_START_TRIANGLE),
             },
@@ -67,13 +67,11 @@ pub fn untiled_output(job: &MeshJob) -> Result<Option<&Path>> {
             "give --max-error instead (decimated tile by tile, in bounded memory)",
         )?;
     } else if fits {
-        // 82 bytes per sample measured untiled on ETOPO5 at ε = 1, more at
-        // smaller bounds.
         crate::memory::check_whole_raster_fits(
             &job.input,
             (reader.width(), reader.height()),
             crate::memory::Need {
-                bytes_per_sample: 120,
+                bytes_per_sample: tinsmith_tiling::WHOLE_GRID_BYTES_PER_SAMPLE,
                 extra_bytes: 0,
             },
             "meshing in one tile (the raster fits --tile-size)",

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use tinsmith_georef::{Placement, F64_SAMPLE_TOLERANCE};
+use tinsmith_georef::{Placement, PlacementProblem};
 
 use crate::error::bail;
 use crate::Result;
@@ -21,34 +21,23 @@ pub fn check_transform(info: &tinsmith_raster::RasterInfo, pixel_coords: bool) -
     let input = info.path.display();
     let fix = "assign a real one (e.g. `gdal_translate -of VRT -a_ullr ULX ULY LRX LRY IN \
                OUT.vrt`) or write --pixel-coords";
-    if t.0.iter().any(|c| !c.is_finite()) {
-        bail!(
+    match Placement::World(t).check_places_samples(info.width, info.height) {
+        Ok(()) => {}
+        Err(PlacementProblem::NotFinite) => bail!(
             "{input}: its geotransform {:?} has a coefficient that is not a finite number; {fix}",
             t.0
-        );
-    }
-    if t.is_singular() {
-        bail!(
+        ),
+        Err(PlacementProblem::Singular) => bail!(
             "{input}: its geotransform {:?} is singular (a pixel size of 0: samples have no \
              distinct positions); {fix}",
             t.0
-        );
-    }
-    let (w, h) = (
-        f64::from(info.width.max(1) - 1),
-        f64::from(info.height.max(1) - 1),
-    );
-    for (x, y) in [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)] {
-        // Mapped back as `verify` maps a double-precision file's positions.
-        let back = Placement::World(t).sample_at(t.sample_centre(x, y), F64_SAMPLE_TOLERANCE);
-        if back.ok() != Some([x as i64, y as i64]) {
-            bail!(
-                "{input}: its geotransform {:?} has pixels too small for its origin: in f64 \
-                 the position of sample ({x}, {y}) does not map back to it, so samples would \
-                 share positions; {fix}",
-                t.0
-            );
-        }
+        ),
+        Err(PlacementProblem::PixelsTooSmall { x, y }) => bail!(
+            "{input}: its geotransform {:?} has pixels too small for its origin: in f64 \
+             the position of sample ({x}, {y}) does not map back to it, so samples would \
+             share positions; {fix}",
+            t.0
+        ),
     }
     Ok(())
 }

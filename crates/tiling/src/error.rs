@@ -49,6 +49,7 @@ pub enum Error {
         band: usize,
     },
     /// Opening or scanning the raster failed (the message names the file).
+    #[cfg(feature = "raster")]
     #[error(transparent)]
     Raster(#[from] tinsmith_raster::Error),
     /// Reading a tile's samples failed.

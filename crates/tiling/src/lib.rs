@@ -43,9 +43,12 @@ mod edge;
 mod engine;
 mod error;
 mod halo;
+mod memory;
 mod ordered_pool;
 mod per_tile_writer;
 mod plan;
+#[cfg(feature = "raster")]
+mod raster_source;
 mod sink;
 mod source;
 mod tin_check;
@@ -58,9 +61,15 @@ pub use engine::{
     mesh_tiles, worker_count, TileOptions, TileProgress, TilesReport, DEFAULT_TILE_SIZE,
 };
 pub use error::{Error, Result};
+pub use memory::{
+    available_bytes, BYTES_PER_START_TRIANGLE, COUNT_TARGET_BYTES_PER_SAMPLE,
+    WHOLE_GRID_BYTES_PER_SAMPLE,
+};
 pub use per_tile_writer::PerTileWriter;
 pub use plan::{TileIndex, TilePlan, TileWindow};
+#[cfg(feature = "raster")]
+pub use raster_source::RasterSource;
 pub use sink::{FinishedTile, SinkError, TileSink};
-pub use source::{GridSource, RasterSource, ReadError, TileSource, WindowRead};
+pub use source::{GridSource, ReadError, TileSource, WindowRead};
 pub use tin_check::check_tin;
 pub use welded_writer::WeldedWriter;

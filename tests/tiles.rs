@@ -675,6 +675,18 @@ fn a_pyramid_wider_than_half_the_globe_keeps_its_data_at_every_level() {
     );
     pyramid(&dir, &input, "p", &["--max-zoom", "2", "-q"]);
     let tiles = decode_pyramid(&dir.path("p"));
+    // The tiles west of 0 degrees hold the raster's own first columns (-10..0) as well as
+    // its part past 180 (a block meeting the domain on both sides of its gap used to build
+    // only the second): their data reaches their east edge.
+    for key in [(0, 0, 0), (1, 1, 0), (1, 1, 1), (2, 3, 1), (2, 3, 2)] {
+        let t = tiles
+            .get(&key)
+            .unwrap_or_else(|| panic!("{key:?} is missing"));
+        assert!(
+            !t.edges[2].is_empty(),
+            "{key:?} has no vertex on its east edge (0 degrees)"
+        );
+    }
     for (&(z, x, y), t) in tiles.range(..(2, 0, 0)) {
         check_tile((z, x, y), t);
         let children: f64 = [(0, 0), (1, 0), (0, 1), (1, 1)]

@@ -89,15 +89,28 @@ pub(super) fn block_window(bounds: &GeoBounds, block: TileRect, level: u8) -> Ti
             x1 += turn;
         }
     } else {
-        // The turn of the block's columns that meets the domain, then clipped to it.
+        // The turns of the block's columns that meet the domain, clipped to it. A domain
+        // wider than half a turn (but not all of it) can meet a block in two turns, on
+        // either side of its gap: the window then spans both, or the block would lose the
+        // tiles of one side.
         let (d0, d1) = (i64::from(d.x0), i64::from(d.x0 + d.width));
         let overlap = |k: i64| (x1 + k * turn).min(d1) - (x0 + k * turn).max(d0);
-        let k = [0, 1, -1]
-            .into_iter()
-            .max_by_key(|&k| (overlap(k), -k.abs()))
-            .expect("three turns");
-        x0 = (x0 + k * turn).max(d0);
-        x1 = (x1 + k * turn).min(d1);
+        let meeting: Vec<i64> = [0, 1, -1].into_iter().filter(|&k| overlap(k) > 0).collect();
+        match meeting.as_slice() {
+            [] => {
+                let k = [0, 1, -1]
+                    .into_iter()
+                    .max_by_key(|&k| (overlap(k), -k.abs()))
+                    .expect("three turns");
+                x0 = (x0 + k * turn).max(d0);
+                x1 = (x1 + k * turn).min(d1);
+            }
+            turns => {
+                let starts = turns.iter().map(|k| (x0 + k * turn).max(d0));
+                let ends = turns.iter().map(|k| (x1 + k * turn).min(d1));
+                (x0, x1) = (starts.min().expect("a turn"), ends.max().expect("a turn"));
+            }
+        }
     }
     TileRect {
         level,

@@ -429,28 +429,31 @@ fn check_pyramid(input: &str, quality: f64, flat_roots: usize) {
     }
     assert_eq!(listed, tiles.len());
 
-    // With metadataAvailability CesiumJS requests both root tiles: one the raster does
-    // not reach is flat at height 0, with no tile below it.
-    let flat: Vec<_> = [(0, 0, 0), (0, 1, 0)]
-        .iter()
-        .map(|key| {
-            let t = tiles
-                .get(key)
-                .unwrap_or_else(|| panic!("{key:?} is missing"));
-            (key, t.h.iter().all(|&h| h == 0.0))
-        })
-        .filter(|(_, flat)| *flat)
+    // Both root tiles are written (the whole globe; CesiumJS requests both with
+    // metadataAvailability too): one the raster does not reach is flat at height 0, with
+    // no tile below it.
+    let empty: Vec<_> = [(0u32, 0u32, 0u32), (0, 1, 0)]
+        .into_iter()
+        .filter(|&(_, x, _)| !tiles.keys().any(|&(z, cx, _)| z == 1 && cx / 2 == x))
         .collect();
-    assert_eq!(flat.len(), flat_roots, "flat root tiles");
-    for (key, _) in flat {
-        let below = &tiles[key].metadata["available"];
+    assert_eq!(
+        empty.len(),
+        flat_roots,
+        "root tiles the raster does not reach"
+    );
+    for key in empty {
+        let t = tiles
+            .get(&key)
+            .unwrap_or_else(|| panic!("{key:?} is missing"));
+        assert!(t.h.iter().all(|&h| h == 0.0), "{key:?} is not flat");
+        let below = &t.metadata["available"];
         assert!(
             below
                 .as_array()
                 .unwrap()
                 .iter()
                 .all(|level| level.as_array().unwrap().is_empty()),
-            "a flat root lists tiles below it: {below}"
+            "a root without data lists tiles below it: {below}"
         );
     }
     for (&key, t) in &tiles {
@@ -1319,7 +1322,9 @@ fn a_tile_does_not_depend_on_the_zoom_range_or_the_threads() {
         &["-q", "--normals", "--min-zoom", "6", "--max-zoom", "12"],
     );
     let own = level_files(&dir.path("own"), 0..=11);
-    assert_eq!(own.keys().filter(|p| p.starts_with("11")).count(), 18);
+    // The 18 tiles with data, and 2 the projected raster's lon/lat box reaches without
+    // data, flat (the whole globe is drawn).
+    assert_eq!(own.keys().filter(|p| p.starts_with("11")).count(), 20);
     assert!(level_files(&dir.path("coarse"), 0..=8) == level_files(&dir.path("own"), 0..=8));
     assert!(level_files(&dir.path("deep"), 0..=11) == own);
     assert!(level_files(&dir.path("middle"), 6..=11) == level_files(&dir.path("own"), 6..=11));
@@ -1668,4 +1673,63 @@ fn water_masks_mark_the_sea_a_mask_or_the_dem_itself_says() {
     let o = dir.run(&["tiles", &dem, "-o", "bad", "--water", "water.txt"]);
     assert_fails_naming(&o, &["water.txt", "--water"]);
     assert!(!dir.path("bad").exists());
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn a_regional_pyramid_draws_the_whole_globe_with_its_data_on_it() {
+    let dir = Dir::new();
+    // A 1 x 1 degree DEM without nodata, 50 to 150 m.
+    let dem = ascii_grid(
+        &dir,
+        "patch.asc",
+        (10.0, 45.0, 0.01),
+        (100, 100),
+        |lon, lat| 50.0 + 100.0 * (lon - 10.0) * (lat - 45.0),
+    );
+    pyramid(
+        &dir,
+        &dem,
+        "globe",
+        &["-q", "--vertical-datum", "ellipsoid"],
+    );
+    pyramid(
+        &dir,
+        &dem,
+        "data",
+        &["-q", "--vertical-datum", "ellipsoid", "--data-only"],
+    );
+    let (globe, data) = (
+        decode_pyramid(&dir.path("globe")),
+        decode_pyramid(&dir.path("data")),
+    );
+    // Both roots, and every tile covers its whole square: the globe beyond the raster is
+    // flat at 0, so a client draws it all.
+    assert!(globe.contains_key(&(0, 0, 0)) && globe.contains_key(&(0, 1, 0)));
+    for (&key, t) in &globe {
+        check_tile(key, t);
+        assert!(
+            (covered(t) - 1.0).abs() < 1e-9,
+            "{key:?} covers {}",
+            covered(t)
+        );
+        let outside = t.h.iter().filter(|&&h| h == 0.0).count();
+        assert!(outside > 0, "{key:?}: no vertex on the flat globe");
+    }
+    assert!(check_shared_edges(&globe) > 0);
+    // The same tiles hold the data: at the finest level the bound is tight enough for the
+    // data to stand above the flat globe.
+    let finest = *globe.keys().next_back().unwrap();
+    assert!(
+        globe[&finest].h.iter().any(|&h| h > 40.0),
+        "{finest:?} lost its data"
+    );
+    // --data-only: tiles end where the raster does, and only the root it reaches exists.
+    assert!(!data.contains_key(&(0, 0, 0)));
+    assert!(covered(&data[&(0, 1, 0)]) < 0.01);
+    assert_eq!(
+        globe.keys().collect::<Vec<_>>()[1..],
+        data.keys().collect::<Vec<_>>()[..],
+        "the same tiles but the root without data"
+    );
 }

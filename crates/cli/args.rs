@@ -145,6 +145,12 @@ pub struct TilesArgs {
     /// (0), or a polygon layer of water.
     #[arg(long, value_name = "SOURCE")]
     pub water: Option<String>,
+    /// Only the raster's data: no triangles beyond it, no root tile it does not reach
+    /// (a layer to draw over another pyramid). Without it, the globe beyond the raster is
+    /// flat at height 0 (the ellipsoid) and both root tiles are written, so that a client
+    /// shows the whole globe with the data on it.
+    #[arg(long)]
+    pub data_only: bool,
     /// Coarsest level written.
     #[arg(long, default_value_t = 0)]
     pub min_zoom: u8,
@@ -280,6 +286,7 @@ impl TilesArgs {
             update: self.update,
             vertical_datum: tinsmith_raster::VerticalDatum::Ellipsoid,
             water: None,
+            whole_globe: !self.data_only,
         }
     }
 }

@@ -185,7 +185,7 @@ fn show(feedback: &dyn Feedback, progress: Progress<'_>) {
 fn note_level(feedback: &dyn Feedback, level: &LevelReport) {
     let flat = match level.flat_tiles {
         0 => String::new(),
-        n => format!(" ({n} flat: a root tile without data, for --metadata)"),
+        n => format!(" ({n} flat: a root tile without data, for the whole globe)"),
     };
     feedback.note(&format!(
         "level {:>2}: {} tiles{flat}, {} bytes, bound {:.3} m, measured {:.3} m, {:.2} s",

@@ -42,6 +42,10 @@ const PIXELS_PER_POINT: usize = 16;
 /// is NaN when no pixel of nonzero weight is valid, and when the position is outside the
 /// raster's pixel edges (or PROJ cannot transform it).
 ///
+/// Points outside the raster's pixel edges (or that PROJ cannot transform) get `outside`
+/// (NaN for no data, or a height to fill the rest of the globe with, not shifted by the
+/// datum); nodata within the raster stays NaN.
+///
 /// With a `datum` other than the ellipsoid, each valid sample `H` becomes `H + N`, the
 /// geoid's height above the WGS84 ellipsoid at the point as PROJ's `vgridshift`
 /// interpolates its grid ([`Geoid`]), added in `f64` before the sample is rounded to
@@ -66,6 +70,7 @@ pub fn sample_geographic(
     band: usize,
     lattice: &GeoLattice,
     datum: &VerticalDatum,
+    outside: f32,
 ) -> Result<Vec<f32>> {
     let opened = OpenBand::open(path, band)?;
     let locator = Locator::new(path, &opened)?;
@@ -108,6 +113,13 @@ pub fn sample_geographic(
                     &mut lons,
                     &mut lats,
                 )?;
+            }
+            if !outside.is_nan() {
+                for (v, f) in values.iter_mut().zip(&footprints) {
+                    if f.is_none() {
+                        *v = f64::from(outside);
+                    }
+                }
             }
             let block_width = (i1 - i0) as usize;
             for (k, row) in values.chunks_exact(block_width).enumerate() {

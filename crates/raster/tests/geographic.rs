@@ -78,8 +78,8 @@ fn windows(lattice: &GeoLattice, seed: u64, columns: &[u32]) -> Vec<(u32, u32, u
 /// and checks every window's samples are the whole lattice's, bit for bit. Returns the
 /// whole lattice's samples.
 fn check_windows(path: &Path, lattice: &GeoLattice, seed: u64, columns: &[u32]) -> Vec<f32> {
-    let whole =
-        sample_geographic(path, 1, lattice, &VerticalDatum::Ellipsoid).expect("whole lattice");
+    let whole = sample_geographic(path, 1, lattice, &VerticalDatum::Ellipsoid, f32::NAN)
+        .expect("whole lattice");
     let valid = whole.iter().filter(|v| v.is_finite()).count();
     assert!(valid > 0, "{}: no sample", path.display());
     assert!(valid < whole.len(), "{}: no sample beyond", path.display());
@@ -91,7 +91,8 @@ fn check_windows(path: &Path, lattice: &GeoLattice, seed: u64, columns: &[u32]) 
             height: h,
             ..*lattice
         };
-        let part = sample_geographic(path, 1, &window, &VerticalDatum::Ellipsoid).expect("window");
+        let part = sample_geographic(path, 1, &window, &VerticalDatum::Ellipsoid, f32::NAN)
+            .expect("window");
         for j in 0..h {
             for i in 0..w {
                 let a = part[(j * w + i) as usize];
@@ -201,8 +202,9 @@ fn global_rasters_in_any_frame_sample_the_same_in_any_window() {
                         first_column: lattice.first_column + turns * turn,
                         ..lattice
                     };
-                    let again = sample_geographic(path, 1, &east, &VerticalDatum::Ellipsoid)
-                        .expect("a turn east");
+                    let again =
+                        sample_geographic(path, 1, &east, &VerticalDatum::Ellipsoid, f32::NAN)
+                            .expect("a turn east");
                     let differ = (0..whole.len())
                         .filter(|&k| {
                             whole[k].to_bits() != again[k].to_bits()
@@ -249,8 +251,8 @@ fn a_global_raster_samples_alike_in_0_to_360_minus_360_to_0_and_minus_180_to_180
             width,
             height: (176.0 / step) as u32 + 1,
         };
-        let b =
-            sample_geographic(&west, 1, &lattice, &VerticalDatum::Ellipsoid).expect("-180..180");
+        let b = sample_geographic(&west, 1, &lattice, &VerticalDatum::Ellipsoid, f32::NAN)
+            .expect("-180..180");
         // A sample everywhere but around the nodata hole (235..265°, -22.5..-2.5°), next
         // to 0° and ±180° too.
         for (k, v) in b.iter().enumerate() {
@@ -262,8 +264,8 @@ fn a_global_raster_samples_alike_in_0_to_360_minus_360_to_0_and_minus_180_to_180
             );
         }
         for source in [&east, &far_west] {
-            let a =
-                sample_geographic(source, 1, &lattice, &VerticalDatum::Ellipsoid).expect("0..360");
+            let a = sample_geographic(source, 1, &lattice, &VerticalDatum::Ellipsoid, f32::NAN)
+                .expect("0..360");
             let differ: Vec<usize> = (0..a.len()).filter(|&k| !same(a[k], b[k])).collect();
             assert!(
                 differ.is_empty(),
@@ -329,7 +331,8 @@ fn a_raster_east_of_180_samples_as_the_same_raster_west_of_it() {
             height: 97,
         };
         let a = check_windows(&east, &lattice, 5, &[]);
-        let b = sample_geographic(&west, 1, &lattice, &VerticalDatum::Ellipsoid).expect("west");
+        let b = sample_geographic(&west, 1, &lattice, &VerticalDatum::Ellipsoid, f32::NAN)
+            .expect("west");
         assert!(a.iter().filter(|v| v.is_finite()).count() > 10_000);
         for (k, (x, y)) in a.iter().zip(&b).enumerate() {
             assert!(
@@ -428,7 +431,8 @@ fn check_against_gdalwarp(
     valid: impl Fn(i64, i64) -> bool,
 ) -> usize {
     let dir = tempfile::tempdir().expect("tempdir");
-    let ours = sample_geographic(path, 1, lattice, &VerticalDatum::Ellipsoid).expect("samples");
+    let ours =
+        sample_geographic(path, 1, lattice, &VerticalDatum::Ellipsoid, f32::NAN).expect("samples");
     let theirs = gdalwarp_samples(dir.path(), path, lattice);
     let (w, h) = size;
     let mut compared = 0;

@@ -70,6 +70,9 @@ pub(super) struct TileOptions {
     /// Where the water mask comes from; absent without one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(super) water: Option<crate::Water>,
+    /// [`TerrainOptions::whole_globe`]; absent when false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub(super) whole_globe: bool,
 }
 
 impl TileOptions {
@@ -86,6 +89,7 @@ impl TileOptions {
             vertical_datum: (options.vertical_datum != tinsmith_raster::VerticalDatum::Ellipsoid)
                 .then(|| options.vertical_datum.spec()),
             water: options.water.clone(),
+            whole_globe: options.whole_globe,
         }
     }
 
@@ -107,6 +111,7 @@ impl TileOptions {
                 tinsmith_raster::VerticalDatum::parse,
             ),
             water: self.water.clone(),
+            whole_globe: self.whole_globe,
         }
     }
 }

@@ -60,6 +60,23 @@ pub struct TerrainOptions {
     pub vertical_datum: tinsmith_raster::VerticalDatum,
     /// Add the water mask extension (2) from this source.
     pub water: Option<crate::Water>,
+    /// Draw the whole globe: the globe beyond the raster is flat at height 0 (the
+    /// ellipsoid), every tile the raster reaches covers its whole rectangle, and both
+    /// root tiles are written, so that a client shows a globe with the data on it.
+    /// Without it, tiles have no triangles beyond the raster.
+    pub whole_globe: bool,
+}
+
+impl TerrainOptions {
+    /// The height of the globe beyond the raster: 0 for [`TerrainOptions::whole_globe`],
+    /// else NaN (no data).
+    pub(super) fn outside(&self) -> f32 {
+        if self.whole_globe {
+            0.0
+        } else {
+            f32::NAN
+        }
+    }
 }
 
 impl Default for TerrainOptions {
@@ -77,6 +94,7 @@ impl Default for TerrainOptions {
             update: false,
             vertical_datum: tinsmith_raster::VerticalDatum::Ellipsoid,
             water: None,
+            whole_globe: false,
         }
     }
 }
@@ -318,6 +336,7 @@ fn build_into(
         path: input,
         band: options.band,
         datum: &options.vertical_datum,
+        outside: options.outside(),
     };
     let cut = Cut::coarsest(own_level);
     let pool = worker_pool(&bounds, max_zoom.max(cut.anchor), options.threads)?;
@@ -585,10 +604,14 @@ pub(super) fn build_block(
     // Levels finer than the anchor first, each sampled alone; then the anchor and the
     // levels filtered from it, down to the block's own.
     for z in (cut.anchor + 1..=max_zoom).rev() {
-        let level = |z: u8| block_level(bounds, block, z, reach_margin(z, z));
+        let level = |z: u8| {
+            block_level(bounds, block, z, reach_margin(z, z)).filled_with(options.outside())
+        };
         stream_levels(source, &level, (z, z), band(z), pool, &mut writer)?;
     }
-    let level = |z: u8| block_level(bounds, block, z, reach_margin(cut.split, z));
+    let level = |z: u8| {
+        block_level(bounds, block, z, reach_margin(cut.split, z)).filled_with(options.outside())
+    };
     let zooms = (cut.split, cut.anchor);
     stream_levels(source, &level, zooms, band(cut.anchor), pool, &mut writer)?;
     let samples = writer
@@ -616,8 +639,9 @@ pub(super) fn worker_pool(
         })
 }
 
-/// Writes, with `--metadata`, the root tiles the raster does not reach, flat (CesiumJS
-/// then ignores `available` and requests both root tiles), and adds them to `written`.
+/// Writes, with `--metadata` (CesiumJS then ignores `available` and requests both root
+/// tiles) or a whole globe, the root tiles the raster does not reach, flat, and adds them
+/// to `written`.
 pub(super) fn write_flat_roots(
     written: &mut Written,
     max_zoom: u8,
@@ -626,7 +650,7 @@ pub(super) fn write_flat_roots(
     pool: &rayon::ThreadPool,
     known: &Entries,
 ) -> TerrainResult<()> {
-    if !(options.metadata && options.min_zoom == 0) {
+    if !((options.metadata || options.whole_globe) && options.min_zoom == 0) {
         return Ok(());
     }
     let scope = Scope {
@@ -686,7 +710,7 @@ pub(super) fn build_top(
         under: None,
     };
     let mut writer = TileWriter::new(scope, max_zoom, available, known, store, options, pool);
-    let level = |z: u8| LevelRows::new(domain(bounds, z));
+    let level = |z: u8| LevelRows::new(domain(bounds, z)).filled_with(options.outside());
     let band = band_tile_rows(domain(bounds, cut.split));
     stream_levels(
         samples,
@@ -1100,6 +1124,7 @@ mod tests {
                 path: &input,
                 band: 1,
                 datum: &tinsmith_raster::VerticalDatum::Ellipsoid,
+                outside: f32::NAN,
             };
             let options = TerrainOptions {
                 max_zoom: Some(max_zoom),
@@ -1153,6 +1178,7 @@ mod tests {
             path: &input,
             band: 1,
             datum: &tinsmith_raster::VerticalDatum::Ellipsoid,
+            outside: f32::NAN,
         };
         let options = TerrainOptions {
             max_zoom: Some(2),

@@ -77,6 +77,9 @@ pub(super) fn options_key(options: &TerrainOptions) -> String {
     if let Some(water) = &options.water {
         text["water"] = water.label().into();
     }
+    if options.whole_globe {
+        text["whole_globe"] = true.into();
+    }
     hex(&Sha256::digest(text.to_string().as_bytes()))
 }
 

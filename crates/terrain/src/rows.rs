@@ -49,6 +49,9 @@ pub(super) struct LevelRows {
     values: Vec<f32>,
     /// The samples anything built from this level reads, when not all of them.
     reach: Option<Reach>,
+    /// The height of the globe beyond the raster (NaN: none), which the coarser level's
+    /// filter reads past this level's lattice (see [`LevelRows::filled_with`]).
+    outside: f32,
 }
 
 /// The part of a level that the tiles built from it depend on (see
@@ -91,7 +94,17 @@ impl LevelRows {
             first: 0,
             values: Vec::new(),
             reach: None,
+            outside: f32::NAN,
         }
+    }
+
+    /// The same level on a globe filled with `outside` beyond the raster: the sampler
+    /// gives it to points outside the raster, and the filter reads it past the level's
+    /// lattice (which holds the whole raster), so a coarser level is the filter of the
+    /// whole filled globe. NaN: no fill.
+    pub(super) fn filled_with(mut self, outside: f32) -> LevelRows {
+        self.outside = outside;
+        self
     }
 
     /// The same level, of which only `reach` is made: the finest level is sampled there
@@ -128,6 +141,7 @@ impl LevelRows {
             first: 0,
             values: vec![0.0; side * side],
             reach: None,
+            outside: f32::NAN,
         }
     }
 
@@ -463,10 +477,11 @@ impl LevelRows {
             {
                 let (mut sum, mut weight) = (0.0f64, 0.0f64);
                 for (r, (_, wy)) in fine_rows.iter().zip(TAPS) {
-                    let Some(r) = r else { continue };
                     for (column, (_, wx)) in taps.iter().zip(TAPS) {
-                        let Some(v) = column.map(|c| r[c]) else {
-                            continue;
+                        // Past the lattice: the globe beyond the raster, if filled.
+                        let v = match (r, column) {
+                            (Some(r), Some(c)) => r[*c],
+                            _ => self.outside,
                         };
                         if v.is_finite() {
                             sum += wx * wy * f64::from(v);

@@ -104,6 +104,7 @@ pub fn build_shard(
         path: input,
         band: options.band,
         datum: &options.vertical_datum,
+        outside: options.outside(),
     };
     let key = options_key(options);
     let mut known = Entries::new();

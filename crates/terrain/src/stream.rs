@@ -61,6 +61,8 @@ pub(super) struct Warp<'a> {
     pub(super) band: usize,
     /// What the band's heights are above; they are turned into ellipsoidal heights.
     pub(super) datum: &'a tinsmith_raster::VerticalDatum,
+    /// The height of points outside the raster (NaN: no data there).
+    pub(super) outside: f32,
 }
 
 impl RowSource for Warp<'_> {
@@ -72,7 +74,11 @@ impl RowSource for Warp<'_> {
     ) -> TerrainResult<Vec<f32>> {
         let lattice = level.lattice(rows, columns);
         Ok(sample_geographic(
-            self.path, self.band, &lattice, self.datum,
+            self.path,
+            self.band,
+            &lattice,
+            self.datum,
+            self.outside,
         )?)
     }
 }

@@ -98,7 +98,13 @@ pub(crate) fn mask(water: &Water, rect: GeoRectangle) -> TerrainResult<Mask> {
     let mut cells = vec![0u8; n * n];
     match water {
         Water::Raster { path, band } => {
-            let values = sample_geographic(path, *band, &lattice(0), &VerticalDatum::Ellipsoid)?;
+            let values = sample_geographic(
+                path,
+                *band,
+                &lattice(0),
+                &VerticalDatum::Ellipsoid,
+                f32::NAN,
+            )?;
             for (k, v) in values.iter().enumerate() {
                 let (i, j) = (k % n, k / n);
                 if *v >= 0.5 {
@@ -115,7 +121,13 @@ pub(crate) fn mask(water: &Water, rect: GeoRectangle) -> TerrainResult<Mask> {
         }
         Water::SeaLevel { path, band } => {
             let wide = n + 2;
-            let values = sample_geographic(path, *band, &lattice(1), &VerticalDatum::Ellipsoid)?;
+            let values = sample_geographic(
+                path,
+                *band,
+                &lattice(1),
+                &VerticalDatum::Ellipsoid,
+                f32::NAN,
+            )?;
             // Cells of the ring beyond a pole are not on the globe: never nodata sea.
             let on_globe = |j: usize| {
                 let lat = rect.south + step / 2.0 + (j as f64 - 1.0) * step;

@@ -26,8 +26,8 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 # (case of bench/compare.py, epsilon, picture size)
 PICTURES = [("bigtujunga", 30.0, 800), ("fuji", 20.0, 560)]
 # (name, DEM under ../shared/data, terrain directory, camera: lon, lat, height m, heading,
-# pitch, vertical exaggeration; water mask: none, or "below-0" for a mask of the DEM's
-# samples below 0 m)
+# pitch, vertical exaggeration; variant: none, "below-0" for a water mask of the DEM's
+# samples below 0 m, or "data-only" for `--data-only`)
 CESIUM = [
     ("cesium-global", "dem/etopo5_global_5arcmin.tif", "etopo5",
      (85, 25, 11_000_000, 0, -90, 20), None),
@@ -35,6 +35,10 @@ CESIUM = [
      (-118.19, 34.16, 9_000, 20, -30, 1), None),
     ("cesium-water", "dem/etopo5_global_5arcmin.tif", "etopo5-water",
      (15, 38, 4_000_000, 0, -90, 20), "below-0"),
+    ("cesium-regional-globe", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga",
+     (-118.19, 34.16, 15_000_000, 0, -90, 1), None),
+    ("cesium-regional-data-only", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga-data-only",
+     (-118.19, 34.16, 15_000_000, 0, -90, 1), "data-only"),
 ]
 PAGE = ("<!doctype html><html><head><link rel=\"icon\" href=\"data:,\">"
         "<script>window.CESIUM_BASE_URL = '/cesium/';</script>"
@@ -112,9 +116,13 @@ def cesium_pictures(args, data, out, tmp):
     site.mkdir()
     (site / "index.html").write_text(PAGE)
     os.symlink(ROOT / ".tools/node_modules/cesium/Build/Cesium", site / "cesium")
-    for _, dem, terrain, _, water in CESIUM:
-        extra = []
-        if water == "below-0":
+    built = set()
+    for _, dem, terrain, _, variant in CESIUM:
+        if terrain in built:
+            continue
+        built.add(terrain)
+        extra = ["--data-only"] if variant == "data-only" else []
+        if variant == "below-0":
             # 255 (water) where the DEM is below 0 m, 0 elsewhere: -scale maps 0 m to 0
             # and -1 m to 255, and Byte clips the rest.
             mask = tmp / f"{terrain}-mask.tif"
@@ -127,10 +135,10 @@ def cesium_pictures(args, data, out, tmp):
                               text=True)
     try:
         base = server.stdout.readline().strip().rsplit(" ", 1)[-1]
-        for name, _, terrain, view, water in CESIUM:
+        for name, _, terrain, view, variant in CESIUM:
             run(["node", ROOT / "bench/cesium_shot.cjs", f"{base}index.html",
                  f"{base}{terrain}/", out / f"{name}.png", *view,
-                 *(["water"] if water else [])])
+                 *(["water"] if variant == "below-0" else [])])
     finally:
         server.kill()
         server.wait()
@@ -150,6 +158,15 @@ def cesium_pictures(args, data, out, tmp):
         "cells, about 5 km at level 4, which shows as the coasts' steps).",
         "",
         "![ETOPO5 with water masks in CesiumJS](images/cesium-water.png)",
+        "",
+        "A regional pyramid (Big Tujunga, 30 m, about 36 x 19 km) seen from 15,000 km: as "
+        "built (the globe beyond the raster flat at 0 m, both root tiles written) CesiumJS "
+        "draws the whole globe; with `--data-only`, a speck and no globe.",
+        "",
+        "| Big Tujunga, whole globe | Big Tujunga, `--data-only` |",
+        "|---|---|",
+        "| ![the whole globe](images/cesium-regional-globe.png) "
+        "| ![a speck, no globe](images/cesium-regional-data-only.png) |",
         "",
     ]
 

@@ -14,25 +14,32 @@ use serde_json::Value;
 use crate::tiles::{ascii_grid, decode_pyramid, egm96_undulations, gdal_samples};
 use crate::util::{fixture, serve, stderr, Dir};
 
-#[test]
-#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
-fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
+/// `DIR/site/`: CesiumJS (linked from `.tools`) and a page that loads it, beside the
+/// pyramids a test writes there. Fails when CesiumJS or Chromium is missing.
+fn cesium_page(dir: &Dir) {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let cesium = repo.join(".tools/node_modules/cesium/Build/Cesium");
     assert!(
         cesium.join("Cesium.js").exists() && Path::new("/usr/bin/chromium").exists(),
         "CesiumJS or Chromium is missing: run `make oracles`"
     );
-    let dir = Dir::new();
-    let input = fixture("tintn_valid_raster_3857.tif");
-    let o = dir.run(&["tiles", &input, "-o", "site/terrain", "--normals"]);
-    assert!(o.status.success(), "{}", stderr(&o));
     std::os::unix::fs::symlink(&cesium, dir.path("site/cesium")).unwrap();
     dir.write(
         "site/index.html",
         "<!doctype html><html><head><link rel=\"icon\" href=\"data:,\"><script>window.CESIUM_BASE_URL = '/cesium/';</script>\
          <script src=\"/cesium/Cesium.js\"></script></head><body></body></html>\n",
     );
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = Dir::new();
+    let input = fixture("tintn_valid_raster_3857.tif");
+    let o = dir.run(&["tiles", &input, "-o", "site/terrain", "--normals"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    cesium_page(&dir);
     let layer: Value =
         serde_json::from_slice(&std::fs::read(dir.path("site/terrain/layer.json")).unwrap())
             .unwrap();
@@ -130,11 +137,6 @@ fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn cesiumjs_receives_the_water_masks() {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let cesium = repo.join(".tools/node_modules/cesium/Build/Cesium");
-    assert!(
-        cesium.join("Cesium.js").exists() && Path::new("/usr/bin/chromium").exists(),
-        "CesiumJS or Chromium is missing: run `make oracles`"
-    );
     let dir = Dir::new();
     // Land west of 10.6°E, nodata sea east of it.
     let dem = ascii_grid(
@@ -160,12 +162,7 @@ fn cesiumjs_receives_the_water_masks() {
         "-q",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    std::os::unix::fs::symlink(&cesium, dir.path("site/cesium")).unwrap();
-    dir.write(
-        "site/index.html",
-        "<!doctype html><html><head><link rel=\"icon\" href=\"data:,\"><script>window.CESIUM_BASE_URL = '/cesium/';</script>\
-         <script src=\"/cesium/Cesium.js\"></script></head><body></body></html>\n",
-    );
+    cesium_page(&dir);
     let tiles = decode_pyramid(&dir.path("site/terrain"));
     let (&(z, x, y), finest) = tiles.iter().next_back().expect("tiles");
     let ours = finest.water_mask.clone().expect("a water mask");

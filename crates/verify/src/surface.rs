@@ -12,32 +12,37 @@ use crate::{MeshRef, Result, VerifyError};
 /// # Errors
 /// [`VerifyError::MeshSize`] if `mesh.heights.len() != mesh.positions.len()`.
 pub fn surface(width: u32, height: u32, mesh: MeshRef<'_>) -> Result<Vec<f64>> {
+    let mut out = vec![f64::NAN; width as usize * height as usize];
+    for (positions, heights) in triangles(mesh)? {
+        rasterize(positions, width, height, |x, y, weights| {
+            out[y as usize * width as usize + x as usize] = interpolate(weights, heights);
+        });
+    }
+    Ok(out)
+}
+
+/// Each triangle's corner positions and heights; triangles with an index past the
+/// vertices are left out.
+///
+/// # Errors
+/// [`VerifyError::MeshSize`] if `mesh.heights.len() != mesh.positions.len()`.
+fn triangles<'a>(
+    mesh: MeshRef<'a>,
+) -> Result<impl Iterator<Item = ([[i64; 2]; 3], [f64; 3])> + 'a> {
     if mesh.heights.len() != mesh.positions.len() {
         return Err(VerifyError::MeshSize {
             positions: mesh.positions.len(),
             heights: mesh.heights.len(),
         });
     }
-    let mut out = vec![f64::NAN; width as usize * height as usize];
-    for triangle in mesh.triangles {
-        let Some(corners) = triangle
-            .iter()
-            .map(|&i| {
-                mesh.positions
-                    .get(i as usize)
-                    .map(|&p| (p, mesh.heights[i as usize]))
-            })
-            .collect::<Option<Vec<_>>>()
-        else {
-            continue;
+    Ok(mesh.triangles.iter().filter_map(move |t| {
+        let corner = |k: usize| {
+            let i = t[k] as usize;
+            mesh.positions.get(i).map(|&p| (p, mesh.heights[i]))
         };
-        let positions = [corners[0].0, corners[1].0, corners[2].0];
-        let heights = [corners[0].1, corners[1].1, corners[2].1];
-        rasterize(positions, width, height, |x, y, weights| {
-            out[y as usize * width as usize + x as usize] = interpolate(weights, heights);
-        });
-    }
-    Ok(out)
+        let (a, b, c) = (corner(0)?, corner(1)?, corner(2)?);
+        Some(([a.0, b.0, c.0], [a.1, b.1, c.1]))
+    }))
 }
 
 /// The TIN's height at the samples of a `width x height` grid in the given `columns` and
@@ -56,29 +61,11 @@ pub fn surface_at(
     columns: &[u32],
     rows: &[u32],
 ) -> Result<Vec<f64>> {
-    if mesh.heights.len() != mesh.positions.len() {
-        return Err(VerifyError::MeshSize {
-            positions: mesh.positions.len(),
-            heights: mesh.heights.len(),
-        });
-    }
+    let corners = triangles(mesh)?;
     let column_index = lattice_index(columns, width, "columns")?;
     let row_index = lattice_index(rows, height, "rows")?;
     let mut out = vec![f64::NAN; columns.len() * rows.len()];
-    for triangle in mesh.triangles {
-        let Some(corners) = triangle
-            .iter()
-            .map(|&i| {
-                mesh.positions
-                    .get(i as usize)
-                    .map(|&p| (p, mesh.heights[i as usize]))
-            })
-            .collect::<Option<Vec<_>>>()
-        else {
-            continue;
-        };
-        let positions = [corners[0].0, corners[1].0, corners[2].0];
-        let heights = [corners[0].1, corners[1].1, corners[2].1];
+    for (positions, heights) in corners {
         let keep_row = |y: u32| row_index[y as usize] != u32::MAX;
         rasterize_rows(positions, width, height, keep_row, |x, y, weights| {
             let column = column_index[x as usize];

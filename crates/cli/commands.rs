@@ -73,7 +73,7 @@ pub fn preview(args: &PreviewArgs) -> Result<bool> {
         (Some(_), _) => tinsmith_pipeline::preview(&args.job())?,
         (None, Some(bound)) => {
             let mut decimate = tinsmith_pipeline::MeshJob::new(&args.input);
-            decimate.max_error = Some(bound);
+            decimate.decimation.max_error = Some(bound);
             tinsmith_pipeline::preview_decimated(&args.job(), &decimate, &Stderr::new(true))?
         }
         (None, None) => anyhow::bail!(

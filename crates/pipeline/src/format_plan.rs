@@ -112,7 +112,7 @@ impl FormatPlan {
         job: &MeshJob,
         feedback: &dyn Feedback,
     ) -> Result<FormatPlan> {
-        let max_error = job.max_error.unwrap_or(f64::INFINITY);
+        let max_error = job.decimation.max_error.unwrap_or(f64::INFINITY);
         if format == MeshFormat::GeoJson && !job.export.geojson_source_crs && !job.pixel_coords {
             // Before any work: what `write` would refuse for the raster as a whole.
             check_wgs84_mesh_possible(info, out(job))?;
@@ -159,7 +159,7 @@ impl FormatPlan {
         // Raised vertex heights are not samples: bound their rounding from the range, up
         // to the highest sample raised (by at most the raise for the whole bound; the
         // decimation's bound is smaller).
-        let samples_only = !job.raises_vertex_heights(info.min.zip(info.max));
+        let samples_only = !job.decimation.raises_vertex_heights(info.min.zip(info.max));
         let raise = if samples_only {
             0.0
         } else {

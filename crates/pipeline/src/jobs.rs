@@ -4,13 +4,9 @@
 
 use std::path::PathBuf;
 
-use tinsmith_core::{
-    DecimationOptions, EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation,
-    VertexHeights,
-};
+use tinsmith_choices::DecimationChoices;
+use tinsmith_core::DecimationOptions;
 use tinsmith_formats::MeshFormat;
-
-use crate::error::bail;
 
 /// Samples per tile side (shared row and column included) unless a job says otherwise.
 pub const DEFAULT_TILE_SIZE: u32 = tinsmith_tiling::DEFAULT_TILE_SIZE;
@@ -27,40 +23,10 @@ pub struct MeshJob {
     pub output: Option<PathBuf>,
     /// The format and its format-specific choices.
     pub export: ExportChoices,
-    /// Largest allowed |sample - TIN| at any valid sample; `None` with a count target.
-    pub max_error: Option<f64>,
-    /// Decimate until at most this many triangles remain (greedy order).
-    pub max_triangles: Option<usize>,
-    /// Decimate until at most this many vertices remain (greedy order).
-    pub max_vertices: Option<usize>,
+    /// The decimation asked for: bound or count, orders, holes, contour levels.
+    pub decimation: DecimationChoices,
     /// Band to read, 1-based.
     pub band: usize,
-    /// How a candidate triangle's error is measured.
-    pub error_model: ErrorModel,
-    /// Edge selection when holes are retriangulated by ears.
-    pub selection: EdgeSelection,
-    /// Removal order.
-    pub order: Order,
-    /// Hole retriangulation.
-    pub retriangulate: Retriangulation,
-    /// Largest hole solved optimally by dynamic programming.
-    pub dp_max_ring: u16,
-    /// The mesh decimation starts from.
-    pub initial_mesh: InitialMesh,
-    /// Longest triangle edge allowed, in sample spacings.
-    pub max_edge_length: Option<u32>,
-    /// Rounds of error-lowering edge flips after decimating.
-    pub flip_rounds: usize,
-    /// Rounds of extended-hole removals after decimating.
-    pub extend_rounds: usize,
-    /// Where vertices sit in height.
-    pub vertex_heights: VertexHeights,
-    /// Shape the TIN for contour lines every this much (plus `contour_offset`).
-    pub contour_interval: Option<f64>,
-    /// Shift of the `contour_interval` levels.
-    pub contour_offset: Option<f64>,
-    /// Shape the TIN for contour lines at these levels.
-    pub contour_levels: Vec<f64>,
     /// Write (column, row, value) instead of georeferenced coordinates.
     pub pixel_coords: bool,
     /// Where to write the JSON report.
@@ -109,23 +75,8 @@ impl MeshJob {
             input: input.into(),
             output: None,
             export: ExportChoices::default(),
-            max_error: None,
-            max_triangles: None,
-            max_vertices: None,
+            decimation: DecimationChoices::default(),
             band: 1,
-            error_model: ErrorModel::default(),
-            selection: EdgeSelection::default(),
-            order: Order::default(),
-            retriangulate: Retriangulation::default(),
-            dp_max_ring: 8,
-            initial_mesh: InitialMesh::default(),
-            max_edge_length: None,
-            flip_rounds: 0,
-            extend_rounds: 0,
-            vertex_heights: VertexHeights::default(),
-            contour_interval: None,
-            contour_offset: None,
-            contour_levels: Vec::new(),
             pixel_coords: false,
             report: None,
             tile_size: DEFAULT_TILE_SIZE,
@@ -136,68 +87,17 @@ impl MeshJob {
         }
     }
 
-    /// Whether a triangle or vertex count is the target.
-    pub fn has_count_target(&self) -> bool {
-        self.max_triangles.is_some() || self.max_vertices.is_some()
-    }
-
-    /// Whether decimation raises the vertex heights for this job on a raster whose valid
-    /// heights span `heights` (the core's rule,
-    /// [`DecimationOptions::raises_vertex_heights`], on the options the job gives).
-    pub fn raises_vertex_heights(&self, heights: Option<(f64, f64)>) -> bool {
-        let max_abs = heights.map_or(0.0, |(lo, hi)| lo.abs().max(hi.abs()));
-        let max_error = self.max_error.unwrap_or(f64::INFINITY);
-        self.decimation_options(max_error, heights)
-            .is_ok_and(|options| options.raises_vertex_heights(max_abs))
-    }
-
-    /// The decimation options the job asks for, with `max_error` as the bound (the
-    /// untiled path passes the bound less the output format's height rounding); contour
-    /// levels from `contour_interval` run over `heights`, the raster's valid range.
+    /// The decimation options the job asks for, with `bound` as the bound (the untiled
+    /// path passes the asked bound less the output format's height rounding); contour
+    /// levels from an interval run over `heights`, the raster's valid range.
     pub fn decimation_options(
         &self,
-        max_error: f64,
+        bound: f64,
         heights: Option<(f64, f64)>,
     ) -> crate::Result<DecimationOptions> {
-        let mut options = DecimationOptions::new(max_error)
-            .with_selection(self.selection)
-            .with_error_model(self.error_model)
-            .with_order(self.order)
-            .with_retriangulation(self.retriangulate)
-            .with_initial_mesh(self.initial_mesh);
-        options.dp_max_ring = self.dp_max_ring as usize;
-        options.max_edge_length = self.max_edge_length;
-        options.flip_rounds = self.flip_rounds;
-        options.extend_rounds = self.extend_rounds;
-        options.vertex_heights = self.vertex_heights;
-        if self.has_count_target() && (self.flip_rounds > 0 || self.extend_rounds > 0) {
-            bail!(
-                "{}: --flip-rounds and --extend-rounds work to an error bound, not with \
-                 --max-triangles or --max-vertices",
-                self.input.display()
-            );
-        }
-        if let Some(n) = self.max_triangles {
-            options = options.with_max_triangles(n);
-        }
-        if let Some(n) = self.max_vertices {
-            options = options.with_max_vertices(n);
-        }
-        let levels = match (self.contour_interval, heights) {
-            (Some(interval), Some((lo, hi))) => {
-                let offset = self.contour_offset.unwrap_or(0.0);
-                Some(tinsmith_contour::interval_levels(interval, offset, lo, hi)?)
-            }
-            (Some(_), None) => Some(Vec::new()),
-            (None, _) if !self.contour_levels.is_empty() => {
-                Some(tinsmith_contour::sorted_levels(&self.contour_levels)?)
-            }
-            (None, _) => None,
-        };
-        if let Some(levels) = levels {
-            options = options.with_contour_levels(&levels);
-        }
-        Ok(options)
+        self.decimation
+            .decimation_options(bound, heights)
+            .map_err(|e| crate::error::Error::Refused(format!("{}: {e}", self.input.display())))
     }
 }
 

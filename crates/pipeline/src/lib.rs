@@ -20,7 +20,7 @@
 //!
 //! let mut job = MeshJob::new("dem.tif");
 //! job.output = Some("dem.ply".into());
-//! job.max_error = Some(0.5);
+//! job.decimation.max_error = Some(0.5);
 //! mesh(&job, &Silent)?;
 //! # Ok::<(), tinsmith_pipeline::Error>(())
 //! ```
@@ -56,6 +56,7 @@ pub use preview::{preview, preview_decimated, Previewed, WHOLE_READ_SAMPLES};
 pub use scan::scan_raster;
 pub use serve::{serve, ServeOptions};
 pub use tiles::{merge_tiles, tiles, tiles_shard, vertical_datum, water_source};
+pub use tinsmith_choices::DecimationChoices;
 pub use tinsmith_georef::readable;
 pub use tinsmith_tiling::available_bytes;
 pub use verify::{verify, Verified};

@@ -117,7 +117,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         );
     }
 
-    let max_error = job.max_error.unwrap_or(f64::INFINITY);
+    let max_error = job.decimation.max_error.unwrap_or(f64::INFINITY);
     let plan =
         crate::format_plan::FormatPlan::new(format, &raster.info, Some(grid), job, feedback)?;
     // Float32 formats leave the decimator the bound less their height rounding.

@@ -408,8 +408,9 @@ pub fn preview_decimated(
     let mut from_mesh = job.clone();
     from_mesh.mesh = mesh;
     from_mesh.format = None;
-    from_mesh.max_error = job.max_error.or(decimate.max_error);
+    from_mesh.max_error = job.max_error.or(decimate.decimation.max_error);
     let bound = decimate
+        .decimation
         .max_error
         .map_or("a count target".to_owned(), tinsmith_georef::readable);
     from_mesh.mesh_label = Some(format!("decimated by tinsmith within {bound}"));

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use serde::Serialize;
-use tinsmith_core::{Order, VertexHeights};
+use tinsmith_core::VertexHeights;
 use tinsmith_georef::readable;
 
 use crate::jobs::MeshJob;
@@ -85,6 +85,7 @@ impl<'a> MeshSummary<'a> {
     pub fn new(job: &'a MeshJob, output: &'a Path, outcome: Outcome) -> MeshSummary<'a> {
         let (triangles_before, vertices_before) = outcome.before;
         let (triangles_after, vertices_after) = outcome.after;
+        let choices = &job.decimation;
         MeshSummary {
             input: &job.input,
             band: job.band,
@@ -93,32 +94,28 @@ impl<'a> MeshSummary<'a> {
             width: outcome.size.0,
             height: outcome.size.1,
             valid_samples: outcome.valid_samples,
-            max_error: job.max_error,
-            max_triangles: job.max_triangles,
-            max_vertices: job.max_vertices,
-            error_model: job.error_model.name(),
-            selection: job.selection.name(),
+            max_error: choices.max_error,
+            max_triangles: choices.max_triangles,
+            max_vertices: choices.max_vertices,
+            error_model: choices.error_model.name(),
+            selection: choices.selection.name(),
             // A count target always removes in greedy order (see `with_max_triangles`).
-            order: if job.has_count_target() {
-                Order::Greedy.name()
-            } else {
-                job.order.name()
-            },
-            retriangulate: job.retriangulate.name(),
-            initial_mesh: job.initial_mesh.name(),
-            max_edge_length: job.max_edge_length,
-            dp_max_ring: job.dp_max_ring,
-            flip_rounds: job.flip_rounds,
-            extend_rounds: job.extend_rounds,
+            order: choices.effective_order().name(),
+            retriangulate: choices.retriangulate.name(),
+            initial_mesh: choices.initial_mesh.name(),
+            max_edge_length: choices.max_edge_length,
+            dp_max_ring: choices.dp_max_ring,
+            flip_rounds: choices.flip_rounds,
+            extend_rounds: choices.extend_rounds,
             // As they came out: raised only where decimation raises them.
             vertex_heights: if outcome.vertex_heights_raised {
                 VertexHeights::Raised.name()
             } else {
                 VertexHeights::Samples.name()
             },
-            contour_interval: job.contour_interval,
-            contour_offset: job.contour_offset,
-            contour_levels: &job.contour_levels,
+            contour_interval: choices.contour_interval,
+            contour_offset: choices.contour_offset,
+            contour_levels: &choices.contour_levels,
             pixel_coords: job.pixel_coords,
             triangles_before,
             triangles_after,

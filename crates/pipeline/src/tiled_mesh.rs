@@ -46,15 +46,10 @@ pub fn untiled_output(job: &MeshJob) -> Result<Option<&Path>> {
     crate::transform_check::check_transform(reader.info(), job.pixel_coords)?;
     crate::format_plan::check_float32_positions(format, reader.info(), job)?;
     let fits = reader.width() <= job.tile_size && reader.height() <= job.tile_size;
-    let count_target = job.has_count_target();
+    let count_target = job.decimation.has_count_target();
     if count_target && !fits {
-        // The start mesh has four times the triangles asked for, at most two per sample.
-        let by_vertices = job
-            .max_vertices
-            .map_or(u64::MAX, |v| (v as u64).saturating_mul(2));
-        let target = (job.max_triangles.map_or(u64::MAX, |t| t as u64)).min(by_vertices);
         let samples = u64::from(reader.width()) * u64::from(reader.height());
-        let start_triangles = target.saturating_mul(4).min(samples.saturating_mul(2));
+        let start_triangles = job.decimation.count_target_start_triangles(samples);
         crate::memory::check_whole_raster_fits(
             &job.input,
             (reader.width(), reader.height()),
@@ -117,13 +112,13 @@ struct Tiles {
 pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let total = Instant::now();
     let input = job.input.display();
-    if job.has_count_target() {
+    if job.decimation.has_count_target() {
         bail!(
             "{input}: --max-triangles and --max-vertices need the whole raster at once, and \
              --per-tile meshes it tile by tile; give --max-error"
         );
     }
-    let Some(max_error) = job.max_error else {
+    let Some(max_error) = job.decimation.max_error else {
         bail!("{input}: tiles need --max-error");
     };
     // With -o, `untiled_output` has checked the output path, its sidecar and the

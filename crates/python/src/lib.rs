@@ -64,23 +64,25 @@ fn choices_from_dict(d: &Bound<'_, PyDict>) -> PyResult<choices::MeshChoices> {
         })
     }
     let text = |key: &str| -> PyResult<String> { get::<String>(d, key) };
+    let mut decimation = tinsmith_choices::DecimationChoices::default();
+    decimation.max_error = get(d, "max_error")?;
+    decimation.max_triangles = get(d, "max_triangles")?;
+    decimation.max_vertices = get(d, "max_vertices")?;
+    decimation.error_model = choices::error_model(&text("error_model")?)?;
+    decimation.selection = choices::selection(&text("selection")?)?;
+    decimation.order = choices::order(&text("order")?)?;
+    decimation.retriangulate = choices::retriangulate(&text("retriangulate")?)?;
+    decimation.dp_max_ring = get(d, "dp_max_ring")?;
+    decimation.initial_mesh = choices::initial_mesh(&text("initial_mesh")?)?;
+    decimation.max_edge_length = get(d, "max_edge_length")?;
+    decimation.flip_rounds = get(d, "flip_rounds")?;
+    decimation.extend_rounds = get(d, "extend_rounds")?;
+    decimation.vertex_heights = choices::vertex_heights(&text("vertex_heights")?)?;
+    decimation.contour_interval = get(d, "contour_interval")?;
+    decimation.contour_offset = get(d, "contour_offset")?;
+    decimation.contour_levels = get::<Option<Vec<f64>>>(d, "contour_levels")?.unwrap_or_default();
     Ok(choices::MeshChoices {
-        max_error: get(d, "max_error")?,
-        max_triangles: get(d, "max_triangles")?,
-        max_vertices: get(d, "max_vertices")?,
-        error_model: choices::error_model(&text("error_model")?)?,
-        selection: choices::selection(&text("selection")?)?,
-        order: choices::order(&text("order")?)?,
-        retriangulate: choices::retriangulate(&text("retriangulate")?)?,
-        dp_max_ring: get(d, "dp_max_ring")?,
-        initial_mesh: choices::initial_mesh(&text("initial_mesh")?)?,
-        max_edge_length: get(d, "max_edge_length")?,
-        flip_rounds: get(d, "flip_rounds")?,
-        extend_rounds: get(d, "extend_rounds")?,
-        vertex_heights: choices::vertex_heights(&text("vertex_heights")?)?,
-        contour_interval: get(d, "contour_interval")?,
-        contour_offset: get(d, "contour_offset")?,
-        contour_levels: get::<Option<Vec<f64>>>(d, "contour_levels")?.unwrap_or_default(),
+        decimation,
         tile_size: get(d, "tile_size")?,
         threads: get(d, "threads")?,
         format: match get::<Option<String>>(d, "format")? {

@@ -77,7 +77,7 @@ pub fn mesh<'py>(
 ) -> PyResult<Tin> {
     let total = Instant::now();
     let choices = crate::choices_from_dict(choices)?;
-    if let Some(e) = choices.max_error {
+    if let Some(e) = choices.decimation.max_error {
         if !(e.is_finite() && e >= 0.0) {
             return Err(PyValueError::new_err(format!(
                 "max_error must be a finite number >= 0, got {e}"
@@ -92,8 +92,8 @@ pub fn mesh<'py>(
     }
     let (rows, columns) = crate::heights::shape(heights)?;
     let fits = columns <= choices.tile_size as usize && rows <= choices.tile_size as usize;
-    let count_target = choices.has_count_target();
-    if !fits && !count_target && choices.max_error.is_none() {
+    let count_target = choices.decimation.has_count_target();
+    if !fits && !count_target && choices.decimation.max_error.is_none() {
         return Err(PyValueError::new_err("tiles need max_error"));
     }
     // Refused before the grid is allocated: the CLI's measured need of a whole-grid run or
@@ -101,15 +101,8 @@ pub fn mesh<'py>(
     // again for its caches and the welded mesh (an allowance, not a measurement: the
     // tiles' own working memory is bounded by the tile size).
     let (per_sample, extra) = if count_target {
-        let by_vertices = choices
-            .max_vertices
-            .map_or(u64::MAX, |v| (v as u64).saturating_mul(2));
-        let target = choices
-            .max_triangles
-            .map_or(u64::MAX, |t| t as u64)
-            .min(by_vertices);
         let samples = (rows * columns) as u64;
-        let start = target.saturating_mul(4).min(samples.saturating_mul(2));
+        let start = choices.decimation.count_target_start_triangles(samples);
         (
             tinsmith_tiling::COUNT_TARGET_BYTES_PER_SAMPLE,
             start.saturating_mul(tinsmith_tiling::BYTES_PER_START_TRIANGLE),
@@ -152,7 +145,7 @@ pub fn mesh<'py>(
         meshed.vertices,
         meshed.triangles,
         meshed.measured_max_error,
-        choices.max_error,
+        choices.decimation.max_error,
         report,
         georef,
     )
@@ -170,7 +163,7 @@ fn decimation_bound(
     heights: Option<(f64, f64)>,
     whole: bool,
 ) -> PyResult<f64> {
-    let max_error = choices.max_error.unwrap_or(f64::INFINITY);
+    let max_error = choices.decimation.max_error.unwrap_or(f64::INFINITY);
     let Some(format) = choices.format.filter(|f| f.is_float32()) else {
         return Ok(max_error);
     };
@@ -243,34 +236,33 @@ fn summary(
         ("height", Int(grid.height().into())),
         ("valid_samples", Int(valid)),
         ("isolated_samples", Int(valid.saturating_sub(before.1))),
-        ("max_error", OptFloat(choices.max_error)),
+        ("max_error", OptFloat(choices.decimation.max_error)),
         (
             "max_triangles",
-            OptInt(choices.max_triangles.map(|n| n as u64)),
+            OptInt(choices.decimation.max_triangles.map(|n| n as u64)),
         ),
         (
             "max_vertices",
-            OptInt(choices.max_vertices.map(|n| n as u64)),
+            OptInt(choices.decimation.max_vertices.map(|n| n as u64)),
         ),
-        ("error_model", Text(choices.error_model.name())),
-        ("selection", Text(choices.selection.name())),
+        ("error_model", Text(choices.decimation.error_model.name())),
+        ("selection", Text(choices.decimation.selection.name())),
+        ("order", Text(choices.decimation.effective_order().name())),
         (
-            "order",
-            Text(if choices.has_count_target() {
-                tinsmith_core::Order::Greedy.name()
-            } else {
-                choices.order.name()
-            }),
+            "retriangulate",
+            Text(choices.decimation.retriangulate.name()),
         ),
-        ("retriangulate", Text(choices.retriangulate.name())),
-        ("initial_mesh", Text(choices.initial_mesh.name())),
+        ("initial_mesh", Text(choices.decimation.initial_mesh.name())),
         (
             "max_edge_length",
-            OptInt(choices.max_edge_length.map(u64::from)),
+            OptInt(choices.decimation.max_edge_length.map(u64::from)),
         ),
-        ("dp_max_ring", Int(choices.dp_max_ring.into())),
-        ("flip_rounds", Int(choices.flip_rounds as u64)),
-        ("extend_rounds", Int(choices.extend_rounds as u64)),
+        ("dp_max_ring", Int(choices.decimation.dp_max_ring.into())),
+        ("flip_rounds", Int(choices.decimation.flip_rounds as u64)),
+        (
+            "extend_rounds",
+            Int(choices.decimation.extend_rounds as u64),
+        ),
         (
             "vertex_heights",
             Text(if raised {
@@ -279,9 +271,18 @@ fn summary(
                 tinsmith_core::VertexHeights::Samples.name()
             }),
         ),
-        ("contour_interval", OptFloat(choices.contour_interval)),
-        ("contour_offset", OptFloat(choices.contour_offset)),
-        ("contour_levels", Floats(choices.contour_levels.clone())),
+        (
+            "contour_interval",
+            OptFloat(choices.decimation.contour_interval),
+        ),
+        (
+            "contour_offset",
+            OptFloat(choices.decimation.contour_offset),
+        ),
+        (
+            "contour_levels",
+            Floats(choices.decimation.contour_levels.clone()),
+        ),
         ("pixel_coords", Bool(matches!(placement, Placement::Pixel))),
         ("triangles_before", Int(before.0)),
         ("triangles_after", Int(after.0)),

@@ -181,20 +181,35 @@ impl Tin {
     /// (the CLI's `--geojson-source-crs`). STL and glTF store float32 offsets from a local
     /// origin: mesh with `format="stl"` or `"glb"` to leave room for that rounding, as the
     /// CLI does; the file is refused (`BoundError`) when the rounding could take it past
-    /// `max_error`.
-    #[pyo3(signature = (path, format=None, crs=None))]
+    /// `max_error`. `base` (STL only, the CLI's `--base`) closes the surface into a solid
+    /// with a floor at that height, below the lowest vertex; `normals` (glTF only,
+    /// `--normals`) writes per-vertex normals.
+    #[pyo3(signature = (path, format=None, crs=None, base=None, normals=false))]
     fn write(
         &self,
         py: Python<'_>,
         path: PathBuf,
         format: Option<&str>,
         crs: Option<&Bound<'_, PyAny>>,
+        base: Option<f64>,
+        normals: bool,
     ) -> PyResult<()> {
         let value = |e: tinsmith_formats::Error| PyValueError::new_err(e.to_string());
         let format = match format {
             Some(name) => MeshFormat::from_name(name).map_err(value)?,
             None => MeshFormat::from_path(&path).map_err(value)?,
         };
+        for (given, name, only) in [
+            (base.is_some(), "base", MeshFormat::Stl),
+            (normals, "normals", MeshFormat::Glb),
+        ] {
+            if given && format != only {
+                return Err(PyValueError::new_err(format!(
+                    "{}: {name} applies to {only} output only, not {format}",
+                    path.display()
+                )));
+            }
+        }
         let (wkt, epsg) = crs_of(crs)?;
         let origin = format.is_float32().then(|| self.georef.origin());
         let vertices = self.vertices.bind(py).try_readonly()?;
@@ -237,7 +252,27 @@ impl Tin {
                 }
             }
         }
-        let options = WriteOptions::new().with_origin(origin);
+        if let (Some(base), Some(origin)) = (base, origin) {
+            let lowest = vertices.iter().map(|v| v[2]).fold(f64::INFINITY, f64::min);
+            if !base.is_finite() || base >= lowest {
+                return Err(PyValueError::new_err(format!(
+                    "{}: base {base} must be a finite height below the lowest vertex \
+                     ({lowest})",
+                    path.display()
+                )));
+            }
+            // The floor is written as float32 like every other coordinate.
+            if !((base - origin.offset()[2]) as f32).is_finite() {
+                return Err(PyValueError::new_err(format!(
+                    "{}: base {base} is beyond the range of the format's float32 coordinates",
+                    path.display()
+                )));
+            }
+        }
+        let options = WriteOptions::new()
+            .with_origin(origin)
+            .with_base(base)
+            .with_normals(normals);
         let mesh = MeshRef::new(vertices, triangles)
             .with_crs_wkt(wkt.as_deref())
             .with_epsg(epsg);

@@ -355,9 +355,14 @@ def test_trimesh_view():
         ("samples.glb", ["--max-error", "0.5", "--tile-size", "1024", "--vertex-heights", "samples"],
          dict(max_error=0.5, tile_size=1024, format="glb", vertex_heights="samples")),
         ("tiled.glb", ["--max-error", "1"], dict(max_error=1.0, format="glb")),
+        ("solid.stl", ["--max-error", "3", "--base", "-50"],
+         dict(max_error=3.0, format="stl", write=dict(base=-50.0))),
+        ("normals.glb", ["--max-error", "2", "--normals"],
+         dict(max_error=2.0, format="glb", write=dict(normals=True))),
     ],
 )
 def test_same_bytes_as_the_cli(tmp_path, becmodel, cli, name, args, kwargs):
+    write = kwargs.pop("write", {})
     heights, transform, nodata = becmodel
     dem = REPO / "data" / "becmodel_dem_bc_albers_50m.tif"
     by_cli = tmp_path / f"cli-{name}"
@@ -368,8 +373,27 @@ def test_same_bytes_as_the_cli(tmp_path, becmodel, cli, name, args, kwargs):
     wkt = json.loads(crs)["crs_wkt"]
     tin = tinsmith.mesh(heights, nodata=nodata, transform=transform, **kwargs)
     by_package = tmp_path / f"package-{name}"
-    tin.write(by_package, crs=wkt)
+    tin.write(by_package, crs=wkt, **write)
     assert by_package.read_bytes() == by_cli.read_bytes()
+
+
+def test_base_and_normals_belong_to_their_formats(tmp_path):
+    tin = tinsmith.mesh(bumps(), 1.0, format="stl")
+    lowest = float(tin.vertices[:, 2].min())
+    with pytest.raises(ValueError, match="base applies to STL output only"):
+        tin.write(tmp_path / "m.ply", base=lowest - 1)
+    with pytest.raises(ValueError, match="normals applies to glTF output only"):
+        tin.write(tmp_path / "m.stl", normals=True)
+    with pytest.raises(ValueError, match="below the lowest vertex"):
+        tin.write(tmp_path / "m.stl", base=lowest)
+    assert not list(tmp_path.iterdir())
+    tin.write(tmp_path / "m.stl", base=lowest - 1)
+    solid = trimesh.load(tmp_path / "m.stl")
+    # STL holds offsets from a local origin: the floor sits 1 below the lowest vertex and
+    # the solid spans from it to the highest.
+    highest = float(tin.vertices[:, 2].max())
+    assert solid.is_watertight
+    assert solid.extents[2] == pytest.approx(highest - lowest + 1, abs=1e-3)
 
 
 # -- the GIL and Ctrl-C ---------------------------------------------------------------------

@@ -31,8 +31,11 @@ class Tin:
         path: Union[str, "PathLike[str]"],
         format: Optional[str] = None,
         crs: Union[str, int, Any, None] = None,
+        base: Optional[float] = None,
+        normals: bool = False,
     ) -> None:
-        """Write the TIN as ply, obj, stl, glb, geojson, fgb or landxml."""
+        """Write the TIN as ply, obj, stl, glb, geojson, fgb or landxml; ``base`` closes an
+        STL into a solid with a floor at that height, ``normals`` adds glTF normals."""
     def to_trimesh(self) -> Any:
         """The TIN as a ``trimesh.Trimesh``."""
     def __len__(self) -> int: ...

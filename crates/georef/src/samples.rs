@@ -1,5 +1,7 @@
 //! A rectangle of raster samples as plain data: what ingestion hands out.
 
+use std::sync::Arc;
+
 /// A `width` x `height` block of samples: `values` in row-major order (row 0 first, then
 /// row 1, ...), so sample `(x, y)` (column, row) is `values[y * width + x]`.
 ///
@@ -8,11 +10,47 @@
 /// are at least 1, that there are exactly `width * height` values, and that there are
 /// fewer than 2^32 - 1 of them (so every sample has a `u32` index). Nothing else is
 /// computed or cached: building the decimator's grid from it is the core's business.
-#[derive(Debug, Clone, PartialEq)]
+///
+/// The values are owned ([`Samples::new`]) or shared with their owner
+/// ([`Samples::shared`], e.g. a numpy array read in place); either way they never change
+/// while a `Samples` holds them.
+#[derive(Clone)]
 pub struct Samples {
     width: u32,
     height: u32,
-    values: Vec<f64>,
+    values: Values,
+}
+
+/// Where the values of [`Samples`] live.
+#[derive(Clone)]
+enum Values {
+    Owned(Vec<f64>),
+    Shared(Arc<dyn AsRef<[f64]> + Send + Sync>),
+}
+
+impl std::fmt::Debug for Samples {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Samples")
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .field("shared", &matches!(self.values, Values::Shared(_)))
+            .finish_non_exhaustive()
+    }
+}
+
+/// Equal when the sizes and the values are equal, nodata (NaN) equal to nodata, however
+/// they are held.
+impl PartialEq for Samples {
+    fn eq(&self, other: &Samples) -> bool {
+        self.width == other.width
+            && self.height == other.height
+            && self.values().len() == other.values().len()
+            && self
+                .values()
+                .iter()
+                .zip(other.values())
+                .all(|(a, b)| a == b || (a.is_nan() && b.is_nan()))
+    }
 }
 
 /// Why [`Samples::new`] refused its values; the messages name the grid the values were to
@@ -46,23 +84,35 @@ impl Samples {
     /// if either dimension is zero ([`SamplesError::Size`]), or if there are 2^32 - 1
     /// samples or more ([`SamplesError::TooLarge`]).
     pub fn new(width: u32, height: u32, values: Vec<f64>) -> Result<Samples, SamplesError> {
-        let expected = width as usize * height as usize;
-        if width == 0 || height == 0 || values.len() != expected {
-            return Err(SamplesError::Size {
-                width,
-                height,
-                expected,
-                actual: values.len(),
-            });
-        }
-        if expected as u64 >= u32::MAX as u64 {
-            return Err(SamplesError::TooLarge { width, height });
-        }
+        check_size(width, height, values.len())?;
         Ok(Samples {
             width,
             height,
-            values,
+            values: Values::Owned(values),
         })
+    }
+
+    /// Samples read where `values` holds them, without a copy: the same checks as
+    /// [`Samples::new`]. The holder must keep its slice unchanged for as long as any
+    /// `Samples` (or a clone) refers to it, and must hold every nodata sample as NaN or
+    /// another non-finite value, each of which is nodata here.
+    pub fn shared(
+        width: u32,
+        height: u32,
+        values: Arc<dyn AsRef<[f64]> + Send + Sync>,
+    ) -> Result<Samples, SamplesError> {
+        check_size(width, height, (*values).as_ref().len())?;
+        Ok(Samples {
+            width,
+            height,
+            values: Values::Shared(values),
+        })
+    }
+
+    /// Whether the values are shared with their owner ([`Samples::shared`]) rather than
+    /// owned.
+    pub fn is_shared(&self) -> bool {
+        matches!(self.values, Values::Shared(_))
     }
 
     /// Number of columns (at least 1).
@@ -80,7 +130,10 @@ impl Samples {
     /// All `width * height` samples, row-major; nodata samples are NaN (non-finite).
     #[inline]
     pub fn values(&self) -> &[f64] {
-        &self.values
+        match &self.values {
+            Values::Owned(values) => values,
+            Values::Shared(values) => (**values).as_ref(),
+        }
     }
 
     /// The value at column `x`, row `y`, or `None` when it is nodata or out of range.
@@ -89,13 +142,13 @@ impl Samples {
         if x >= self.width || y >= self.height {
             return None;
         }
-        let v = self.values[y as usize * self.width as usize + x as usize];
+        let v = self.values()[y as usize * self.width as usize + x as usize];
         v.is_finite().then_some(v)
     }
 
     /// Number of valid (finite) samples.
     pub fn valid_count(&self) -> usize {
-        self.values.iter().filter(|v| v.is_finite()).count()
+        self.values().iter().filter(|v| v.is_finite()).count()
     }
 
     /// Number of cells whose four corners are valid: the area, in cells, that a TIN of
@@ -113,11 +166,29 @@ impl Samples {
     pub fn cell_is_valid(&self, x: usize, y: usize) -> bool {
         let w = self.width as usize;
         let i = y * w + x;
-        self.values[i].is_finite()
-            && self.values[i + 1].is_finite()
-            && self.values[i + w].is_finite()
-            && self.values[i + w + 1].is_finite()
+        let values = self.values();
+        values[i].is_finite()
+            && values[i + 1].is_finite()
+            && values[i + w].is_finite()
+            && values[i + w + 1].is_finite()
     }
+}
+
+/// Refuses a `width` x `height` grid of `count` values as [`Samples::new`] documents.
+fn check_size(width: u32, height: u32, count: usize) -> Result<(), SamplesError> {
+    let expected = width as usize * height as usize;
+    if width == 0 || height == 0 || count != expected {
+        return Err(SamplesError::Size {
+            width,
+            height,
+            expected,
+            actual: count,
+        });
+    }
+    if expected as u64 >= u32::MAX as u64 {
+        return Err(SamplesError::TooLarge { width, height });
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -142,6 +213,22 @@ mod tests {
             .to_string(),
             "grid of 65536x65536 has more than 2^32-1 samples"
         );
+    }
+
+    #[test]
+    fn shared_values_are_read_in_place_and_compare_as_owned_ones() {
+        let values: Arc<Vec<f64>> = Arc::new(vec![1.0, 2.0, f64::NAN, 4.0]);
+        let shared = Samples::shared(2, 2, values.clone()).unwrap();
+        assert!(shared.is_shared());
+        assert_eq!(shared.values().as_ptr(), values.as_ptr());
+        let owned = Samples::new(2, 2, vec![1.0, 2.0, f64::NAN, 4.0]).unwrap();
+        assert!(!owned.is_shared());
+        assert_eq!(shared, owned);
+        assert_ne!(
+            shared,
+            Samples::new(2, 2, vec![1.0, 2.0, 3.0, 4.0]).unwrap()
+        );
+        assert!(Samples::shared(3, 2, values).is_err());
     }
 
     #[test]

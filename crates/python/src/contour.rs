@@ -39,16 +39,15 @@ pub fn contour<'py>(
     let placement = Georef::new(transform, columns as u32, rows as u32)?.placement();
     let read = crate::heights::read(heights, nodata, mask.as_ref())?;
     let value = |e: tinsmith_contour::Error| PyValueError::new_err(e.to_string());
-    let (width, height) = (read.width, read.height);
-    let grid_values = read.values;
+    let (width, height) = (read.width(), read.height());
+    let grid_values = read.values();
     let interrupt = Interruptible::new();
     let result = py.detach(|| -> Result<_, crate::Failure> {
         let mesh = match max_error.filter(|&e| e > 0.0) {
-            None => ContourMesh::from_grid(width, height, &grid_values)
+            None => ContourMesh::from_grid(width, height, grid_values)
                 .map_err(|e| crate::Failure::Value(e.to_string()))?,
             Some(e) => {
-                let grid = Grid::new(width, height, grid_values.clone())
-                    .map_err(|e| crate::Failure::Value(e.to_string()))?;
+                let grid = Grid::from_samples(read.clone());
                 let options = DecimationOptions::new(e);
                 let d = interrupt
                     .run(|| decimate_with_progress(&grid, &options, &mut |_| interrupt.check()))?

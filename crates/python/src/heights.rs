@@ -1,19 +1,15 @@
-//! A 2D numpy array of any numeric dtype, read into the one `f64` grid the decimator holds:
-//! nodata and masked-out samples become NaN, in a single pass over the array as it lies in
-//! memory (any strides), with no intermediate copy.
+//! A 2D numpy array of any numeric dtype as the samples the decimator reads: a C-ordered
+//! `float64` array with no nodata value, no mask and no infinities is read in place (no
+//! copy); any other array is read once, in a single pass over it as it lies in memory (any
+//! strides), into one `f64` grid, nodata and masked-out samples made NaN.
+
+use std::sync::Arc;
 
 use numpy::ndarray::ArrayView2;
 use numpy::{PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyMemoryError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-
-/// The samples of a heights array: `width` columns, `height` rows, row-major `f64`, NaN
-/// for nodata.
-pub struct Heights {
-    pub width: u32,
-    pub height: u32,
-    pub values: Vec<f64>,
-}
+use tinsmith_georef::Samples;
 
 /// A sample type the binding reads without converting the array first.
 trait Sample: numpy::Element + Copy {
@@ -98,14 +94,22 @@ pub fn shape(array: &Bound<'_, PyAny>) -> PyResult<(usize, usize)> {
     Ok((rows, columns))
 }
 
-/// Reads `array` (2D, any of the numeric dtypes numpy has but float16 and complex) into
-/// the grid's samples; `mask` (same shape, `True` = valid) and `nodata` turn samples into
-/// NaN. The caller has checked the shape ([`shape`]) and the memory ([`check_fits`]).
+/// Reads `array` (2D, any of the numeric dtypes numpy has but float16 and complex) as the
+/// grid's samples; `mask` (same shape, `True` = valid) and `nodata` turn samples into NaN.
+/// A C-ordered `float64` array without `mask`, without a finite `nodata` and without
+/// infinities is read in place ([`Samples::is_shared`]); the caller must not let Python
+/// write to it while the samples live (the binding drops them before it returns). The
+/// caller has checked the shape ([`shape`]) and the memory ([`check_fits`]).
 pub fn read(
     array: &Bound<'_, PyAny>,
     nodata: Option<f64>,
     mask: Option<&PyReadonlyArray2<'_, bool>>,
-) -> PyResult<Heights> {
+) -> PyResult<Samples> {
+    if mask.is_none() && !nodata.is_some_and(f64::is_finite) {
+        if let Some(samples) = in_place::samples(array)? {
+            return Ok(samples);
+        }
+    }
     let mask = mask.map(|m| m.as_array());
     macro_rules! try_types {
         ($($t:ty),*) => {$(
@@ -129,7 +133,7 @@ fn collect<T: Sample>(
     view: ArrayView2<'_, T>,
     nodata: Option<f64>,
     mask: Option<ArrayView2<'_, bool>>,
-) -> PyResult<Heights> {
+) -> PyResult<Samples> {
     let (rows, columns) = view.dim();
     if let Some(m) = &mask {
         if m.dim() != view.dim() {
@@ -160,9 +164,60 @@ fn collect<T: Sample>(
     for v in values.iter_mut().filter(|v| v.is_infinite()) {
         *v = f64::NAN;
     }
-    Ok(Heights {
-        width: columns as u32,
-        height: rows as u32,
-        values,
-    })
+    Samples::new(columns as u32, rows as u32, values)
+        .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// A C-ordered `float64` array read where numpy keeps it.
+#[allow(unsafe_code)]
+mod in_place {
+    use super::*;
+
+    /// The values of a `float64` array, kept alive by a reference to it.
+    struct ArrayValues {
+        /// Holds the array (and so its buffer, which numpy neither frees nor moves while
+        /// a reference exists: `resize` refuses a referenced array).
+        _array: Py<PyArray2<f64>>,
+        /// The first value's address and the count of values.
+        start: usize,
+        len: usize,
+    }
+
+    impl AsRef<[f64]> for ArrayValues {
+        fn as_ref(&self) -> &[f64] {
+            // SAFETY: `start` and `len` are a contiguous `f64` buffer of the array that
+            // `_array` keeps alive (see `samples`); the binding reads it only during the
+            // call, which does not let Python write to it (see `read`).
+            unsafe { std::slice::from_raw_parts(self.start as *const f64, self.len) }
+        }
+    }
+
+    /// The samples of `array` in place, when it is a C-ordered, aligned `float64` array
+    /// in native byte order with no infinity (NaN is nodata as it stands); `None`
+    /// otherwise.
+    pub fn samples(array: &Bound<'_, PyAny>) -> PyResult<Option<Samples>> {
+        let Ok(typed) = array.cast::<PyArray2<f64>>() else {
+            return Ok(None);
+        };
+        // `as_slice` also takes Fortran order, whose memory is column-major.
+        if !typed.is_c_contiguous() {
+            return Ok(None);
+        }
+        let readonly = typed.try_readonly()?;
+        let Ok(values) = readonly.as_slice() else {
+            return Ok(None);
+        };
+        if values.iter().any(|v| v.is_infinite()) {
+            return Ok(None);
+        }
+        let (rows, columns) = readonly.as_array().dim();
+        let shared = ArrayValues {
+            _array: typed.clone().unbind(),
+            start: values.as_ptr() as usize,
+            len: values.len(),
+        };
+        Samples::shared(columns as u32, rows as u32, Arc::new(shared))
+            .map(Some)
+            .map_err(|e| PyValueError::new_err(e.to_string()))
+    }
 }

@@ -115,9 +115,9 @@ pub fn mesh<'py>(
     crate::heights::check_fits(columns as u64, rows as u64, per_sample, extra, "meshing")?;
     let georef = Georef::new(transform, columns as u32, rows as u32)?;
 
-    let read = crate::heights::read(heights, nodata, mask.as_ref())?;
-    let grid = Grid::new(read.width, read.height, read.values)
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let samples = crate::heights::read(heights, nodata, mask.as_ref())?;
+    let in_place = samples.is_shared();
+    let grid = Grid::from_samples(samples);
     let heights_range = valid_range(&grid);
     let georef = georef.with_heights(heights_range);
     let bound = decimation_bound(
@@ -138,7 +138,10 @@ pub fn mesh<'py>(
             tiled(&grid, &options, &choices, placement, &interrupt, total)
         }
     });
-    let meshed = interrupt.finish(py, meshed)?;
+    let mut meshed = interrupt.finish(py, meshed)?;
+    meshed
+        .report
+        .push(("heights_in_place", ReportValue::Bool(in_place)));
     let report = dict(py, meshed.report)?;
     Tin::new(
         py,

@@ -69,7 +69,7 @@ pub fn verify<'py>(
     let report = py
         .detach(|| {
             tinsmith_verify::verify(
-                GridRef::new(grid.width, grid.height, &grid.values),
+                GridRef::new(grid.width(), grid.height(), grid.values()),
                 MeshRef::new(&positions, &heights, &tris),
                 &options,
             )

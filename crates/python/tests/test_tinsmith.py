@@ -61,6 +61,42 @@ def test_bound_holds_tiled_with_nodata_by_numpy(becmodel):
     assert covered == domain_samples(~np.isnan(f))
 
 
+def test_float64_arrays_are_read_in_place_when_nothing_needs_rewriting():
+    z = bumps()
+    z[10:14, 20:30] = np.nan
+    before = z.copy()
+    in_place = tinsmith.mesh(z, 1.0)
+    assert in_place.report["heights_in_place"] is True
+    assert np.array_equal(z, before, equal_nan=True)
+    worst, _ = max_error_numpy(z, in_place.vertices, in_place.triangles)
+    assert worst <= 1.0
+    nothing_masked = np.ma.masked_array(z, mask=np.zeros(z.shape, dtype=bool))
+    assert tinsmith.mesh(nothing_masked, 1.0).report["heights_in_place"] is True
+    # Each of these needs its samples rewritten or converted: one copy, the same mesh.
+    with_inf = z.copy()
+    with_inf[10, 20] = np.inf
+    copies = [
+        tinsmith.mesh(np.asfortranarray(z), 1.0),
+        tinsmith.mesh(z, 1.0, nodata=-9999.0),
+        tinsmith.mesh(z, 1.0, mask=~np.isnan(z)),
+        tinsmith.mesh(with_inf, 1.0),
+        tinsmith.mesh(np.ma.masked_invalid(z), 1.0),
+    ]
+    for tin in copies:
+        assert tin.report["heights_in_place"] is False
+        assert np.array_equal(tin.vertices, in_place.vertices)
+        assert np.array_equal(tin.triangles, in_place.triangles)
+    assert tinsmith.mesh(z.astype(np.float32), 1.0).report["heights_in_place"] is False
+    # Read in place for the tiled engine too, and the array outlives nothing it lent.
+    big = bumps(700, 650)
+    tiled = tinsmith.mesh(big, 2.0, tile_size=256, threads=2)
+    assert tiled.report["heights_in_place"] is True and "tiles" in tiled.report
+    assert np.array_equal(
+        tiled.triangles, tinsmith.mesh(big.copy(order="F"), 2.0, tile_size=256).triangles
+    )
+    big.resize((10, 10), refcheck=True)  # nothing holds the buffer after the call
+
+
 def test_same_mesh_for_one_and_two_threads(becmodel):
     heights, _, _ = becmodel
     one = tinsmith.mesh(heights, 2.0, tile_size=128, threads=1)

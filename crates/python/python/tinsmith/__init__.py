@@ -45,8 +45,10 @@ def _heights(heights: Any, mask: Any) -> Tuple[np.ndarray, Optional[np.ndarray]]
     strides) and the validity mask (True = valid), a numpy masked array's mask included."""
     if isinstance(heights, np.ma.MaskedArray):
         invalid = np.ma.getmaskarray(heights)
-        valid = ~invalid
-        mask = valid if mask is None else (np.asarray(mask, dtype=bool) & valid)
+        if invalid.any():
+            valid = ~invalid
+            mask = valid if mask is None else (np.asarray(mask, dtype=bool) & valid)
+        # Nothing masked: the data alone (a float64 array is then read in place).
         heights = heights.data
     # xarray.DataArray and anything else array-like.
     array = np.asarray(heights)
@@ -127,8 +129,11 @@ def mesh(
         A 2D array (rows, columns) of any real numeric dtype: float64/32, int8..64,
         uint8..64 are read as they lie in memory (C or Fortran order, any strides, no
         conversion copy); float16 is widened to float64 first. A numpy masked array's
-        mask marks nodata; ``xarray.DataArray`` works through ``np.asarray``. The
-        decimator keeps one float64 copy of the grid for the call.
+        mask marks nodata; ``xarray.DataArray`` works through ``np.asarray``. A C-order
+        float64 array with no ``nodata``, no ``mask`` (nothing masked) and no infinities
+        is read in place, not copied (``report["heights_in_place"]``); any other array is
+        read once into the decimator's float64 grid. Do not write to the array from
+        another thread during the call.
     max_error
         The bound: every valid sample is within it of the TIN (``None`` with a count
         target).

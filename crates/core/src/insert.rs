@@ -37,6 +37,9 @@ use crate::mesh::CompactBound;
 use crate::predicates::{orient, Point};
 use crate::{ErrorBound, Grid};
 
+/// Insertion calls its `tick` once every this many vertices inserted.
+const TICK_INSERTIONS: usize = 1024;
+
 const NONE: u32 = u32::MAX;
 
 /// Triangles (counter-clockwise sample indices) and their exact bounds of a greedy
@@ -51,6 +54,7 @@ pub(crate) fn insertion_triangles(
     max_edge_squared: i64,
     keep_border: Option<&dyn Fn(u32, u32) -> bool>,
     max_vertices: usize,
+    tick: &dyn Fn(),
 ) -> Option<(Vec<[u32; 3]>, Vec<CompactBound>)> {
     let (w, h) = (grid.width() as i64, grid.height() as i64);
     if w < 2 || h < 2 || limit <= 0.0 {
@@ -101,6 +105,9 @@ pub(crate) fn insertion_triangles(
         }
         if t.vertices >= max_vertices {
             return None;
+        }
+        if t.vertices.is_multiple_of(TICK_INSERTIONS) {
+            tick();
         }
         t.insert(slot, sample as u32)?;
         t.vertices += 1;
@@ -436,8 +443,8 @@ mod tests {
     fn every_triangle_is_within_the_limit() {
         let g = grid(41, 29, bumpy);
         for limit in [0.05, 0.5, 2.0, 50.0] {
-            let (c, b) =
-                insertion_triangles(&g, limit, i64::MAX, None, usize::MAX).expect("no nodata");
+            let (c, b) = insertion_triangles(&g, limit, i64::MAX, None, usize::MAX, &|| {})
+                .expect("no nodata");
             check(&g, limit, &c, &b);
         }
     }
@@ -446,7 +453,8 @@ mod tests {
     fn a_decided_border_is_the_outline() {
         let g = grid(41, 29, |x, y| if y == 0 { 0.0 } else { bumpy(x, y) });
         let keep = |x: u32, y: u32| y != 0 || x.is_multiple_of(10);
-        let (c, b) = insertion_triangles(&g, 0.5, i64::MAX, Some(&keep), usize::MAX).unwrap();
+        let (c, b) =
+            insertion_triangles(&g, 0.5, i64::MAX, Some(&keep), usize::MAX, &|| {}).unwrap();
         check(&g, 0.5, &c, &b);
         for t in &c {
             for &v in t {
@@ -461,7 +469,7 @@ mod tests {
     #[test]
     fn long_edges_split() {
         let g = grid(33, 33, |x, y| (x + y) as f64);
-        let (c, b) = insertion_triangles(&g, 1.0, 9, None, usize::MAX).unwrap();
+        let (c, b) = insertion_triangles(&g, 1.0, 9, None, usize::MAX, &|| {}).unwrap();
         check(&g, 1.0, &c, &b);
         let w = 33;
         for t in &c {
@@ -476,9 +484,9 @@ mod tests {
     #[test]
     fn a_plane_is_two_triangles_and_a_budget_stops_it() {
         let g = grid(20, 20, |x, y| 2.0 * x as f64 - y as f64);
-        let (c, _) = insertion_triangles(&g, 0.1, i64::MAX, None, usize::MAX).unwrap();
+        let (c, _) = insertion_triangles(&g, 0.1, i64::MAX, None, usize::MAX, &|| {}).unwrap();
         assert_eq!(c.len(), 2);
         let rough = grid(20, 20, bumpy);
-        assert!(insertion_triangles(&rough, 0.01, i64::MAX, None, 10).is_none());
+        assert!(insertion_triangles(&rough, 0.01, i64::MAX, None, 10, &|| {}).is_none());
     }
 }

@@ -94,6 +94,7 @@ pub(crate) fn rtin_for_count(
     limit: f64,
     max_edge_squared: i64,
     full_border: bool,
+    tick: &dyn Fn(),
 ) -> (Vec<[u32; 3]>, Vec<CompactBound>, f64) {
     let (lo, hi) = grid
         .values()
@@ -115,6 +116,7 @@ pub(crate) fn rtin_for_count(
     // 2^-40 of the range is far below any meaningful error, and the RTIN there is close
     // to the full grid.
     for _ in 0..40 {
+        tick();
         if bound <= limit {
             let rtin = Rtin::new(grid, bound, max_edge_squared, full_border);
             let need = rtin.refinement();

@@ -24,6 +24,12 @@ use crate::predicates::{orient, Point};
 use crate::ErrorBound;
 use crate::Grid;
 
+/// The 1-D pass calls its `tick` once every this many lines.
+pub(crate) const TICK_LINES: usize = 64;
+
+/// [`StripPlan::triangles`] calls its `tick` once every this many triangles measured.
+pub(crate) const TICK_TRIANGLES: usize = 1 << 14;
+
 /// The strip start planned: its lines simplified, its triangles not yet made.
 pub(crate) struct StripPlan<'g> {
     grid: &'g Grid,
@@ -37,14 +43,20 @@ pub(crate) struct StripPlan<'g> {
 impl<'g> StripPlan<'g> {
     /// Simplifies the rows and the columns within `limit` and keeps whichever keep fewer
     /// samples (rows on a tie); `None` if the grid is less than two samples wide or high.
-    pub(crate) fn new(grid: &'g Grid, limit: f64, full_border: bool) -> Option<StripPlan<'g>> {
+    /// `tick` is called every [`TICK_LINES`] lines.
+    pub(crate) fn new(
+        grid: &'g Grid,
+        limit: f64,
+        full_border: bool,
+        tick: &dyn Fn(),
+    ) -> Option<StripPlan<'g>> {
         if grid.width() < 2 || grid.height() < 2 {
             return None;
         }
         let rows = Lines::new(grid, true);
         let columns = Lines::new(grid, false);
-        let along_rows = kept_samples(grid, rows, limit, full_border);
-        let along_columns = kept_samples(grid, columns, limit, full_border);
+        let along_rows = kept_samples(grid, rows, limit, full_border, tick);
+        let along_columns = kept_samples(grid, columns, limit, full_border, tick);
         let (lines, kept) = if along_columns.positions.len() < along_rows.positions.len() {
             (columns, along_columns)
         } else {
@@ -79,7 +91,8 @@ impl<'g> StripPlan<'g> {
     /// The triangles (counter-clockwise sample indices, in row-major order of their
     /// first corner's row) with their exact errors; `None` if one measured above the
     /// limit after all (the 1-D pass works in floating point, the measurement decides).
-    pub(crate) fn triangles(&self) -> Option<(Vec<[u32; 3]>, Vec<CompactBound>)> {
+    /// `tick` is called every [`TICK_TRIANGLES`] triangles.
+    pub(crate) fn triangles(&self, tick: &dyn Fn()) -> Option<(Vec<[u32; 3]>, Vec<CompactBound>)> {
         let grid = self.grid;
         let width = self.lines.width;
         let point = |i: usize| Point {
@@ -97,6 +110,9 @@ impl<'g> StripPlan<'g> {
                 (c, b, pc, pb)
             };
             let bound = triangle_error(grid, &pa, &pb, &pc, self.limit)?;
+            if corners.len().is_multiple_of(TICK_TRIANGLES) {
+                tick();
+            }
             corners.push([a as u32, b as u32, c as u32]);
             bounds.push(CompactBound::from(bound));
             Some(())
@@ -233,11 +249,16 @@ impl Kept {
 
 /// How many samples the strips along rows keep (one of the two passes of
 /// [`StripPlan::new`]).
-pub(crate) fn kept_along_rows(grid: &Grid, limit: f64, full_border: bool) -> usize {
+pub(crate) fn kept_along_rows(
+    grid: &Grid,
+    limit: f64,
+    full_border: bool,
+    tick: &dyn Fn(),
+) -> usize {
     if grid.width() < 2 || grid.height() < 2 {
         return grid.values().len();
     }
-    kept_samples(grid, Lines::new(grid, true), limit, full_border)
+    kept_samples(grid, Lines::new(grid, true), limit, full_border, tick)
         .positions
         .len()
 }
@@ -246,7 +267,7 @@ pub(crate) fn kept_along_rows(grid: &Grid, limit: f64, full_border: bool) -> usi
 /// (and, with `full_border`, every position of the two outer lines on each side and the
 /// two outer positions at each end of every line) are kept, and each stretch between two
 /// of them that borders a valid cell is simplified within `limit`.
-fn kept_samples(grid: &Grid, lines: Lines, limit: f64, full_border: bool) -> Kept {
+fn kept_samples(grid: &Grid, lines: Lines, limit: f64, full_border: bool, tick: &dyn Fn()) -> Kept {
     let (count, len) = (lines.count(), lines.len());
     let values = grid.values();
     let mut kept = Kept {
@@ -275,6 +296,9 @@ fn kept_samples(grid: &Grid, lines: Lines, limit: f64, full_border: bool) -> Kep
     let (mut before, mut after) = (Vec::with_capacity(len), Vec::with_capacity(len));
     strip_cells(None, &mut before);
     for line in 0..count {
+        if line.is_multiple_of(TICK_LINES) {
+            tick();
+        }
         kept.starts.push(kept.positions.len());
         if line > 0 {
             std::mem::swap(&mut before, &mut after);
@@ -445,9 +469,9 @@ mod tests {
             .map(|i| (i % 5) as f64 + 2.0 * (i / 5) as f64)
             .collect();
         let grid = Grid::new(5, 4, values).unwrap();
-        let plan = StripPlan::new(&grid, 0.25, false).unwrap();
+        let plan = StripPlan::new(&grid, 0.25, false, &|| {}).unwrap();
         assert_eq!(plan.triangle_count(), 6);
-        let (corners, bounds) = plan.triangles().unwrap();
+        let (corners, bounds) = plan.triangles(&|| {}).unwrap();
         assert_eq!(corners.len(), 6);
         assert!(bounds.iter().all(|b| ErrorBound::from(*b).max() == 0.0));
         assert_eq!(doubled_area_in_domain(&grid, &corners), 2 * 4 * 3);
@@ -468,8 +492,8 @@ mod tests {
         let grid = Grid::new(w, h, values).unwrap();
         for full_border in [false, true] {
             for limit in [0.3, 2.0, 50.0] {
-                let plan = StripPlan::new(&grid, limit, full_border).unwrap();
-                let (corners, bounds) = plan.triangles().unwrap();
+                let plan = StripPlan::new(&grid, limit, full_border, &|| {}).unwrap();
+                let (corners, bounds) = plan.triangles(&|| {}).unwrap();
                 assert_eq!(corners.len(), plan.triangle_count());
                 assert!(bounds.iter().all(|b| ErrorBound::from(*b).max() <= limit));
                 let area = doubled_area_in_domain(&grid, &corners);

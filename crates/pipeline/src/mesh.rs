@@ -126,13 +126,14 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let options = job
         .decimation_options(plan.decimation_bound, heights)
         .naming_file(&job.input)?;
-    let result = decimate_with_progress(grid, &options, &mut |p| {
-        feedback.status(&format!(
+    let result = decimate_with_progress(grid, &options, &mut |p| match p.sweep {
+        0 => feedback.status("decimating: building the start mesh"),
+        _ => feedback.status(&format!(
             "decimating: sweep {}, {:3.0}% of its vertices tried, {} removed",
             p.sweep,
             100.0 * p.sweep_fraction,
             p.removed
-        ))
+        )),
     })
     .naming_file(&job.input)?;
     feedback.clear_status();

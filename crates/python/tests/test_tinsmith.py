@@ -486,6 +486,25 @@ def test_ctrl_c_interrupts_a_long_call(tiles):
     assert len(tinsmith.mesh(z[:50, :50], 50.0)) > 0
 
 
+def test_ctrl_c_interrupts_the_start_mesh():
+    # A count target on 4000 x 4000 samples: about 2.5 s building its start mesh (the
+    # RTINs it tries) on this machine before the first removal.
+    rng = np.random.default_rng(1)
+    z = np.cumsum(np.cumsum(rng.normal(0, 1, size=(4000, 4000)), 0), 1)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.perf_counter()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            tinsmith.mesh(z, max_triangles=200_000)
+    finally:
+        timer.join()
+        signal.signal(signal.SIGINT, previous)
+    elapsed = time.perf_counter() - start
+    assert elapsed < 1.5, f"interrupted only after {elapsed:.1f} s"
+
+
 # -- doctests ---------------------------------------------------------------------------------
 
 

@@ -50,6 +50,7 @@ pub(super) fn coarse_start(
     limit: f64,
     max_edge_squared: i64,
     keep_border: Option<&dyn Fn(u32, u32) -> bool>,
+    tick: &dyn Fn(),
 ) -> Start {
     let full_border = keep_border.is_some();
     let (w, h) = (grid.width() as usize, grid.height() as usize);
@@ -64,9 +65,9 @@ pub(super) fn coarse_start(
             // With an edge cap the strips cannot start, so only their rows are planned
             // (half the pass) to count what they keep.
             let kept = if max_edge_squared != i64::MAX {
-                Some(kept_along_rows(grid, limit, full_border))
+                Some(kept_along_rows(grid, limit, full_border, tick))
             } else {
-                strips = StripPlan::new(grid, limit, full_border);
+                strips = StripPlan::new(grid, limit, full_border, tick);
                 strips.as_ref().map(|s| s.kept_count())
             };
             kept.filter(|&kept| kept.saturating_mul(AUTO_INSERT_SHARE) <= w * h)
@@ -75,7 +76,7 @@ pub(super) fn coarse_start(
     };
     if let Some(budget) = budget {
         if let Some((corners, bounds)) =
-            insertion_triangles(grid, limit, max_edge_squared, keep_border, budget)
+            insertion_triangles(grid, limit, max_edge_squared, keep_border, budget, tick)
         {
             return Start {
                 corners,
@@ -91,6 +92,7 @@ pub(super) fn coarse_start(
         max_edge_squared,
         full_border,
         strips,
+        tick,
     );
     Start {
         corners,
@@ -107,12 +109,13 @@ fn bottom_up_start(
     max_edge_squared: i64,
     full_border: bool,
     strips: Option<StripPlan<'_>>,
+    tick: &dyn Fn(),
 ) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
     let rtin = || rtin_triangles(grid, limit, max_edge_squared, full_border);
     if initial_mesh == InitialMesh::Rtin || max_edge_squared != i64::MAX {
         return rtin();
     }
-    let Some(strips) = strips.or_else(|| StripPlan::new(grid, limit, full_border)) else {
+    let Some(strips) = strips.or_else(|| StripPlan::new(grid, limit, full_border, tick)) else {
         return rtin();
     };
     let cheap_rtin = if initial_mesh != InitialMesh::Strips {
@@ -127,7 +130,7 @@ fn bottom_up_start(
         None
     };
     cheap_rtin
-        .or_else(|| strips.triangles())
+        .or_else(|| strips.triangles(tick))
         .unwrap_or_else(rtin)
 }
 

@@ -745,3 +745,143 @@ fn wgs84_geojson_rounded_by_another_tool_is_named_as_rounded() {
     let o = d.run(&["verify", &dem, "r12.geojson", "--max-error", "5"]);
     assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
 }
+
+/// The OBJ file's vertices.
+fn obj_vertices(path: &std::path::Path) -> Vec<[f64; 3]> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|c| c.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn heights_converted_from_a_geoid_are_what_proj_gives() {
+    let d = Dir::new();
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let mesh = |out: &str, extra: &[&str]| {
+        let mut args = vec!["mesh", &dem, "-o", out, "--max-error", "3", "-q"];
+        args.extend_from_slice(extra);
+        let o = d.run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    let geoid = ["--vertical-datum", "egm96", "--vertex-heights", "samples"];
+    mesh(
+        "whole.obj",
+        &[&geoid[..], &["--tile-size", "1024", "--report", "r.json"]].concat(),
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path("r.json")).unwrap()).unwrap();
+    assert_eq!(report["vertical_datum"], "egm96");
+
+    // Each vertex sits on a sample: its height is that sample (read by gdallocationinfo)
+    // plus EGM96's undulation at the sample's longitude, latitude (gdaltransform), both
+    // independent of tinsmith.
+    let vertices: Vec<[f64; 3]> = obj_vertices(&d.path("whole.obj"))
+        .into_iter()
+        .step_by(97)
+        .collect();
+    assert!(vertices.len() > 20);
+    let positions: String = vertices
+        .iter()
+        .map(|v| format!("{:?} {:?}\n", v[0], v[1]))
+        .collect();
+    let mut child = std::process::Command::new("gdallocationinfo")
+        .args(["-valonly", "-geoloc", &dem])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("gdallocationinfo runs");
+    let mut stdin = child.stdin.take().unwrap();
+    let feeder =
+        std::thread::spawn(move || std::io::Write::write_all(&mut stdin, positions.as_bytes()));
+    let out = child.wait_with_output().unwrap();
+    feeder.join().unwrap().unwrap();
+    let samples: Vec<f64> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| l.trim().parse().unwrap())
+        .collect();
+    // gdaltransform reads and writes longitude first.
+    let lon_lat = crate::util::gdaltransform("EPSG:3005", "EPSG:4326", &vertices);
+    let lon_lat: Vec<[f64; 3]> = lon_lat.iter().map(|p| [p[0], p[1], 0.0]).collect();
+    let n = crate::util::gdaltransform("EPSG:4326+5773", "EPSG:4979", &lon_lat);
+    for ((v, h), n) in vertices.iter().zip(&samples).zip(&n) {
+        assert!(n[2].abs() > 5.0, "an undulation of {}", n[2]);
+        assert!(
+            (v[2] - (h + n[2])).abs() < 1e-6,
+            "vertex {v:?}: sample {h} + N {}",
+            n[2]
+        );
+    }
+
+    // verify measures the same converted heights; the band's own are tens of metres off.
+    let check = |mesh: &str, datum: bool| {
+        let mut args = vec!["verify", &dem, mesh, "--max-error", "3"];
+        if datum {
+            args.extend(["--vertical-datum", "egm96"]);
+        }
+        d.run(&args)
+    };
+    assert!(check("whole.obj", true).status.success());
+    let against_own = check("whole.obj", false);
+    assert!(!against_own.status.success() && stdout(&against_own).contains("exceeds"));
+    // Tiled (the default tile size splits this raster), the same heights and bound.
+    mesh("tiled.obj", &geoid);
+    let v = check("tiled.obj", true);
+    assert!(v.status.success(), "{}", stdout(&v));
+    let p = d.run(&[
+        "preview",
+        &dem,
+        "tiled.obj",
+        "-o",
+        "p.png",
+        "--vertical-datum",
+        "egm96",
+        "--error",
+    ]);
+    assert!(p.status.success(), "{}", stderr(&p));
+}
+
+#[test]
+fn a_geoid_datum_needs_a_placed_raster_and_its_grid() {
+    let d = Dir::new();
+    let png = fixture("mr_heart_256x256_u8_frame07.png");
+    let o = d.run(&[
+        "mesh",
+        &png,
+        "-o",
+        "m.ply",
+        "--max-error",
+        "1",
+        "--vertical-datum",
+        "egm96",
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("no CRS or no geotransform"),
+        "{}",
+        stderr(&o)
+    );
+    let dem = fixture("becmodel_dem_bc_albers_50m.tif");
+    let missing = d.path("nowhere.gtx");
+    let missing = missing.to_str().unwrap();
+    let o = d.run(&[
+        "mesh",
+        &dem,
+        "-o",
+        "m.ply",
+        "--max-error",
+        "1",
+        "--vertical-datum",
+        missing,
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("nowhere.gtx"), "{}", stderr(&o));
+    assert!(d.files().is_empty(), "{:?}", d.files());
+}

@@ -87,6 +87,10 @@ pub struct PreviewArgs {
     /// The mesh holds (column, row, value) coordinates (it was written with --pixel-coords).
     #[arg(long)]
     pub pixel_coords: bool,
+    /// The mesh was made with `mesh --vertical-datum DATUM`: read the band's heights the
+    /// same way.
+    #[arg(long, value_name = "DATUM", value_parser = mesh::parse_datum)]
+    pub vertical_datum: Option<tinsmith_raster::VerticalDatum>,
 }
 
 impl PreviewArgs {
@@ -103,6 +107,7 @@ impl PreviewArgs {
         job.format = self.format;
         job.band = self.band;
         job.pixel_coords = self.pixel_coords;
+        job.vertical_datum = self.vertical_datum.clone();
         job
     }
 }
@@ -253,6 +258,10 @@ pub struct VerifyArgs {
     /// The mesh holds (column, row, value) coordinates (it was written with --pixel-coords).
     #[arg(long)]
     pub pixel_coords: bool,
+    /// The mesh was made with `mesh --vertical-datum DATUM`: measure it against the
+    /// band's heights converted the same way.
+    #[arg(long, value_name = "DATUM", value_parser = mesh::parse_datum)]
+    pub vertical_datum: Option<tinsmith_raster::VerticalDatum>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -266,6 +275,7 @@ impl VerifyArgs {
         job.max_error = self.max_error;
         job.band = self.band;
         job.pixel_coords = self.pixel_coords;
+        job.vertical_datum = self.vertical_datum.clone();
         job
     }
 }

@@ -8,7 +8,8 @@ use crate::progress::Stderr;
 
 /// Prints the band's metadata and value statistics; always `Ok(true)` on success.
 pub fn run(args: &InfoArgs) -> Result<bool> {
-    let info = tinsmith_pipeline::scan_raster(&args.input, args.band, &Stderr::new(args.quiet))?;
+    let info =
+        tinsmith_pipeline::scan_raster(&args.input, args.band, None, &Stderr::new(args.quiet))?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&info)?);
         return Ok(true);

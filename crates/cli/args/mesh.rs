@@ -36,6 +36,12 @@ pub struct MeshArgs {
     /// Band to read (1-based).
     #[arg(long, default_value_t = 1)]
     pub band: usize,
+    /// Mesh heights above the WGS84 ellipsoid, turned from heights above this geoid
+    /// (egm96, egm2008 or a geoid grid file) at every sample through PROJ; the bound holds
+    /// against the converted heights, and the file's CRS loses INPUT's vertical part.
+    /// Default: the band's heights as they are.
+    #[arg(long, value_name = "DATUM", value_parser = parse_datum)]
+    pub vertical_datum: Option<tinsmith_raster::VerticalDatum>,
     /// Error model.
     #[arg(long, value_enum, default_value_t = ErrorModelArg::Exact)]
     pub error_model: ErrorModelArg,
@@ -152,6 +158,7 @@ impl MeshArgs {
         job.output = self.output.clone();
         job.export = self.export.choices();
         job.band = self.band;
+        job.vertical_datum = self.vertical_datum.clone();
         let choices = &mut job.decimation;
         choices.max_error = self.max_error;
         choices.max_triangles = self.max_triangles;
@@ -191,5 +198,13 @@ impl ExportArgs {
         choices.normals = self.normals;
         choices.geojson_source_crs = self.geojson_source_crs;
         choices
+    }
+}
+
+/// A `--vertical-datum` value: `egm96`, `egm2008`, `ellipsoid` or a geoid grid file.
+pub fn parse_datum(text: &str) -> Result<tinsmith_raster::VerticalDatum, String> {
+    match text.trim() {
+        "" => Err("give egm96, egm2008, ellipsoid or a geoid grid file".into()),
+        text => Ok(tinsmith_raster::VerticalDatum::parse(text)),
     }
 }

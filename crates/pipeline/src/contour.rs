@@ -75,7 +75,7 @@ pub fn contour(job: &ContourJob, feedback: &dyn Feedback) -> Result<()> {
     // A TIN decimated here is shaped for the levels (fewer segments, same bound), so they
     // come from the raster's height range first; a --mesh file's come from its own heights.
     let (contoured, info, source, levels) = if tiled {
-        let info = crate::scan::scan_raster(&job.input, job.band, feedback)?;
+        let info = crate::scan::scan_raster(&job.input, job.band, None, feedback)?;
         let levels = levels_for(job, info.min.zip(info.max))?;
         let (contoured, tiles) = tiled_lines(job, e, &info, &levels, feedback)?;
         let source = format!("TIN within {} ({tiles} tiles)", readable(e));

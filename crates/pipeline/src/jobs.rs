@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use tinsmith_choices::DecimationChoices;
 use tinsmith_core::DecimationOptions;
 use tinsmith_formats::MeshFormat;
+use tinsmith_raster::VerticalDatum;
 
 /// Samples per tile side (shared row and column included) unless a job says otherwise.
 pub const DEFAULT_TILE_SIZE: u32 = tinsmith_tiling::DEFAULT_TILE_SIZE;
@@ -27,6 +28,10 @@ pub struct MeshJob {
     pub decimation: DecimationChoices,
     /// Band to read, 1-based.
     pub band: usize,
+    /// The geoid the band's heights are above, to mesh them as heights above the WGS84
+    /// ellipsoid (see `tinsmith_raster::read_samples_on`); `None` meshes them as they
+    /// are.
+    pub vertical_datum: Option<VerticalDatum>,
     /// Write (column, row, value) instead of georeferenced coordinates.
     pub pixel_coords: bool,
     /// Where to write the JSON report.
@@ -77,6 +82,7 @@ impl MeshJob {
             export: ExportChoices::default(),
             decimation: DecimationChoices::default(),
             band: 1,
+            vertical_datum: None,
             pixel_coords: false,
             report: None,
             tile_size: DEFAULT_TILE_SIZE,
@@ -177,6 +183,9 @@ pub struct VerifyJob {
     pub band: usize,
     /// The mesh holds (column, row, value) coordinates.
     pub pixel_coords: bool,
+    /// The mesh was made with heights converted from this geoid (`MeshJob::vertical_datum`):
+    /// the band is read the same way.
+    pub vertical_datum: Option<VerticalDatum>,
 }
 
 impl VerifyJob {
@@ -189,6 +198,7 @@ impl VerifyJob {
             max_error: None,
             band: 1,
             pixel_coords: false,
+            vertical_datum: None,
         }
     }
 }
@@ -221,6 +231,9 @@ pub struct PreviewJob {
     pub max_error: Option<f64>,
     /// What the PNG's text says the mesh is (default: its path).
     pub mesh_label: Option<String>,
+    /// The mesh was made with heights converted from this geoid: the band is read the
+    /// same way.
+    pub vertical_datum: Option<VerticalDatum>,
 }
 
 impl PreviewJob {
@@ -243,6 +256,7 @@ impl PreviewJob {
             error: false,
             max_error: None,
             mesh_label: None,
+            vertical_datum: None,
         }
     }
 }

@@ -84,6 +84,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         picture.format = job.export.format;
         picture.band = job.band;
         picture.pixel_coords = job.pixel_coords;
+        picture.vertical_datum = job.vertical_datum.clone();
         picture.size = PREVIEW_SIZE;
         crate::preview::check_fits(&picture)?;
         crate::tiled_mesh::run(job, feedback)?;
@@ -105,7 +106,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let reserved = reserve_report(job, Some((output, format)))?;
 
     let t = Instant::now();
-    let raster = tinsmith_raster::read_samples(&job.input, job.band)?;
+    let raster = crate::mesh_file::read_raster(&job.input, job.band, job.vertical_datum.as_ref())?;
     let read_seconds = t.elapsed().as_secs_f64();
     crate::output_paths::note_gcps_unused(&raster.info, job.pixel_coords, feedback);
     let grid = &Grid::from_samples(raster.samples);

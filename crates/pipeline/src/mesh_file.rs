@@ -4,6 +4,7 @@
 //! expects.
 
 use std::path::Path;
+use tinsmith_raster::VerticalDatum;
 
 use tinsmith_formats::{Mesh, MeshFormat};
 use tinsmith_georef::{Placement, PositionError};
@@ -310,16 +311,39 @@ pub(crate) struct MeshOnRaster {
     pub(crate) orientation: Orientation,
 }
 
+/// Band `band` of `input` read whole, its heights converted from `datum` to heights
+/// above the ellipsoid when given.
+pub(crate) fn read_raster(
+    input: &Path,
+    band: usize,
+    datum: Option<&VerticalDatum>,
+) -> Result<tinsmith_raster::Raster> {
+    let datum = datum.unwrap_or(&VerticalDatum::Ellipsoid);
+    Ok(tinsmith_raster::read_samples_on(input, band, datum)?)
+}
+
+/// A reader of windows of band `band` of `input`, its heights converted from `datum` to
+/// heights above the ellipsoid when given.
+pub(crate) fn window_reader(
+    input: &Path,
+    band: usize,
+    datum: Option<&VerticalDatum>,
+) -> Result<tinsmith_raster::WindowReader> {
+    let datum = datum.unwrap_or(&VerticalDatum::Ellipsoid);
+    Ok(tinsmith_raster::WindowReader::open_on(input, band, datum)?)
+}
+
 /// Reads band `band` of `input` whole and the mesh file `mesh` (in `format`) onto it, as
 /// `verify` measures it: see [`read_onto_lattice`].
 pub(crate) fn read_onto_raster(
     input: &Path,
     band: usize,
+    datum: Option<&VerticalDatum>,
     mesh: &Path,
     format: MeshFormat,
     pixel_coords: bool,
 ) -> Result<MeshOnRaster> {
-    let raster = tinsmith_raster::read_samples(input, band)?;
+    let raster = read_raster(input, band, datum)?;
     let on = read_onto_lattice(&raster.info, mesh, format, pixel_coords)?;
     Ok(MeshOnRaster {
         raster,

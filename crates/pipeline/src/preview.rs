@@ -56,7 +56,8 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
     check_picture_path(&job.output, job.size)?;
     crate::output_paths::check_writable_target(&job.output, &job.input)?;
     let format = check_fits(job)?;
-    let mut reader = tinsmith_raster::WindowReader::open(&job.input, job.band)?;
+    let mut reader =
+        crate::mesh_file::window_reader(&job.input, job.band, job.vertical_datum.as_ref())?;
     let drawn = DrawnSamples::new(reader.width(), reader.height(), job.size)?;
     let (info, values, mesh, verified_max_error) = if reads_whole(&reader) {
         let MeshOnRaster {
@@ -65,7 +66,14 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
             heights,
             triangles,
             orientation,
-        } = read_onto_raster(&job.input, job.band, &job.mesh, format, job.pixel_coords)?;
+        } = read_onto_raster(
+            &job.input,
+            job.band,
+            job.vertical_datum.as_ref(),
+            &job.mesh,
+            format,
+            job.pixel_coords,
+        )?;
         let grid = &raster.samples;
         let report = tinsmith_verify::verify(
             GridRef::new(grid.width(), grid.height(), grid.values()),
@@ -403,6 +411,7 @@ pub fn preview_decimated(
     decimate.export.format = None;
     decimate.band = job.band;
     decimate.pixel_coords = job.pixel_coords;
+    decimate.vertical_datum = job.vertical_datum.clone();
     decimate.report = None;
     crate::mesh(&decimate, feedback)?;
     let mut from_mesh = job.clone();

@@ -16,6 +16,9 @@ pub struct MeshSummary<'a> {
     #[serde(serialize_with = "lossy_path")]
     input: &'a Path,
     band: usize,
+    /// The geoid the band's heights were converted from (`--vertical-datum`): the mesh's
+    /// heights, and the bound, are above the WGS84 ellipsoid; `null` for the band's own.
+    vertical_datum: Option<String>,
     width: u32,
     height: u32,
     valid_samples: u64,
@@ -89,6 +92,7 @@ impl<'a> MeshSummary<'a> {
         MeshSummary {
             input: &job.input,
             band: job.band,
+            vertical_datum: job.vertical_datum.as_ref().map(|d| d.label()),
             isolated_samples: outcome.valid_samples.saturating_sub(vertices_before),
             band_count: outcome.band_count,
             width: outcome.size.0,

@@ -33,7 +33,8 @@ pub fn untiled_output(job: &MeshJob) -> Result<Option<&Path>> {
     // Checks the untiled path makes first, so that errors come in the same order.
     let format = crate::format_plan::format(job)?;
     crate::output_paths::check_writable_target(output, &job.input)?;
-    let reader = tinsmith_raster::WindowReader::open(&job.input, job.band)?;
+    let reader =
+        crate::mesh_file::window_reader(&job.input, job.band, job.vertical_datum.as_ref())?;
     if !job.pixel_coords {
         // The CRS written: none for a raster without a geotransform (pixel coordinates).
         let info = reader.info();
@@ -134,7 +135,8 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let reserved = crate::mesh::reserve_report(job, welded_output)?;
 
     let t = Instant::now();
-    let info = crate::scan::scan_raster(&job.input, job.band, feedback)?;
+    let info =
+        crate::scan::scan_raster(&job.input, job.band, job.vertical_datum.as_ref(), feedback)?;
     crate::output_paths::note_gcps_unused(&info, job.pixel_coords, feedback);
     let source = RasterSource::new(&info)?;
     let scan_seconds = t.elapsed().as_secs_f64();

@@ -39,7 +39,14 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
         heights,
         triangles,
         orientation,
-    } = read_onto_raster(&job.input, job.band, &job.mesh, format, job.pixel_coords)?;
+    } = read_onto_raster(
+        &job.input,
+        job.band,
+        job.vertical_datum.as_ref(),
+        &job.mesh,
+        format,
+        job.pixel_coords,
+    )?;
     let grid = &raster.samples;
     let mut options = VerifyOptions::new().with_orientation(orientation);
     if let Some(e) = job.max_error {

@@ -6,7 +6,10 @@ use std::path::{Path, PathBuf};
 
 use gdal::spatial_ref::{CoordTransform, CoordTransformOptions, SpatialRef};
 
+use tinsmith_georef::GeoTransform;
+
 use crate::error::{Error, Result};
+use crate::info::RasterInfo;
 use crate::read::OpenBand;
 
 /// What the heights of a raster are measured from.
@@ -234,6 +237,88 @@ impl Geoid {
             });
         }
         Ok(z)
+    }
+}
+
+/// A raster's heights above a geoid turned into heights above the WGS84 ellipsoid at its
+/// samples: each valid sample gains the geoid's height `N` at the sample's centre (its
+/// position in the raster's CRS taken to WGS84 longitude, latitude by PROJ, then `N` as
+/// [`Geoid::undulations`] interpolates it). The same sample always gains the same `N`,
+/// whichever window or strip it is read in.
+///
+/// It holds no PROJ object (a reader that holds one must stay `Send`): each
+/// [`HeightShift::apply`] sets up its own transformations, a small cost beside a window's
+/// samples.
+pub(crate) struct HeightShift {
+    datum: VerticalDatum,
+    crs_wkt: String,
+    transform: GeoTransform,
+}
+
+impl HeightShift {
+    /// The shift of `datum`'s heights for the raster `info` describes; `Ok(None)` for the
+    /// ellipsoid (heights used as they are).
+    ///
+    /// # Errors
+    /// [`Error::VerticalDatum`] naming the raster when it has no CRS or no geotransform
+    /// (the geoid cannot be placed), or as [`Geoid::new`].
+    pub(crate) fn new(info: &RasterInfo, datum: &VerticalDatum) -> Result<Option<HeightShift>> {
+        // Checked now, so that a missing grid fails before any sample is read.
+        if Geoid::new(datum)?.is_none() {
+            return Ok(None);
+        }
+        let (Some(crs_wkt), Some(transform)) = (info.crs_wkt.clone(), info.transform()) else {
+            return Err(Error::VerticalDatum {
+                path: info.path.clone(),
+                reason: format!(
+                    "heights above {} need the raster's position on the globe, and it has no \
+                     CRS or no geotransform",
+                    datum.label()
+                ),
+            });
+        };
+        Ok(Some(HeightShift {
+            datum: datum.clone(),
+            crs_wkt,
+            transform,
+        }))
+    }
+
+    /// Adds `N` to every finite sample of the `size.0` x `size.1` window (row-major
+    /// `values`) whose top-left sample is `origin`.
+    ///
+    /// # Errors
+    /// [`Error::Crs`] when PROJ cannot take a sample to WGS84; [`Error::VerticalDatum`]
+    /// when the geoid grid does not cover one.
+    pub(crate) fn apply(
+        &self,
+        origin: (usize, usize),
+        size: (usize, usize),
+        values: &mut [f64],
+    ) -> Result<()> {
+        let valid: Vec<usize> = (0..values.len())
+            .filter(|&i| values[i].is_finite())
+            .collect();
+        if valid.is_empty() {
+            return Ok(());
+        }
+        let mut points: Vec<[f64; 3]> = valid
+            .iter()
+            .map(|&i| {
+                let (x, y) = (origin.0 + i % size.0, origin.1 + i / size.0);
+                let [px, py] = self.transform.sample_centre(x as f64, y as f64);
+                [px, py, 0.0]
+            })
+            .collect();
+        crate::reproject::to_wgs84(&self.crs_wkt, &mut points)?;
+        let lon: Vec<f64> = points.iter().map(|p| p[0]).collect();
+        let lat: Vec<f64> = points.iter().map(|p| p[1]).collect();
+        let geoid = Geoid::new(&self.datum)?.expect("a geoid, as `new` found");
+        let n = geoid.undulations(&lon, &lat)?;
+        for (&i, n) in valid.iter().zip(n) {
+            values[i] += n;
+        }
+        Ok(())
     }
 }
 

@@ -4,6 +4,8 @@ use std::path::PathBuf;
 
 use tinsmith_georef::{GeoTransform, Samples};
 
+use crate::datum::VerticalDatum;
+
 /// Metadata of one band of a raster file, plus statistics over its samples.
 ///
 /// Serialises with serde (for `--json` style output). A NaN nodata value serialises as
@@ -67,6 +69,11 @@ pub struct RasterInfo {
     /// `tinsmith_core::Grid::integral_heights`). `false` when the statistics were not
     /// computed.
     pub integral_heights: bool,
+    /// `Some(datum)` when the heights were read as heights above the WGS84 ellipsoid,
+    /// turned from heights above `datum` (a geoid) at every sample; `None` when they are
+    /// the band's own values. Readers opened from this info read them the same way.
+    #[serde(skip)]
+    pub converted_from: Option<VerticalDatum>,
 }
 
 impl RasterInfo {

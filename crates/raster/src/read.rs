@@ -8,6 +8,7 @@ use gdal::spatial_ref::SpatialRef;
 use gdal::{Dataset, DatasetOptions, GdalOpenFlags, Metadata};
 use tinsmith_georef::Samples;
 
+use crate::datum::{HeightShift, VerticalDatum};
 use crate::decode::{SampleDecoder, SampleType, Stats};
 use crate::error::{gdal_reason, Error, Result};
 use crate::info::{Raster, RasterInfo};
@@ -39,7 +40,24 @@ pub fn open_info_with_progress(
     band: usize,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<RasterInfo> {
-    let opened = OpenBand::open(path, band)?;
+    open_info_on(path, band, &VerticalDatum::Ellipsoid, progress)
+}
+
+/// [`open_info_with_progress`] of the heights above the WGS84 ellipsoid that the band's
+/// heights above `datum` are (see [`read_samples_on`]): the statistics are those of the
+/// converted heights, and [`RasterInfo::converted_from`] says so. With
+/// [`VerticalDatum::Ellipsoid`] the band's own heights.
+///
+/// # Errors
+/// As [`open_info`], plus [`Error::VerticalDatum`] and [`Error::Crs`] as
+/// [`read_samples_on`].
+pub fn open_info_on(
+    path: &Path,
+    band: usize,
+    datum: &VerticalDatum,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<RasterInfo> {
+    let opened = OpenBand::open(path, band)?.converting(datum)?;
     let rb = opened.band()?;
     let mut stats = Stats::default();
     let mut buf = Vec::new();
@@ -68,7 +86,22 @@ pub fn open_info_with_progress(
 /// As [`open_info`], plus [`Error::TooLarge`] (checked before any sample is read) and
 /// [`Error::AllNodata`] when no sample is valid.
 pub fn read_samples(path: &Path, band: usize) -> Result<Raster> {
-    let opened = OpenBand::open(path, band)?;
+    read_samples_on(path, band, &VerticalDatum::Ellipsoid)
+}
+
+/// [`read_samples`], turning heights above `datum` (a geoid: most DEMs hold orthometric
+/// heights) into heights above the WGS84 ellipsoid: each valid sample gains the geoid's
+/// height at its centre, placed through the raster's CRS and geotransform and
+/// interpolated by PROJ from the geoid's grid. Windows and strips of the same raster read
+/// with the same datum ([`crate::WindowReader::open_on`], [`open_info_on`]) give the same
+/// values sample for sample. With [`VerticalDatum::Ellipsoid`] this is [`read_samples`].
+///
+/// # Errors
+/// As [`read_samples`], plus [`Error::VerticalDatum`] when the raster has no CRS or
+/// geotransform, or the geoid's grid is missing or does not cover a sample, and
+/// [`Error::Crs`] when PROJ cannot take a sample to WGS84.
+pub fn read_samples_on(path: &Path, band: usize, datum: &VerticalDatum) -> Result<Raster> {
+    let opened = OpenBand::open(path, band)?.converting(datum)?;
     let (width, height) = (opened.info.width, opened.info.height);
     let samples = width as u64 * height as u64;
     if samples >= u32::MAX as u64 {
@@ -128,6 +161,8 @@ pub(crate) struct OpenBand {
     /// GDAL's name of the band's type (`Byte` for a signed Byte band too), read as such.
     gdal_type: String,
     pub(crate) mask_source: Option<MaskSource>,
+    /// Heights above a geoid turned into ellipsoidal heights as they are read.
+    shift: Option<HeightShift>,
 }
 
 /// Where the band's validity mask comes from, besides its nodata value.
@@ -264,6 +299,7 @@ impl OpenBand {
             min: None,
             max: None,
             integral_heights: false,
+            converted_from: None,
         };
         Ok(OpenBand {
             dataset,
@@ -271,7 +307,28 @@ impl OpenBand {
             decoder,
             gdal_type,
             mask_source,
+            shift: None,
         })
+    }
+
+    /// The band with its heights above `datum` read as heights above the WGS84
+    /// ellipsoid (see [`read_samples_on`]); unchanged for the ellipsoid.
+    pub(crate) fn converting(mut self, datum: &VerticalDatum) -> Result<OpenBand> {
+        self.shift = HeightShift::new(&self.info, datum)?;
+        if self.shift.is_some() {
+            self.info.converted_from = Some(datum.clone());
+            // The heights are no longer in the raster's vertical CRS, if it declares one.
+            if let Some(wkt) = self.info.crs_wkt.as_deref() {
+                let horizontal = crate::horizontal_crs(wkt);
+                if horizontal != wkt {
+                    self.info.epsg = gdal::spatial_ref::SpatialRef::from_wkt(&horizontal)
+                        .ok()
+                        .and_then(epsg_code);
+                    self.info.crs_wkt = Some(horizontal);
+                }
+            }
+        }
+        Ok(self)
     }
 
     pub(crate) fn dataset(&self) -> &Dataset {
@@ -345,6 +402,9 @@ impl OpenBand {
                     *v = f64::NAN;
                 }
             }
+        }
+        if let Some(shift) = &self.shift {
+            shift.apply(origin, size, dst)?;
         }
         Ok(())
     }

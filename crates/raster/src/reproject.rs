@@ -152,6 +152,25 @@ pub fn same_crs(a: &str, b: &str) -> bool {
     }
 }
 
+/// The horizontal part of a compound CRS given as WKT (its vertical CRS stripped, as
+/// heights converted to another vertical reference must not claim it), as WKT; `wkt`
+/// itself when it has no vertical part or GDAL cannot read it.
+pub fn horizontal_crs(wkt: &str) -> String {
+    let Ok(srs) = SpatialRef::from_wkt(wkt) else {
+        return wkt.to_owned();
+    };
+    if !srs.is_compound() {
+        return wkt.to_owned();
+    }
+    // SAFETY: the handle is live and owned by `srs`, which the call changes in place.
+    #[allow(unsafe_code)]
+    let stripped = unsafe { gdal_sys::OSRStripVertical(srs.to_c_hsrs()) };
+    match stripped == gdal_sys::OGRErr::OGRERR_NONE {
+        true => srs.to_wkt().unwrap_or_else(|_| wkt.to_owned()),
+        false => wkt.to_owned(),
+    }
+}
+
 /// GDAL's `IsSame` with the axis order of geographic CRSs and the data axis mapping aside:
 /// ESRI's WGS84 (longitude, latitude axes) is EPSG:4326 (latitude, longitude), which plain
 /// `IsSame` denies once both are read in the same x, y order.

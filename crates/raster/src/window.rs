@@ -5,6 +5,7 @@ use std::path::Path;
 use tinsmith_georef::Samples;
 
 use crate::coverage::coarse_read;
+use crate::datum::VerticalDatum;
 use crate::error::{Error, Result};
 use crate::info::RasterInfo;
 use crate::read::OpenBand;
@@ -61,8 +62,19 @@ impl WindowReader {
     /// [`Error::NotFound`], [`Error::NotARaster`], [`Error::BandOutOfRange`],
     /// [`Error::UnsupportedType`] and [`Error::Read`], each naming `path`.
     pub fn open(path: &Path, band: usize) -> Result<WindowReader> {
+        WindowReader::open_on(path, band, &VerticalDatum::Ellipsoid)
+    }
+
+    /// [`WindowReader::open`], reading heights above `datum` as heights above the WGS84
+    /// ellipsoid, sample for sample as [`crate::read_samples_on`] reads them (the reader's
+    /// [`RasterInfo::converted_from`] says so).
+    ///
+    /// # Errors
+    /// As [`WindowReader::open`], plus [`Error::VerticalDatum`] as
+    /// [`crate::read_samples_on`].
+    pub fn open_on(path: &Path, band: usize, datum: &VerticalDatum) -> Result<WindowReader> {
         Ok(WindowReader {
-            opened: OpenBand::open(path, band)?,
+            opened: OpenBand::open(path, band)?.converting(datum)?,
         })
     }
 

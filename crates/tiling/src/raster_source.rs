@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use tinsmith_georef::Samples;
-use tinsmith_raster::{RasterInfo, WindowReader};
+use tinsmith_raster::{RasterInfo, VerticalDatum, WindowReader};
 
 use crate::error::{Error, Result};
 use crate::source::{ReadError, TileSource, WindowRead};
@@ -21,11 +21,14 @@ pub struct RasterSource {
     height: u32,
     max_abs_value: f64,
     integral_heights: bool,
+    /// The datum whose heights the readers turn into ellipsoidal ones, as `info` was read.
+    converted_from: Option<VerticalDatum>,
 }
 
 impl RasterSource {
-    /// The band described by `info`, which must come from `tinsmith_raster::open_info`
-    /// (it has the statistics the raster-wide max |value| comes from).
+    /// The band described by `info`, which must come from `tinsmith_raster::open_info` or
+    /// `open_info_on` (it has the statistics the raster-wide max |value| comes from);
+    /// windows are read as `info` was (heights converted from its `converted_from` datum).
     ///
     /// # Errors
     /// [`Error::AllNodata`] when the band has no valid sample.
@@ -41,6 +44,7 @@ impl RasterSource {
             height: info.height,
             max_abs_value,
             integral_heights: info.integral_heights,
+            converted_from: info.converted_from.clone(),
         })
     }
 
@@ -84,7 +88,9 @@ impl TileSource for RasterSource {
     }
 
     fn reader(&self) -> std::result::Result<WindowReader, ReadError> {
-        Ok(WindowReader::open(&self.path, self.band)?)
+        let datum = self.converted_from.as_ref();
+        let datum = datum.unwrap_or(&VerticalDatum::Ellipsoid);
+        Ok(WindowReader::open_on(&self.path, self.band, datum)?)
     }
 }
 

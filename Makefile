@@ -20,7 +20,7 @@ PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
   rioxarray==0.19.0 xarray==2026.9.0 pandas==3.1.1 pyproj==3.7.2
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps gdal oracles demo pictures test python-test bench-python bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview
+.PHONY: deps gdal oracles demo pictures test python-test bench-python bench-ctb bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview
 
 ## Everything the tests need: GDAL, then the independent oracles.
 deps: gdal
@@ -179,6 +179,13 @@ bench-compare: deps
 bench-python: python-package
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check pydelatin==0.4.0 rasterio
 	$(VENV)/bin/python bench/python_vs_pydelatin.py --shared ../shared
+
+## Terrain pyramids against ctb's quantized-mesh fork, built from a checkout you give:
+## make bench-ctb CTB=~/src/cesium-terrain-builder (bench/README-ctb.md; about 3 minutes).
+bench-ctb:
+	@test -n "$(CTB)" || { echo "give CTB=PATH, a checkout of ctb's quantized-mesh fork (bench/README-ctb.md)"; exit 2; }
+	cargo build --release --quiet
+	python3 bench/pyramid_vs_ctb.py --ctb "$(CTB)" --shared ../shared
 
 ## Benchmark the tiled engine on a 16384^2 DEM built from ../shared/data (about an hour).
 bench-tiles:

@@ -201,6 +201,9 @@ impl Grid {
     /// the full mesh.
     pub fn domain_sample_count(&self) -> usize {
         let (w, h) = (self.width() as usize, self.height() as usize);
+        if self.samples.all_valid() {
+            return if w > 1 && h > 1 { w * h } else { 0 };
+        }
         let cell = |x: usize, y: usize| x < w - 1 && y < h - 1 && self.cell_is_valid(x, y);
         let mut n = 0;
         for y in 0..h {

@@ -155,9 +155,19 @@ impl Samples {
     /// these samples can cover.
     pub fn valid_cell_count(&self) -> usize {
         let (w, h) = (self.width as usize, self.height as usize);
+        if self.all_valid() {
+            // One pass that vectorises, instead of four loads a cell: most DEM tiles have
+            // no nodata, and the decimator asks often.
+            return (w - 1) * (h - 1);
+        }
         (0..h - 1)
             .map(|y| (0..w - 1).filter(|&x| self.cell_is_valid(x, y)).count())
             .sum()
+    }
+
+    /// Whether every sample is valid (finite).
+    pub fn all_valid(&self) -> bool {
+        self.values().iter().all(|v| v.is_finite())
     }
 
     /// Whether the cell with top-left sample `(x, y)` has four valid corners. Panics when

@@ -23,6 +23,7 @@
 //! # }
 //! ```
 
+mod coverage;
 mod decimate;
 mod error;
 mod error_bound;
@@ -37,6 +38,7 @@ mod mesh;
 mod options;
 mod predicates;
 mod rtin;
+mod scatter;
 mod strips;
 mod tin;
 
@@ -52,4 +54,5 @@ pub use options::{
     DecimationOptions, EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation,
     VertexHeights,
 };
+pub use scatter::{decimate_scatter, Scatter, ScatterReport, ScatterTin, MAX_SCATTER_COORDINATE};
 pub use tin::{Tin, TinVertex};

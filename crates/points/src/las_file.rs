@@ -11,6 +11,9 @@ use crate::ReadOptions;
 /// ASPRS class 2: ground.
 const GROUND: u8 = 2;
 
+/// GeoTIFF's key value for a user-defined CRS.
+const USER_DEFINED: u16 = 32767;
+
 /// Points read per call to the reader.
 const CHUNK: u64 = 65_536;
 
@@ -123,9 +126,11 @@ fn file_crs(header: &las::Header) -> FileCrs {
             .trim()
             .to_string()
     });
+    // 32767 is GeoTIFF's "user-defined": no EPSG code, the CRS is spelled out in other keys.
+    let code = |c: Option<u16>| c.filter(|&c| c != USER_DEFINED);
     let geotiff_epsg = header.get_geotiff_crs().ok().flatten().and_then(|g| {
-        g.get_projected_crs_geo_key_value()
-            .or_else(|| g.get_geodetic_crs_geo_key_value())
+        code(g.get_projected_crs_geo_key_value())
+            .or_else(|| code(g.get_geodetic_crs_geo_key_value()))
     });
     FileCrs {
         wkt: wkt.filter(|w| !w.is_empty()),

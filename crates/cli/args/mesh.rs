@@ -140,8 +140,9 @@ pub struct PointArgs {
     /// Drop LAS points flagged withheld.
     #[arg(long, help_heading = "Point input")]
     pub no_withheld: bool,
-    /// Which height a position with several points keeps.
-    #[arg(long, value_enum, default_value_t = DuplicatesArg::Mean, help_heading = "Point input")]
+    /// Which height a position with several points keeps (lowest: fewest triangles on the
+    /// sample LiDAR, see docs/results.md).
+    #[arg(long, value_enum, default_value_t = DuplicatesArg::Lowest, help_heading = "Point input")]
     pub duplicates: DuplicatesArg,
 }
 

@@ -210,7 +210,8 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
         }
     }
     let t = Instant::now();
-    let check = verify_points(&points, &vertices, tin.triangles(), max_error);
+    let tolerance = position_tolerance(format, &vertices);
+    let check = verify_points(&points, &vertices, tin.triangles(), max_error, tolerance);
     let verify_seconds = t.elapsed().as_secs_f64();
     if !check.passed() {
         bail!(
@@ -290,6 +291,22 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     Ok(())
 }
 
+/// How far a float32 format may move a position (x, y): its rounding of the TIN's extent,
+/// doubled; 0 for formats that keep `f64` positions.
+fn position_tolerance(format: MeshFormat, vertices: &[[f64; 3]]) -> f64 {
+    if !format.is_float32() {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for v in vertices {
+        for a in 0..2 {
+            lo[a] = lo[a].min(v[a]);
+            hi[a] = hi[a].max(v[a]);
+        }
+    }
+    2.0 * f64::from(f32::EPSILON) * (hi[0] - lo[0]).max(hi[1] - lo[1]).max(0.0)
+}
+
 /// What failed, in a line.
 fn describe(r: &PointsReport) -> String {
     let mut parts = Vec::new();
@@ -340,11 +357,13 @@ pub fn verify_points_file(
         );
     }
     let mesh = tinsmith_formats::read_mesh_as(mesh_path, format)?;
+    let tolerance = position_tolerance(format, &mesh.vertices);
     Ok(verify_points(
         &points,
         &mesh.vertices,
         &mesh.triangles,
         max_error,
+        tolerance,
     ))
 }
 

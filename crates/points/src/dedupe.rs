@@ -5,12 +5,15 @@ use crate::cloud::PointCloud;
 /// Which height a position with several points keeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Duplicates {
-    /// The lowest (ground under vegetation returns).
+    /// The lowest (ground under vegetation returns). The default: on the sample LAZ
+    /// files at every class and a 0.1 m bound it kept the fewest triangles (autzen, 7
+    /// duplicates: 101,301 against 101,305 for the mean; Lidar HD, 19 duplicates: 10,864
+    /// against 10,894), and a low return is the likelier ground.
+    #[default]
     Lowest,
     /// The highest.
     Highest,
     /// The mean of the heights.
-    #[default]
     Mean,
     /// The first in file order.
     First,

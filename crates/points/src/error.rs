@@ -16,7 +16,7 @@ pub enum Error {
         source: std::io::Error,
     },
     /// The LAS/LAZ reader refused the file (bad header, truncated or corrupt data).
-    #[error("{}: {source}", path.display())]
+    #[error("{}: not a readable LAS/LAZ file (truncated or corrupt?): {source}", path.display())]
     Las {
         /// The file.
         path: PathBuf,

@@ -22,6 +22,7 @@ pub(crate) fn read_las(path: &Path, options: &ReadOptions) -> Result<PointCloud>
         path: path.to_path_buf(),
         source,
     };
+    check_point_count(path)?;
     let mut reader = las::Reader::from_path(path).map_err(las_error)?;
     let header = reader.header().clone();
     let declared = header.number_of_points();
@@ -32,7 +33,14 @@ pub(crate) fn read_las(path: &Path, options: &ReadOptions) -> Result<PointCloud>
     let (mut raw, mut z, mut class) = (Vec::new(), Vec::new(), Vec::new());
     let mut read = 0u64;
     loop {
-        let n = reader.fill_points(CHUNK, &mut data).map_err(las_error)?;
+        let n = reader.fill_points(CHUNK, &mut data).map_err(|e| {
+            format_error(
+                path,
+                format!(
+                    "the point data is truncated or corrupt after {read} of the {declared}                      points the header declares ({e})"
+                ),
+            )
+        })?;
         if n == 0 {
             break;
         }
@@ -116,6 +124,56 @@ pub(crate) fn read_las(path: &Path, options: &ReadOptions) -> Result<PointCloud>
         classes,
         points_in_file: read,
     })
+}
+
+/// Checks the header's point counts against each other and, for uncompressed data,
+/// against the bytes the file holds for its points: a count that says fewer points than
+/// the file holds would otherwise read as a smaller cloud without a word. (A count that
+/// says more fails when the reader runs out of points.)
+fn check_point_count(path: &Path) -> Result<()> {
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let file_len = file.metadata().map_err(io)?.len();
+    let raw = las::raw::Header::read_from(&mut file).map_err(|source| Error::Las {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let legacy = u64::from(raw.number_of_point_records);
+    let count = match &raw.large_file {
+        Some(large) => {
+            if legacy != 0 && legacy != large.number_of_point_records {
+                return Err(format_error(
+                    path,
+                    format!(
+                        "the header declares {} points and, in its legacy field, {legacy}",
+                        large.number_of_point_records
+                    ),
+                ));
+            }
+            large.number_of_point_records
+        }
+        None => legacy,
+    };
+    let compressed = raw.point_data_record_format & 0b1100_0000 != 0;
+    if !compressed {
+        let record = u64::from(raw.point_data_record_length).max(1);
+        let end = raw
+            .evlr
+            .as_ref()
+            .filter(|e| e.number_of_evlrs > 0)
+            .map_or(file_len, |e| e.start_of_first_evlr);
+        let held = end.saturating_sub(u64::from(raw.offset_to_point_data)) / record;
+        if held != count {
+            return Err(format_error(
+                path,
+                format!("the header declares {count} points but the file holds {held}"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The CRS the header's VLRs declare (unreadable CRS records count as none).

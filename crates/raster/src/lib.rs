@@ -81,6 +81,8 @@ pub use info::{Raster, RasterInfo};
 pub use polygons::{burn_polygons, is_vector};
 pub use quiet::{silence_gdal_errors, take_gdal_warnings};
 pub use read::{open_info, open_info_with_progress, read_samples};
-pub use reproject::{crs_wkt, epsg_code, from_wgs84, is_geographic, is_wgs84_lon_lat, same_crs, to_wgs84};
+pub use reproject::{
+    crs_wkt, epsg_code, from_wgs84, is_geographic, is_wgs84_lon_lat, same_crs, to_wgs84,
+};
 pub use sample::sample_geographic;
 pub use window::{read_window, WindowReader};

@@ -19,8 +19,12 @@ pub struct PointsReport {
     pub max_error: f64,
     /// The point with that error: its index, x, y, z, and the TIN's height there.
     pub worst: Option<(usize, [f64; 3], f64)>,
-    /// Points no triangle contains (the TIN does not cover them).
+    /// Points no triangle contains (the TIN does not cover them), beyond the position
+    /// tolerance.
     pub uncovered: usize,
+    /// Points no triangle contains but within the position tolerance of one: measured
+    /// against the nearest such triangle's plane.
+    pub near_edge: usize,
     /// The first uncovered point, if any.
     pub first_uncovered: Option<(usize, [f64; 3])>,
     /// Triangles with zero or negative area (counter-clockwise in x right, y up is
@@ -44,6 +48,11 @@ impl PointsReport {
 /// Coordinates are shifted to the vertices' lower-left corner first, so the arithmetic
 /// keeps the precision of the TIN's extent rather than of its absolute coordinates.
 ///
+/// A point in no triangle but within `tolerance` (a distance in x, y) of one is measured
+/// against the plane of the nearest: the allowance for a file format that rounds
+/// positions (float32), where a point on the TIN's outline may fall a rounding outside
+/// it. Give 0 for formats that keep positions exactly.
+///
 /// # Panics
 /// When a triangle names a vertex that does not exist.
 pub fn verify_points(
@@ -51,6 +60,7 @@ pub fn verify_points(
     vertices: &[[f64; 3]],
     triangles: &[[u32; 3]],
     bound: f64,
+    tolerance: f64,
 ) -> PointsReport {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for v in vertices {
@@ -68,6 +78,7 @@ pub fn verify_points(
         max_error: 0.0,
         worst: None,
         uncovered: 0,
+        near_edge: 0,
         first_uncovered: None,
         bad_triangles: 0,
         bound,
@@ -104,9 +115,19 @@ pub fn verify_points(
             }
         }
         if !covered {
-            report.uncovered += 1;
-            report.first_uncovered.get_or_insert((i, *p));
-            continue;
+            match buckets.nearest(&q, tolerance, triangles, &local) {
+                Some(t) => {
+                    let [a, b, c] = triangles[t as usize].map(|k| local[k as usize]);
+                    let surface = interpolate(&a, &b, &c, &q);
+                    worst_here = ((q[2] - surface).abs(), surface);
+                    report.near_edge += 1;
+                }
+                None => {
+                    report.uncovered += 1;
+                    report.first_uncovered.get_or_insert((i, *p));
+                    continue;
+                }
+            }
         }
         if worst_here.0 > report.max_error || report.worst.is_none() {
             report.max_error = report.max_error.max(worst_here.0);
@@ -228,6 +249,35 @@ impl Buckets {
         }
     }
 
+    /// The triangle nearest to `p` among those within `tolerance` of it (by distance to
+    /// their sides), if any.
+    fn nearest(
+        &self,
+        p: &[f64; 3],
+        tolerance: f64,
+        triangles: &[[u32; 3]],
+        local: &[[f64; 3]],
+    ) -> Option<u32> {
+        if tolerance <= 0.0 {
+            return None;
+        }
+        let mut best: Option<(f64, u32)> = None;
+        for dy in [-tolerance, tolerance] {
+            for dx in [-tolerance, tolerance] {
+                for &t in self.candidates(&[p[0] + dx, p[1] + dy, 0.0]) {
+                    let c = triangles[t as usize].map(|k| local[k as usize]);
+                    let d = (0..3)
+                        .map(|e| segment_distance(p, &c[e], &c[(e + 1) % 3]))
+                        .fold(f64::INFINITY, f64::min);
+                    if d <= tolerance && best.is_none_or(|(bd, bt)| d < bd || (d == bd && t < bt)) {
+                        best = Some((d, t));
+                    }
+                }
+            }
+        }
+        best.map(|(_, t)| t)
+    }
+
     /// The triangles that may contain `p` (a point on a bucket's edge gets both buckets'
     /// lists through the rounding-tolerant cell range).
     fn candidates(&self, p: &[f64; 3]) -> &[u32] {
@@ -240,6 +290,18 @@ impl Buckets {
         let b = y * self.columns + x;
         &self.triangles[self.start[b] as usize..self.start[b + 1] as usize]
     }
+}
+
+/// Distance in x, y from `p` to the segment `ab`.
+fn segment_distance(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let length2 = dx * dx + dy * dy;
+    let s = if length2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    ((p[0] - a[0] - s * dx).powi(2) + (p[1] - a[1] - s * dy).powi(2)).sqrt()
 }
 
 #[cfg(test)]
@@ -261,10 +323,10 @@ mod tests {
         let (v, t) = square();
         // z = (x - x0) + (y - y0) is the plane through all four corners.
         let on = [[1e6 + 2.5, 5e6 + 7.0, 9.5], [1e6 + 5.0, 5e6 + 5.0, 10.0]];
-        let r = verify_points(&on, &v, &t, 1e-9);
+        let r = verify_points(&on, &v, &t, 1e-9, 0.0);
         assert!(r.passed(), "{r:?}");
         let off = [[1e6 + 2.5, 5e6 + 7.0, 9.7]];
-        let r = verify_points(&off, &v, &t, 0.1);
+        let r = verify_points(&off, &v, &t, 0.1, 0.0);
         assert!(!r.passed());
         assert!((r.max_error - 0.2).abs() < 1e-6);
         assert_eq!(r.worst.unwrap().0, 0);
@@ -273,9 +335,13 @@ mod tests {
     #[test]
     fn uncovered_points_and_bad_triangles_fail() {
         let (v, t) = square();
-        let r = verify_points(&[[1e6 - 1.0, 5e6, 0.0]], &v, &t, 1.0);
+        let r = verify_points(&[[1e6 - 1.0, 5e6, 0.0]], &v, &t, 1.0, 0.0);
         assert_eq!(r.uncovered, 1);
         assert!(!r.passed());
+        // Within the tolerance of the outline: measured against the nearest plane.
+        let r = verify_points(&[[1e6 - 1e-3, 5e6 + 5.0, 5.0]], &v, &t, 1.0, 2e-3);
+        assert_eq!((r.uncovered, r.near_edge), (0, 1));
+        assert!(r.passed(), "{r:?}");
         let r = verify_points(
             &[[1e6 + 1.0, 5e6 + 0.5, 1.5]],
             &v,

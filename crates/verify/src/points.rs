@@ -347,6 +347,7 @@ mod tests {
             &v,
             &[[0, 2, 1], [0, 2, 3]],
             1.0,
+            0.0,
         );
         assert_eq!(r.bad_triangles, 1);
         assert!(!r.passed());

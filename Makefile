@@ -19,7 +19,7 @@ PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
   maturin==1.16.0 pytest==9.2.0 affine==3.0.1 shapely==2.2.0
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps gdal oracles demo pictures test python-test bench-python bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview
+.PHONY: deps gdal oracles demo pictures test python-test bench-python bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview bench-points
 
 ## Everything the tests need: GDAL, then the independent oracles.
 deps: gdal
@@ -189,6 +189,13 @@ bench-tiles:
 bench-preview:
 	cargo build --release --quiet
 	python3 bench/preview_memory.py --shared ../shared --out /tmp/tinsmith-preview/results.md
+
+## Point input: points/s and bytes per point for read, triangulate and decimate on the
+## LAS/LAZ files of ../shared/data/points and 1 M points sampled from a DEM, and triangles
+## kept against the full Delaunay (docs/results.md, "Points"; about a minute).
+bench-points:
+	cargo build --release --quiet
+	python3 bench/points.py --shared ../shared
 
 ## Sharded pyramids: ETOPO5 and a 16384 x 8192 resample in one process vs 4 shards on a
 ## Dask LocalCluster, and 1000 shards of a planet-size VRT (docs/results.md, "Sharded

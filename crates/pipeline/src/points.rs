@@ -178,13 +178,24 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     let delaunay_triangles = triangles.len();
 
     let t = Instant::now();
-    let options = DecimationOptions::new(max_error)
+    let points = world_points(&cloud);
+    // Float32 formats store positions and heights relative to the points' middle: the
+    // decimator keeps the heights' rounding, measured at every point, off the bound.
+    let origin = format.is_float32().then(|| LocalOrigin::of_points(&points));
+    let rounding = origin.map_or(0.0, |o| o.height_rounding(&cloud.z));
+    if max_error.is_finite() && rounding > 0.0 && rounding >= max_error {
+        bail!(
+            "{}: float32 rounds heights by up to {rounding}, not less than --max-error \
+             {max_error}; write .ply, .obj, .fgb or .xml",
+            output.display()
+        );
+    }
+    let options = DecimationOptions::new(max_error - rounding)
         .with_selection(job.selection)
         .with_error_model(job.error_model)
         .with_retriangulation(job.retriangulate);
     let mut options = options;
     options.dp_max_ring = job.dp_max_ring as usize;
-    let points = world_points(&cloud);
     let PointCloud {
         xy,
         z,
@@ -200,9 +211,6 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     let decimate_seconds = t.elapsed().as_secs_f64();
 
     let mut vertices: Vec<[f64; 3]> = tin.vertices().iter().map(|&v| points[v as usize]).collect();
-    let origin = format
-        .is_float32()
-        .then(|| LocalOrigin::of_points(&vertices));
     if let Some(origin) = origin {
         // Verified as the float32 file will hold the positions and heights.
         for v in &mut vertices {

@@ -16,7 +16,7 @@ TOOLS := .tools
 # for shapely's lines.
 PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
   azure-storage-blob==12.27.1 dask[distributed]==2026.8.0 pyyaml==6.0.4 pillow==11.3.0 \
-  maturin==1.16.0 pytest==9.2.0 affine==3.0.1 shapely==2.2.0
+  maturin==1.16.0 pytest==9.2.0 affine==3.0.1 shapely==2.2.0 laspy[lazrs]==2.7.0
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
 .PHONY: deps gdal oracles demo pictures test python-test bench-python bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview bench-points

@@ -387,6 +387,78 @@ fn las_and_laz_read_the_same_classes_and_give_the_same_mesh() {
     );
 }
 
+/// The venv's Python, with laspy and its LAZ backend (lazrs), an independent LAS reader.
+fn laspy() -> std::path::PathBuf {
+    let python = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python3");
+    let ok = python.exists()
+        && std::process::Command::new(&python)
+            .args(["-c", "import laspy, lazrs"])
+            .status()
+            .is_ok_and(|s| s.success());
+    assert!(ok, "oracle missing: laspy[lazrs] in .venv; run `make deps`");
+    python
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn laspy_reads_the_points_our_mesh_is_within_the_bound_of() {
+    let python = laspy();
+    let dir = Dir::new();
+    let points = classified_points();
+    for input in ["p.las", "p.laz"] {
+        write_las(&dir.path(input), &points, None);
+        let out = format!("{input}.ply");
+        let o = dir.run(&[
+            "mesh",
+            input,
+            "-o",
+            &out,
+            "--max-error",
+            "0.03",
+            "--no-withheld",
+            "--report",
+            "r.json",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        // laspy decodes the file on its own and writes the ground points it finds, not
+        // withheld, as text: our mesh must be within the bound of every one of them.
+        let script = format!(
+            "import laspy, numpy as np\n\
+             las = laspy.read('{input}')\n\
+             keep = (np.asarray(las.classification) == 2) & ~np.asarray(las.withheld, dtype=bool)\n\
+             xyz = np.column_stack([las.x[keep], las.y[keep], las.z[keep]])\n\
+             np.savetxt('{input}.csv', xyz, fmt='%.3f', delimiter=',')\n\
+             print(int(keep.sum()), len(las.points))"
+        );
+        let o = std::process::Command::new(&python)
+            .args(["-c", &script])
+            .current_dir(dir.path(""))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        let counts: Vec<u64> = stdout(&o)
+            .split_whitespace()
+            .map(|c| c.parse().unwrap())
+            .collect();
+        let r = report(&dir, "r.json");
+        assert_eq!(
+            counts,
+            vec![
+                r["points_read"].as_u64().unwrap(),
+                r["points_in_file"].as_u64().unwrap()
+            ]
+        );
+        let csv = format!("{input}.csv");
+        let o = dir.run(&["verify", &csv, &out, "--max-error", "0.03"]);
+        assert!(o.status.success(), "{input}: {}{}", stdout(&o), stderr(&o));
+        assert!(
+            stdout(&o).contains(&format!("{} points", counts[0])),
+            "{}",
+            stdout(&o)
+        );
+    }
+}
+
 /// Runs `mesh` on `input` and checks the failure: non-zero exit, the file and `problem`
 /// named, and no output left beside the input.
 fn refused(dir: &Dir, input: &str, problem: &str) {

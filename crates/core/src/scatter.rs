@@ -509,6 +509,96 @@ mod tests {
         }
     }
 
+    /// Random distinct lattice points, the four corners of the square among them, with
+    /// heights from `f`, and their Delaunay triangulation (spade).
+    fn random_scatter(
+        n: usize,
+        seed: u64,
+        side: i64,
+        f: impl Fn(f64, f64) -> f64,
+    ) -> (Scatter, Vec<[u32; 3]>) {
+        use spade::{DelaunayTriangulation, Point2, Triangulation};
+        let mut s = seed;
+        let mut next = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        let mut seen = std::collections::BTreeSet::new();
+        let mut xy = vec![[0, 0], [side, 0], [0, side], [side, side]];
+        seen.extend(xy.iter().copied());
+        while xy.len() < n {
+            let p = [
+                (next() % (side as u64 + 1)) as i64,
+                (next() % (side as u64 + 1)) as i64,
+            ];
+            if seen.insert(p) {
+                xy.push(p);
+            }
+        }
+        let z = xy.iter().map(|p| f(p[0] as f64, p[1] as f64)).collect();
+        let d: DelaunayTriangulation<Point2<f64>> = DelaunayTriangulation::bulk_load(
+            xy.iter()
+                .map(|p| Point2::new(p[0] as f64, p[1] as f64))
+                .collect(),
+        )
+        .unwrap();
+        // Bulk loading reorders the vertices: back to point indices by position.
+        let index: std::collections::BTreeMap<[i64; 2], u32> =
+            xy.iter().enumerate().map(|(i, p)| (*p, i as u32)).collect();
+        let tris = d
+            .inner_faces()
+            .map(|f| {
+                f.vertices().map(|v| {
+                    let p = v.position();
+                    index[&[p.x as i64, p.y as i64]]
+                })
+            })
+            .collect();
+        (Scatter::new(xy, z).unwrap(), tris)
+    }
+
+    #[test]
+    fn random_points_within_the_bound_for_every_model_method_and_seed() {
+        for seed in [1, 2, 3] {
+            let (s, tris) = random_scatter(400, seed, 1000, |x, y| {
+                (x / 90.0).sin() * 30.0 + (y / 140.0).cos() * 20.0 + ((x * y) % 7.0) * 0.1
+            });
+            for model in [ErrorModel::Exact, ErrorModel::Bounds] {
+                for method in [Retriangulation::Dp, Retriangulation::Ears] {
+                    for bound in [0.5, 4.0] {
+                        let mut options = DecimationOptions::new(bound);
+                        options.error_model = model;
+                        options.retriangulation = method;
+                        let (tin, report) = decimate_scatter(&s, tris.clone(), &options).unwrap();
+                        let worst = worst_error(&s, &tin);
+                        assert!(
+                            worst <= bound,
+                            "{seed} {model:?} {method:?} {bound}: {worst}"
+                        );
+                        assert!(
+                            report.final_vertices < s.len(),
+                            "{seed} {model:?} {method:?}"
+                        );
+                        // The hull's corners stay.
+                        for corner in 0..4u32 {
+                            assert!(tin.vertices().contains(&corner));
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_plane_of_random_points_keeps_only_its_corners() {
+        let (s, tris) = random_scatter(300, 9, 500, |x, y| 3.0 + 0.5 * x - 0.25 * y);
+        let (tin, _) = decimate_scatter(&s, tris, &DecimationOptions::new(1e-6)).unwrap();
+        assert_eq!(tin.vertices(), &[0, 1, 2, 3]);
+        assert_eq!(tin.triangles().len(), 2);
+    }
+
     #[test]
     fn bad_triangulations_are_refused() {
         let (s, mut tris) = lattice_scatter(3, 3, |_, _| 0.0);

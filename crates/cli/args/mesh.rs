@@ -140,8 +140,8 @@ pub struct PointArgs {
     /// Drop LAS points flagged withheld.
     #[arg(long, help_heading = "Point input")]
     pub no_withheld: bool,
-    /// Which height a position with several points keeps (lowest: fewest triangles on the
-    /// sample LiDAR, see docs/results.md).
+    /// Which height a position with several points keeps (see docs/cli.md, "Point
+    /// input", for how the default was chosen).
     #[arg(long, value_enum, default_value_t = DuplicatesArg::Lowest, help_heading = "Point input")]
     pub duplicates: DuplicatesArg,
 }

@@ -282,6 +282,8 @@ struct ScatterRemover {
     ring: Vec<Point>,
     bounds: Vec<ErrorBound>,
     new_triangles: Vec<(u32, [u32; 3], ErrorBound)>,
+    /// The new triangles' slots and corner points, while charging points to them.
+    corner_points: Vec<(u32, [Point; 3])>,
     model: crate::ErrorModel,
     selection: crate::EdgeSelection,
     method: crate::Retriangulation,
@@ -301,6 +303,7 @@ impl ScatterRemover {
             ring: Vec::new(),
             bounds: Vec::new(),
             new_triangles: Vec::new(),
+            corner_points: Vec::new(),
             model: rules.model,
             selection: rules.selection,
             method: rules.method,
@@ -415,11 +418,17 @@ impl ScatterRemover {
         for &t in &self.star.triangles {
             self.first[t as usize] = NONE;
         }
+        self.corner_points.clear();
+        self.corner_points.extend(
+            self.new_triangles
+                .iter()
+                .map(|(slot, c, _)| (*slot, c.map(|u| mesh.point(u)))),
+        );
         for (&p, point) in self.hole_ids.iter().zip(&self.hole_points.points) {
-            let home = self.new_triangles.iter().find(|(_, c, _)| {
-                let [a, b, cc] = c.map(|u| mesh.point(u));
-                in_closed_triangle(&a, &b, &cc, point)
-            });
+            let home = self
+                .corner_points
+                .iter()
+                .find(|(_, [a, b, c])| in_closed_triangle(a, b, c, point));
             // Some new triangle holds every point of the hole: they tile it.
             let slot = home.map_or(self.new_triangles[0].0, |h| h.0);
             debug_assert!(home.is_some(), "point {p} outside its hole");

@@ -6,9 +6,11 @@ use crate::cloud::PointCloud;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Duplicates {
     /// The lowest (ground under vegetation returns). The default: on the sample LAZ
-    /// files at every class and a 0.1 m bound it kept the fewest triangles (autzen, 7
-    /// duplicates: 101,301 against 101,305 for the mean; Lidar HD, 19 duplicates: 10,864
-    /// against 10,894), and a low return is the likelier ground.
+    /// files at every class and a 0.1 m bound the mean kept the most triangles (autzen,
+    /// 7 duplicates: 101,307 against 101,303 for lowest, highest and first; Lidar HD, 19
+    /// duplicates: 11,029 against 11,011 for lowest and first, 10,999 for highest), the
+    /// other rules are within 0.2 % of one another, and a low return is the likelier
+    /// ground.
     #[default]
     Lowest,
     /// The highest.
@@ -19,16 +21,20 @@ pub enum Duplicates {
     First,
 }
 
-/// Sorts the points by position (y, then x: row by row) and merges points at the same
-/// position into one by `rule`; returns how many points were merged away. Deterministic:
-/// ties keep file order, and the mean is summed in file order.
+/// Sorts the points along the Z-order (Morton) curve of their lattice positions and
+/// merges points at the same position into one by `rule`; returns how many points were
+/// merged away. Deterministic: ties keep file order, and the mean is summed in file order.
+///
+/// Z-order keeps points that are near in the plane near in memory, and the decimator
+/// sweeps in point order: against row-major order it cut the decimation of 1 M points
+/// sampled from a DEM (`make bench-points`'s) from 6.9 s to 5.4 s (best of 3), for
+/// 0.6 % more triangles (88,147 against 87,643).
 pub fn dedupe(cloud: &mut PointCloud, rule: Duplicates) -> usize {
     let n = cloud.xy.len();
-    let mut order: Vec<u32> = (0..n as u32).collect();
-    order.sort_by_key(|&i| {
-        let [x, y] = cloud.xy[i as usize];
-        (y, x, i)
-    });
+    // Keys computed once (16 bytes per point while sorting), not at every comparison.
+    let mut keyed: Vec<(u64, u32)> = (0..n).map(|i| (morton(cloud.xy[i]), i as u32)).collect();
+    keyed.sort_unstable();
+    let order: Vec<u32> = keyed.into_iter().map(|(_, i)| i).collect();
     let (mut xy, mut z) = (Vec::with_capacity(n), Vec::with_capacity(n));
     let mut run = 0;
     while run < n {
@@ -52,6 +58,20 @@ pub fn dedupe(cloud: &mut PointCloud, rule: Duplicates) -> usize {
     cloud.xy = xy;
     cloud.z = z;
     merged
+}
+
+/// The Z-order key of a lattice position (coordinates below 2^31): their bits
+/// interleaved, x in the even bits.
+fn morton([x, y]: [i64; 2]) -> u64 {
+    fn spread(v: i64) -> u64 {
+        let mut v = v as u64 & 0x7fff_ffff;
+        v = (v | v << 16) & 0x0000_ffff_0000_ffff;
+        v = (v | v << 8) & 0x00ff_00ff_00ff_00ff;
+        v = (v | v << 4) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | v << 2) & 0x3333_3333_3333_3333;
+        (v | v << 1) & 0x5555_5555_5555_5555
+    }
+    spread(x) | spread(y) << 1
 }
 
 #[cfg(test)]
@@ -88,10 +108,12 @@ mod tests {
     }
 
     #[test]
-    fn sorted_row_by_row() {
+    fn sorted_along_the_z_order_curve() {
         let mut c = cloud(&[([3, 0], 1.0), ([1, 2], 2.0), ([0, 1], 3.0), ([2, 0], 4.0)]);
         assert_eq!(dedupe(&mut c, Duplicates::First), 0);
-        assert_eq!(c.xy, vec![[2, 0], [3, 0], [0, 1], [1, 2]]);
-        assert_eq!(c.z, vec![4.0, 1.0, 3.0, 2.0]);
+        // Keys: (0,1) -> 2, (2,0) -> 4, (3,0) -> 5, (1,2) -> 9.
+        assert_eq!(c.xy, vec![[0, 1], [2, 0], [3, 0], [1, 2]]);
+        assert_eq!(c.z, vec![3.0, 4.0, 1.0, 2.0]);
+        assert_eq!(morton([(1 << 31) - 1, (1 << 31) - 1]), (1 << 62) - 1);
     }
 }

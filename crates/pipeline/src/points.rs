@@ -32,6 +32,12 @@ fn read(
     let mut options = ReadOptions::default();
     options.classes = choices.classes.clone();
     options.no_withheld = choices.no_withheld;
+    if !path_is_las(path) && (choices.classes.is_some() || choices.no_withheld) {
+        feedback.note(&format!(
+            "{}: --classes and --no-withheld apply to LAS and LAZ only; every point is read",
+            path.display()
+        ));
+    }
     let mut cloud = tinsmith_points::read_points(path, &options)?;
     match &cloud.classes {
         ClassChoice::DefaultGround => feedback.note(&format!(

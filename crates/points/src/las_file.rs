@@ -160,12 +160,22 @@ fn check_point_count(path: &Path) -> Result<()> {
     let compressed = raw.point_data_record_format & 0b1100_0000 != 0;
     if !compressed {
         let record = u64::from(raw.point_data_record_length).max(1);
-        let end = raw
-            .evlr
-            .as_ref()
-            .filter(|e| e.number_of_evlrs > 0)
-            .map_or(file_len, |e| e.start_of_first_evlr);
-        let held = end.saturating_sub(u64::from(raw.offset_to_point_data)) / record;
+        let offset = u64::from(raw.offset_to_point_data);
+        // The points end where the first EVLR or internal waveform packet starts, or the
+        // file ends.
+        let after = [
+            raw.evlr
+                .as_ref()
+                .filter(|e| e.number_of_evlrs > 0)
+                .map(|e| e.start_of_first_evlr),
+            raw.start_of_waveform_data_packet_record,
+        ];
+        let end = after
+            .into_iter()
+            .flatten()
+            .filter(|&at| at >= offset)
+            .fold(file_len, u64::min);
+        let held = end.saturating_sub(offset) / record;
         if held != count {
             return Err(format_error(
                 path,

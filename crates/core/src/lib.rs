@@ -10,6 +10,11 @@
 //! sample's position differs from the sample value by at most
 //! [`DecimationOptions::max_error`]. The domain (the union of valid cells) is never changed.
 //!
+//! [`decimate_scatter`] decimates a triangulation of scattered points (a [`Scatter`] on an
+//! integer lattice, the paper's general case) with the same stars, classes and hole
+//! retriangulation: every point is within the bound of the output's interpolation at its
+//! position, and the triangulation's outline is never changed.
+//!
 //! # Example
 //! ```
 //! use tinsmith_core::{decimate, DecimationOptions, Grid};

@@ -257,6 +257,8 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
         .with_crs_wkt(if wgs84 { None } else { crs.as_deref() })
         .with_epsg(if wgs84 { Some(4326) } else { epsg });
     tinsmith_formats::write_mesh_with(output, format, mesh, &write_options)?;
+    let crs_written = !wgs84 && crs.as_deref().is_some_and(|w| !w.trim().is_empty());
+    crate::output_paths::note_prj_left_beside(output, format, crs_written, feedback);
     let write_seconds = t.elapsed().as_secs_f64();
 
     feedback.note(&format!(

@@ -17,10 +17,10 @@ TOOLS := .tools
 PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
   azure-storage-blob==12.27.1 dask[distributed]==2026.8.0 pyyaml==6.0.4 pillow==11.3.0 \
   maturin==1.16.0 pytest==9.2.0 affine==3.0.1 shapely==2.2.0 rasterio==1.4.4 \
-  rioxarray==0.19.0 xarray==2026.9.0 pandas==3.1.1 pyproj==3.7.2
+  rioxarray==0.19.0 xarray==2026.9.0 pandas==3.1.1 pyproj==3.7.2 laspy[lazrs]==2.7.0
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps gdal oracles demo pictures test python-test bench-python bench-ctb bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview
+.PHONY: deps gdal oracles demo pictures test python-test bench-python bench-ctb bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview bench-points
 
 ## Everything the tests need: GDAL, then the independent oracles.
 deps: gdal
@@ -197,6 +197,13 @@ bench-tiles:
 bench-preview:
 	cargo build --release --quiet
 	python3 bench/preview_memory.py --shared ../shared --out /tmp/tinsmith-preview/results.md
+
+## Point input: points/s and bytes per point for read, triangulate and decimate on the
+## LAS/LAZ files of ../shared/data/points and 1 M points sampled from a DEM, and triangles
+## kept against the full Delaunay (docs/results.md, "Points"; about a minute).
+bench-points:
+	cargo build --release --quiet
+	python3 bench/points.py --shared ../shared
 
 ## Sharded pyramids: ETOPO5 and a 16384 x 8192 resample in one process vs 4 shards on a
 ## Dask LocalCluster, and 1000 shards of a planet-size VRT (docs/results.md, "Sharded

@@ -12,6 +12,7 @@ mod formats;
 mod mbtiles;
 mod mesh_and_verify;
 mod object_storage;
+mod points;
 mod preview;
 mod serve;
 mod shards;

@@ -240,7 +240,8 @@ pub struct InfoArgs {
 
 #[derive(Debug, Args)]
 pub struct VerifyArgs {
-    /// The raster the mesh was made from.
+    /// The raster the mesh was made from, or its points (.las, .laz, .xyz/.csv/.txt):
+    /// every point is measured against the mesh.
     pub input: PathBuf,
     /// The mesh to check (.ply, .obj, .stl, .glb, .geojson, .fgb, .xml, or any with
     /// --format); GeoJSON in WGS84 is transformed back to the raster's CRS.
@@ -265,6 +266,8 @@ pub struct VerifyArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub points: mesh::PointArgs,
 }
 
 impl VerifyArgs {

@@ -9,6 +9,28 @@ use crate::args::VerifyArgs;
 /// Runs the verifier and prints its report; `Ok(false)` when the mesh is invalid or
 /// exceeds `--max-error`.
 pub fn run(args: &VerifyArgs) -> Result<bool> {
+    if tinsmith_pipeline::is_point_input(&args.input) {
+        let Some(max_error) = args.max_error else {
+            anyhow::bail!(
+                "{}: verifying points needs --max-error",
+                args.input.display()
+            );
+        };
+        let report = tinsmith_pipeline::verify_points_file(
+            &args.input,
+            &args.mesh,
+            args.format,
+            max_error,
+            &args.points.choices(None),
+            &tinsmith_pipeline::Silent,
+        )?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&report)?);
+        } else {
+            println!("{}", tinsmith_pipeline::points_summary(&report));
+        }
+        return Ok(report.passed());
+    }
     let verified = tinsmith_pipeline::verify(&args.job())?;
     let report = &verified.report;
     if args.json {

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use tinsmith_formats::MeshFormat;
-use tinsmith_pipeline::{ExportChoices, MeshJob, TileFormat};
+use tinsmith_pipeline::{Duplicates, ExportChoices, MeshJob, PointChoices, TileFormat};
 
 use super::values::{
     ErrorModelArg, InitialMeshArg, OrderArg, RetriangulateArg, SelectionArg, VertexHeightsArg,
@@ -13,7 +13,9 @@ use super::{parse_finite, parse_interval, parse_max_error};
 
 #[derive(Debug, Args)]
 pub struct MeshArgs {
-    /// Any single-band raster GDAL can read (GeoTIFF, ESRI ASCII, HGT, VRT, PNG...).
+    /// Any single-band raster GDAL can read (GeoTIFF, ESRI ASCII, HGT, VRT, PNG...), or
+    /// points: .las, .laz, or .xyz/.csv/.txt text (x y z columns), Delaunay-triangulated
+    /// and decimated within --max-error of every point.
     pub input: PathBuf,
     /// Output mesh; the format follows the extension (.ply, .obj, .stl, .glb, .geojson,
     /// .fgb, .xml or .landxml for LandXML) unless --format names it. Optional with --per-tile.
@@ -122,6 +124,61 @@ pub struct MeshArgs {
     // Checked in `mesh::run`: clap's `requires` lets it through beside -o.
     #[arg(long, value_enum)]
     pub tile_format: Option<TileFormatArg>,
+    #[command(flatten)]
+    pub points: PointArgs,
+    /// Points only: the CRS to write (EPSG:CODE, WKT, ...), instead of the file's.
+    #[arg(long, value_name = "CRS", help_heading = "Point input")]
+    pub crs: Option<String>,
+}
+
+/// The flags of point input (LAS/LAZ, XYZ/CSV text), shared by `mesh` and `verify`.
+#[derive(Debug, Args)]
+pub struct PointArgs {
+    /// LAS classes to keep, comma-separated [default: 2 (ground) when the file has any
+    /// ground point, else every class].
+    #[arg(
+        long,
+        value_name = "C,..",
+        value_delimiter = ',',
+        help_heading = "Point input"
+    )]
+    pub classes: Vec<u8>,
+    /// Drop LAS points flagged withheld.
+    #[arg(long, help_heading = "Point input")]
+    pub no_withheld: bool,
+    /// Which height a position with several points keeps (see docs/cli.md, "Point
+    /// input", for how the default was chosen).
+    #[arg(long, value_enum, default_value_t = DuplicatesArg::Lowest, help_heading = "Point input")]
+    pub duplicates: DuplicatesArg,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum DuplicatesArg {
+    /// The lowest height.
+    Lowest,
+    /// The highest height.
+    Highest,
+    /// The mean of the heights.
+    Mean,
+    /// The first in file order.
+    First,
+}
+
+impl PointArgs {
+    /// The point choices these flags ask for (`crs` from `mesh --crs`).
+    pub fn choices(&self, crs: Option<String>) -> PointChoices {
+        let mut choices = PointChoices::default();
+        choices.classes = (!self.classes.is_empty()).then(|| self.classes.clone());
+        choices.no_withheld = self.no_withheld;
+        choices.duplicates = match self.duplicates {
+            DuplicatesArg::Lowest => Duplicates::Lowest,
+            DuplicatesArg::Highest => Duplicates::Highest,
+            DuplicatesArg::Mean => Duplicates::Mean,
+            DuplicatesArg::First => Duplicates::First,
+        };
+        choices.crs = crs;
+        choices
+    }
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -186,6 +243,7 @@ impl MeshArgs {
             TileFormatArg::Ply => TileFormat::Ply,
             TileFormatArg::Obj => TileFormat::Obj,
         });
+        job.points = self.points.choices(self.crs.clone());
         job
     }
 }

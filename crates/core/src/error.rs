@@ -28,6 +28,10 @@ pub enum Error {
         "heights reach {0:e} in magnitude; decimation takes heights within ±1e37 (errors are kept as float32)"
     )]
     HeightsTooLarge(f64),
+    /// Scattered points or their triangulation are unusable (see [`crate::Scatter::new`],
+    /// [`crate::decimate_scatter`]); the message says which and why.
+    #[error("{0}")]
+    Scatter(String),
     /// The maximum error is negative, NaN or infinite.
     #[error("maximum error must be a finite number >= 0, got {0}")]
     InvalidMaxError(f64),

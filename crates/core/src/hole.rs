@@ -12,7 +12,8 @@ mod dp;
 mod ears;
 mod propagation;
 
-use crate::exact::{corner_samples, error_at, triangle_error};
+use crate::coverage::Coverage;
+use crate::exact::error_at;
 use crate::predicates::{in_closed_triangle, orient, plane_gradient, Point};
 use crate::{EdgeSelection, ErrorBound, ErrorModel, Grid, Retriangulation};
 use dp::Solved;
@@ -70,10 +71,11 @@ pub(crate) struct Retriangulator {
     stack: Vec<(usize, usize)>,
 }
 
-/// What the retriangulation needs besides the hole: the rules and the grid.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Rules<'g> {
-    pub grid: &'g Grid,
+/// What the retriangulation needs besides the hole: the rules and the samples the new
+/// triangles must come within the bound of (a grid, or a hole's scattered points).
+#[derive(Debug)]
+pub(crate) struct Rules<'g, S: Coverage + ?Sized = Grid> {
+    pub grid: &'g S,
     pub model: ErrorModel,
     pub selection: EdgeSelection,
     pub method: Retriangulation,
@@ -85,6 +87,14 @@ pub(crate) struct Rules<'g> {
     /// Contour levels (sorted) the DP minimizes the spanned count of, if any.
     pub levels: Option<&'g [f64]>,
 }
+
+impl<S: Coverage + ?Sized> Clone for Rules<'_, S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<S: Coverage + ?Sized> Copy for Rules<'_, S> {}
 
 impl Retriangulator {
     /// Loads a hole: the removed vertex, its ring and the bounds of its star triangles
@@ -113,7 +123,10 @@ impl Retriangulator {
     /// Triangulates the loaded hole under `rules`, accepting only triangles whose bound is
     /// at most `rules.limit` on both sides. Returns the triangles (corners index the ring)
     /// and the largest bound among them, or `None` on a dead end (paper §3.4).
-    pub(crate) fn retriangulate(&mut self, rules: &Rules<'_>) -> Option<(&[HoleTriangle], f64)> {
+    pub(crate) fn retriangulate<S: Coverage + ?Sized>(
+        &mut self,
+        rules: &Rules<'_, S>,
+    ) -> Option<(&[HoleTriangle], f64)> {
         if !self.centre_can_fit(rules.limit) {
             return None;
         }
@@ -182,13 +195,13 @@ impl Retriangulator {
 
     /// The bound of new triangle `abc` under the error model, if within the limit. For
     /// `Bounds`, `edges` are the bounds of its three edges (paper §3.3.3).
-    fn triangle_cost(
+    fn triangle_cost<S: Coverage + ?Sized>(
         &mut self,
         a: usize,
         b: usize,
         c: usize,
         edges: [SegmentError; 3],
-        rules: &Rules<'_>,
+        rules: &Rules<'_, S>,
     ) -> Option<ErrorBound> {
         self.triangle_cost_capped([a, b, c], edges, rules, rules.limit, false)
     }
@@ -197,11 +210,11 @@ impl Retriangulator {
     /// error is known to exceed `cap` (the DP passes the best cost found so far).
     /// `in_hole` says the triangle is known to lie in the hole with no other ring vertex
     /// in it (its sides are ring edges or diagonals), as the DP's triangles do.
-    fn triangle_cost_capped(
+    fn triangle_cost_capped<S: Coverage + ?Sized>(
         &mut self,
         [a, b, c]: [usize; 3],
         edges: [SegmentError; 3],
-        rules: &Rules<'_>,
+        rules: &Rules<'_, S>,
         cap: f64,
         in_hole: bool,
     ) -> Option<ErrorBound> {
@@ -223,7 +236,7 @@ impl Retriangulator {
                 // The corners' samples: the vertices themselves unless heights are raised.
                 let raised;
                 let samples = if rules.grid.has_vertex_heights() {
-                    raised = corner_samples(rules.grid, [pa, pb, pc]);
+                    raised = rules.grid.corner_samples([pa, pb, pc]);
                     [&raised[0], &raised[1], &raised[2], &centre]
                 } else {
                     [pa, pb, pc, &centre]
@@ -238,7 +251,10 @@ impl Retriangulator {
                 // Equal values: a zero error may come out as 0.0 one way and -0.0 the other.
                 debug_assert_eq!(
                     e.map(|b| (b.above, b.below)),
-                    triangle_error(rules.grid, pa, pb, pc, cap).map(|b| (b.above, b.below)),
+                    rules
+                        .grid
+                        .triangle_error(pa, pb, pc, cap)
+                        .map(|b| (b.above, b.below)),
                     "a unit hole holds no other sample"
                 );
                 e?
@@ -260,7 +276,7 @@ impl Retriangulator {
                         {
                             None
                         } else {
-                            triangle_error(rules.grid, pa, pb, pc, cap)
+                            rules.grid.triangle_error(pa, pb, pc, cap)
                         };
                         // "Over the cap" is only worth keeping when the cap is the limit.
                         if e.is_some() || cap >= rules.limit {
@@ -289,6 +305,7 @@ fn within(bound: ErrorBound, limit: f64) -> bool {
 mod tests {
     use super::propagation::clip_segment;
     use super::*;
+    use crate::exact::triangle_error;
 
     fn pt(x: i64, y: i64, z: f64) -> Point {
         Point { x, y, z }

@@ -10,6 +10,11 @@
 //! sample's position differs from the sample value by at most
 //! [`DecimationOptions::max_error`]. The domain (the union of valid cells) is never changed.
 //!
+//! [`decimate_scatter`] decimates a triangulation of scattered points (a [`Scatter`] on an
+//! integer lattice, the paper's general case) with the same stars, classes and hole
+//! retriangulation: every point is within the bound of the output's interpolation at its
+//! position, and the triangulation's outline is never changed.
+//!
 //! # Example
 //! ```
 //! use tinsmith_core::{decimate, DecimationOptions, Grid};
@@ -23,6 +28,7 @@
 //! # }
 //! ```
 
+mod coverage;
 mod decimate;
 mod error;
 mod error_bound;
@@ -37,6 +43,7 @@ mod mesh;
 mod options;
 mod predicates;
 mod rtin;
+mod scatter;
 mod strips;
 mod tin;
 
@@ -52,4 +59,5 @@ pub use options::{
     DecimationOptions, EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation,
     VertexHeights,
 };
+pub use scatter::{decimate_scatter, Scatter, ScatterReport, ScatterTin, MAX_SCATTER_COORDINATE};
 pub use tin::{Tin, TinVertex};

@@ -74,10 +74,52 @@ pub(crate) struct Star {
     pub open: bool,
 }
 
-/// Triangle mesh over a grid's domain, with per-triangle [`ErrorBound`]s.
+/// Where a mesh's vertices are and what heights they carry: a grid's samples (vertex ids
+/// are sample indices) or scattered points (vertex ids are point indices).
+pub(crate) trait Vertices {
+    /// Position and height of vertex `v` (for a grid, [`Grid::vertex_height`]).
+    fn point(&self, v: u32) -> Point;
+    /// Position and sample value at vertex `v`.
+    fn sample_point(&self, v: u32) -> Point;
+    /// Number of vertex ids.
+    fn vertex_count(&self) -> usize;
+}
+
+impl Vertices for Grid {
+    #[inline]
+    fn point(&self, v: u32) -> Point {
+        let w = self.width() as usize;
+        let i = v as usize;
+        let (x, y) = (i % w, i / w);
+        Point {
+            x: x as i64,
+            y: y as i64,
+            z: self.vertex_height_at(i, x, y),
+        }
+    }
+
+    #[inline]
+    fn sample_point(&self, v: u32) -> Point {
+        let w = self.width() as usize;
+        let i = v as usize;
+        Point {
+            x: (i % w) as i64,
+            y: (i / w) as i64,
+            z: self.values()[i],
+        }
+    }
+
+    fn vertex_count(&self) -> usize {
+        self.width() as usize * self.height() as usize
+    }
+}
+
+/// Triangle mesh over a grid's domain or over scattered points, with per-triangle
+/// [`ErrorBound`]s. Generic over where its vertices are, so that stars, classes and
+/// removals are shared; monomorphized, so the grid's mesh pays nothing for it.
 #[derive(Debug)]
-pub(crate) struct Mesh<'g> {
-    grid: &'g Grid,
+pub(crate) struct Mesh<'g, V: Vertices + ?Sized = Grid> {
+    samples: &'g V,
     corners: Vec<[u32; 3]>,
     neighbours: Vec<[u32; 3]>,
     /// Bounds stored as `f32` rounded up (so still bounds), halving their memory.
@@ -89,7 +131,7 @@ pub(crate) struct Mesh<'g> {
     live_triangles: usize,
 }
 
-impl<'g> Mesh<'g> {
+impl<'g> Mesh<'g, Grid> {
     /// The initial mesh (paper §4): each valid cell split into two triangles along its
     /// `(x, y)`-`(x + 1, y + 1)` diagonal, all bounds zero.
     pub(crate) fn from_grid(grid: &'g Grid) -> Mesh<'g> {
@@ -151,7 +193,7 @@ impl<'g> Mesh<'g> {
             }
         }
         let mut mesh = Mesh {
-            grid,
+            samples: grid,
             corners,
             bounds: vec![CompactBound::default(); 2 * cells],
             neighbours,
@@ -201,7 +243,7 @@ impl<'g> Mesh<'g> {
         drop(waiting);
         let live = corners.len();
         let mut mesh = Mesh {
-            grid,
+            samples: grid,
             corners,
             bounds,
             neighbours,
@@ -238,13 +280,15 @@ impl<'g> Mesh<'g> {
             return false;
         }
         let exact = |p: &Point, q: &Point, r: &Point| {
-            crate::exact::triangle_error(self.grid, p, q, r, f64::INFINITY).expect("no limit")
+            crate::exact::triangle_error(self.samples, p, q, r, f64::INFINITY).expect("no limit")
         };
         let bounds = [exact(&pc, &pa, &pd), exact(&pc, &pd, &pb)];
         self.flip(t, e, bounds);
         true
     }
+}
 
+impl<'g, V: Vertices + ?Sized> Mesh<'g, V> {
     /// The triangle across edge `j` of `t` (from corner `j` to corner `j + 1`), or
     /// [`NONE`] on the domain boundary.
     pub(crate) fn across(&self, t: u32, j: usize) -> u32 {
@@ -330,16 +374,6 @@ impl<'g> Mesh<'g> {
         }
     }
 
-    /// Grid columns.
-    pub(crate) fn width(&self) -> u32 {
-        self.grid.width()
-    }
-
-    /// Grid rows.
-    pub(crate) fn height(&self) -> u32 {
-        self.grid.height()
-    }
-
     /// Number of live triangles.
     pub(crate) fn triangle_count(&self) -> usize {
         self.live_triangles
@@ -350,38 +384,22 @@ impl<'g> Mesh<'g> {
         self.vertex_triangle[v as usize] != NONE
     }
 
-    /// Samples per grid row (vertex `v` sits at column `v % width`, row `v / width`).
-    pub(crate) fn grid_width(&self) -> usize {
-        self.grid.width() as usize
-    }
-
     /// Number of vertex slots (grid samples).
     pub(crate) fn vertex_slots(&self) -> usize {
         self.vertex_triangle.len()
     }
 
-    /// Position and height of vertex `v` (see [`Grid::vertex_height`]).
+    /// Position and height of vertex `v` (see [`Vertices::point`]).
+    #[inline]
     pub(crate) fn point(&self, v: u32) -> Point {
-        let w = self.grid.width() as usize;
-        let i = v as usize;
-        let (x, y) = (i % w, i / w);
-        Point {
-            x: x as i64,
-            y: y as i64,
-            z: self.grid.vertex_height_at(i, x, y),
-        }
+        self.samples.point(v)
     }
 
     /// Position and sample value at vertex `v`: what the TIN must come within the bound of
     /// there once `v` is gone.
+    #[inline]
     pub(crate) fn sample_point(&self, v: u32) -> Point {
-        let w = self.grid.width() as usize;
-        let i = v as usize;
-        Point {
-            x: (i % w) as i64,
-            y: (i / w) as i64,
-            z: self.grid.values()[i],
-        }
+        self.samples.sample_point(v)
     }
 
     /// Bound of triangle `t`.
@@ -627,5 +645,69 @@ impl<'g> Mesh<'g> {
                 );
             }
         }
+    }
+}
+
+impl Mesh<'_, Grid> {
+    /// Grid columns.
+    pub(crate) fn width(&self) -> u32 {
+        self.samples.width()
+    }
+
+    /// Grid rows.
+    pub(crate) fn height(&self) -> u32 {
+        self.samples.height()
+    }
+
+    /// Samples per grid row (vertex `v` sits at column `v % width`, row `v / width`).
+    pub(crate) fn grid_width(&self) -> usize {
+        self.samples.width() as usize
+    }
+}
+
+impl<'g, V: Vertices + ?Sized> Mesh<'g, V> {
+    /// A mesh from counter-clockwise triangles over `samples`' vertices that form a
+    /// conforming triangulation, all bounds zero. Neighbours are found by sorting the
+    /// directed edges (12 bytes per edge while linking).
+    pub(crate) fn from_conforming(samples: &'g V, corners: Vec<[u32; 3]>) -> Mesh<'g, V> {
+        let n = samples.vertex_count();
+        let mut edges: Vec<(u64, u32)> = Vec::with_capacity(3 * corners.len());
+        for (t, c) in corners.iter().enumerate() {
+            for e in 0..3 {
+                let (a, b) = (c[e], c[(e + 1) % 3]);
+                // The undirected edge's key, the triangle and which edge it is.
+                let key = u64::from(a.min(b)) << 32 | u64::from(a.max(b));
+                edges.push((key, (t as u32) << 2 | e as u32));
+            }
+        }
+        edges.sort_unstable();
+        let mut neighbours = vec![[NONE; 3]; corners.len()];
+        for pair in edges.windows(2) {
+            if pair[0].0 == pair[1].0 {
+                let (t, e) = ((pair[0].1 >> 2) as usize, (pair[0].1 & 3) as usize);
+                let (u, k) = ((pair[1].1 >> 2) as usize, (pair[1].1 & 3) as usize);
+                neighbours[t][e] = u as u32;
+                neighbours[u][k] = t as u32;
+            }
+        }
+        drop(edges);
+        let mut vertex_triangle = vec![NONE; n];
+        for (t, c) in corners.iter().enumerate() {
+            for &v in c {
+                vertex_triangle[v as usize] = t as u32;
+            }
+        }
+        let live = corners.len();
+        let mut mesh = Mesh {
+            samples,
+            bounds: vec![CompactBound::default(); corners.len()],
+            corners,
+            neighbours,
+            vertex_triangle,
+            pinched: vec![false; n],
+            live_triangles: live,
+        };
+        mesh.mark_pinched();
+        mesh
     }
 }

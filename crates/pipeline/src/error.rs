@@ -55,6 +55,9 @@ pub enum Error {
     /// A picture could not be drawn.
     #[error(transparent)]
     Preview(#[from] tinsmith_preview::PreviewError),
+    /// A point file could not be read.
+    #[error(transparent)]
+    Points(#[from] tinsmith_points::Error),
     /// An I/O operation failed (the `io::Error` is also the source, so that a closed
     /// pipe can be told apart).
     #[error("{0}")]

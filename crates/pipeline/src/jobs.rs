@@ -47,6 +47,22 @@ pub struct MeshJob {
     /// A PNG of the mesh's edges over the raster's hillshade (`tinsmith preview`'s
     /// default picture, 1600 pixels), written after the mesh.
     pub preview: Option<PathBuf>,
+    /// Point input (LAS/LAZ, XYZ/CSV text): which points and how duplicates merge.
+    pub points: PointChoices,
+}
+
+/// The choices that apply to point input only.
+#[derive(Debug, Clone, Default, PartialEq)]
+#[non_exhaustive]
+pub struct PointChoices {
+    /// LAS classes to keep; `None`: ground (class 2) if the file has any, else all.
+    pub classes: Option<Vec<u8>>,
+    /// Drop LAS points flagged withheld.
+    pub no_withheld: bool,
+    /// Which height a position with several points keeps.
+    pub duplicates: tinsmith_points::Duplicates,
+    /// The CRS to write (anything GDAL's `SetFromUserInput` takes), instead of the file's.
+    pub crs: Option<String>,
 }
 
 /// The format of the files a per-tile run writes.
@@ -90,6 +106,7 @@ impl MeshJob {
             per_tile: None,
             tile_format: None,
             preview: None,
+            points: PointChoices::default(),
         }
     }
 

@@ -34,6 +34,7 @@ mod memory;
 mod mesh;
 mod mesh_file;
 mod output_paths;
+mod points;
 mod preview;
 mod report;
 mod scan;
@@ -49,14 +50,18 @@ pub use error::{Error, Result};
 pub use feedback::{Feedback, Silent};
 pub use format_plan::{parse_format, FormatPlan};
 pub use jobs::{
-    ContourJob, ExportChoices, MeshJob, PreviewJob, TileFormat, VerifyJob, DEFAULT_TILE_SIZE,
+    ContourJob, ExportChoices, MeshJob, PointChoices, PreviewJob, TileFormat, VerifyJob,
+    DEFAULT_TILE_SIZE,
 };
 pub use mesh::mesh;
+pub use points::{duplicates_name, is_point_input, points_summary, verify_points_file};
 pub use preview::{preview, preview_decimated, Previewed, WHOLE_READ_SAMPLES};
 pub use scan::scan_raster;
 pub use serve::{serve, ServeOptions};
 pub use tiles::{merge_tiles, tiles, tiles_shard, vertical_datum, water_source};
 pub use tinsmith_choices::DecimationChoices;
 pub use tinsmith_georef::readable;
+pub use tinsmith_points::Duplicates;
 pub use tinsmith_tiling::available_bytes;
+pub use tinsmith_verify::PointsReport;
 pub use verify::{verify, Verified};

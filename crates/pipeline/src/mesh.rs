@@ -37,6 +37,9 @@ struct MeshReport<'a> {
 /// than `job.tile_size` or with `job.per_tile`); the mesh is written only if the
 /// independent verifier confirms the bound, with its heights as the file holds them.
 pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
+    if crate::points::is_point_input(&job.input) {
+        return crate::points::mesh_points(job, feedback);
+    }
     if job.tile_format.is_some() && job.per_tile.is_none() {
         bail!(
             "--tile-format sets the format of the --per-tile files; without --per-tile the \

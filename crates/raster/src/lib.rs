@@ -82,7 +82,8 @@ pub use polygons::{burn_polygons, is_vector};
 pub use quiet::{silence_gdal_errors, take_gdal_warnings};
 pub use read::{open_info, open_info_on, open_info_with_progress, read_samples, read_samples_on};
 pub use reproject::{
-    from_wgs84, horizontal_crs, is_geographic, is_wgs84_lon_lat, same_crs, to_wgs84,
+    crs_wkt, epsg_code, from_wgs84, horizontal_crs, is_geographic, is_wgs84_lon_lat, same_crs,
+    to_wgs84,
 };
 pub use sample::sample_geographic;
 pub use window::{read_window, WindowReader};

@@ -142,6 +142,31 @@ pub fn is_geographic(wkt: &str) -> Result<bool> {
     Ok(spatial_ref(wkt)?.is_geographic())
 }
 
+/// The WKT of a CRS given as anything GDAL's `SetFromUserInput` takes (`EPSG:2193`, WKT,
+/// PROJ strings).
+///
+/// # Errors
+/// [`Error::Crs`] when GDAL cannot read the CRS.
+pub fn crs_wkt(text: &str) -> Result<String> {
+    let srs = spatial_ref(text)?;
+    srs.to_wkt().map_err(|source| Error::Crs {
+        reason: format!("GDAL cannot write the CRS `{}` as WKT", short(text)),
+        source: Box::new(source),
+    })
+}
+
+/// The EPSG code a CRS text names at its root (`ID["EPSG", ...]` in WKT2,
+/// `AUTHORITY["EPSG", ...]` in WKT1, `EPSG:CODE`), if any: a CRS written from the EPSG
+/// database by an older release keeps its code when its datum's name has changed since,
+/// which GDAL's `IsSame` does not forgive.
+pub fn epsg_code(text: &str) -> Option<u32> {
+    let srs = spatial_ref(text).ok()?;
+    if !srs.auth_name()?.eq_ignore_ascii_case("EPSG") {
+        return None;
+    }
+    u32::try_from(srs.auth_code().ok()?).ok()
+}
+
 /// Whether two CRS texts (WKT in any dialect, ESRI's `.prj` included, or anything GDAL's
 /// `SetFromUserInput` takes) name the same CRS, by GDAL's `IsSame` (axis order aside).
 /// False when GDAL cannot read either.

@@ -3,6 +3,7 @@
 //! solved top-down.
 
 use super::{HoleTriangle, Retriangulator, Rules, SegmentError};
+use crate::coverage::Coverage;
 use crate::levels::{dirichlet_energy, triangle_levels};
 use crate::predicates::orient;
 #[cfg(test)]
@@ -28,7 +29,10 @@ impl Retriangulator {
     /// the limit). Ties within an interval go to the smallest summed error (least Dirichlet
     /// energy), then the smallest `k`. Solved top-down from the whole ring (see
     /// [`Retriangulator::solve_interval`]).
-    pub(super) fn dynamic_programming(&mut self, rules: &Rules<'_>) -> bool {
+    pub(super) fn dynamic_programming<S: Coverage + ?Sized>(
+        &mut self,
+        rules: &Rules<'_, S>,
+    ) -> bool {
         let m = self.ring.len();
         self.triangles.clear();
         self.diagonal.clear();
@@ -83,12 +87,12 @@ impl Retriangulator {
     /// asked for what could still beat the best split so far, so a hole that cannot be
     /// triangulated is usually refuted after few triangles, where filling the whole table
     /// bottom-up measured them all (15-18 % of the decimation's time, same output).
-    fn solve_interval(
+    fn solve_interval<S: Coverage + ?Sized>(
         &mut self,
         i: usize,
         j: usize,
         cap: f64,
-        rules: &Rules<'_>,
+        rules: &Rules<'_, S>,
     ) -> Option<(f64, f64)> {
         let m = self.ring.len();
         if j == i + 1 {

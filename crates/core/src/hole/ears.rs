@@ -2,6 +2,7 @@
 //! the ear chosen by the edge selection rule.
 
 use super::{HoleTriangle, Retriangulator, Rules, SegmentError};
+use crate::coverage::Coverage;
 use crate::predicates::{in_closed_triangle, orient};
 use crate::{EdgeSelection, ErrorBound, ErrorModel};
 
@@ -13,7 +14,11 @@ pub(super) struct Ear {
 }
 
 impl Retriangulator {
-    pub(super) fn clip_ears(&mut self, rule: EdgeSelection, rules: &Rules<'_>) -> bool {
+    pub(super) fn clip_ears<S: Coverage + ?Sized>(
+        &mut self,
+        rule: EdgeSelection,
+        rules: &Rules<'_, S>,
+    ) -> bool {
         let m = self.ring.len();
         self.triangles.clear();
         self.prev.clear();
@@ -91,7 +96,7 @@ impl Retriangulator {
     }
 
     /// The ear at `q` if it is convex and its triangle's bound is within the limit.
-    fn ear(&mut self, q: usize, rules: &Rules<'_>) -> Option<Ear> {
+    fn ear<S: Coverage + ?Sized>(&mut self, q: usize, rules: &Rules<'_, S>) -> Option<Ear> {
         let (p, r) = (self.prev[q] as usize, self.next[q] as usize);
         if orient(&self.ring[p], &self.ring[q], &self.ring[r]) <= 0 {
             return None;

@@ -1,0 +1,74 @@
+//! The samples a triangle covers, as the exact error model measures them: a grid's lattice
+//! samples in the triangle, or the scattered points charged to the hole being filled.
+
+use crate::exact::{corner_samples, error_at, triangle_error};
+use crate::predicates::{in_closed_triangle, Point};
+use crate::{ErrorBound, Grid};
+
+/// The original samples a new triangle of a hole must come within the bound of.
+pub(crate) trait Coverage {
+    /// The exact above/below error of the plane through counter-clockwise triangle `abc`
+    /// over every sample in the closed triangle, or `None` once either side exceeds
+    /// `limit`.
+    fn triangle_error(&self, a: &Point, b: &Point, c: &Point, limit: f64) -> Option<ErrorBound>;
+    /// Whether every height is an integer, so that an error of 0 is decided exactly.
+    fn integral_heights(&self) -> bool;
+    /// Whether vertex heights differ from their samples (raised, see
+    /// [`crate::VertexHeights`]).
+    fn has_vertex_heights(&self) -> bool;
+    /// The samples at the given vertices' positions.
+    fn corner_samples(&self, corners: [&Point; 3]) -> [Point; 3];
+}
+
+impl Coverage for Grid {
+    #[inline]
+    fn triangle_error(&self, a: &Point, b: &Point, c: &Point, limit: f64) -> Option<ErrorBound> {
+        triangle_error(self, a, b, c, limit)
+    }
+
+    #[inline]
+    fn integral_heights(&self) -> bool {
+        Grid::integral_heights(self)
+    }
+
+    #[inline]
+    fn has_vertex_heights(&self) -> bool {
+        Grid::has_vertex_heights(self)
+    }
+
+    #[inline]
+    fn corner_samples(&self, corners: [&Point; 3]) -> [Point; 3] {
+        corner_samples(self, corners)
+    }
+}
+
+/// The scattered points of one hole: the removed vertex and the points charged to its
+/// star's triangles. Every point the hole's new triangles cover is among them (a point on
+/// the hole's outline may be charged to the triangle outside; the outline's edges stay, so
+/// its error does not change).
+#[derive(Debug, Default)]
+pub(crate) struct HolePoints {
+    pub(crate) points: Vec<Point>,
+}
+
+impl Coverage for HolePoints {
+    fn triangle_error(&self, a: &Point, b: &Point, c: &Point, limit: f64) -> Option<ErrorBound> {
+        let inside = self
+            .points
+            .iter()
+            .filter(|p| in_closed_triangle(a, b, c, p));
+        error_at(a, b, c, inside, limit)
+    }
+
+    fn integral_heights(&self) -> bool {
+        false
+    }
+
+    fn has_vertex_heights(&self) -> bool {
+        false
+    }
+
+    fn corner_samples(&self, corners: [&Point; 3]) -> [Point; 3] {
+        corners.map(|p| *p)
+    }
+}

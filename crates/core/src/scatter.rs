@@ -1,0 +1,634 @@
+//! Decimation of a triangulation of scattered points (the paper's general case: vertex
+//! classes, holes and error bounds are defined on any 2D triangulation, §3), with the error
+//! measured at every point.
+//!
+//! Every point starts as a vertex of the caller's triangulation (a Delaunay triangulation
+//! of the points, say). A removed vertex is charged to the new triangle that contains it
+//! (decided by the exact `i64` predicates); a removal is accepted only if every point
+//! charged to the hole, the removed vertex included, is within the bound of the new
+//! triangle containing it. Stars, classes, hole retriangulation (DP or ears) and both
+//! error models are the grid's: only where samples are differs.
+
+use crate::coverage::HolePoints;
+use crate::decimate::{effective_limit, MAX_ABS_HEIGHT};
+use crate::hole::{Retriangulator, Rules};
+use crate::mesh::{Mesh, Star, VertexClass, Vertices, NONE};
+use crate::predicates::{in_closed_triangle, orient, Point};
+use crate::{DecimationOptions, Error, ErrorBound, Result};
+
+/// The largest lattice coordinate a [`Scatter`] takes: with coordinates in
+/// `0..=MAX_SCATTER_COORDINATE` every difference is below 2^31, so each product in an
+/// orientation determinant is below 2^62 and the determinant is exact in `i64`.
+pub const MAX_SCATTER_COORDINATE: i64 = (1 << 31) - 1;
+
+/// The largest hole (ring vertices) retriangulated, as on grids (see the grid driver).
+const MAX_HOLE_RING: usize = 64;
+
+/// Scattered samples at distinct integer lattice positions, each with a height.
+///
+/// Positions are in `0..=`[`MAX_SCATTER_COORDINATE`] on both axes, so the core's exact
+/// predicates apply to them unchanged; heights are finite and within
+/// [`MAX_ABS_HEIGHT`].
+#[derive(Debug, Clone)]
+pub struct Scatter {
+    xy: Vec<[i64; 2]>,
+    z: Vec<f64>,
+}
+
+impl Scatter {
+    /// Scattered samples from lattice positions and heights (the same count).
+    ///
+    /// # Errors
+    /// [`Error::Scatter`] when the counts differ, there are `u32::MAX` points or more, a
+    /// position is outside `0..=MAX_SCATTER_COORDINATE` or a height is not finite;
+    /// [`Error::HeightsTooLarge`] when some |height| exceeds [`MAX_ABS_HEIGHT`].
+    pub fn new(xy: Vec<[i64; 2]>, z: Vec<f64>) -> Result<Scatter> {
+        if xy.len() != z.len() {
+            return Err(Error::Scatter(format!(
+                "{} positions but {} heights",
+                xy.len(),
+                z.len()
+            )));
+        }
+        if xy.len() >= u32::MAX as usize {
+            return Err(Error::Scatter(format!(
+                "{} points; at most {} fit 32-bit vertex ids",
+                xy.len(),
+                u32::MAX - 1
+            )));
+        }
+        let range = 0..=MAX_SCATTER_COORDINATE;
+        if let Some(p) = xy
+            .iter()
+            .find(|p| !range.contains(&p[0]) || !range.contains(&p[1]))
+        {
+            return Err(Error::Scatter(format!(
+                "lattice position ({}, {}) is outside 0..={MAX_SCATTER_COORDINATE}",
+                p[0], p[1]
+            )));
+        }
+        if let Some(h) = z.iter().find(|h| !h.is_finite()) {
+            return Err(Error::Scatter(format!("height {h} is not finite")));
+        }
+        let max_abs = z.iter().fold(0.0f64, |m, h| m.max(h.abs()));
+        if max_abs > MAX_ABS_HEIGHT {
+            return Err(Error::HeightsTooLarge(max_abs));
+        }
+        Ok(Scatter { xy, z })
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.xy.len()
+    }
+
+    /// Whether there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.xy.is_empty()
+    }
+
+    /// Lattice position of point `i`.
+    ///
+    /// # Panics
+    /// When `i` is out of range.
+    pub fn position(&self, i: usize) -> [i64; 2] {
+        self.xy[i]
+    }
+
+    /// Height of point `i`.
+    ///
+    /// # Panics
+    /// When `i` is out of range.
+    pub fn height(&self, i: usize) -> f64 {
+        self.z[i]
+    }
+
+    fn max_abs_height(&self) -> f64 {
+        self.z.iter().fold(0.0f64, |m, h| m.max(h.abs()))
+    }
+}
+
+impl Vertices for Scatter {
+    #[inline]
+    fn point(&self, v: u32) -> Point {
+        let [x, y] = self.xy[v as usize];
+        Point {
+            x,
+            y,
+            z: self.z[v as usize],
+        }
+    }
+
+    #[inline]
+    fn sample_point(&self, v: u32) -> Point {
+        self.point(v)
+    }
+
+    fn vertex_count(&self) -> usize {
+        self.xy.len()
+    }
+}
+
+/// A decimated triangulation of a [`Scatter`]: kept points and triangles over them.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ScatterTin {
+    vertices: Vec<u32>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl ScatterTin {
+    /// The kept points, as indices into the [`Scatter`], increasing.
+    pub fn vertices(&self) -> &[u32] {
+        &self.vertices
+    }
+
+    /// Triangles as indices into [`ScatterTin::vertices`], counter-clockwise in lattice
+    /// coordinates (x right, y up), non-degenerate; they tile the input triangulation's
+    /// domain exactly.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+}
+
+/// What a scattered decimation reached.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ScatterReport {
+    /// Triangles of the input triangulation.
+    pub initial_triangles: usize,
+    /// Vertices kept.
+    pub final_vertices: usize,
+    /// Triangles kept.
+    pub final_triangles: usize,
+    /// Largest error bound of any kept triangle: an upper bound on the true error.
+    pub max_bound: f64,
+    /// Sweeps until nothing could be removed.
+    pub sweeps: usize,
+    /// Removal attempts.
+    pub attempts: usize,
+}
+
+/// Decimates the triangulation `triangles` of `scatter` (counter-clockwise corner
+/// triples of point indices forming a conforming triangulation, every point a vertex)
+/// into a TIN within `options.max_error` of every point.
+///
+/// Vertices are removed in repeated sweeps in point order, each sweep visiting only the
+/// vertices whose star changed (a vertex whose star did not change fails again), until a
+/// sweep removes nothing (the paper's order, §3.1). Corner vertices (§3.2: any boundary
+/// vertex whose two boundary edges are not collinear) are never removed, so the domain
+/// (the triangulation's union, a convex hull for a Delaunay triangulation) is unchanged.
+/// `options.error_model`, `retriangulation`, `selection` and `dp_max_ring` apply as on
+/// grids; the start is always the given triangulation and the order the sweep.
+///
+/// # Guarantee
+/// Every point is within `max_error` of the TIN's linear interpolation at its position,
+/// with the same rounding slack as [`crate::decimate`] (`2^-40 (max_error + max|z|)`).
+///
+/// # Determinism
+/// The result depends only on the inputs.
+///
+/// # Errors
+/// [`Error::InvalidMaxError`] for a negative, NaN or infinite bound; [`Error::Scatter`]
+/// for a count or vertical target (not supported here), a triangle that is not
+/// counter-clockwise or names a missing point, or a point in no triangle.
+pub fn decimate_scatter(
+    scatter: &Scatter,
+    triangles: Vec<[u32; 3]>,
+    options: &DecimationOptions,
+) -> Result<(ScatterTin, ScatterReport)> {
+    let max_error = options.max_error;
+    if !max_error.is_finite() || max_error < 0.0 {
+        return Err(Error::InvalidMaxError(max_error));
+    }
+    if options.max_triangles.is_some() || options.max_vertices.is_some() {
+        return Err(Error::Scatter(
+            "triangle or vertex count targets are not supported for points".into(),
+        ));
+    }
+    let n = scatter.len();
+    let mut used = vec![false; n];
+    for c in &triangles {
+        if c.iter().any(|&v| v as usize >= n) {
+            return Err(Error::Scatter(format!(
+                "triangle {c:?} names a missing point"
+            )));
+        }
+        let [a, b, cc] = c.map(|v| scatter.point(v));
+        if orient(&a, &b, &cc) <= 0 {
+            return Err(Error::Scatter(format!(
+                "triangle {c:?} is not counter-clockwise"
+            )));
+        }
+        for &v in c {
+            used[v as usize] = true;
+        }
+    }
+    if let Some(v) = used.iter().position(|u| !u) {
+        return Err(Error::Scatter(format!(
+            "point {v} is not a vertex of the triangulation"
+        )));
+    }
+    drop(used);
+    let initial_triangles = triangles.len();
+    let limit = effective_limit(max_error, scatter.max_abs_height());
+    let mut mesh = Mesh::from_conforming(scatter, triangles);
+    #[cfg(any(test, debug_assertions))]
+    mesh.check_invariants();
+    let rules = Rules {
+        grid: &HolePoints::default(),
+        model: options.error_model,
+        selection: options.selection,
+        method: options.retriangulation,
+        dp_max_ring: options.dp_max_ring,
+        limit,
+        max_edge_squared: i64::MAX,
+        levels: None,
+    };
+    let mut remover = ScatterRemover::new(&mesh, rules);
+    let (sweeps, attempts) = remover.sweep(&mut mesh);
+    #[cfg(any(test, debug_assertions))]
+    mesh.check_invariants();
+    let max_bound = mesh
+        .live_triangles()
+        .fold(0.0f64, |m, (t, _)| m.max(mesh.bound(t).max()))
+        .min(limit);
+    let (vertices, triangles) = mesh.into_numbered();
+    let report = ScatterReport {
+        initial_triangles,
+        final_vertices: vertices.len(),
+        final_triangles: triangles.len(),
+        max_bound,
+        sweeps,
+        attempts,
+    };
+    Ok((
+        ScatterTin {
+            vertices,
+            triangles,
+        },
+        report,
+    ))
+}
+
+/// Removes vertices and keeps each removed point charged to the triangle containing it:
+/// per triangle slot the first charged point, per point the next one in its triangle.
+struct ScatterRemover {
+    first: Vec<u32>,
+    next: Vec<u32>,
+    star: Star,
+    hole: Retriangulator,
+    hole_points: HolePoints,
+    /// Point ids of `hole_points.points`, in the same order.
+    hole_ids: Vec<u32>,
+    ring: Vec<Point>,
+    bounds: Vec<ErrorBound>,
+    new_triangles: Vec<(u32, [u32; 3], ErrorBound)>,
+    /// The new triangles' slots and corner points, while charging points to them.
+    corner_points: Vec<(u32, [Point; 3])>,
+    model: crate::ErrorModel,
+    selection: crate::EdgeSelection,
+    method: crate::Retriangulation,
+    dp_max_ring: usize,
+    limit: f64,
+}
+
+impl ScatterRemover {
+    fn new(mesh: &Mesh<'_, Scatter>, rules: Rules<'_, HolePoints>) -> ScatterRemover {
+        ScatterRemover {
+            first: vec![NONE; mesh.triangle_slots()],
+            next: vec![NONE; mesh.vertex_slots()],
+            star: Star::default(),
+            hole: Retriangulator::default(),
+            hole_points: HolePoints::default(),
+            hole_ids: Vec::new(),
+            ring: Vec::new(),
+            bounds: Vec::new(),
+            new_triangles: Vec::new(),
+            corner_points: Vec::new(),
+            model: rules.model,
+            selection: rules.selection,
+            method: rules.method,
+            dp_max_ring: rules.dp_max_ring,
+            limit: rules.limit,
+        }
+    }
+
+    /// Sweeps until one removes nothing; returns the sweeps and the attempts.
+    fn sweep(&mut self, mesh: &mut Mesh<'_, Scatter>) -> (usize, usize) {
+        let n = mesh.vertex_slots();
+        let mut queued = vec![true; n];
+        let mut candidates: Vec<u32> = (0..n as u32).collect();
+        let (mut sweeps, mut attempts) = (0, 0);
+        let mut changed: Vec<u32> = Vec::new();
+        while !candidates.is_empty() {
+            sweeps += 1;
+            for &v in &candidates {
+                queued[v as usize] = false;
+            }
+            for &v in &candidates {
+                if !mesh.contains_vertex(v) {
+                    continue;
+                }
+                attempts += 1;
+                if self.plan(mesh, v) {
+                    self.apply(mesh, v);
+                    for &u in &self.star.ring {
+                        if !queued[u as usize] {
+                            queued[u as usize] = true;
+                            changed.push(u);
+                        }
+                    }
+                }
+            }
+            // Next sweep: the vertices whose star changed, in point order.
+            changed.sort_unstable();
+            std::mem::swap(&mut candidates, &mut changed);
+            changed.clear();
+        }
+        (sweeps, attempts)
+    }
+
+    /// Plans the removal of `v`: true when it is interior or boundary and its hole has a
+    /// triangulation within the limit at every point charged to it.
+    fn plan(&mut self, mesh: &Mesh<'_, Scatter>, v: u32) -> bool {
+        mesh.star(v, &mut self.star);
+        if self.star.ring.len() > MAX_HOLE_RING
+            || mesh.classify(v, &self.star) == VertexClass::Corner
+        {
+            return false;
+        }
+        self.ring.clear();
+        self.ring
+            .extend(self.star.ring.iter().map(|&u| mesh.point(u)));
+        let centre = mesh.sample_point(v);
+        if self.limit == 0.0 && self.ring.iter().any(|p| p.z != centre.z) {
+            // Below the rounding slack only exactly flat stars go, as on grids.
+            return false;
+        }
+        let (lo, hi) = self
+            .ring
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.z), hi.max(p.z))
+            });
+        if centre.z - hi > self.limit || lo - centre.z > self.limit {
+            return false;
+        }
+        self.hole_points.points.clear();
+        self.hole_ids.clear();
+        self.hole_points.points.push(centre);
+        self.hole_ids.push(v);
+        for &t in &self.star.triangles {
+            let mut p = self.first[t as usize];
+            while p != NONE {
+                self.hole_points.points.push(mesh.sample_point(p));
+                self.hole_ids.push(p);
+                p = self.next[p as usize];
+            }
+        }
+        self.bounds.clear();
+        self.bounds
+            .extend(self.star.triangles.iter().map(|&t| mesh.bound(t)));
+        self.hole.load(centre, &self.ring, &self.bounds);
+        let rules = Rules {
+            grid: &self.hole_points,
+            model: self.model,
+            selection: self.selection,
+            method: self.method,
+            dp_max_ring: self.dp_max_ring,
+            limit: self.limit,
+            max_edge_squared: i64::MAX,
+            levels: None,
+        };
+        let Some((triangles, _)) = self.hole.retriangulate(&rules) else {
+            return false;
+        };
+        self.new_triangles.clear();
+        for (tri, &slot) in triangles.iter().zip(&self.star.triangles) {
+            let corners = tri.corners.map(|i| self.star.ring[i as usize]);
+            self.new_triangles.push((slot, corners, tri.bound));
+        }
+        true
+    }
+
+    /// Carries out the last successful plan (for `v`, mesh unchanged since) and charges
+    /// the hole's points to the new triangles containing them (the first in hole order
+    /// for a point on a shared edge: both measured it).
+    fn apply(&mut self, mesh: &mut Mesh<'_, Scatter>, v: u32) {
+        mesh.replace_star(v, &self.star, &self.new_triangles);
+        for &t in &self.star.triangles {
+            self.first[t as usize] = NONE;
+        }
+        self.corner_points.clear();
+        self.corner_points.extend(
+            self.new_triangles
+                .iter()
+                .map(|(slot, c, _)| (*slot, c.map(|u| mesh.point(u)))),
+        );
+        for (&p, point) in self.hole_ids.iter().zip(&self.hole_points.points) {
+            let home = self
+                .corner_points
+                .iter()
+                .find(|(_, [a, b, c])| in_closed_triangle(a, b, c, point));
+            // Some new triangle holds every point of the hole: they tile it.
+            let slot = home.map_or(self.new_triangles[0].0, |h| h.0);
+            debug_assert!(home.is_some(), "point {p} outside its hole");
+            self.next[p as usize] = self.first[slot as usize];
+            self.first[slot as usize] = p;
+        }
+        #[cfg(test)]
+        mesh.check_invariants();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{ErrorModel, Retriangulation};
+
+    /// Points on a sheared lattice (odd columns raised by one), each quad split in two:
+    /// a conforming triangulation that is not a grid's.
+    fn lattice_scatter(w: i64, h: i64, f: impl Fn(f64, f64) -> f64) -> (Scatter, Vec<[u32; 3]>) {
+        let mut xy = Vec::new();
+        let mut z = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                xy.push([x * 3, y * 2 + (x % 2)]);
+                z.push(f(x as f64, y as f64));
+            }
+        }
+        let mut tris = Vec::new();
+        for y in 0..h - 1 {
+            for x in 0..w - 1 {
+                let a = (y * w + x) as u32;
+                let (b, c, d) = (a + 1, a + 1 + w as u32, a + w as u32);
+                tris.push([a, b, c]);
+                tris.push([a, c, d]);
+            }
+        }
+        (Scatter::new(xy, z).unwrap(), tris)
+    }
+
+    /// Measures every point against the TIN by brute force (closed triangles, f64).
+    fn worst_error(s: &Scatter, tin: &ScatterTin) -> f64 {
+        let mut worst = 0.0f64;
+        for i in 0..s.len() {
+            let p = s.point(i as u32);
+            let mut best = f64::INFINITY;
+            for t in tin.triangles() {
+                let [a, b, c] = t.map(|k| s.point(tin.vertices()[k as usize]));
+                if in_closed_triangle(&a, &b, &c, &p) {
+                    let d = orient(&a, &b, &c) as f64;
+                    let (wa, wb) = (orient(&b, &c, &p) as f64 / d, orient(&c, &a, &p) as f64 / d);
+                    let z = wa * a.z + wb * b.z + (1.0 - wa - wb) * c.z;
+                    best = best.min((z - p.z).abs());
+                }
+            }
+            assert!(best.is_finite(), "point {i} in no triangle");
+            worst = worst.max(best);
+        }
+        worst
+    }
+
+    #[test]
+    fn a_plane_keeps_only_its_hull_corners() {
+        let (s, tris) = lattice_scatter(12, 9, |x, y| 2.0 * x - y);
+        let (tin, report) = decimate_scatter(&s, tris, &DecimationOptions::new(1e-6)).unwrap();
+        // The plane z = 2x - y is not linear in the lattice positions (y is shifted on odd
+        // columns), so interior vertices may stay; the bound must hold regardless.
+        assert!(worst_error(&s, &tin) <= 1e-6);
+        assert!(report.final_vertices < s.len());
+    }
+
+    #[test]
+    fn every_point_within_the_bound_for_both_models_and_methods() {
+        let (s, tris) = lattice_scatter(20, 15, |x, y| {
+            (x * 0.7).sin() * 10.0 + (y * 0.4).cos() * 6.0
+        });
+        for model in [ErrorModel::Exact, ErrorModel::Bounds] {
+            for method in [Retriangulation::Dp, Retriangulation::Ears] {
+                let mut options = DecimationOptions::new(1.5);
+                options.error_model = model;
+                options.retriangulation = method;
+                let (tin, report) = decimate_scatter(&s, tris.clone(), &options).unwrap();
+                let worst = worst_error(&s, &tin);
+                assert!(worst <= 1.5, "{model:?} {method:?}: {worst}");
+                assert!(report.final_vertices < s.len() / 2, "{model:?} {method:?}");
+                assert!(report.max_bound <= 1.5);
+            }
+        }
+    }
+
+    /// Random distinct lattice points, the four corners of the square among them, with
+    /// heights from `f`, and their Delaunay triangulation (spade).
+    fn random_scatter(
+        n: usize,
+        seed: u64,
+        side: i64,
+        f: impl Fn(f64, f64) -> f64,
+    ) -> (Scatter, Vec<[u32; 3]>) {
+        use spade::{DelaunayTriangulation, Point2, Triangulation};
+        let mut s = seed;
+        let mut next = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        let mut seen = std::collections::BTreeSet::new();
+        let mut xy = vec![[0, 0], [side, 0], [0, side], [side, side]];
+        seen.extend(xy.iter().copied());
+        while xy.len() < n {
+            let p = [
+                (next() % (side as u64 + 1)) as i64,
+                (next() % (side as u64 + 1)) as i64,
+            ];
+            if seen.insert(p) {
+                xy.push(p);
+            }
+        }
+        let z = xy.iter().map(|p| f(p[0] as f64, p[1] as f64)).collect();
+        let d: DelaunayTriangulation<Point2<f64>> = DelaunayTriangulation::bulk_load(
+            xy.iter()
+                .map(|p| Point2::new(p[0] as f64, p[1] as f64))
+                .collect(),
+        )
+        .unwrap();
+        // Bulk loading reorders the vertices: back to point indices by position.
+        let index: std::collections::BTreeMap<[i64; 2], u32> =
+            xy.iter().enumerate().map(|(i, p)| (*p, i as u32)).collect();
+        let tris = d
+            .inner_faces()
+            .map(|f| {
+                f.vertices().map(|v| {
+                    let p = v.position();
+                    index[&[p.x as i64, p.y as i64]]
+                })
+            })
+            .collect();
+        (Scatter::new(xy, z).unwrap(), tris)
+    }
+
+    #[test]
+    fn random_points_within_the_bound_for_every_model_method_and_seed() {
+        for seed in [1, 2, 3] {
+            let (s, tris) = random_scatter(400, seed, 1000, |x, y| {
+                (x / 90.0).sin() * 30.0 + (y / 140.0).cos() * 20.0 + ((x * y) % 7.0) * 0.1
+            });
+            for model in [ErrorModel::Exact, ErrorModel::Bounds] {
+                for method in [Retriangulation::Dp, Retriangulation::Ears] {
+                    for bound in [0.5, 4.0] {
+                        let mut options = DecimationOptions::new(bound);
+                        options.error_model = model;
+                        options.retriangulation = method;
+                        let (tin, report) = decimate_scatter(&s, tris.clone(), &options).unwrap();
+                        let worst = worst_error(&s, &tin);
+                        assert!(
+                            worst <= bound,
+                            "{seed} {model:?} {method:?} {bound}: {worst}"
+                        );
+                        assert!(
+                            report.final_vertices < s.len(),
+                            "{seed} {model:?} {method:?}"
+                        );
+                        // The hull's corners stay.
+                        for corner in 0..4u32 {
+                            assert!(tin.vertices().contains(&corner));
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_plane_of_random_points_keeps_only_its_corners() {
+        let (s, tris) = random_scatter(300, 9, 500, |x, y| 3.0 + 0.5 * x - 0.25 * y);
+        let (tin, _) = decimate_scatter(&s, tris, &DecimationOptions::new(1e-6)).unwrap();
+        assert_eq!(tin.vertices(), &[0, 1, 2, 3]);
+        assert_eq!(tin.triangles().len(), 2);
+    }
+
+    #[test]
+    fn bad_triangulations_are_refused() {
+        let (s, mut tris) = lattice_scatter(3, 3, |_, _| 0.0);
+        tris[0].swap(1, 2);
+        assert!(matches!(
+            decimate_scatter(&s, tris, &DecimationOptions::new(1.0)),
+            Err(Error::Scatter(_))
+        ));
+        let (s, mut tris) = lattice_scatter(3, 3, |_, _| 0.0);
+        tris.truncate(2);
+        assert!(decimate_scatter(&s, tris, &DecimationOptions::new(1.0)).is_err());
+        assert!(Scatter::new(vec![[0, -1]], vec![0.0]).is_err());
+        assert!(Scatter::new(vec![[0, 0]], vec![f64::NAN]).is_err());
+    }
+
+    #[test]
+    fn same_input_same_output() {
+        let (s, tris) = lattice_scatter(15, 11, |x, y| (x * y).sqrt());
+        let o = DecimationOptions::new(0.3);
+        let a = decimate_scatter(&s, tris.clone(), &o).unwrap();
+        let b = decimate_scatter(&s, tris, &o).unwrap();
+        assert_eq!(a, b);
+    }
+}

@@ -1,0 +1,403 @@
+//! `tinsmith mesh` and `tinsmith verify` on point files (LAS/LAZ, XYZ/CSV text): read,
+//! merge duplicates, Delaunay-triangulate, decimate with every point within the bound,
+//! verify independently, write.
+
+use std::path::Path;
+use std::time::Instant;
+
+use serde::Serialize;
+use tinsmith_core::{decimate_scatter, DecimationOptions, Scatter};
+use tinsmith_formats::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
+use tinsmith_points::{ClassChoice, PointCloud, ReadOptions};
+use tinsmith_verify::{verify_points, PointsReport};
+
+use crate::error::{bail, Context};
+use crate::jobs::{MeshJob, PointChoices};
+use crate::Feedback;
+use crate::Result;
+
+/// Whether `path` is read as points (by its extension: `.las`, `.laz`, `.xyz`, `.csv`,
+/// `.txt`) rather than as a raster.
+pub fn is_point_input(path: &Path) -> bool {
+    tinsmith_points::is_point_file(path)
+}
+
+/// The points of `path` after the class filter and the duplicates rule, and how many
+/// points were merged away. Notes on `feedback` which classes were kept.
+fn read(
+    path: &Path,
+    choices: &PointChoices,
+    feedback: &dyn Feedback,
+) -> Result<(PointCloud, usize)> {
+    let mut options = ReadOptions::default();
+    options.classes = choices.classes.clone();
+    options.no_withheld = choices.no_withheld;
+    if !path_is_las(path) && (choices.classes.is_some() || choices.no_withheld) {
+        feedback.note(&format!(
+            "{}: --classes and --no-withheld apply to LAS and LAZ only; every point is read",
+            path.display()
+        ));
+    }
+    let mut cloud = tinsmith_points::read_points(path, &options)?;
+    match &cloud.classes {
+        ClassChoice::DefaultGround => feedback.note(&format!(
+            "{}: ground points only (class 2, the file has some; --classes to choose)",
+            path.display()
+        )),
+        ClassChoice::All if path_is_las(path) => feedback.note(&format!(
+            "{}: every class (the file has no ground points)",
+            path.display()
+        )),
+        _ => {}
+    }
+    let merged = tinsmith_points::dedupe(&mut cloud, choices.duplicates);
+    if merged > 0 {
+        feedback.note(&format!(
+            "{}: {merged} points merged into others at the same x, y (--duplicates {})",
+            path.display(),
+            duplicates_name(choices.duplicates)
+        ));
+    }
+    Ok((cloud, merged))
+}
+
+fn path_is_las(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("las") || e.eq_ignore_ascii_case("laz"))
+}
+
+/// The `--duplicates` name of a rule.
+pub fn duplicates_name(rule: tinsmith_points::Duplicates) -> &'static str {
+    match rule {
+        tinsmith_points::Duplicates::Lowest => "lowest",
+        tinsmith_points::Duplicates::Highest => "highest",
+        tinsmith_points::Duplicates::Mean => "mean",
+        tinsmith_points::Duplicates::First => "first",
+    }
+}
+
+/// The CRS to write: `--crs`, else the file's (a WKT VLR and GeoTIFF keys must agree, by
+/// GDAL's `IsSame`), as WKT.
+fn resolve_crs(path: &Path, cloud: &PointCloud, given: Option<&str>) -> Result<Option<String>> {
+    if let Some(text) = given {
+        return Ok(Some(tinsmith_raster::crs_wkt(text)?));
+    }
+    let geotiff = cloud.crs.geotiff_epsg.map(|c| format!("EPSG:{c}"));
+    // The WKT record, when present, is what LAS 1.4 readers take; the GeoTIFF keys must
+    // not contradict it.
+    match (&cloud.crs.wkt, &geotiff) {
+        (Some(wkt), Some(code)) => {
+            let same = tinsmith_raster::same_crs(wkt, code)
+                || cloud.crs.geotiff_epsg.map(u32::from) == tinsmith_raster::epsg_code(wkt);
+            if !same {
+                bail!(
+                    "{}: the WKT CRS record and the GeoTIFF keys ({code}) name different CRSs; \
+                     give the right one with --crs",
+                    path.display()
+                );
+            }
+            Ok(Some(wkt.clone()))
+        }
+        (Some(wkt), None) => Ok(Some(wkt.clone())),
+        (None, Some(code)) => Ok(Some(tinsmith_raster::crs_wkt(code)?)),
+        (None, None) => Ok(None),
+    }
+}
+
+/// Every point in world coordinates with its height (after the duplicates rule).
+fn world_points(cloud: &PointCloud) -> Vec<[f64; 3]> {
+    (0..cloud.xy.len())
+        .map(|i| {
+            let [x, y] = cloud.world(i);
+            [x, y, cloud.z[i]]
+        })
+        .collect()
+}
+
+/// The `--report` JSON of a point run.
+#[derive(Debug, Serialize)]
+struct PointsMeshReport<'a> {
+    input: &'a Path,
+    output: &'a Path,
+    max_error: f64,
+    points_in_file: u64,
+    points_read: usize,
+    duplicates_merged: usize,
+    duplicates_rule: &'static str,
+    classes: String,
+    lattice_spacing: [f64; 2],
+    delaunay_triangles: usize,
+    triangles: usize,
+    vertices: usize,
+    max_error_bound: f64,
+    measured_max_error: f64,
+    sweeps: usize,
+    removal_attempts: usize,
+    seconds: PointsSeconds,
+}
+
+#[derive(Debug, Serialize)]
+struct PointsSeconds {
+    read: f64,
+    triangulate: f64,
+    decimate: f64,
+    verify: f64,
+    write: f64,
+}
+
+/// `tinsmith mesh` on a point file: the TIN within `job.decimation.max_error` of every point (after
+/// the duplicates rule), verified independently in memory as the file will hold it, then
+/// written; nothing is written when any step fails.
+pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
+    let input = &job.input;
+    let Some(output) = job.output.as_deref() else {
+        bail!("{}: point input writes one mesh: give -o", input.display());
+    };
+    let Some(max_error) = job.decimation.max_error else {
+        bail!(
+            "{}: point input needs --max-error (count targets are for rasters)",
+            input.display()
+        );
+    };
+    if job.per_tile.is_some()
+        || job.preview.is_some()
+        || job.decimation.contour_interval.is_some()
+        || job.vertical_datum.is_some()
+    {
+        bail!(
+            "{}: --per-tile, --preview, --contour-interval and --vertical-datum apply to \
+             rasters only",
+            input.display()
+        );
+    }
+    crate::output_paths::check_writable_target(output, input)?;
+    let format = crate::format_plan::format(job)?;
+    let reserved = crate::mesh::reserve_report(job, Some((output, format)))?;
+
+    let t = Instant::now();
+    let (cloud, merged) = read(input, &job.points, feedback)?;
+    let crs = resolve_crs(input, &cloud, job.points.crs.as_deref())?;
+    let read_seconds = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let triangles = match tinsmith_points::delaunay(&cloud) {
+        Ok(triangles) => triangles,
+        Err(e) => bail!("{}: cannot triangulate: {e}", input.display()),
+    };
+    let triangulate_seconds = t.elapsed().as_secs_f64();
+    let delaunay_triangles = triangles.len();
+
+    let t = Instant::now();
+    let points = world_points(&cloud);
+    // Float32 formats store positions and heights relative to the points' middle: the
+    // decimator keeps the heights' rounding, measured at every point, off the bound.
+    let origin = format.is_float32().then(|| LocalOrigin::of_points(&points));
+    let rounding = origin.map_or(0.0, |o| o.height_rounding(&cloud.z));
+    if max_error.is_finite() && rounding > 0.0 && rounding >= max_error {
+        bail!(
+            "{}: float32 rounds heights by up to {rounding}, not less than --max-error \
+             {max_error}; write .ply, .obj, .fgb or .xml",
+            output.display()
+        );
+    }
+    let options = DecimationOptions::new(max_error - rounding)
+        .with_selection(job.decimation.selection)
+        .with_error_model(job.decimation.error_model)
+        .with_retriangulation(job.decimation.retriangulate);
+    let mut options = options;
+    options.dp_max_ring = job.decimation.dp_max_ring as usize;
+    let PointCloud {
+        xy,
+        z,
+        spacing,
+        points_in_file,
+        classes,
+        ..
+    } = cloud;
+    let points_read = xy.len();
+    let scatter = Scatter::new(xy, z).with_context(|| format!("{}", input.display()))?;
+    let (tin, report) = decimate_scatter(&scatter, triangles, &options)
+        .with_context(|| format!("{}", input.display()))?;
+    let decimate_seconds = t.elapsed().as_secs_f64();
+
+    let mut vertices: Vec<[f64; 3]> = tin.vertices().iter().map(|&v| points[v as usize]).collect();
+    if let Some(origin) = origin {
+        // Verified as the float32 file will hold the positions and heights.
+        for v in &mut vertices {
+            *v = origin.quantize(*v);
+        }
+    }
+    let t = Instant::now();
+    let tolerance = position_tolerance(format, &vertices);
+    let check = verify_points(&points, &vertices, tin.triangles(), max_error, tolerance);
+    let verify_seconds = t.elapsed().as_secs_f64();
+    if !check.passed() {
+        bail!(
+            "{}: the mesh failed verification ({}); nothing written",
+            input.display(),
+            describe(&check)
+        );
+    }
+
+    let t = Instant::now();
+    let mut written = vertices.clone();
+    let epsg = None;
+    if format == MeshFormat::GeoJson && !job.export.geojson_source_crs {
+        let Some(wkt) = crs.as_deref() else {
+            bail!(
+                "{}: GeoJSON is written in WGS84 and the points have no CRS; give --crs or \
+                 --geojson-source-crs",
+                input.display()
+            );
+        };
+        tinsmith_raster::to_wgs84(wkt, &mut written)?;
+    }
+    let wgs84 = format == MeshFormat::GeoJson && !job.export.geojson_source_crs;
+    let write_options = WriteOptions::new()
+        .with_origin(origin)
+        .with_base(job.export.base)
+        .with_normals(job.export.normals);
+    let mesh = MeshRef::new(&written, tin.triangles())
+        .with_crs_wkt(if wgs84 { None } else { crs.as_deref() })
+        .with_epsg(if wgs84 { Some(4326) } else { epsg });
+    tinsmith_formats::write_mesh_with(output, format, mesh, &write_options)?;
+    let crs_written = !wgs84 && crs.as_deref().is_some_and(|w| !w.trim().is_empty());
+    crate::output_paths::note_prj_left_beside(output, format, crs_written, feedback);
+    let write_seconds = t.elapsed().as_secs_f64();
+
+    feedback.note(&format!(
+        "{}: {} points ({} Delaunay triangles) -> {} triangles, {} vertices; largest error \
+         {} (bound {max_error}), verified at every point",
+        output.display(),
+        points_read,
+        delaunay_triangles,
+        report.final_triangles,
+        report.final_vertices,
+        crate::readable(check.max_error),
+    ));
+    let summary = PointsMeshReport {
+        input,
+        output,
+        max_error,
+        points_in_file,
+        points_read,
+        duplicates_merged: merged,
+        duplicates_rule: duplicates_name(job.points.duplicates),
+        classes: match classes {
+            ClassChoice::All => "all".into(),
+            ClassChoice::DefaultGround => "2 (ground, the default)".into(),
+            ClassChoice::Listed(list) => format!("{list:?}"),
+        },
+        lattice_spacing: spacing,
+        delaunay_triangles,
+        triangles: report.final_triangles,
+        vertices: report.final_vertices,
+        max_error_bound: report.max_bound,
+        measured_max_error: check.max_error,
+        sweeps: report.sweeps,
+        removal_attempts: report.attempts,
+        seconds: PointsSeconds {
+            read: read_seconds,
+            triangulate: triangulate_seconds,
+            decimate: decimate_seconds,
+            verify: verify_seconds,
+            write: write_seconds,
+        },
+    };
+    if let Some(reserved) = reserved {
+        reserved.write(&serde_json::to_vec_pretty(&summary)?)?;
+    }
+    tinsmith_output::mark_finished();
+    Ok(())
+}
+
+/// How far a float32 format may move a position (x, y): its rounding of the TIN's extent,
+/// doubled; 0 for formats that keep `f64` positions.
+fn position_tolerance(format: MeshFormat, vertices: &[[f64; 3]]) -> f64 {
+    if !format.is_float32() {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for v in vertices {
+        for a in 0..2 {
+            lo[a] = lo[a].min(v[a]);
+            hi[a] = hi[a].max(v[a]);
+        }
+    }
+    2.0 * f64::from(f32::EPSILON) * (hi[0] - lo[0]).max(hi[1] - lo[1]).max(0.0)
+}
+
+/// What failed, in a line.
+fn describe(r: &PointsReport) -> String {
+    let mut parts = Vec::new();
+    if r.uncovered > 0 {
+        parts.push(format!("{} points outside the mesh", r.uncovered));
+    }
+    if r.bad_triangles > 0 {
+        parts.push(format!(
+            "{} degenerate or clockwise triangles",
+            r.bad_triangles
+        ));
+    }
+    if r.max_error > r.bound {
+        if let Some((i, p, s)) = r.worst {
+            parts.push(format!(
+                "point {i} at ({}, {}) has z {} and the mesh {s}: error {} > {}",
+                p[0],
+                p[1],
+                p[2],
+                crate::readable(r.max_error),
+                r.bound
+            ));
+        }
+    }
+    parts.join("; ")
+}
+
+/// `tinsmith verify` on a point file: reads the points (with the same class filter and
+/// duplicates rule `mesh` used) and the mesh file, and measures every point against the
+/// mesh with the independent verifier. A mesh outside the bound is not an error: see
+/// [`PointsReport::passed`].
+pub fn verify_points_file(
+    points_path: &Path,
+    mesh_path: &Path,
+    format: Option<MeshFormat>,
+    max_error: f64,
+    choices: &PointChoices,
+    feedback: &dyn Feedback,
+) -> Result<PointsReport> {
+    let (cloud, _) = read(points_path, choices, feedback)?;
+    let points = world_points(&cloud);
+    let format = crate::mesh_file::mesh_format(mesh_path, format)?;
+    if format == MeshFormat::GeoJson {
+        bail!(
+            "{}: verify reads point meshes from PLY, OBJ, STL, glTF, FlatGeobuf or LandXML \
+             (GeoJSON is in WGS84)",
+            mesh_path.display()
+        );
+    }
+    let mesh = tinsmith_formats::read_mesh_as(mesh_path, format)?;
+    let tolerance = position_tolerance(format, &mesh.vertices);
+    Ok(verify_points(
+        &points,
+        &mesh.vertices,
+        &mesh.triangles,
+        max_error,
+        tolerance,
+    ))
+}
+
+/// Text for a points verification, as `tinsmith verify` prints it.
+pub fn points_summary(r: &PointsReport) -> String {
+    if r.passed() {
+        format!(
+            "{} points, largest error {} <= {}: passed",
+            r.points,
+            crate::readable(r.max_error),
+            r.bound
+        )
+    } else {
+        format!("{} points: FAILED: {}", r.points, describe(r))
+    }
+}

@@ -217,7 +217,9 @@ impl Retriangulator {
         let scan_only = cap == 0.0 && rules.grid.integral_heights();
         let bound = match rules.model {
             ErrorModel::Bounds => self.triangle_bound(a, b, c, edges),
-            ErrorModel::Exact if self.unit_hole && in_hole && !scan_only => {
+            ErrorModel::Exact
+                if self.unit_hole && in_hole && !scan_only && rules.grid.variable_count() == 0 =>
+            {
                 let centre = self.centre.expect("hole loaded");
                 let inside = in_closed_triangle(pa, pb, pc, &centre);
                 // The corners' samples: the vertices themselves unless heights are raised.

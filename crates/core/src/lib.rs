@@ -39,6 +39,7 @@ mod predicates;
 mod rtin;
 mod strips;
 mod tin;
+mod variables;
 
 pub use decimate::{
     decimate, decimate_with_border, decimate_with_progress, effective_limit, vertex_raise,
@@ -53,3 +54,4 @@ pub use options::{
     VertexHeights,
 };
 pub use tin::{Tin, TinVertex};
+pub use variables::Variable;

@@ -53,6 +53,7 @@ mod problems;
 mod report;
 mod scan_convert;
 mod surface;
+mod variables;
 mod verify;
 
 pub use error::{Result, VerifyError};
@@ -61,4 +62,5 @@ pub use mesh::MeshRef;
 pub use options::{Orientation, VerifyOptions};
 pub use report::{ErrorLocation, Report};
 pub use surface::{surface, surface_at};
+pub use variables::verify_variable;
 pub use verify::verify;

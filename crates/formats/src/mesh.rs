@@ -24,6 +24,18 @@ pub struct MeshRef<'a> {
     /// LandXML, GeoJSON). `Some(4326)` means longitude, latitude in degrees (GeoJSON then
     /// writes plain RFC 7946).
     pub epsg: Option<u32>,
+    /// Values carried per vertex besides the position (several variables over one
+    /// mesh); written by PLY (a `double` property each), refused by the other formats.
+    pub attributes: &'a [VertexAttribute<'a>],
+}
+
+/// One value per vertex, under a name (a PLY property name: no whitespace).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VertexAttribute<'a> {
+    /// The name the file gives it.
+    pub name: &'a str,
+    /// One value per vertex, in vertex order.
+    pub values: &'a [f64],
 }
 
 impl<'a> MeshRef<'a> {
@@ -34,7 +46,14 @@ impl<'a> MeshRef<'a> {
             triangles,
             crs_wkt: None,
             epsg: None,
+            attributes: &[],
         }
+    }
+
+    /// Sets the per-vertex attributes (see [`MeshRef::attributes`]).
+    pub fn with_attributes(mut self, attributes: &'a [VertexAttribute<'a>]) -> Self {
+        self.attributes = attributes;
+        self
     }
 
     /// Sets the CRS's EPSG code (see [`MeshRef::epsg`]).
@@ -63,6 +82,46 @@ impl<'a> MeshRef<'a> {
 
     /// Checks what the readers check, so that no file is written that cannot be read back.
     pub(crate) fn check(&self, path: &Path, format: MeshFormat) -> Result<()> {
+        if let Some(attribute) = self.attributes.first() {
+            if format != MeshFormat::Ply {
+                return Err(Error::BadOption {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "{format} carries heights only; per-vertex variables (`{}`) are \
+                         written to PLY",
+                        attribute.name
+                    ),
+                });
+            }
+        }
+        for attribute in self.attributes {
+            let bad_name = attribute.name.is_empty()
+                || attribute
+                    .name
+                    .chars()
+                    .any(|c| c.is_whitespace() || !c.is_ascii())
+                || ["x", "y", "z"].contains(&attribute.name)
+                || self
+                    .attributes
+                    .iter()
+                    .filter(|a| a.name == attribute.name)
+                    .count()
+                    > 1;
+            if bad_name || attribute.values.len() != self.vertices.len() {
+                return Err(Error::BadOption {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "vertex attribute `{}`: {}",
+                        attribute.name,
+                        if bad_name {
+                            "not a distinct PLY property name"
+                        } else {
+                            "not one value per vertex"
+                        }
+                    ),
+                });
+            }
+        }
         if format == MeshFormat::Ply {
             // PLY indices are written as `int`.
             let max = i32::MAX as usize + 1;
@@ -119,6 +178,9 @@ pub struct Mesh {
     /// The EPSG code the file records (FlatGeobuf, LandXML, GeoJSON). A GeoJSON file
     /// without a `crs` member is RFC 7946 longitude, latitude: `Some(4326)`.
     pub epsg: Option<u32>,
+    /// Per-vertex values besides the position, with their names: a PLY file's other
+    /// scalar vertex properties, in header order (none from the other formats).
+    pub attributes: Vec<(String, Vec<f64>)>,
 }
 
 impl Mesh {
@@ -129,16 +191,27 @@ impl Mesh {
             triangles,
             crs_wkt: None,
             epsg: None,
+            attributes: Vec::new(),
         }
     }
 
-    /// Borrows the mesh for [`crate::write_mesh`].
+    /// The values of attribute `name`, one per vertex.
+    pub fn attribute(&self, name: &str) -> Option<&[f64]> {
+        self.attributes
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_slice())
+    }
+
+    /// Borrows the mesh for [`crate::write_mesh`] (without its attributes, which
+    /// [`MeshRef::with_attributes`] takes as borrowed [`VertexAttribute`]s).
     pub fn as_mesh_ref(&self) -> MeshRef<'_> {
         MeshRef {
             vertices: &self.vertices,
             triangles: &self.triangles,
             crs_wkt: self.crs_wkt.as_deref(),
             epsg: self.epsg,
+            attributes: &[],
         }
     }
 }

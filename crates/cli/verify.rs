@@ -9,12 +9,34 @@ use crate::args::VerifyArgs;
 /// Runs the verifier and prints its report; `Ok(false)` when the mesh is invalid or
 /// exceeds `--max-error`.
 pub fn run(args: &VerifyArgs) -> Result<bool> {
-    let verified = tinsmith_pipeline::verify(&args.job())?;
+    let verified = tinsmith_pipeline::verify(&args.job()?)?;
     let report = &verified.report;
-    if args.json {
+    if args.json && verified.variables.is_empty() {
         println!("{}", serde_json::to_string_pretty(report)?);
+    } else if args.json {
+        let variables: Vec<_> = verified
+            .variables
+            .iter()
+            .map(|(v, r)| serde_json::json!({ "variable": v, "report": r }))
+            .collect();
+        let both = serde_json::json!({ "height": report, "variables": variables });
+        println!("{}", serde_json::to_string_pretty(&both)?);
     } else {
         print_report(report, args);
+        for (v, r) in &verified.variables {
+            println!(
+                "band {} ({}):{}max error {}, allowed {}{}",
+                v.band,
+                v.name,
+                " ".repeat(9usize.saturating_sub(v.band.to_string().len() + v.name.len())),
+                readable(v.measured_max_error),
+                readable(v.max_error),
+                if r.passed() { "" } else { "  FAILED" }
+            );
+            for problem in &r.problems {
+                println!("  problem:       {problem}");
+            }
+        }
     }
     if !report.passed() && verified.band_count > 1 {
         note!(
@@ -25,7 +47,7 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
             verified.band_count
         );
     }
-    Ok(report.passed())
+    Ok(verified.passed())
 }
 
 fn print_report(report: &Report, args: &VerifyArgs) {

@@ -22,10 +22,12 @@ pub struct MeshArgs {
     #[command(flatten)]
     pub export: ExportArgs,
     /// Largest allowed |sample - TIN| at any valid sample, in data units. Required unless
-    /// --max-triangles or --max-vertices is given.
+    /// --max-triangles or --max-vertices is given. With --bands, one bound for every band
+    /// or a comma-separated bound per band.
     #[arg(long, value_parser = parse_max_error, allow_hyphen_values = true,
+          value_delimiter = ',', num_args = 1,
           required_unless_present_any = ["max_triangles", "max_vertices"])]
-    pub max_error: Option<f64>,
+    pub max_error: Vec<f64>,
     /// Decimate until at most N triangles remain (greedy order), then report the verified
     /// max error.
     #[arg(long, value_name = "N")]
@@ -34,8 +36,18 @@ pub struct MeshArgs {
     #[arg(long, value_name = "N")]
     pub max_vertices: Option<usize>,
     /// Band to read (1-based).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, conflicts_with = "bands")]
     pub band: usize,
+    /// Several variables over one mesh: these bands (comma-separated, 1-based), each
+    /// within its own --max-error at every sample; a vertex goes only when every band
+    /// stays within its bound. The first (or --height-band) is the height, the others are
+    /// written per vertex (PLY only, a property named after the band's description or
+    /// band_N). The domain is where every band is valid. Exact error model, untiled.
+    #[arg(long, value_delimiter = ',', num_args = 1, value_name = "B,B,...")]
+    pub bands: Vec<usize>,
+    /// With --bands: the band that is the height (listed in --bands) [default: the first].
+    #[arg(long, value_name = "N", requires = "bands")]
+    pub height_band: Option<usize>,
     /// Error model.
     #[arg(long, value_enum, default_value_t = ErrorModelArg::Exact)]
     pub error_model: ErrorModelArg,
@@ -146,15 +158,27 @@ pub struct ExportArgs {
 }
 
 impl MeshArgs {
-    /// The job these flags ask for.
-    pub fn job(&self) -> MeshJob {
+    /// The job these flags ask for; fails when --bands, --max-error and --height-band
+    /// do not fit together.
+    pub fn job(&self) -> tinsmith_pipeline::Result<MeshJob> {
         let mut job = MeshJob::new(&self.input);
         job.output = self.output.clone();
         job.export = self.export.choices();
-        job.max_error = self.max_error;
+        let (band, max_error, variables) = tinsmith_pipeline::resolve_bands(
+            &self.input,
+            &self.bands,
+            &self.max_error,
+            self.height_band,
+        )?;
+        job.max_error = max_error;
         job.max_triangles = self.max_triangles;
         job.max_vertices = self.max_vertices;
-        job.band = self.band;
+        job.band = if self.bands.is_empty() {
+            self.band
+        } else {
+            band
+        };
+        job.variables = variables;
         job.error_model = self.error_model.into();
         job.selection = self.selection.into();
         job.order = self.order.into();
@@ -178,7 +202,7 @@ impl MeshArgs {
             TileFormatArg::Ply => TileFormat::Ply,
             TileFormatArg::Obj => TileFormat::Obj,
         });
-        job
+        Ok(job)
     }
 }
 

@@ -11,6 +11,7 @@ use tinsmith_core::{
 use tinsmith_formats::MeshFormat;
 
 use crate::error::bail;
+use crate::variables::BandVariable;
 
 /// Samples per tile side (shared row and column included) unless a job says otherwise.
 pub const DEFAULT_TILE_SIZE: u32 = tinsmith_tiling::DEFAULT_TILE_SIZE;
@@ -33,8 +34,12 @@ pub struct MeshJob {
     pub max_triangles: Option<usize>,
     /// Decimate until at most this many vertices remain (greedy order).
     pub max_vertices: Option<usize>,
-    /// Band to read, 1-based.
+    /// Band to read, 1-based: the height.
     pub band: usize,
+    /// Other bands decimated with the height, each within its own bound (see
+    /// [`crate::resolve_bands`]); the domain is where every band is valid. Untiled, exact
+    /// error model, PLY output only.
+    pub variables: Vec<BandVariable>,
     /// How a candidate triangle's error is measured.
     pub error_model: ErrorModel,
     /// Edge selection when holes are retriangulated by ears.
@@ -113,6 +118,7 @@ impl MeshJob {
             max_triangles: None,
             max_vertices: None,
             band: 1,
+            variables: Vec::new(),
             error_model: ErrorModel::default(),
             selection: EdgeSelection::default(),
             order: Order::default(),
@@ -275,6 +281,9 @@ pub struct VerifyJob {
     pub max_error: Option<f64>,
     /// Band the mesh was made from, 1-based.
     pub band: usize,
+    /// Other bands the mesh carries per vertex, each checked against its bound (the
+    /// domain is where every band is valid).
+    pub variables: Vec<BandVariable>,
     /// The mesh holds (column, row, value) coordinates.
     pub pixel_coords: bool,
 }
@@ -288,6 +297,7 @@ impl VerifyJob {
             format: None,
             max_error: None,
             band: 1,
+            variables: Vec::new(),
             pixel_coords: false,
         }
     }

@@ -41,6 +41,7 @@ mod serve;
 mod tiled_mesh;
 mod tiles;
 mod transform_check;
+mod variables;
 mod verify;
 mod wgs84;
 
@@ -58,4 +59,5 @@ pub use serve::{serve, ServeOptions};
 pub use tiles::{merge_tiles, tiles, tiles_shard, vertical_datum, water_source};
 pub use tinsmith_georef::readable;
 pub use tinsmith_tiling::available_bytes;
+pub use variables::{resolve_bands, BandVariable, VariableReport};
 pub use verify::{verify, Verified};

@@ -65,6 +65,7 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
             heights,
             triangles,
             orientation,
+            attributes,
         } = read_onto_raster(&job.input, job.band, &job.mesh, format, job.pixel_coords)?;
         let grid = &raster.samples;
         let report = tinsmith_verify::verify(
@@ -90,6 +91,7 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
             heights,
             triangles,
             orientation,
+            attributes,
         };
         (raster.info, values, mesh, Some(report.max_error))
     } else {

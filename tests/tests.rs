@@ -17,3 +17,4 @@ mod serve;
 mod shards;
 mod tiled_mesh;
 mod tiles;
+mod variables;

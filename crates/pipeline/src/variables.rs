@@ -52,6 +52,12 @@ pub fn resolve_bands(
             Vec::new(),
         ));
     }
+    if bounds.is_empty() {
+        bail!(
+            "{name}: --bands takes error bounds (--max-error), not --max-triangles or \
+             --max-vertices"
+        );
+    }
     if bands.contains(&0) {
         bail!("{name}: --bands: bands are numbered from 1");
     }

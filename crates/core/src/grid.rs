@@ -29,8 +29,9 @@ pub struct Grid {
     flat_blocks: Arc<Vec<FlatLevel>>,
     /// See [`Grid::vertex_height`]; 0 when vertices sit at their samples' values.
     raise: f64,
-    /// Extra variables ([`Grid::with_variables`]); empty for a grid of heights alone.
-    variables: Arc<Vec<Measured>>,
+    /// Extra variables ([`Grid::with_variables`]); empty for a grid of heights alone (a
+    /// slice, so that the exact model's test for none reads no memory beyond the grid).
+    variables: Arc<[Measured]>,
 }
 
 /// Square blocks of one size, each with its samples' common value when they are all bit
@@ -87,7 +88,7 @@ impl Grid {
             equal_runs: equal_runs.map(Arc::new),
             flat_blocks: Arc::new(flat_blocks),
             raise: 0.0,
-            variables: Arc::new(Vec::new()),
+            variables: Arc::from(Vec::new()),
         }
     }
 
@@ -105,7 +106,7 @@ impl Grid {
     pub fn with_variables(height: Samples, variables: Vec<Variable>) -> Result<Grid> {
         let (height, measured) = joined(height, variables)?;
         Ok(Grid {
-            variables: Arc::new(measured),
+            variables: Arc::from(measured),
             ..Grid::from_samples(height)
         })
     }
@@ -133,12 +134,11 @@ impl Grid {
     /// (see `crate::variables`); the samples are shared, not copied.
     pub(crate) fn with_height_limit(&self, height_limit: f64) -> Grid {
         Grid {
-            variables: Arc::new(
-                self.variables
-                    .iter()
-                    .map(|v| v.for_limit(height_limit))
-                    .collect(),
-            ),
+            variables: self
+                .variables
+                .iter()
+                .map(|v| v.for_limit(height_limit))
+                .collect(),
             ..self.clone()
         }
     }

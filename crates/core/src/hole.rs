@@ -258,7 +258,11 @@ impl Retriangulator {
                         let centre = self.centre.expect("hole loaded");
                         let e = if !scan_only
                             && in_closed_triangle(pa, pb, pc, &centre)
-                            && error_at(pa, pb, pc, [&centre], cap).is_none()
+                            && (error_at(pa, pb, pc, [&centre], cap).is_none()
+                                || (rules.grid.variable_count() > 0
+                                    && crate::variables::centre_exceeds(
+                                        rules.grid, pa, pb, pc, &centre, cap,
+                                    )))
                         {
                             None
                         } else {

@@ -12,7 +12,7 @@
 
 use tinsmith_georef::Samples;
 
-use crate::exact::{corner_samples, height_error};
+use crate::exact::{corner_samples, error_at, height_error};
 use crate::predicates::Point;
 use crate::{effective_limit, Error, ErrorBound, Grid, Result, MAX_ABS_HEIGHT};
 
@@ -192,4 +192,53 @@ pub(crate) fn with_variables(
         bound.below = bound.below.max(scaled(e.below));
     }
     (bound.above <= limit && bound.below <= limit).then_some(bound)
+}
+
+/// Whether some variable's value at `centre` (a sample in the closed triangle `abc`) is
+/// beyond `cap` (in height units, as [`with_variables`] takes it) or its own limit from
+/// the plane through its values at the corners: then the triangle's scan would refuse it
+/// too (the same arithmetic on one of its samples), so it need not run. Variables held
+/// exactly at 0 are left to the scan.
+pub(crate) fn centre_exceeds(
+    grid: &Grid,
+    a: &Point,
+    b: &Point,
+    c: &Point,
+    centre: &Point,
+    cap: f64,
+) -> bool {
+    grid.variables().iter().any(|v| {
+        if v.unconstrained() || v.limit == 0.0 {
+            return false;
+        }
+        let cap = if cap.is_finite() && v.scale > 0.0 {
+            v.limit.min(cap / v.scale)
+        } else {
+            v.limit
+        };
+        let [va, vb, vc, vm] = corner_samples(&v.grid, [a, b, c, centre]);
+        error_at(&va, &vb, &vc, [&vm], cap).is_none()
+    })
+}
+
+/// Whether some variable's value at `centre` lies further than its own limit outside the
+/// range of its values at the `ring` vertices: every retriangulation of the hole
+/// interpolates the centre from ring values, so its removal can never pass (the cheap
+/// exact rejection the height gets too).
+pub(crate) fn centre_outside_ring(grid: &Grid, centre: &Point, ring: &[Point]) -> bool {
+    grid.variables().iter().any(|v| {
+        if v.unconstrained() {
+            return false;
+        }
+        let width = v.grid.width() as i64;
+        let value = |p: &Point| v.grid.values()[(p.y * width + p.x) as usize];
+        let (lo, hi) = ring
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                let z = value(p);
+                (lo.min(z), hi.max(z))
+            });
+        let z = value(centre);
+        z - hi > v.limit || lo - z > v.limit
+    })
 }

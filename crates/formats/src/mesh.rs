@@ -25,7 +25,8 @@ pub struct MeshRef<'a> {
     /// writes plain RFC 7946).
     pub epsg: Option<u32>,
     /// Values carried per vertex besides the position (several variables over one
-    /// mesh); written by PLY (a `double` property each), refused by the other formats.
+    /// mesh); written by PLY (a `double` property each) and glTF (a float32 `_NAME`
+    /// attribute each, the name in capitals), refused by the other formats.
     pub attributes: &'a [VertexAttribute<'a>],
 }
 
@@ -83,12 +84,12 @@ impl<'a> MeshRef<'a> {
     /// Checks what the readers check, so that no file is written that cannot be read back.
     pub(crate) fn check(&self, path: &Path, format: MeshFormat) -> Result<()> {
         if let Some(attribute) = self.attributes.first() {
-            if format != MeshFormat::Ply {
+            if !matches!(format, MeshFormat::Ply | MeshFormat::Glb) {
                 return Err(Error::BadOption {
                     path: path.to_path_buf(),
                     reason: format!(
                         "{format} carries heights only; per-vertex variables (`{}`) are \
-                         written to PLY",
+                         written to PLY or glTF",
                         attribute.name
                     ),
                 });
@@ -179,7 +180,8 @@ pub struct Mesh {
     /// without a `crs` member is RFC 7946 longitude, latitude: `Some(4326)`.
     pub epsg: Option<u32>,
     /// Per-vertex values besides the position, with their names: a PLY file's other
-    /// scalar vertex properties, in header order (none from the other formats).
+    /// scalar vertex properties, in header order; a glTF file's float `_NAME` attributes
+    /// as `NAME`; none from the other formats.
     pub attributes: Vec<(String, Vec<f64>)>,
 }
 

@@ -114,10 +114,10 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     // `untiled_output` has checked the output path and its sidecar.
     let format = crate::format_plan::format(job)?;
     if !job.variables.is_empty() {
-        if format != MeshFormat::Ply {
+        if !matches!(format, MeshFormat::Ply | MeshFormat::Glb) {
             bail!(
                 "{}: {format} carries heights only; the variables of --bands are written \
-                 to PLY (.ply), one property per band",
+                 to PLY (.ply) or glTF (.glb), one property or attribute per band",
                 output.display()
             );
         }
@@ -142,7 +142,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let (grid, variables) = if job.variables.is_empty() {
         (Grid::from_samples(samples), Vec::new())
     } else {
-        crate::variables::read(&job.input, samples, &job.variables)?
+        crate::variables::read(&job.input, samples, &job.variables, format.is_float32())?
     };
     let grid = &grid;
     let read_seconds = t.elapsed().as_secs_f64();
@@ -187,7 +187,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
             check.problems.join("; ")
         );
     }
-    let at_vertices = crate::variables::vertex_values(grid, tin);
+    let at_vertices = crate::variables::vertex_values(grid, tin, format.is_float32());
     let variable_reports =
         crate::variables::check(&job.input, grid, &variables, tin, &at_vertices)?;
     let verify_seconds = t.elapsed().as_secs_f64();

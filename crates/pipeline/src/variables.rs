@@ -111,11 +111,14 @@ pub fn resolve_bands(
 
 /// Reads every variable's band of `input` beside the `height` samples already read, into
 /// one grid (the domain is where every band is valid), with each variable's band, bound
-/// and the name files give it.
+/// and the name files give it. For a `float32` file each band is decimated within its
+/// bound less the largest float32 rounding of its values, so that the values as stored
+/// keep the bound; a bound below that rounding is refused.
 pub(crate) fn read(
     input: &Path,
     height: Samples,
     variables: &[BandVariable],
+    float32: bool,
 ) -> Result<(Grid, Vec<(BandVariable, String)>)> {
     let mut read = Vec::with_capacity(variables.len());
     let mut names: Vec<String> = Vec::new();
@@ -123,7 +126,25 @@ pub(crate) fn read(
         let raster = tinsmith_raster::read_samples(input, v.band)?;
         let name = property_name(raster.info.description.as_deref(), v.band, &names);
         names.push(name);
-        read.push(Variable::new(raster.samples, v.max_error).naming_file(input)?);
+        let rounding = match float32 {
+            true => raster
+                .samples
+                .values()
+                .iter()
+                .filter(|x| x.is_finite())
+                .fold(0.0f64, |m, &x| m.max((x - f64::from(x as f32)).abs())),
+            false => 0.0,
+        };
+        if rounding > v.max_error {
+            bail!(
+                "{}: band {}: float32 rounds its values by up to {rounding}, more than its \
+                 bound {}; write PLY (double) instead",
+                input.display(),
+                v.band,
+                v.max_error
+            );
+        }
+        read.push(Variable::new(raster.samples, v.max_error - rounding).naming_file(input)?);
     }
     let grid = Grid::with_variables(height, read).naming_file(input)?;
     Ok((grid, variables.iter().cloned().zip(names).collect()))
@@ -168,8 +189,9 @@ pub struct VariableReport {
     pub measured_max_error: f64,
 }
 
-/// Each variable's values at the TIN's vertices (in vertex order).
-pub(crate) fn vertex_values(grid: &Grid, tin: &Tin) -> Vec<Vec<f64>> {
+/// Each variable's values at the TIN's vertices (in vertex order), rounded to float32 for
+/// a `float32` file (as it will hold them).
+pub(crate) fn vertex_values(grid: &Grid, tin: &Tin, float32: bool) -> Vec<Vec<f64>> {
     let width = grid.width() as usize;
     (0..grid.variable_count())
         .map(|k| {
@@ -177,6 +199,7 @@ pub(crate) fn vertex_values(grid: &Grid, tin: &Tin) -> Vec<Vec<f64>> {
             tin.vertices()
                 .iter()
                 .map(|v| values[v.y as usize * width + v.x as usize])
+                .map(|x| if float32 { f64::from(x as f32) } else { x })
                 .collect()
         })
         .collect()
@@ -263,14 +286,20 @@ pub(crate) fn verify_file(
 ) -> Result<Vec<(VariableReport, Report)>> {
     let mut out = Vec::new();
     for (k, (variable, name)) in variables.iter().enumerate() {
-        let Some((_, values)) = attributes.iter().find(|(n, _)| n == name) else {
+        // glTF semantics are in capitals.
+        let found = attributes.iter().find(|(n, _)| n == name).or_else(|| {
+            attributes
+                .iter()
+                .find(|(n, _)| n.eq_ignore_ascii_case(name))
+        });
+        let Some((_, values)) = found else {
             let held: Vec<&str> = attributes.iter().map(|(n, _)| n.as_str()).collect();
             bail!(
                 "{}: holds no per-vertex values `{name}` for band {} (it holds {})",
                 mesh_path.display(),
                 variable.band,
                 if held.is_empty() {
-                    "none; only PLY files carry variables".to_owned()
+                    "none; only PLY and glTF files carry variables".to_owned()
                 } else {
                     held.join(", ")
                 }

@@ -58,6 +58,7 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
             &job.input,
             raster.samples.clone(),
             &job.variables,
+            false,
         )?),
     };
     let joined_samples;

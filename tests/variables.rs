@@ -347,18 +347,18 @@ fn bad_band_lists_and_bounds_are_refused_with_nothing_written() {
         assert_fails_naming(&o, names);
         assert_eq!(d.files(), ["multi.tif"], "{flags:?}");
     }
-    // Only PLY carries the variables; count targets are not bounds.
+    // Only PLY and glTF carry the variables; count targets are not bounds.
     let o = d.run(&[
         "mesh",
         "multi.tif",
         "-o",
-        "m.glb",
+        "m.obj",
         "--bands",
         "1,2",
         "--max-error",
         "1",
     ]);
-    assert_fails_naming(&o, &["m.glb", "PLY"]);
+    assert_fails_naming(&o, &["m.obj", "PLY"]);
     let o = d.run(&[
         "mesh",
         "multi.tif",
@@ -440,4 +440,54 @@ fn trimesh_reads_one_property_per_band() {
         assert_eq!(at("band_2", i), field(1.1)(x, y), "vertex {i}");
         assert_eq!(at("band_3", i), 0.25 * field(2.0)(x, y), "vertex {i}");
     }
+}
+
+#[test]
+#[ignore = "needs the Khronos glTF validator in .tools (make deps)"]
+fn gltf_carries_each_band_as_an_attribute_the_validator_accepts() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let modules = std::env::var_os("TINSMITH_NODE_MODULES")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo.join(".tools/node_modules"));
+    assert!(
+        modules.join("gltf-validator").exists(),
+        "oracle missing: gltf-validator in .tools/node_modules; run `make deps`"
+    );
+    let d = Dir::new();
+    three_bands(&d);
+    let r = mesh_ok(
+        &d,
+        &[
+            "-o",
+            "m.glb",
+            "--bands",
+            "1,2,3",
+            "--max-error",
+            "1,0.5,0.25",
+            "--normals",
+        ],
+    );
+    assert_eq!(r["variables"].as_array().unwrap().len(), 2);
+    let script = repo.join("tests/oracles/gltf_validate.js");
+    let o = Command::new("node")
+        .arg(&script)
+        .arg(d.path("m.glb"))
+        .output()
+        .expect("node runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: Value = serde_json::from_slice(&o.stdout).expect("validator JSON");
+    assert_eq!(report["issues"]["numErrors"], 0, "{report:#}");
+    assert_eq!(report["issues"]["numWarnings"], 0, "{report:#}");
+    // Read back: each band against its float32 attribute.
+    let o = d.run(&[
+        "verify",
+        "multi.tif",
+        "m.glb",
+        "--bands",
+        "1,2,3",
+        "--max-error",
+        "1,0.5,0.25",
+    ]);
+    assert!(o.status.success(), "{} {}", stdout(&o), stderr(&o));
+    assert!(stdout(&o).contains("band 2 (band_2)"), "{}", stdout(&o));
 }

@@ -253,8 +253,8 @@ pub struct VerifyArgs {
     #[arg(long, default_value_t = 1, conflicts_with = "bands")]
     pub band: usize,
     /// The bands a `mesh --bands` mesh was made from: the first (or --height-band) against
-    /// the mesh's heights, each other against the PLY vertex property of its name, each
-    /// within its --max-error, over the domain where every band is valid.
+    /// the mesh's heights, each other against the PLY property (glTF attribute) of its
+    /// name, each within its --max-error, over the domain where every band is valid.
     #[arg(long, value_delimiter = ',', num_args = 1, value_name = "B,B,...")]
     pub bands: Vec<usize>,
     /// With --bands: the band that is the height [default: the first].

@@ -132,7 +132,10 @@ fn fixtures_convert_between_formats_unchanged() -> tinsmith_formats::Result<()> 
     let mut original = read_mesh(&fixture("data", "hand_ascii.ply"))?;
     // Its extra vertex property is read as an attribute, which the conversion (positions,
     // triangles, CRS) does not carry.
-    assert_eq!(original.attribute("intensity"), Some(&[12.0, 13.0, 14.0, 15.0][..]));
+    assert_eq!(
+        original.attribute("intensity"),
+        Some(&[12.0, 13.0, 14.0, 15.0][..])
+    );
     original.attributes.clear();
     let mut current = original.clone();
     for format in [MeshFormat::Obj, MeshFormat::Ply, MeshFormat::Obj] {

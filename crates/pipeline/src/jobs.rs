@@ -38,7 +38,7 @@ pub struct MeshJob {
     pub band: usize,
     /// Other bands decimated with the height, each within its own bound (see
     /// [`crate::resolve_bands`]); the domain is where every band is valid. Untiled, exact
-    /// error model, PLY output only.
+    /// error model, PLY or glTF output only.
     pub variables: Vec<BandVariable>,
     /// How a candidate triangle's error is measured.
     pub error_model: ErrorModel,

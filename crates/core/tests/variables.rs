@@ -39,7 +39,7 @@ fn reports(grid: &Grid, tin: &Tin, bound: f64) -> (Report, Vec<Report>) {
     let domain = GridRef::new(w, h, grid.values());
     let options = VerifyOptions::new().with_orientation(Orientation::CounterClockwise);
     let mesh = MeshRef::new(&positions, &heights, tin.triangles());
-    let height = verify(domain, mesh, &options.clone().with_max_error(bound)).unwrap();
+    let height = verify(domain, mesh, &options.with_max_error(bound)).unwrap();
     let variables = (0..grid.variable_count())
         .map(|k| {
             let (values, max_error) = grid.variable(k);
@@ -48,7 +48,7 @@ fn reports(grid: &Grid, tin: &Tin, bound: f64) -> (Report, Vec<Report>) {
                 .iter()
                 .map(|v| values[(v.y * w + v.x) as usize])
                 .collect();
-            let options = options.clone().with_max_error(max_error);
+            let options = options.with_max_error(max_error);
             verify_variable(domain, values, mesh, &at_vertices, &options).unwrap()
         })
         .collect();

@@ -491,3 +491,49 @@ fn gltf_carries_each_band_as_an_attribute_the_validator_accepts() {
     assert!(o.status.success(), "{} {}", stdout(&o), stderr(&o));
     assert!(stdout(&o).contains("band 2 (band_2)"), "{}", stdout(&o));
 }
+
+#[test]
+fn geojson_and_flatgeobuf_carry_each_triangles_corner_means_as_gdal_reads_them() {
+    let d = Dir::new();
+    three_bands(&d);
+    for name in ["m.geojson", "m.fgb"] {
+        mesh_ok(
+            &d,
+            &[
+                "-o",
+                name,
+                "--bands",
+                "1,2,3",
+                "--max-error",
+                "1,0.5,0.25",
+                "--pixel-coords",
+            ],
+        );
+        // GDAL reads the file (an independent reader) and writes it as GeoJSON.
+        let text = run_in(&d, "ogr2ogr", &["-f", "GeoJSON", "/vsistdout/", name]);
+        let json: Value = serde_json::from_str(&text).expect("GeoJSON from ogr2ogr");
+        let features = json["features"].as_array().expect("features");
+        assert!(features.len() > 10, "{name}");
+        for f in features {
+            let ring = f["geometry"]["coordinates"][0].as_array().expect("ring");
+            let corners: Vec<(usize, usize)> = ring[..3]
+                .iter()
+                .map(|p| {
+                    (
+                        p[0].as_f64().unwrap() as usize,
+                        p[1].as_f64().unwrap() as usize,
+                    )
+                })
+                .collect();
+            for (band, field) in [("band_2", field(1.1)), ("band_3", field(2.0))] {
+                let scale = if band == "band_3" { 0.25 } else { 1.0 };
+                let sum: f64 = corners.iter().map(|&(x, y)| scale * field(x, y)).sum();
+                let got = f["properties"][band].as_f64().expect("a mean per band");
+                assert!(
+                    (got - sum / 3.0).abs() <= 1e-12 * sum.abs().max(1.0),
+                    "{name} {f}"
+                );
+            }
+        }
+    }
+}

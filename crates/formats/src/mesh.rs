@@ -25,8 +25,10 @@ pub struct MeshRef<'a> {
     /// writes plain RFC 7946).
     pub epsg: Option<u32>,
     /// Values carried per vertex besides the position (several variables over one
-    /// mesh); written by PLY (a `double` property each) and glTF (a float32 `_NAME`
-    /// attribute each, the name in capitals), refused by the other formats.
+    /// mesh); written by PLY (a `double` property each), glTF (a float32 `_NAME`
+    /// attribute each, the name in capitals), GeoJSON and FlatGeobuf (per triangle: the
+    /// mean of its three corners' values, a number property or `Double` column each);
+    /// refused by OBJ, STL and LandXML.
     pub attributes: &'a [VertexAttribute<'a>],
 }
 
@@ -37,6 +39,12 @@ pub struct VertexAttribute<'a> {
     pub name: &'a str,
     /// One value per vertex, in vertex order.
     pub values: &'a [f64],
+}
+
+/// The mean of `values` at the corners of triangle `t`, as GeoJSON and FlatGeobuf
+/// write it: summed in corner order, divided by 3.
+pub(crate) fn corner_mean(values: &[f64], t: [u32; 3]) -> f64 {
+    (values[t[0] as usize] + values[t[1] as usize] + values[t[2] as usize]) / 3.0
 }
 
 impl<'a> MeshRef<'a> {
@@ -84,12 +92,12 @@ impl<'a> MeshRef<'a> {
     /// Checks what the readers check, so that no file is written that cannot be read back.
     pub(crate) fn check(&self, path: &Path, format: MeshFormat) -> Result<()> {
         if let Some(attribute) = self.attributes.first() {
-            if !matches!(format, MeshFormat::Ply | MeshFormat::Glb) {
+            if !format.carries_attributes() {
                 return Err(Error::BadOption {
                     path: path.to_path_buf(),
                     reason: format!(
-                        "{format} carries heights only; per-vertex variables (`{}`) are \
-                         written to PLY or glTF",
+                        "{format} carries heights only; variables (`{}`) are written to \
+                         PLY, glTF, GeoJSON or FlatGeobuf",
                         attribute.name
                     ),
                 });

@@ -114,10 +114,11 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     // `untiled_output` has checked the output path and its sidecar.
     let format = crate::format_plan::format(job)?;
     if !job.variables.is_empty() {
-        if !matches!(format, MeshFormat::Ply | MeshFormat::Glb) {
+        if !format.carries_attributes() {
             bail!(
                 "{}: {format} carries heights only; the variables of --bands are written \
-                 to PLY (.ply) or glTF (.glb), one property or attribute per band",
+                 to PLY (.ply) or glTF (.glb), one value per vertex and band, or GeoJSON \
+                 and FlatGeobuf (.geojson, .fgb), each triangle's corner mean per band",
                 output.display()
             );
         }

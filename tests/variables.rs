@@ -537,3 +537,96 @@ fn geojson_and_flatgeobuf_carry_each_triangles_corner_means_as_gdal_reads_them()
         }
     }
 }
+
+/// Writes band `name` as ESRI ASCII with its lower-left corner at `(x0, y0)` and cells of
+/// `cell`.
+fn write_band_at(
+    d: &Dir,
+    name: &str,
+    (x0, y0, cell): (f64, f64, f64),
+    f: impl Fn(usize, usize) -> f64,
+) {
+    let mut text = format!(
+        "ncols {W}\nnrows {H}\nxllcorner {x0}\nyllcorner {y0}\ncellsize {cell}\nNODATA_value -9999\n"
+    );
+    for y in 0..H {
+        let row: Vec<String> = (0..W).map(|x| format!("{}", f(x, y))).collect();
+        text.push_str(&row.join(" "));
+        text.push('\n');
+    }
+    d.write(name, &text);
+}
+
+#[test]
+fn attributes_from_another_raster_on_the_same_grid() {
+    let d = Dir::new();
+    write_band(&d, "dem.asc", field(0.3));
+    write_band(&d, "other.asc", field(1.7));
+    let r = {
+        let o = d.run(&[
+            "mesh",
+            "dem.asc",
+            "-o",
+            "m.ply",
+            "--max-error",
+            "1",
+            "--attributes",
+            "other.asc",
+            "--attribute-error",
+            "0.5",
+            "--report",
+            "r.json",
+            "-q",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        report(&d)
+    };
+    assert_eq!(r["variables"][0]["name"], "other_band_1", "{r}");
+    assert!(r["variables"][0]["measured_max_error"].as_f64().unwrap() <= 0.5);
+    let o = d.run(&[
+        "verify",
+        "dem.asc",
+        "m.ply",
+        "--max-error",
+        "1",
+        "--attributes",
+        "other.asc:1",
+        "--attribute-error",
+        "0.5",
+    ]);
+    assert!(o.status.success(), "{} {}", stdout(&o), stderr(&o));
+    assert!(stdout(&o).contains("(other_band_1)"), "{}", stdout(&o));
+
+    // Elsewhere, or on another grid: refused, naming the file, nothing written.
+    write_band_at(&d, "far.asc", (90_000.0, 2000.0, 10.0), field(1.0));
+    write_band_at(&d, "finer.asc", (1000.0, 2000.0, 5.0), field(1.0));
+    for (file, problem) in [("far.asc", "does not overlap"), ("finer.asc", "gdalwarp")] {
+        let o = d.run(&[
+            "mesh",
+            "dem.asc",
+            "-o",
+            "n.ply",
+            "--max-error",
+            "1",
+            "--attributes",
+            file,
+            "--attribute-error",
+            "0.5",
+        ]);
+        assert_fails_naming(&o, &[file, problem]);
+        assert!(!d.path("n.ply").exists());
+    }
+    let o = d.run(&[
+        "mesh",
+        "dem.asc",
+        "-o",
+        "n.ply",
+        "--max-error",
+        "1",
+        "--attributes",
+        "other.asc:1",
+        "--attribute-error",
+        "0.5,0.5",
+    ]);
+    assert_fails_naming(&o, &["other.asc", "2 bounds for 1 bands"]);
+}

@@ -260,6 +260,15 @@ pub struct VerifyArgs {
     /// With --bands: the band that is the height [default: the first].
     #[arg(long, value_name = "N", requires = "bands")]
     pub height_band: Option<usize>,
+    /// Variables from another raster on the input's grid (same size and geotransform;
+    /// refused, naming it, when it does not overlap or would need resampling): FILE's
+    /// bands B,... (all without :B,...), each within --attribute-error, as --bands' are.
+    #[arg(long, value_name = "FILE[:B,B,...]", requires = "attribute_error")]
+    pub attributes: Option<String>,
+    /// The bound of each --attributes band: one for all, or a comma-separated one per band.
+    #[arg(long, value_name = "E", value_parser = parse_max_error, allow_hyphen_values = true,
+          value_delimiter = ',', num_args = 1, requires = "attributes")]
+    pub attribute_error: Vec<f64>,
     /// The mesh holds (column, row, value) coordinates (it was written with --pixel-coords).
     #[arg(long)]
     pub pixel_coords: bool,
@@ -287,6 +296,10 @@ impl VerifyArgs {
             band
         };
         job.variables = variables;
+        if let Some(spec) = &self.attributes {
+            let more = tinsmith_pipeline::attribute_variables(spec, &self.attribute_error)?;
+            job.variables.extend(more);
+        }
         job.pixel_coords = self.pixel_coords;
         Ok(job)
     }

@@ -49,6 +49,15 @@ pub struct MeshArgs {
     /// With --bands: the band that is the height (listed in --bands) [default: the first].
     #[arg(long, value_name = "N", requires = "bands")]
     pub height_band: Option<usize>,
+    /// Variables from another raster on the input's grid (same size and geotransform;
+    /// refused, naming it, when it does not overlap or would need resampling): FILE's
+    /// bands B,... (all without :B,...), each within --attribute-error, as --bands' are.
+    #[arg(long, value_name = "FILE[:B,B,...]", requires = "attribute_error")]
+    pub attributes: Option<String>,
+    /// The bound of each --attributes band: one for all, or a comma-separated one per band.
+    #[arg(long, value_name = "E", value_parser = parse_max_error, allow_hyphen_values = true,
+          value_delimiter = ',', num_args = 1, requires = "attributes")]
+    pub attribute_error: Vec<f64>,
     /// Error model.
     #[arg(long, value_enum, default_value_t = ErrorModelArg::Exact)]
     pub error_model: ErrorModelArg,
@@ -180,6 +189,10 @@ impl MeshArgs {
             band
         };
         job.variables = variables;
+        if let Some(spec) = &self.attributes {
+            let more = tinsmith_pipeline::attribute_variables(spec, &self.attribute_error)?;
+            job.variables.extend(more);
+        }
         job.error_model = self.error_model.into();
         job.selection = self.selection.into();
         job.order = self.order.into();

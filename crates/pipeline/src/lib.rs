@@ -59,5 +59,5 @@ pub use serve::{serve, ServeOptions};
 pub use tiles::{merge_tiles, tiles, tiles_shard, vertical_datum, water_source};
 pub use tinsmith_georef::readable;
 pub use tinsmith_tiling::available_bytes;
-pub use variables::{resolve_bands, BandVariable, VariableReport};
+pub use variables::{attribute_variables, resolve_bands, BandVariable, VariableReport};
 pub use verify::{verify, Verified};

@@ -143,7 +143,12 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let (grid, variables) = if job.variables.is_empty() {
         (Grid::from_samples(samples), Vec::new())
     } else {
-        crate::variables::read(&job.input, samples, &job.variables, format.is_float32())?
+        crate::variables::read(
+            &job.input,
+            (samples, &raster_info),
+            &job.variables,
+            format.is_float32(),
+        )?
     };
     let grid = &grid;
     let read_seconds = t.elapsed().as_secs_f64();

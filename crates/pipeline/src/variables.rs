@@ -2,11 +2,12 @@
 //! height and the variables with their bounds, reading them onto one grid whose domain is
 //! where every band is valid, naming them in files, and measuring each one independently.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 use tinsmith_core::{Grid, Tin, Variable};
 use tinsmith_georef::Samples;
+use tinsmith_raster::RasterInfo;
 use tinsmith_verify::{GridRef, MeshRef, Orientation, Report, VerifyOptions};
 
 use crate::error::{bail, Context};
@@ -21,6 +22,58 @@ pub struct BandVariable {
     pub band: usize,
     /// Its bound (`f64::INFINITY`: carried, never constraining).
     pub max_error: f64,
+    /// The raster it is read from when not the input (`--attributes`): it must be on the
+    /// input's grid (same size and geotransform).
+    pub file: Option<PathBuf>,
+}
+
+/// `--attributes FILE[:B,B,...]` with `--attribute-error E` (one bound, or one per band):
+/// those bands of another raster (all of them without `:bands`) as variables.
+pub fn attribute_variables(spec: &str, bounds: &[f64]) -> Result<Vec<BandVariable>> {
+    let (path, bands) = match spec.rsplit_once(':') {
+        Some((path, list))
+            if !path.is_empty() && list.split(',').all(|b| b.trim().parse::<usize>().is_ok()) =>
+        {
+            let bands: Vec<usize> = list
+                .split(',')
+                .map(|b| b.trim().parse().unwrap_or(0))
+                .collect();
+            (PathBuf::from(path), bands)
+        }
+        _ => {
+            let path = PathBuf::from(spec);
+            let count = tinsmith_raster::open_info(&path, 1)?.band_count;
+            (path, (1..=count).collect())
+        }
+    };
+    let name = path.display();
+    if bands.contains(&0) {
+        bail!("{name}: --attributes: bands are numbered from 1");
+    }
+    if let Some(&bad) = bounds.iter().find(|e| e.is_nan() || **e < 0.0) {
+        bail!("{name}: --attribute-error {bad}: every bound must be a number >= 0");
+    }
+    if bounds.len() != 1 && bounds.len() != bands.len() {
+        bail!(
+            "{name}: --attribute-error gives {} bounds for {} bands: give one bound for all, \
+             or one per band",
+            bounds.len(),
+            bands.len()
+        );
+    }
+    Ok(bands
+        .iter()
+        .enumerate()
+        .map(|(i, &band)| BandVariable {
+            band,
+            max_error: if bounds.len() == 1 {
+                bounds[0]
+            } else {
+                bounds[i]
+            },
+            file: Some(path.clone()),
+        })
+        .collect())
 }
 
 /// The height band, its bound and the other bands as variables, from `--bands` (empty:
@@ -104,6 +157,7 @@ pub fn resolve_bands(
         .map(|(i, &band)| BandVariable {
             band,
             max_error: bound(i),
+            file: None,
         })
         .collect();
     Ok((height, Some(bound(at)), variables))
@@ -116,15 +170,32 @@ pub fn resolve_bands(
 /// keep the bound; a bound below that rounding is refused.
 pub(crate) fn read(
     input: &Path,
-    height: Samples,
+    height: (Samples, &RasterInfo),
     variables: &[BandVariable],
     float32: bool,
 ) -> Result<(Grid, Vec<(BandVariable, String)>)> {
+    let (height, info) = height;
     let mut read = Vec::with_capacity(variables.len());
     let mut names: Vec<String> = Vec::new();
     for v in variables {
-        let raster = tinsmith_raster::read_samples(input, v.band)?;
-        let name = property_name(raster.info.description.as_deref(), v.band, &names);
+        let raster = match &v.file {
+            None => tinsmith_raster::read_samples(input, v.band)?,
+            Some(file) => {
+                let raster = tinsmith_raster::read_samples(file, v.band)?;
+                check_same_grid(file, &raster.info, input, info)?;
+                raster
+            }
+        };
+        let fallback = match &v.file {
+            None => format!("band_{}", v.band),
+            Some(file) => format!(
+                "{}_band_{}",
+                file.file_stem()
+                    .map_or("attribute".into(), |s| s.to_string_lossy()),
+                v.band
+            ),
+        };
+        let name = property_name(raster.info.description.as_deref(), &fallback, &names);
         names.push(name);
         let rounding = match float32 {
             true => raster
@@ -153,26 +224,110 @@ pub(crate) fn read(
 /// The name a file gives a band's values: its description made a PLY property name
 /// (whitespace and anything but ASCII letters, digits, `_` and `-` as `_`), or `band_N`
 /// when it has none, it would read as a position (`x`, `y`, `z`), or another band took it.
-fn property_name(description: Option<&str>, band: usize, taken: &[String]) -> String {
-    let fallback = format!("band_{band}");
-    let Some(d) = description else {
-        return fallback;
+fn property_name(description: Option<&str>, fallback: &str, taken: &[String]) -> String {
+    let clean = |d: &str| -> String {
+        d.trim()
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect()
     };
-    let name: String = d
-        .trim()
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
-                c
-            } else {
-                '_'
-            }
+    let usable = |name: &String| {
+        !name.is_empty() && !["x", "y", "z"].contains(&name.as_str()) && !taken.contains(name)
+    };
+    if let Some(name) = description.map(clean).filter(usable) {
+        return name;
+    }
+    let mut name = clean(fallback);
+    while !usable(&name) {
+        name.push('_');
+    }
+    name
+}
+
+/// Refuses an attribute raster that is not on the input's grid: one that shares no area
+/// with it, or one on another grid (size or geotransform), which would need resampling.
+fn check_same_grid(file: &Path, other: &RasterInfo, input: &Path, info: &RasterInfo) -> Result<()> {
+    let extent = |i: &RasterInfo| {
+        i.geo_transform.map(|g| {
+            let xs = [
+                g[0],
+                g[0] + g[1] * f64::from(i.width) + g[2] * f64::from(i.height),
+            ];
+            let ys = [
+                g[3],
+                g[3] + g[4] * f64::from(i.width) + g[5] * f64::from(i.height),
+            ];
+            (
+                xs[0].min(xs[1]),
+                xs[0].max(xs[1]),
+                ys[0].min(ys[1]),
+                ys[0].max(ys[1]),
+            )
         })
-        .collect();
-    if name.is_empty() || ["x", "y", "z"].contains(&name.as_str()) || taken.contains(&name) {
-        fallback
-    } else {
-        name
+    };
+    let same_size = (other.width, other.height) == (info.width, info.height);
+    let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-9 * scale.max(1.0);
+    match (
+        extent(other),
+        extent(info),
+        other.geo_transform,
+        info.geo_transform,
+    ) {
+        (None, None, _, _) if same_size => Ok(()),
+        (Some(o), Some(i), Some(go), Some(gi)) => {
+            if o.1 <= i.0 || i.1 <= o.0 || o.3 <= i.2 || i.3 <= o.2 {
+                bail!(
+                    "{}: --attributes: does not overlap {} (extents x {}..{}, y {}..{} against \
+                     x {}..{}, y {}..{})",
+                    file.display(),
+                    input.display(),
+                    o.0,
+                    o.1,
+                    o.2,
+                    o.3,
+                    i.0,
+                    i.1,
+                    i.2,
+                    i.3
+                );
+            }
+            let pixel = gi[1].abs().max(gi[5].abs());
+            let same = same_size
+                && go
+                    .iter()
+                    .zip(&gi)
+                    .all(|(a, b)| close(*a, *b, pixel.max(a.abs() * 1e-6)));
+            if !same {
+                bail!(
+                    "{}: --attributes: on another grid than {} ({}x{} against {}x{}, or another \
+                     geotransform); resample it onto that grid first, e.g. gdalwarp -te {} {} {} {} \
+                     -ts {} {} {} OUT.tif",
+                    file.display(),
+                    input.display(),
+                    other.width,
+                    other.height,
+                    info.width,
+                    info.height,
+                    i.0, i.2, i.1, i.3,
+                    info.width,
+                    info.height,
+                    file.display()
+                );
+            }
+            Ok(())
+        }
+        _ => bail!(
+            "{}: --attributes: cannot be placed on {}'s grid (one has a geotransform, the \
+             other not, or their sizes differ)",
+            file.display(),
+            input.display()
+        ),
     }
 }
 
@@ -336,17 +491,8 @@ mod tests {
         let (h, e, v) = resolve_bands(p, &[1, 2, 3], &[1.0, 0.5, 0.25], None).unwrap();
         assert_eq!((h, e), (1, Some(1.0)));
         assert_eq!(
-            v,
-            [
-                BandVariable {
-                    band: 2,
-                    max_error: 0.5
-                },
-                BandVariable {
-                    band: 3,
-                    max_error: 0.25
-                }
-            ]
+            (v[0].band, v[0].max_error, v[1].band, v[1].max_error),
+            (2, 0.5, 3, 0.25)
         );
         let (h, e, v) = resolve_bands(p, &[1, 2, 3], &[2.0], Some(3)).unwrap();
         assert_eq!((h, e, v.len()), (3, Some(2.0), 2));
@@ -368,12 +514,14 @@ mod tests {
 
     #[test]
     fn names_come_from_descriptions_unless_unusable() {
-        assert_eq!(property_name(None, 2, &[]), "band_2");
+        assert_eq!(property_name(None, "band_2", &[]), "band_2");
         assert_eq!(
-            property_name(Some("surface temp (K)"), 2, &[]),
+            property_name(Some("surface temp (K)"), "band_2", &[]),
             "surface_temp__K_"
         );
-        assert_eq!(property_name(Some("z"), 3, &[]), "band_3");
-        assert_eq!(property_name(Some("dtm"), 3, &["dtm".to_owned()]), "band_3");
+        assert_eq!(property_name(Some("z"), "band_3", &[]), "band_3");
+        let taken = ["dtm".to_owned(), "band_3".to_owned()];
+        assert_eq!(property_name(Some("dtm"), "band_3", &taken), "band_3_");
+        assert_eq!(property_name(None, "dem_band_1", &taken), "dem_band_1");
     }
 }

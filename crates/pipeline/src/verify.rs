@@ -56,7 +56,7 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
         true => None,
         false => Some(crate::variables::read(
             &job.input,
-            raster.samples.clone(),
+            (raster.samples.clone(), &raster.info),
             &job.variables,
             false,
         )?),

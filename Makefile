@@ -177,7 +177,7 @@ bench-compare: deps
 ## correlation (docs/results.md, "Several variables over one mesh"; a few minutes).
 bench-variables: deps
 	cargo build --release --quiet
-	$(VENV)/bin/python bench/variables.py --shared ../shared
+	$(VENV)/bin/python bench/variables.py --shared ../shared --repeat 7
 
 ## tinsmith.mesh vs pydelatin in one Python process, one thread each, on the DEMs of
 ## bench-compare: triangles, seconds, errors, peak memory, and the binding's per-call

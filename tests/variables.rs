@@ -630,3 +630,105 @@ fn attributes_from_another_raster_on_the_same_grid() {
     ]);
     assert_fails_naming(&o, &["other.asc", "2 bounds for 1 bands"]);
 }
+
+/// `rgb.tif`: an 8-bit height and three 8-bit colour bands.
+fn height_and_colours(d: &Dir) -> [fn(usize, usize) -> f64; 4] {
+    let bands: [fn(usize, usize) -> f64; 4] = [
+        |x, y| ((x * 3 + y * 2) % 200) as f64 + if x > 20 { 30.0 } else { 0.0 },
+        |x, _| (x * 6) as f64,
+        |_, y| (y * 8) as f64,
+        |x, y| {
+            if (x / 8 + y / 8) % 2 == 0 {
+                250.0
+            } else {
+                10.0
+            }
+        },
+    ];
+    for (i, f) in bands.iter().enumerate() {
+        write_band(d, &format!("c{i}.asc"), f);
+    }
+    run_in(
+        d,
+        "gdalbuildvrt",
+        &[
+            "-q",
+            "-separate",
+            "stack.vrt",
+            "c0.asc",
+            "c1.asc",
+            "c2.asc",
+            "c3.asc",
+        ],
+    );
+    run_in(
+        d,
+        "gdal_translate",
+        &["-q", "-ot", "Byte", "stack.vrt", "rgb.tif"],
+    );
+    bands
+}
+
+#[test]
+#[ignore = "needs trimesh in .venv and the glTF validator in .tools (make deps)"]
+fn three_8_bit_bands_are_vertex_colours_in_ply_obj_and_gltf() {
+    let d = Dir::new();
+    let bands = height_and_colours(&d);
+    for name in ["c.ply", "c.obj", "c.glb"] {
+        let o = d.run(&[
+            "mesh",
+            "rgb.tif",
+            "-o",
+            name,
+            "--bands",
+            "1,2,3,4",
+            "--max-error",
+            "2,8,8,8",
+            "--pixel-coords",
+            "-q",
+        ]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/oracles/vertex_colours.py");
+        let o = Command::new(python())
+            .arg(&script)
+            .arg(d.path(name))
+            .output()
+            .expect("python runs");
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let json: Value = serde_json::from_slice(&o.stdout).expect("oracle JSON");
+        let vertices = json["vertices"].as_array().unwrap();
+        assert!(vertices.len() > 10, "{name}");
+        for (v, c) in vertices.iter().zip(json["colours"].as_array().unwrap()) {
+            let (x, y) = (
+                v[0].as_f64().unwrap().round() as usize,
+                v[1].as_f64().unwrap().round() as usize,
+            );
+            let expected: Vec<u64> = bands[1..].iter().map(|f| f(x, y) as u64).collect();
+            let got: Vec<u64> = (0..3).map(|k| c[k].as_u64().unwrap()).collect();
+            assert_eq!(got, expected, "{name} at ({x}, {y})");
+        }
+    }
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/oracles/gltf_validate.js");
+    let o = Command::new("node")
+        .arg(&script)
+        .arg(d.path("c.glb"))
+        .output()
+        .expect("node runs");
+    let report: Value = serde_json::from_slice(&o.stdout).expect("validator JSON");
+    assert_eq!(report["issues"]["numErrors"], 0, "{report:#}");
+    assert_eq!(report["issues"]["numWarnings"], 0, "{report:#}");
+    // The PLY and the glTF keep each band too: verify reads them back.
+    for name in ["c.ply", "c.glb"] {
+        let o = d.run(&[
+            "verify",
+            "rgb.tif",
+            name,
+            "--bands",
+            "1,2,3,4",
+            "--max-error",
+            "2,8,8,8",
+            "--pixel-coords",
+        ]);
+        assert!(o.status.success(), "{name}: {} {}", stdout(&o), stderr(&o));
+    }
+}

@@ -42,8 +42,9 @@ pub struct MeshArgs {
     /// within its own --max-error at every sample; a vertex goes only when every band
     /// stays within its bound. The first (or --height-band) is the height, the others are
     /// written per vertex (PLY: a property named after the band's description or band_N;
-    /// glTF: a _NAME attribute). The domain is where every band is valid. Exact error
-    /// model, untiled.
+    /// glTF: a _NAME attribute; three 8-bit bands also as vertex colours, OBJ included),
+    /// or per triangle (GeoJSON, FlatGeobuf: corner means). The domain is where every
+    /// band is valid. Exact error model, untiled.
     #[arg(long, value_delimiter = ',', num_args = 1, value_name = "B,B,...")]
     pub bands: Vec<usize>,
     /// With --bands: the band that is the height (listed in --bands) [default: the first].

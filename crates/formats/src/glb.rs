@@ -114,7 +114,12 @@ pub(crate) fn write<W: Write>(
     let normals_len = if normals { positions_len } else { 0 };
     // Each vertex attribute: one float32 per vertex, after the normals.
     let attribute_len = 4 * vertex_count;
-    let attributes_len = attribute_len * mesh.attributes.len() as u64;
+    let attributes_len = attribute_len * mesh.attributes.len() as u64
+        + if mesh.colours.is_some() {
+            12 * vertex_count
+        } else {
+            0
+        };
     let indices_len = index_size * 3 * mesh.triangles.len() as u64;
     let total_len = pad4(positions_len + normals_len + attributes_len + indices_len);
 
@@ -157,6 +162,19 @@ pub(crate) fn write<W: Write>(
             views.push(json!({
                 "buffer": 0, "byteOffset": positions_len + normals_len + k as u64 * attribute_len,
                 "byteLength": attribute_len, "target": 34962,
+            }));
+        }
+        if mesh.colours.is_some() {
+            attributes["COLOR_0"] = Value::from(accessors.len());
+            accessors.push(json!({
+                "bufferView": views.len(), "componentType": FLOAT, "count": vertex_count,
+                "type": "VEC3",
+            }));
+            views.push(json!({
+                "buffer": 0,
+                "byteOffset": positions_len + normals_len
+                    + attribute_len * mesh.attributes.len() as u64,
+                "byteLength": 12 * vertex_count, "target": 34962,
             }));
         }
         accessors.push(json!({
@@ -222,6 +240,11 @@ pub(crate) fn write<W: Write>(
     for attribute in mesh.attributes {
         for &value in attribute.values {
             w.write_all(&(value as f32).to_le_bytes())?;
+        }
+    }
+    for colour in mesh.colours.unwrap_or(&[]) {
+        for c in colour {
+            w.write_all(&(f32::from(*c) / 255.0).to_le_bytes())?;
         }
     }
     for &index in mesh.triangles.iter().flatten() {

@@ -30,6 +30,10 @@ pub struct MeshRef<'a> {
     /// mean of its three corners' values, a number property or `Double` column each);
     /// refused by OBJ, STL and LandXML.
     pub attributes: &'a [VertexAttribute<'a>],
+    /// An RGB colour per vertex (three 8-bit bands carried as colours): PLY `uchar red
+    /// green blue` properties, glTF `COLOR_0` (float, 0..1), OBJ `v x y z r g b` (0..1);
+    /// refused by the other formats.
+    pub colours: Option<&'a [[u8; 3]]>,
 }
 
 /// One value per vertex, under a name (a PLY property name: no whitespace).
@@ -56,7 +60,14 @@ impl<'a> MeshRef<'a> {
             crs_wkt: None,
             epsg: None,
             attributes: &[],
+            colours: None,
         }
+    }
+
+    /// Sets the per-vertex colours (see [`MeshRef::colours`]).
+    pub fn with_colours(mut self, colours: Option<&'a [[u8; 3]]>) -> Self {
+        self.colours = colours;
+        self
     }
 
     /// Sets the per-vertex attributes (see [`MeshRef::attributes`]).
@@ -99,6 +110,21 @@ impl<'a> MeshRef<'a> {
                         "{format} carries heights only; variables (`{}`) are written to \
                          PLY, glTF, GeoJSON or FlatGeobuf",
                         attribute.name
+                    ),
+                });
+            }
+        }
+        if let Some(colours) = self.colours {
+            if !matches!(format, MeshFormat::Ply | MeshFormat::Glb | MeshFormat::Obj)
+                || colours.len() != self.vertices.len()
+            {
+                return Err(Error::BadOption {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "vertex colours go to PLY, glTF or OBJ, one per vertex ({} for {} \
+                         vertices, {format})",
+                        colours.len(),
+                        self.vertices.len()
                     ),
                 });
             }
@@ -222,6 +248,7 @@ impl Mesh {
             crs_wkt: self.crs_wkt.as_deref(),
             epsg: self.epsg,
             attributes: &[],
+            colours: None,
         }
     }
 }

@@ -40,6 +40,9 @@ pub(crate) fn write<W: Write>(mut w: W, mesh: MeshRef<'_>) -> io::Result<()> {
     for attribute in mesh.attributes {
         let _ = writeln!(header, "property double {}", attribute.name);
     }
+    if mesh.colours.is_some() {
+        header.push_str("property uchar red\nproperty uchar green\nproperty uchar blue\n");
+    }
     let _ = write!(
         header,
         "element face {}\nproperty list uchar int vertex_indices\nend_header\n",
@@ -47,14 +50,18 @@ pub(crate) fn write<W: Write>(mut w: W, mesh: MeshRef<'_>) -> io::Result<()> {
     );
     w.write_all(header.as_bytes())?;
 
-    let mut record = vec![0u8; 8 * (3 + mesh.attributes.len())];
+    let doubles = 8 * (3 + mesh.attributes.len());
+    let mut record = vec![0u8; doubles + if mesh.colours.is_some() { 3 } else { 0 }];
     for (i, vertex) in mesh.vertices.iter().enumerate() {
         let values = vertex
             .iter()
             .copied()
             .chain(mesh.attributes.iter().map(|a| a.values[i]));
-        for (bytes, value) in record.chunks_exact_mut(8).zip(values) {
+        for (bytes, value) in record[..doubles].chunks_exact_mut(8).zip(values) {
             bytes.copy_from_slice(&value.to_le_bytes());
+        }
+        if let Some(colours) = mesh.colours {
+            record[doubles..].copy_from_slice(&colours[i]);
         }
         w.write_all(&record)?;
     }

@@ -274,13 +274,13 @@ fn check_position_rounding(
 /// Writes the mesh (`vertices` in file coordinates, counter-clockwise `triangles`) as the
 /// plan's format with the raster's CRS: reprojected to WGS84 for GeoJSON unless
 /// `--geojson-source-crs`; a `.prj` sidecar for OBJ, STL and glTF. `attributes` (one
-/// value per vertex each) go to PLY; the other formats refuse them.
+/// value per vertex each) and `colours` go where [`tinsmith_formats::MeshRef`] says.
 pub fn write(
     plan: &FormatPlan,
     job: &MeshJob,
     info: &RasterInfo,
     (mut vertices, triangles): (Vec<[f64; 3]>, &[[u32; 3]]),
-    attributes: &[VertexAttribute<'_>],
+    (attributes, colours): (&[VertexAttribute<'_>], Option<&[[u8; 3]]>),
     feedback: &dyn Feedback,
 ) -> Result<()> {
     let path = out(job);
@@ -319,6 +319,7 @@ pub fn write(
         .with_normals(job.export.normals);
     let mesh = MeshRef::new(&vertices, triangles)
         .with_attributes(attributes)
+        .with_colours(colours)
         .with_crs_wkt(crs.wkt)
         .with_epsg(crs.epsg);
     tinsmith_formats::write_mesh_with(path, plan.format, mesh, &options)?;

@@ -114,7 +114,8 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     // `untiled_output` has checked the output path and its sidecar.
     let format = crate::format_plan::format(job)?;
     if !job.variables.is_empty() {
-        if !format.carries_attributes() {
+        // OBJ carries three 8-bit bands as vertex colours: checked once they are read.
+        if !format.carries_attributes() && format != MeshFormat::Obj {
             bail!(
                 "{}: {format} carries heights only; the variables of --bands are written \
                  to PLY (.ply) or glTF (.glb), one value per vertex and band, or GeoJSON \
@@ -140,8 +141,8 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         info: raster_info,
         ..
     } = raster;
-    let (grid, variables) = if job.variables.is_empty() {
-        (Grid::from_samples(samples), Vec::new())
+    let (grid, variables, rgb) = if job.variables.is_empty() {
+        (Grid::from_samples(samples), Vec::new(), false)
     } else {
         crate::variables::read(
             &job.input,
@@ -151,6 +152,13 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         )?
     };
     let grid = &grid;
+    if format == MeshFormat::Obj && !variables.is_empty() && !rgb {
+        bail!(
+            "{}: OBJ carries three 8-bit bands as vertex colours (v x y z r g b) and no other \
+             variables; write PLY (.ply) or glTF (.glb) for these",
+            output.display()
+        );
+    }
     let read_seconds = t.elapsed().as_secs_f64();
     if grid.valid_cell_count() == 0 {
         bail!(
@@ -214,13 +222,21 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         .iter()
         .zip(&at_vertices)
         .map(|((_, name), values)| VertexAttribute { name, values })
+        .filter(|_| format != MeshFormat::Obj)
         .collect();
+    // Three 8-bit bands are colours too, in the formats that have vertex colours.
+    let colours: Option<Vec<[u8; 3]>> =
+        (rgb && matches!(format, MeshFormat::Ply | MeshFormat::Glb | MeshFormat::Obj)).then(|| {
+            (0..tin.vertices().len())
+                .map(|i| [0, 1, 2].map(|k| at_vertices[k][i] as u8))
+                .collect()
+        });
     crate::format_plan::write(
         &plan,
         job,
         &raster_info,
         (vertices, &triangles),
-        &attributes,
+        (&attributes, colours.as_deref()),
         feedback,
     )?;
     if let (Some(png), Some(bytes)) = (&job.preview, &picture) {

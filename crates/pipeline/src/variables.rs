@@ -163,18 +163,23 @@ pub fn resolve_bands(
     Ok((height, Some(bound(at)), variables))
 }
 
+/// A variable's band and bound, with the name files give it.
+pub(crate) type Named = (BandVariable, String);
+
 /// Reads every variable's band of `input` beside the `height` samples already read, into
 /// one grid (the domain is where every band is valid), with each variable's band, bound
 /// and the name files give it. For a `float32` file each band is decimated within its
 /// bound less the largest float32 rounding of its values, so that the values as stored
-/// keep the bound; a bound below that rounding is refused.
+/// keep the bound; a bound below that rounding is refused. The flag says whether the
+/// variables are exactly three 8-bit (`Byte`) bands: written as vertex colours too.
 pub(crate) fn read(
     input: &Path,
     height: (Samples, &RasterInfo),
     variables: &[BandVariable],
     float32: bool,
-) -> Result<(Grid, Vec<(BandVariable, String)>)> {
+) -> Result<(Grid, Vec<Named>, bool)> {
     let (height, info) = height;
+    let mut bytes = 0;
     let mut read = Vec::with_capacity(variables.len());
     let mut names: Vec<String> = Vec::new();
     for v in variables {
@@ -196,6 +201,7 @@ pub(crate) fn read(
             ),
         };
         let name = property_name(raster.info.description.as_deref(), &fallback, &names);
+        bytes += usize::from(raster.info.data_type == "Byte");
         names.push(name);
         let rounding = match float32 {
             true => raster
@@ -218,7 +224,8 @@ pub(crate) fn read(
         read.push(Variable::new(raster.samples, v.max_error - rounding).naming_file(input)?);
     }
     let grid = Grid::with_variables(height, read).naming_file(input)?;
-    Ok((grid, variables.iter().cloned().zip(names).collect()))
+    let rgb = variables.len() == 3 && bytes == 3;
+    Ok((grid, variables.iter().cloned().zip(names).collect(), rgb))
 }
 
 /// The name a file gives a band's values: its description made a PLY property name

@@ -64,7 +64,7 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
     let joined_samples;
     let grid = match &joined {
         None => &raster.samples,
-        Some((grid, _)) => {
+        Some((grid, _, _)) => {
             joined_samples =
                 tinsmith_georef::Samples::new(grid.width(), grid.height(), grid.values().to_vec())
                     .map_err(tinsmith_core::Error::from)?;
@@ -92,7 +92,7 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
     }
     let variables = match &joined {
         None => Vec::new(),
-        Some((grid, variables)) => crate::variables::verify_file(
+        Some((grid, variables, _)) => crate::variables::verify_file(
             &job.mesh,
             grid,
             variables,

@@ -20,7 +20,7 @@ PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
   rioxarray==0.19.0 xarray==2026.9.0 pandas==3.1.1 pyproj==3.7.2 laspy[lazrs]==2.7.0
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
-.PHONY: deps gdal oracles demo pictures test python-test bench-python bench-ctb bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview bench-points
+.PHONY: deps gdal oracles demo pictures test python-test bench-python bench-ctb bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview bench-points bench-variables
 
 ## Everything the tests need: GDAL, then the independent oracles.
 deps: gdal
@@ -172,6 +172,13 @@ bench-compare: deps
 	cargo build --release --quiet
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check pydelatin rasterio
 	$(VENV)/bin/python bench/compare.py --shared ../shared
+
+## Several variables over one mesh (`mesh --bands`): the heart's 16 MR frames and the
+## CODEM pair, decimation and time against the single-band meshes and the bands'
+## correlation (docs/results.md, "Several variables over one mesh"; a few minutes).
+bench-variables: deps
+	cargo build --release --quiet
+	$(VENV)/bin/python bench/variables.py --shared ../shared --repeat 7
 
 ## tinsmith.mesh vs pydelatin in one Python process, one thread each, on the DEMs of
 ## bench-compare: triangles, seconds, errors, peak memory, and the binding's per-call

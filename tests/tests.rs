@@ -18,3 +18,4 @@ mod serve;
 mod shards;
 mod tiled_mesh;
 mod tiles;
+mod variables;

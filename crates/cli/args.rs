@@ -31,7 +31,7 @@ pub enum Command {
     Info(InfoArgs),
     /// Decimate a raster into a TIN within --max-error of every valid sample.
     #[command(allow_negative_numbers = true)]
-    Mesh(MeshArgs),
+    Mesh(Box<MeshArgs>),
     /// Measure a TIN's true error against its raster at every valid sample.
     #[command(allow_negative_numbers = true)]
     Verify(VerifyArgs),
@@ -250,12 +250,31 @@ pub struct VerifyArgs {
     /// landxml (for a file written with `mesh --format`).
     #[arg(long, value_name = "NAME", value_parser = tinsmith_pipeline::parse_format)]
     pub format: Option<MeshFormat>,
-    /// Fail (exit 1) when the measured error exceeds this.
-    #[arg(long, value_parser = parse_max_error, allow_hyphen_values = true)]
-    pub max_error: Option<f64>,
+    /// Fail (exit 1) when the measured error exceeds this. With --bands, one bound for
+    /// every band or a comma-separated bound per band.
+    #[arg(long, value_parser = parse_max_error, allow_hyphen_values = true,
+          value_delimiter = ',', num_args = 1)]
+    pub max_error: Vec<f64>,
     /// Band the mesh was made from (1-based).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, conflicts_with = "bands")]
     pub band: usize,
+    /// The bands a `mesh --bands` mesh was made from: the first (or --height-band) against
+    /// the mesh's heights, each other against the PLY property (glTF attribute) of its
+    /// name, each within its --max-error, over the domain where every band is valid.
+    #[arg(long, value_delimiter = ',', num_args = 1, value_name = "B,B,...")]
+    pub bands: Vec<usize>,
+    /// With --bands: the band that is the height [default: the first].
+    #[arg(long, value_name = "N", requires = "bands")]
+    pub height_band: Option<usize>,
+    /// Variables from another raster on the input's grid (same size and geotransform;
+    /// refused, naming it, when it does not overlap or would need resampling): FILE's
+    /// bands B,... (all without :B,...), each within --attribute-error, as --bands' are.
+    #[arg(long, value_name = "FILE[:B,B,...]", requires = "attribute_error")]
+    pub attributes: Option<String>,
+    /// The bound of each --attributes band: one for all, or a comma-separated one per band.
+    #[arg(long, value_name = "E", value_parser = parse_max_error, allow_hyphen_values = true,
+          value_delimiter = ',', num_args = 1, requires = "attributes")]
+    pub attribute_error: Vec<f64>,
     /// The mesh holds (column, row, value) coordinates (it was written with --pixel-coords).
     #[arg(long)]
     pub pixel_coords: bool,
@@ -271,15 +290,31 @@ pub struct VerifyArgs {
 }
 
 impl VerifyArgs {
-    /// The job these flags ask for.
-    pub fn job(&self) -> VerifyJob {
+    /// The job these flags ask for; fails when --bands, --max-error and --height-band
+    /// do not fit together.
+    pub fn job(&self) -> tinsmith_pipeline::Result<VerifyJob> {
         let mut job = VerifyJob::new(&self.input, &self.mesh);
         job.format = self.format;
-        job.max_error = self.max_error;
-        job.band = self.band;
+        let (band, max_error, variables) = tinsmith_pipeline::resolve_bands(
+            &self.input,
+            &self.bands,
+            &self.max_error,
+            self.height_band,
+        )?;
+        job.max_error = max_error;
+        job.band = if self.bands.is_empty() {
+            self.band
+        } else {
+            band
+        };
+        job.variables = variables;
+        if let Some(spec) = &self.attributes {
+            let more = tinsmith_pipeline::attribute_variables(spec, &self.attribute_error)?;
+            job.variables.extend(more);
+        }
         job.pixel_coords = self.pixel_coords;
         job.vertical_datum = self.vertical_datum.clone();
-        job
+        Ok(job)
     }
 }
 

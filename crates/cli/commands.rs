@@ -8,7 +8,7 @@ use crate::progress::Stderr;
 
 /// `tinsmith mesh`; `Ok(true)` once the verified mesh is written.
 pub fn mesh(args: &MeshArgs) -> Result<bool> {
-    tinsmith_pipeline::mesh(&args.job(), &Stderr::new(args.quiet))?;
+    tinsmith_pipeline::mesh(&args.job()?, &Stderr::new(args.quiet))?;
     Ok(true)
 }
 

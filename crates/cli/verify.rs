@@ -10,9 +10,9 @@ use crate::args::VerifyArgs;
 /// exceeds `--max-error`.
 pub fn run(args: &VerifyArgs) -> Result<bool> {
     if tinsmith_pipeline::is_point_input(&args.input) {
-        let Some(max_error) = args.max_error else {
+        let [max_error] = args.max_error[..] else {
             anyhow::bail!(
-                "{}: verifying points needs --max-error",
+                "{}: verifying points needs one --max-error",
                 args.input.display()
             );
         };
@@ -31,12 +31,34 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
         }
         return Ok(report.passed());
     }
-    let verified = tinsmith_pipeline::verify(&args.job())?;
+    let verified = tinsmith_pipeline::verify(&args.job()?)?;
     let report = &verified.report;
-    if args.json {
+    if args.json && verified.variables.is_empty() {
         println!("{}", serde_json::to_string_pretty(report)?);
+    } else if args.json {
+        let variables: Vec<_> = verified
+            .variables
+            .iter()
+            .map(|(v, r)| serde_json::json!({ "variable": v, "report": r }))
+            .collect();
+        let both = serde_json::json!({ "height": report, "variables": variables });
+        println!("{}", serde_json::to_string_pretty(&both)?);
     } else {
         print_report(report, args);
+        for (v, r) in &verified.variables {
+            println!(
+                "band {} ({}):{}max error {}, allowed {}{}",
+                v.band,
+                v.name,
+                " ".repeat(9usize.saturating_sub(v.band.to_string().len() + v.name.len())),
+                readable(v.measured_max_error),
+                readable(v.max_error),
+                if r.passed() { "" } else { "  FAILED" }
+            );
+            for problem in &r.problems {
+                println!("  problem:       {problem}");
+            }
+        }
     }
     if !report.passed() && verified.band_count > 1 {
         note!(
@@ -47,7 +69,7 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
             verified.band_count
         );
     }
-    Ok(report.passed())
+    Ok(verified.passed())
 }
 
 fn print_report(report: &Report, args: &VerifyArgs) {

@@ -24,10 +24,12 @@ pub struct MeshArgs {
     #[command(flatten)]
     pub export: ExportArgs,
     /// Largest allowed |sample - TIN| at any valid sample, in data units. Required unless
-    /// --max-triangles or --max-vertices is given.
+    /// --max-triangles or --max-vertices is given. With --bands, one bound for every band
+    /// or a comma-separated bound per band.
     #[arg(long, value_parser = parse_max_error, allow_hyphen_values = true,
+          value_delimiter = ',', num_args = 1,
           required_unless_present_any = ["max_triangles", "max_vertices"])]
-    pub max_error: Option<f64>,
+    pub max_error: Vec<f64>,
     /// Decimate until at most N triangles remain (greedy order), then report the verified
     /// max error.
     #[arg(long, value_name = "N")]
@@ -36,7 +38,7 @@ pub struct MeshArgs {
     #[arg(long, value_name = "N")]
     pub max_vertices: Option<usize>,
     /// Band to read (1-based).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, conflicts_with = "bands")]
     pub band: usize,
     /// Mesh heights above the WGS84 ellipsoid, turned from heights above this geoid
     /// (egm96, egm2008 or a geoid grid file) at every sample through PROJ; the bound holds
@@ -44,6 +46,27 @@ pub struct MeshArgs {
     /// Default: the band's heights as they are.
     #[arg(long, value_name = "DATUM", value_parser = parse_datum)]
     pub vertical_datum: Option<tinsmith_raster::VerticalDatum>,
+    /// Several variables over one mesh: these bands (comma-separated, 1-based), each
+    /// within its own --max-error at every sample; a vertex goes only when every band
+    /// stays within its bound. The first (or --height-band) is the height, the others are
+    /// written per vertex (PLY: a property named after the band's description or band_N;
+    /// glTF: a _NAME attribute; three 8-bit bands also as vertex colours, OBJ included),
+    /// or per triangle (GeoJSON, FlatGeobuf: corner means). The domain is where every
+    /// band is valid. Exact error model, untiled.
+    #[arg(long, value_delimiter = ',', num_args = 1, value_name = "B,B,...")]
+    pub bands: Vec<usize>,
+    /// With --bands: the band that is the height (listed in --bands) [default: the first].
+    #[arg(long, value_name = "N", requires = "bands")]
+    pub height_band: Option<usize>,
+    /// Variables from another raster on the input's grid (same size and geotransform;
+    /// refused, naming it, when it does not overlap or would need resampling): FILE's
+    /// bands B,... (all without :B,...), each within --attribute-error, as --bands' are.
+    #[arg(long, value_name = "FILE[:B,B,...]", requires = "attribute_error")]
+    pub attributes: Option<String>,
+    /// The bound of each --attributes band: one for all, or a comma-separated one per band.
+    #[arg(long, value_name = "E", value_parser = parse_max_error, allow_hyphen_values = true,
+          value_delimiter = ',', num_args = 1, requires = "attributes")]
+    pub attribute_error: Vec<f64>,
     /// Error model.
     #[arg(long, value_enum, default_value_t = ErrorModelArg::Exact)]
     pub error_model: ErrorModelArg,
@@ -209,15 +232,31 @@ pub struct ExportArgs {
 }
 
 impl MeshArgs {
-    /// The job these flags ask for.
-    pub fn job(&self) -> MeshJob {
+    /// The job these flags ask for; fails when --bands, --max-error and --height-band
+    /// do not fit together.
+    pub fn job(&self) -> tinsmith_pipeline::Result<MeshJob> {
         let mut job = MeshJob::new(&self.input);
         job.output = self.output.clone();
         job.export = self.export.choices();
-        job.band = self.band;
+        let (band, max_error, variables) = tinsmith_pipeline::resolve_bands(
+            &self.input,
+            &self.bands,
+            &self.max_error,
+            self.height_band,
+        )?;
+        job.band = if self.bands.is_empty() {
+            self.band
+        } else {
+            band
+        };
         job.vertical_datum = self.vertical_datum.clone();
+        job.variables = variables;
+        if let Some(spec) = &self.attributes {
+            let more = tinsmith_pipeline::attribute_variables(spec, &self.attribute_error)?;
+            job.variables.extend(more);
+        }
         let choices = &mut job.decimation;
-        choices.max_error = self.max_error;
+        choices.max_error = max_error;
         choices.max_triangles = self.max_triangles;
         choices.max_vertices = self.max_vertices;
         choices.error_model = self.error_model.into();
@@ -244,7 +283,7 @@ impl MeshArgs {
             TileFormatArg::Obj => TileFormat::Obj,
         });
         job.points = self.points.choices(self.crs.clone());
-        job
+        Ok(job)
     }
 }
 

@@ -18,6 +18,23 @@ pub(crate) trait Coverage {
     fn has_vertex_heights(&self) -> bool;
     /// The samples at the given vertices' positions.
     fn corner_samples(&self, corners: [&Point; 3]) -> [Point; 3];
+    /// Whether extra variables ride on the heights (several variables over one mesh).
+    fn has_variables(&self) -> bool {
+        false
+    }
+    /// Whether some extra variable already fails at `centre`, a sample in the closed
+    /// triangle `abc` (a cheap rejection before the scan; see
+    /// `crate::variables::centre_exceeds`). Never, without variables.
+    fn variables_refuse_at(
+        &self,
+        _a: &Point,
+        _b: &Point,
+        _c: &Point,
+        _centre: &Point,
+        _cap: f64,
+    ) -> bool {
+        false
+    }
 }
 
 impl Coverage for Grid {
@@ -39,6 +56,22 @@ impl Coverage for Grid {
     #[inline]
     fn corner_samples(&self, corners: [&Point; 3]) -> [Point; 3] {
         corner_samples(self, corners)
+    }
+
+    #[inline]
+    fn has_variables(&self) -> bool {
+        self.variable_count() > 0
+    }
+
+    fn variables_refuse_at(
+        &self,
+        a: &Point,
+        b: &Point,
+        c: &Point,
+        centre: &Point,
+        cap: f64,
+    ) -> bool {
+        self.has_variables() && crate::variables::centre_exceeds(self, a, b, c, centre, cap)
     }
 }
 

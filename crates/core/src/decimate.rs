@@ -169,6 +169,21 @@ fn run(
         return Err(Error::HeightsTooLarge(max_abs));
     }
     let limit = effective_limit(max_error, max_abs);
+    let scaled;
+    let grid = if grid.variable_count() > 0 {
+        if options.error_model != ErrorModel::Exact {
+            return Err(Error::VariablesUnsupported("needs the exact error model"));
+        }
+        if count_target {
+            return Err(Error::VariablesUnsupported(
+                "takes an error bound, not a triangle or vertex count",
+            ));
+        }
+        scaled = grid.with_height_limit(limit);
+        &scaled
+    } else {
+        grid
+    };
     let raised;
     let grid = if options.raises_vertex_heights(max_abs) {
         raised = grid.with_raised_heights(vertex_raise(max_error, max_abs));

@@ -32,6 +32,26 @@ pub enum Error {
     /// [`crate::decimate_scatter`]); the message says which and why.
     #[error("{0}")]
     Scatter(String),
+    /// A variable's grid is not the height's size ([`crate::Grid::with_variables`]).
+    #[error(
+        "variable {index} is a {width}x{height} grid; the height's is {expected_width}x{expected_height}"
+    )]
+    VariableSize {
+        /// The variable's index among the variables (0-based).
+        index: usize,
+        /// Its columns.
+        width: u32,
+        /// Its rows.
+        height: u32,
+        /// The height's columns.
+        expected_width: u32,
+        /// The height's rows.
+        expected_height: u32,
+    },
+    /// Extra variables were given with options they do not support: the error model of
+    /// bounds, or a triangle or vertex count target.
+    #[error("decimation with several variables {0}")]
+    VariablesUnsupported(&'static str),
     /// The maximum error is negative, NaN or infinite.
     #[error("maximum error must be a finite number >= 0, got {0}")]
     InvalidMaxError(f64),

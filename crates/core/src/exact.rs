@@ -7,12 +7,30 @@ use crate::{ErrorBound, Grid};
 
 /// The exact above/below error of the plane through counter-clockwise triangle `abc` over
 /// every grid sample in the closed triangle, or `None` as soon as either side exceeds
-/// `limit`.
+/// `limit`; on a grid with variables ([`Grid::with_variables`]), every variable within its
+/// own limit too, the bound being the largest of the height's and the variables' errors
+/// in height units (see `crate::variables`).
+#[inline]
+pub(crate) fn triangle_error(
+    grid: &Grid,
+    a: &Point,
+    b: &Point,
+    c: &Point,
+    limit: f64,
+) -> Option<ErrorBound> {
+    let height = height_error(grid, a, b, c, limit)?;
+    if grid.variables().is_empty() {
+        return Some(height);
+    }
+    crate::variables::with_variables(grid, a, b, c, limit, height)
+}
+
+/// [`triangle_error`] of the height alone (or of a variable's own grid).
 ///
 /// Which samples are inside is decided exactly (integer edge functions, row by row); the
 /// plane is evaluated in `f64` from corner `a`. The triangle must lie in the grid's domain
 /// (all its samples valid), which decimation guarantees.
-pub(crate) fn triangle_error(
+pub(crate) fn height_error(
     grid: &Grid,
     a: &Point,
     b: &Point,

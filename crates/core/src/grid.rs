@@ -4,7 +4,8 @@ use std::sync::Arc;
 
 use tinsmith_georef::Samples;
 
-use crate::Result;
+use crate::variables::{joined, Measured};
+use crate::{Result, Variable};
 
 /// A `width` x `height` grid of samples in row-major order (row 0 first).
 ///
@@ -28,6 +29,9 @@ pub struct Grid {
     flat_blocks: Arc<Vec<FlatLevel>>,
     /// See [`Grid::vertex_height`]; 0 when vertices sit at their samples' values.
     raise: f64,
+    /// Extra variables ([`Grid::with_variables`]); empty for a grid of heights alone (a
+    /// slice, so that the exact model's test for none reads no memory beyond the grid).
+    variables: Arc<[Measured]>,
 }
 
 /// Square blocks of one size, each with its samples' common value when they are all bit
@@ -84,6 +88,58 @@ impl Grid {
             equal_runs: equal_runs.map(Arc::new),
             flat_blocks: Arc::new(flat_blocks),
             raise: 0.0,
+            variables: Arc::from(Vec::new()),
+        }
+    }
+
+    /// The grid of `height` carrying `variables` (paper §6): decimation then removes a
+    /// vertex only when every triangle it makes keeps the height within
+    /// [`crate::DecimationOptions::max_error`] and each variable within its own bound, at
+    /// every sample of the domain (exact error model only). The domain is where the
+    /// height and every variable are valid: a sample nodata in any of them is nodata in
+    /// the grid. Vertices carry every variable at its sample's value (never raised).
+    ///
+    /// # Errors
+    /// [`crate::Error::VariableSize`] when a variable's grid is not the height's size;
+    /// [`crate::Error::HeightsTooLarge`] when a variable's |value| exceeds
+    /// [`crate::MAX_ABS_HEIGHT`].
+    pub fn with_variables(height: Samples, variables: Vec<Variable>) -> Result<Grid> {
+        let (height, measured) = joined(height, variables)?;
+        Ok(Grid {
+            variables: Arc::from(measured),
+            ..Grid::from_samples(height)
+        })
+    }
+
+    /// Number of extra variables ([`Grid::with_variables`]; 0 for heights alone).
+    pub fn variable_count(&self) -> usize {
+        self.variables.len()
+    }
+
+    /// Variable `k`'s samples (row-major) and bound.
+    ///
+    /// # Panics
+    /// When `k >= self.variable_count()`.
+    pub fn variable(&self, k: usize) -> (&[f64], f64) {
+        let v = &self.variables[k];
+        (v.grid.values(), v.max_error)
+    }
+
+    /// The variables as the decimator measures them.
+    pub(crate) fn variables(&self) -> &[Measured] {
+        &self.variables
+    }
+
+    /// The grid whose variables are scaled for a run enforcing `height_limit` on heights
+    /// (see `crate::variables`); the samples are shared, not copied.
+    pub(crate) fn with_height_limit(&self, height_limit: f64) -> Grid {
+        Grid {
+            variables: self
+                .variables
+                .iter()
+                .map(|v| v.for_limit(height_limit))
+                .collect(),
+            ..self.clone()
         }
     }
 

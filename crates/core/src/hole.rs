@@ -230,7 +230,9 @@ impl Retriangulator {
         let scan_only = cap == 0.0 && rules.grid.integral_heights();
         let bound = match rules.model {
             ErrorModel::Bounds => self.triangle_bound(a, b, c, edges),
-            ErrorModel::Exact if self.unit_hole && in_hole && !scan_only => {
+            ErrorModel::Exact
+                if self.unit_hole && in_hole && !scan_only && !rules.grid.has_variables() =>
+            {
                 let centre = self.centre.expect("hole loaded");
                 let inside = in_closed_triangle(pa, pb, pc, &centre);
                 // The corners' samples: the vertices themselves unless heights are raised.
@@ -272,7 +274,8 @@ impl Retriangulator {
                         let centre = self.centre.expect("hole loaded");
                         let e = if !scan_only
                             && in_closed_triangle(pa, pb, pc, &centre)
-                            && error_at(pa, pb, pc, [&centre], cap).is_none()
+                            && (error_at(pa, pb, pc, [&centre], cap).is_none()
+                                || rules.grid.variables_refuse_at(pa, pb, pc, &centre, cap))
                         {
                             None
                         } else {

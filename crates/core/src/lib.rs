@@ -46,6 +46,7 @@ mod rtin;
 mod scatter;
 mod strips;
 mod tin;
+mod variables;
 
 pub use decimate::{
     decimate, decimate_with_border, decimate_with_progress, effective_limit, vertex_raise,
@@ -61,3 +62,4 @@ pub use options::{
 };
 pub use scatter::{decimate_scatter, Scatter, ScatterReport, ScatterTin, MAX_SCATTER_COORDINATE};
 pub use tin::{Tin, TinVertex};
+pub use variables::Variable;

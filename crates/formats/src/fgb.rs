@@ -71,10 +71,18 @@ pub(crate) fn write<W: Write>(w: W, mesh: MeshRef<'_>) -> io::Result<()> {
     let mut fgb =
         FgbWriter::create_with_options("tin", GeometryType::Polygon, options).map_err(io_error)?;
     fgb.add_column(ID, ColumnType::Long, |_, _| {});
+    for attribute in mesh.attributes {
+        fgb.add_column(attribute.name, ColumnType::Double, |_, _| {});
+    }
     for (id, &[a, b, c]) in mesh.triangles.iter().enumerate() {
         let id64 = id as u64;
         fgb.property(0, ID, &ColumnValue::Long(id as i64))
             .map_err(io_error)?;
+        for (k, attribute) in mesh.attributes.iter().enumerate() {
+            let mean = crate::mesh::corner_mean(attribute.values, [a, b, c]);
+            fgb.property(k + 1, attribute.name, &ColumnValue::Double(mean))
+                .map_err(io_error)?;
+        }
         fgb.polygon_begin(true, 1, 0).map_err(io_error)?;
         fgb.linestring_begin(false, 4, 0).map_err(io_error)?;
         for (k, i) in [a, b, c, a].into_iter().enumerate() {

@@ -108,6 +108,15 @@ impl MeshFormat {
         }
     }
 
+    /// Whether the format carries per-vertex variables ([`crate::MeshRef::attributes`]):
+    /// PLY and glTF per vertex, GeoJSON and FlatGeobuf per triangle (corner means).
+    pub fn carries_attributes(self) -> bool {
+        matches!(
+            self,
+            MeshFormat::Ply | MeshFormat::Glb | MeshFormat::GeoJson | MeshFormat::FlatGeobuf
+        )
+    }
+
     /// Whether the format stores coordinates as float32 relative to a
     /// [`crate::LocalOrigin`] (STL, glTF): what it gives back is
     /// [`crate::LocalOrigin::quantize`] of what was written.

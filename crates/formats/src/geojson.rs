@@ -98,11 +98,13 @@ pub(crate) fn write<W: Write>(mut w: W, mesh: MeshRef<'_>) -> io::Result<()> {
             TriangleParts::Whole(_) => "Polygon",
             TriangleParts::Cut(..) => "MultiPolygon",
         };
-        write!(
-            w,
-            "{{\"type\":\"Feature\",\"properties\":{{\"id\":{id}}},\
-             \"geometry\":{{\"type\":\"{kind}\",\"coordinates\":"
-        )?;
+        write!(w, "{{\"type\":\"Feature\",\"properties\":{{\"id\":{id}")?;
+        for attribute in mesh.attributes {
+            let name = serde_json::to_string(attribute.name).map_err(io::Error::other)?;
+            let mean = crate::mesh::corner_mean(attribute.values, [a, b, c]);
+            write!(w, ",{name}:{mean:?}")?;
+        }
+        write!(w, "}},\"geometry\":{{\"type\":\"{kind}\",\"coordinates\":")?;
         match parts {
             TriangleParts::Whole(corners) => write_ring(&mut w, &corners)?,
             TriangleParts::Cut(west, east) => {

@@ -112,8 +112,16 @@ pub(crate) fn write<W: Write>(
     let index_size: u64 = if small { 2 } else { 4 };
     let positions_len = 12 * vertex_count;
     let normals_len = if normals { positions_len } else { 0 };
+    // Each vertex attribute: one float32 per vertex, after the normals.
+    let attribute_len = 4 * vertex_count;
+    let attributes_len = attribute_len * mesh.attributes.len() as u64
+        + if mesh.colours.is_some() {
+            12 * vertex_count
+        } else {
+            0
+        };
     let indices_len = index_size * 3 * mesh.triangles.len() as u64;
-    let total_len = pad4(positions_len + normals_len + indices_len);
+    let total_len = pad4(positions_len + normals_len + attributes_len + indices_len);
 
     let mut min = [f32::INFINITY; 3];
     let mut max = [f32::NEG_INFINITY; 3];
@@ -145,6 +153,30 @@ pub(crate) fn write<W: Write>(
                 "target": 34962,
             }));
         }
+        for (k, attribute) in mesh.attributes.iter().enumerate() {
+            attributes[attribute_semantic(attribute.name)] = Value::from(accessors.len());
+            accessors.push(json!({
+                "bufferView": views.len(), "componentType": FLOAT, "count": vertex_count,
+                "type": "SCALAR",
+            }));
+            views.push(json!({
+                "buffer": 0, "byteOffset": positions_len + normals_len + k as u64 * attribute_len,
+                "byteLength": attribute_len, "target": 34962,
+            }));
+        }
+        if mesh.colours.is_some() {
+            attributes["COLOR_0"] = Value::from(accessors.len());
+            accessors.push(json!({
+                "bufferView": views.len(), "componentType": FLOAT, "count": vertex_count,
+                "type": "VEC3",
+            }));
+            views.push(json!({
+                "buffer": 0,
+                "byteOffset": positions_len + normals_len
+                    + attribute_len * mesh.attributes.len() as u64,
+                "byteLength": 12 * vertex_count, "target": 34962,
+            }));
+        }
         accessors.push(json!({
             "bufferView": views.len(),
             "componentType": if small { UNSIGNED_SHORT } else { UNSIGNED_INT },
@@ -152,7 +184,8 @@ pub(crate) fn write<W: Write>(
             "type": "SCALAR",
         }));
         views.push(json!({
-            "buffer": 0, "byteOffset": positions_len + normals_len, "byteLength": indices_len,
+            "buffer": 0, "byteOffset": positions_len + normals_len + attributes_len,
+            "byteLength": indices_len,
             "target": 34963,
         }));
         node["mesh"] = Value::from(0);
@@ -204,6 +237,16 @@ pub(crate) fn write<W: Write>(
             }
         }
     }
+    for attribute in mesh.attributes {
+        for &value in attribute.values {
+            w.write_all(&(value as f32).to_le_bytes())?;
+        }
+    }
+    for colour in mesh.colours.unwrap_or(&[]) {
+        for c in colour {
+            w.write_all(&(f32::from(*c) / 255.0).to_le_bytes())?;
+        }
+    }
     for &index in mesh.triangles.iter().flatten() {
         if small {
             w.write_all(&(index as u16).to_le_bytes())?;
@@ -211,9 +254,15 @@ pub(crate) fn write<W: Write>(
             w.write_all(&index.to_le_bytes())?;
         }
     }
-    let written = positions_len + normals_len + indices_len;
+    let written = positions_len + normals_len + attributes_len + indices_len;
     w.write_all(&vec![0u8; (total_len - written) as usize])?;
     Ok(())
+}
+
+/// The glTF attribute semantic of a vertex attribute: application-specific semantics
+/// start with `_`; by convention in capitals (`band_2` is `_BAND_2`).
+pub(crate) fn attribute_semantic(name: &str) -> String {
+    format!("_{}", name.to_ascii_uppercase())
 }
 
 /// A little-endian `u32` at `at`.
@@ -481,6 +530,36 @@ impl Gltf<'_> {
             mesh.vertices.push([t[0] + px, -(t[2] + pz), t[1] + py]);
         }
         let count = positions.len() / 3;
+        // Application-specific float attributes (`_NAME`), read as `NAME`.
+        if let Some(semantics) = primitive["attributes"].as_object() {
+            for (semantic, accessor) in semantics {
+                let Some(name) = semantic.strip_prefix('_') else {
+                    continue;
+                };
+                let accessor = usize_of(accessor, "an attribute's accessor")?;
+                if self.root["accessors"][accessor]["componentType"].as_u64() != Some(FLOAT)
+                    || self.root["accessors"][accessor]["type"].as_str() != Some("SCALAR")
+                {
+                    continue;
+                }
+                let values = self.accessor(accessor, FLOAT, "SCALAR")?;
+                if values.len() != count {
+                    return Err(Problem::malformed(format_args!(
+                        "attribute {semantic} has {} values for {count} vertices",
+                        values.len()
+                    )));
+                }
+                match mesh.attributes.iter_mut().find(|(n, _)| n == name) {
+                    Some((_, all)) => all.extend(values),
+                    None if first == 0 => mesh.attributes.push((name.to_owned(), values)),
+                    None => {
+                        return Err(Problem::unsupported(format_args!(
+                            "attribute {semantic} in some primitives only"
+                        )))
+                    }
+                }
+            }
+        }
         let indices: Vec<f64> = if primitive["indices"].is_null() {
             (0..count).map(|i| i as f64).collect()
         } else {
@@ -774,5 +853,48 @@ mod tests {
             let _ = read(corrupt.as_slice(), Some(corrupt.len() as u64));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod attribute_tests {
+    use super::*;
+    use crate::VertexAttribute;
+
+    #[test]
+    fn vertex_attributes_are_float_attributes_read_back() {
+        // An odd triangle count, so that u16 indices end off a 4-byte boundary: the
+        // attributes come before them and stay aligned.
+        let vertices = [[0.0, 0.0, 1.0], [1.0, 0.0, 2.0], [0.0, 1.0, 3.0]];
+        let triangles = [[0, 1, 2]];
+        let (a, b) = ([0.5, -2.0, 7.25], [255.0, 0.0, 1e6]);
+        let attributes = [
+            VertexAttribute {
+                name: "band_2",
+                values: &a,
+            },
+            VertexAttribute {
+                name: "dtm",
+                values: &b,
+            },
+        ];
+        let mut bytes = Vec::new();
+        let mesh = MeshRef::new(&vertices, &triangles).with_attributes(&attributes);
+        write(&mut bytes, mesh, LocalOrigin::new([0.0; 3]), true).unwrap();
+        let json_len = u32_at(&bytes, 12) as usize;
+        let root: Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+        let semantics = &root["meshes"][0]["primitives"][0]["attributes"];
+        assert!(
+            semantics["_BAND_2"].is_u64() && semantics["_DTM"].is_u64(),
+            "{root}"
+        );
+        for view in root["bufferViews"].as_array().unwrap() {
+            let target = view["target"].as_u64().unwrap();
+            assert!(target == 34963 || view["byteOffset"].as_u64().unwrap() % 4 == 0);
+        }
+        let read = read(&bytes[..], Some(bytes.len() as u64)).unwrap();
+        assert_eq!(read.triangles, triangles);
+        assert_eq!(read.attribute("BAND_2"), Some(&a[..]));
+        assert_eq!(read.attribute("DTM"), Some(&b[..]));
     }
 }

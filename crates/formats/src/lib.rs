@@ -77,7 +77,7 @@ pub use error::{Error, Result};
 pub use file::{prj_path, read_mesh, read_mesh_as, read_mesh_bytes, write_mesh, write_mesh_with};
 pub use format::MeshFormat;
 pub use lines::{write_lines, write_multilines, CrsRef, LineFormat, LinePoint};
-pub use mesh::{Mesh, MeshRef};
+pub use mesh::{Mesh, MeshRef, VertexAttribute};
 pub use options::WriteOptions;
 pub use origin::LocalOrigin;
 pub use stream::MeshStreamWriter;

@@ -24,6 +24,31 @@ pub struct MeshRef<'a> {
     /// LandXML, GeoJSON). `Some(4326)` means longitude, latitude in degrees (GeoJSON then
     /// writes plain RFC 7946).
     pub epsg: Option<u32>,
+    /// Values carried per vertex besides the position (several variables over one
+    /// mesh); written by PLY (a `double` property each), glTF (a float32 `_NAME`
+    /// attribute each, the name in capitals), GeoJSON and FlatGeobuf (per triangle: the
+    /// mean of its three corners' values, a number property or `Double` column each);
+    /// refused by OBJ, STL and LandXML.
+    pub attributes: &'a [VertexAttribute<'a>],
+    /// An RGB colour per vertex (three 8-bit bands carried as colours): PLY `uchar red
+    /// green blue` properties, glTF `COLOR_0` (float, 0..1), OBJ `v x y z r g b` (0..1);
+    /// refused by the other formats.
+    pub colours: Option<&'a [[u8; 3]]>,
+}
+
+/// One value per vertex, under a name (a PLY property name: no whitespace).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VertexAttribute<'a> {
+    /// The name the file gives it.
+    pub name: &'a str,
+    /// One value per vertex, in vertex order.
+    pub values: &'a [f64],
+}
+
+/// The mean of `values` at the corners of triangle `t`, as GeoJSON and FlatGeobuf
+/// write it: summed in corner order, divided by 3.
+pub(crate) fn corner_mean(values: &[f64], t: [u32; 3]) -> f64 {
+    (values[t[0] as usize] + values[t[1] as usize] + values[t[2] as usize]) / 3.0
 }
 
 impl<'a> MeshRef<'a> {
@@ -34,7 +59,21 @@ impl<'a> MeshRef<'a> {
             triangles,
             crs_wkt: None,
             epsg: None,
+            attributes: &[],
+            colours: None,
         }
+    }
+
+    /// Sets the per-vertex colours (see [`MeshRef::colours`]).
+    pub fn with_colours(mut self, colours: Option<&'a [[u8; 3]]>) -> Self {
+        self.colours = colours;
+        self
+    }
+
+    /// Sets the per-vertex attributes (see [`MeshRef::attributes`]).
+    pub fn with_attributes(mut self, attributes: &'a [VertexAttribute<'a>]) -> Self {
+        self.attributes = attributes;
+        self
     }
 
     /// Sets the CRS's EPSG code (see [`MeshRef::epsg`]).
@@ -63,6 +102,61 @@ impl<'a> MeshRef<'a> {
 
     /// Checks what the readers check, so that no file is written that cannot be read back.
     pub(crate) fn check(&self, path: &Path, format: MeshFormat) -> Result<()> {
+        if let Some(attribute) = self.attributes.first() {
+            if !format.carries_attributes() {
+                return Err(Error::BadOption {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "{format} carries heights only; variables (`{}`) are written to \
+                         PLY, glTF, GeoJSON or FlatGeobuf",
+                        attribute.name
+                    ),
+                });
+            }
+        }
+        if let Some(colours) = self.colours {
+            if !matches!(format, MeshFormat::Ply | MeshFormat::Glb | MeshFormat::Obj)
+                || colours.len() != self.vertices.len()
+            {
+                return Err(Error::BadOption {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "vertex colours go to PLY, glTF or OBJ, one per vertex ({} for {} \
+                         vertices, {format})",
+                        colours.len(),
+                        self.vertices.len()
+                    ),
+                });
+            }
+        }
+        for attribute in self.attributes {
+            let bad_name = attribute.name.is_empty()
+                || attribute
+                    .name
+                    .chars()
+                    .any(|c| c.is_whitespace() || !c.is_ascii())
+                || ["x", "y", "z"].contains(&attribute.name)
+                || self
+                    .attributes
+                    .iter()
+                    .filter(|a| a.name == attribute.name)
+                    .count()
+                    > 1;
+            if bad_name || attribute.values.len() != self.vertices.len() {
+                return Err(Error::BadOption {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "vertex attribute `{}`: {}",
+                        attribute.name,
+                        if bad_name {
+                            "not a distinct PLY property name"
+                        } else {
+                            "not one value per vertex"
+                        }
+                    ),
+                });
+            }
+        }
         if format == MeshFormat::Ply {
             // PLY indices are written as `int`.
             let max = i32::MAX as usize + 1;
@@ -119,6 +213,10 @@ pub struct Mesh {
     /// The EPSG code the file records (FlatGeobuf, LandXML, GeoJSON). A GeoJSON file
     /// without a `crs` member is RFC 7946 longitude, latitude: `Some(4326)`.
     pub epsg: Option<u32>,
+    /// Per-vertex values besides the position, with their names: a PLY file's other
+    /// scalar vertex properties, in header order; a glTF file's float `_NAME` attributes
+    /// as `NAME`; none from the other formats.
+    pub attributes: Vec<(String, Vec<f64>)>,
 }
 
 impl Mesh {
@@ -129,16 +227,28 @@ impl Mesh {
             triangles,
             crs_wkt: None,
             epsg: None,
+            attributes: Vec::new(),
         }
     }
 
-    /// Borrows the mesh for [`crate::write_mesh`].
+    /// The values of attribute `name`, one per vertex.
+    pub fn attribute(&self, name: &str) -> Option<&[f64]> {
+        self.attributes
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_slice())
+    }
+
+    /// Borrows the mesh for [`crate::write_mesh`] (without its attributes, which
+    /// [`MeshRef::with_attributes`] takes as borrowed [`VertexAttribute`]s).
     pub fn as_mesh_ref(&self) -> MeshRef<'_> {
         MeshRef {
             vertices: &self.vertices,
             triangles: &self.triangles,
             crs_wkt: self.crs_wkt.as_deref(),
             epsg: self.epsg,
+            attributes: &[],
+            colours: None,
         }
     }
 }

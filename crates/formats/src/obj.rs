@@ -64,8 +64,15 @@ pub(crate) fn write<W: Write>(mut w: W, mesh: MeshRef<'_>) -> io::Result<()> {
     if let Some(crs) = mesh.crs_line() {
         writeln!(w, "# crs: {crs}")?;
     }
-    for [x, y, z] in mesh.vertices {
-        writeln!(w, "v {x:?} {y:?} {z:?}")?;
+    for (i, [x, y, z]) in mesh.vertices.iter().enumerate() {
+        match mesh.colours {
+            // The common extension (MeshLab, trimesh): colour components in 0..1.
+            Some(colours) => {
+                let [r, g, b] = colours[i].map(|c| f64::from(c) / 255.0);
+                writeln!(w, "v {x:?} {y:?} {z:?} {r:?} {g:?} {b:?}")?;
+            }
+            None => writeln!(w, "v {x:?} {y:?} {z:?}")?,
+        }
     }
     for &[a, b, c] in mesh.triangles {
         writeln!(

@@ -20,8 +20,9 @@ const CHUNK_BYTES: usize = 1 << 20;
 /// Records reserved up front when the file size does not bound the element count.
 const UNBOUNDED_RESERVE: u64 = 1 << 16;
 
-/// Writes `mesh` as `binary_little_endian 1.0`: `double` x, y, z and a `uchar int` list
-/// per face. The CRS, if any, goes into a `comment crs <wkt>` header line.
+/// Writes `mesh` as `binary_little_endian 1.0`: `double` x, y, z (then one `double`
+/// property per vertex attribute, named after it) and a `uchar int` list per face. The CRS,
+/// if any, goes into a `comment crs <wkt>` header line.
 ///
 /// The caller has checked the mesh (`MeshRef::check`): indices fit in an `int`.
 pub(crate) fn write<W: Write>(mut w: W, mesh: MeshRef<'_>) -> io::Result<()> {
@@ -33,17 +34,34 @@ pub(crate) fn write<W: Write>(mut w: W, mesh: MeshRef<'_>) -> io::Result<()> {
     }
     let _ = write!(
         header,
-        "element vertex {}\nproperty double x\nproperty double y\nproperty double z\n\
-         element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        "element vertex {}\nproperty double x\nproperty double y\nproperty double z\n",
         mesh.vertices.len(),
+    );
+    for attribute in mesh.attributes {
+        let _ = writeln!(header, "property double {}", attribute.name);
+    }
+    if mesh.colours.is_some() {
+        header.push_str("property uchar red\nproperty uchar green\nproperty uchar blue\n");
+    }
+    let _ = write!(
+        header,
+        "element face {}\nproperty list uchar int vertex_indices\nend_header\n",
         mesh.triangles.len()
     );
     w.write_all(header.as_bytes())?;
 
-    let mut record = [0u8; 24];
-    for vertex in mesh.vertices {
-        for (bytes, coordinate) in record.chunks_exact_mut(8).zip(vertex) {
-            bytes.copy_from_slice(&coordinate.to_le_bytes());
+    let doubles = 8 * (3 + mesh.attributes.len());
+    let mut record = vec![0u8; doubles + if mesh.colours.is_some() { 3 } else { 0 }];
+    for (i, vertex) in mesh.vertices.iter().enumerate() {
+        let values = vertex
+            .iter()
+            .copied()
+            .chain(mesh.attributes.iter().map(|a| a.values[i]));
+        for (bytes, value) in record[..doubles].chunks_exact_mut(8).zip(values) {
+            bytes.copy_from_slice(&value.to_le_bytes());
+        }
+        if let Some(colours) = mesh.colours {
+            record[doubles..].copy_from_slice(&colours[i]);
         }
         w.write_all(&record)?;
     }
@@ -404,6 +422,8 @@ enum Role {
     Coordinate(usize),
     /// The vertex index list of a face.
     Corners,
+    /// Another scalar vertex property: attribute `k` of the mesh.
+    Attribute(usize),
 }
 
 /// The role of every property of every element.
@@ -412,11 +432,14 @@ struct Plan {
     fields: Vec<Vec<(Kind, Role)>>,
     /// Number of vertices the header declares.
     vertex_count: u64,
+    /// The vertex element's other scalar properties, in header order.
+    attributes: Vec<String>,
 }
 
 impl Plan {
     fn new(header: &Header) -> Result<Plan, Problem> {
         let mut vertex_count = None;
+        let mut attributes = Vec::new();
         let mut fields = Vec::with_capacity(header.elements.len());
         for element in &header.elements {
             let mut roles: Vec<(Kind, Role)> = element
@@ -442,6 +465,12 @@ impl Plan {
                             )));
                         }
                         roles[position].1 = Role::Coordinate(axis);
+                    }
+                    for (role, property) in roles.iter_mut().zip(&element.properties) {
+                        if role.1 == Role::Ignore && matches!(role.0, Kind::Scalar(_)) {
+                            role.1 = Role::Attribute(attributes.len());
+                            attributes.push(property.name.clone());
+                        }
                     }
                     vertex_count = Some(element.count);
                 }
@@ -479,20 +508,34 @@ impl Plan {
         Ok(Plan {
             fields,
             vertex_count,
+            attributes,
         })
     }
 }
 
 /// One decoded record: the parts of it the mesh needs.
-#[derive(Debug, Default, Clone, Copy)]
+#[derive(Debug, Default, Clone)]
 struct Record {
     coordinates: [f64; 3],
     corners: [i64; 3],
+    /// The vertex attributes, in [`Plan::attributes`] order.
+    attributes: Vec<f64>,
+}
+
+impl Record {
+    fn for_plan(plan_attributes: usize) -> Record {
+        Record {
+            attributes: vec![0.0; plan_attributes],
+            ..Record::default()
+        }
+    }
 }
 
 /// Collects vertices and triangles, checking them as they come.
 struct MeshBuilder {
     vertices: Vec<[f64; 3]>,
+    /// Per attribute: its name and one value per vertex.
+    attributes: Vec<(String, Vec<f64>)>,
     triangles: Vec<[u32; 3]>,
     vertex_count: u64,
 }
@@ -547,6 +590,11 @@ impl MeshBuilder {
             .map_or(0, |e| e.count);
         Ok(MeshBuilder {
             vertices: Vec::with_capacity(reserve(plan.vertex_count)),
+            attributes: plan
+                .attributes
+                .iter()
+                .map(|name| (name.clone(), Vec::with_capacity(reserve(plan.vertex_count))))
+                .collect(),
             triangles: Vec::with_capacity(reserve(face_count)),
             vertex_count: plan.vertex_count,
         })
@@ -563,6 +611,9 @@ impl MeshBuilder {
                     )));
                 }
                 self.vertices.push(record.coordinates);
+                for ((_, values), &value) in self.attributes.iter_mut().zip(&record.attributes) {
+                    values.push(value);
+                }
             }
             "face" => {
                 let mut triangle = [0u32; 3];
@@ -588,6 +639,7 @@ impl MeshBuilder {
     fn finish(self, crs_wkt: Option<String>) -> Mesh {
         let mut mesh = Mesh::new(self.vertices, self.triangles);
         mesh.crs_wkt = crs_wkt;
+        mesh.attributes = self.attributes;
         mesh
     }
 }
@@ -647,7 +699,7 @@ fn read_binary_element<R: BufRead>(
     let per_chunk = (CHUNK_BYTES / stride).max(1);
     let mut buf = vec![0u8; per_chunk.saturating_mul(stride)];
     let mut done = 0u64;
-    let mut record = Record::default();
+    let mut record = Record::for_plan(mesh.attributes.len());
     while done < element.count {
         let n = usize::try_from(element.count - done).map_or(per_chunk, |left| left.min(per_chunk));
         let bytes = &mut buf[..n * stride];
@@ -658,6 +710,9 @@ fn read_binary_element<R: BufRead>(
                 match (kind, role) {
                     (Kind::Scalar(scalar), Role::Coordinate(axis)) => {
                         record.coordinates[axis] = scalar.to_f64(&raw[offset..], endian);
+                    }
+                    (Kind::Scalar(scalar), Role::Attribute(k)) => {
+                        record.attributes[k] = scalar.to_f64(&raw[offset..], endian);
                     }
                     (Kind::List { count, item }, Role::Corners) => {
                         let corners = count.to_i64(&raw[offset..], endian);
@@ -688,15 +743,19 @@ fn read_binary_variable<R: BufRead>(
     mesh: &mut MeshBuilder,
 ) -> Result<(), Problem> {
     let mut value = [0u8; 8];
-    let mut record = Record::default();
+    let mut record = Record::for_plan(mesh.attributes.len());
     for index in 0..element.count {
         for &(kind, role) in fields {
             match kind {
                 Kind::Scalar(scalar) => {
                     let raw = &mut value[..scalar.size()];
                     r.read_exact(raw).map_err(|e| truncated(element, e))?;
-                    if let Role::Coordinate(axis) = role {
-                        record.coordinates[axis] = scalar.to_f64(raw, endian);
+                    match role {
+                        Role::Coordinate(axis) => {
+                            record.coordinates[axis] = scalar.to_f64(raw, endian);
+                        }
+                        Role::Attribute(k) => record.attributes[k] = scalar.to_f64(raw, endian),
+                        _ => {}
                     }
                 }
                 Kind::List { count, item } => {
@@ -748,7 +807,7 @@ fn read_ascii_element<R: BufRead>(
     }
     let mut buf = Vec::new();
     let mut ignored = 0u64;
-    let mut record = Record::default();
+    let mut record = Record::for_plan(mesh.attributes.len());
     let mut index = 0u64;
     while index < element.count {
         let line = read_line(r, &mut buf, &mut ignored)?.ok_or_else(|| {
@@ -782,10 +841,15 @@ fn read_ascii_element<R: BufRead>(
             match kind {
                 Kind::Scalar(_) => {
                     let token = next("a value")?;
-                    if let Role::Coordinate(axis) = role {
-                        record.coordinates[axis] = token.parse::<f64>().map_err(|_| {
+                    let number = || {
+                        token.parse::<f64>().map_err(|_| {
                             Problem::malformed(format_args!("{}: `{token}` is not a number", at()))
-                        })?;
+                        })
+                    };
+                    match role {
+                        Role::Coordinate(axis) => record.coordinates[axis] = number()?,
+                        Role::Attribute(k) => record.attributes[k] = number()?,
+                        _ => {}
                     }
                 }
                 Kind::List { .. } => {
@@ -1197,5 +1261,48 @@ mod tests {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod attribute_tests {
+    use super::*;
+    use crate::VertexAttribute;
+
+    #[test]
+    fn vertex_attributes_round_trip_as_double_properties() {
+        let vertices = [[0.0, 0.0, 1.0], [1.0, 0.0, 2.0], [0.0, 1.0, 3.0]];
+        let triangles = [[0, 1, 2]];
+        let (a, b) = ([0.5, -1e300, 7.0], [1.0 / 3.0, 2.0, f64::MAX]);
+        let attributes = [
+            VertexAttribute {
+                name: "band_2",
+                values: &a,
+            },
+            VertexAttribute {
+                name: "temperature",
+                values: &b,
+            },
+        ];
+        let mut bytes = Vec::new();
+        write(
+            &mut bytes,
+            MeshRef::new(&vertices, &triangles).with_attributes(&attributes),
+        )
+        .unwrap();
+        let header = String::from_utf8_lossy(&bytes[..300]);
+        assert!(header.contains("property double z\nproperty double band_2\nproperty double temperature\nelement face"), "{header}");
+        let mesh = read(&bytes[..], Some(bytes.len() as u64)).unwrap();
+        assert_eq!(mesh.vertices, vertices);
+        assert_eq!(mesh.triangles, triangles);
+        assert_eq!(mesh.attribute("band_2"), Some(&a[..]));
+        assert_eq!(mesh.attribute("temperature"), Some(&b[..]));
+        // An ASCII file's other properties are read as attributes too, whatever their type.
+        let ascii = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                     property float z\nproperty uchar red\nelement face 1\n\
+                     property list uchar int vertex_indices\nend_header\n\
+                     0 0 1 10\n1 0 2 20\n0 1 3 255\n3 0 1 2\n";
+        let mesh = read(ascii.as_bytes(), None).unwrap();
+        assert_eq!(mesh.attribute("red"), Some(&[10.0, 20.0, 255.0][..]));
     }
 }

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde::Serialize;
 use tinsmith_core::Grid;
-use tinsmith_formats::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
+use tinsmith_formats::{LocalOrigin, MeshFormat, MeshRef, VertexAttribute, WriteOptions};
 use tinsmith_georef::readable;
 use tinsmith_georef::Placement;
 use tinsmith_raster::RasterInfo;
@@ -273,13 +273,14 @@ fn check_position_rounding(
 
 /// Writes the mesh (`vertices` in file coordinates, counter-clockwise `triangles`) as the
 /// plan's format with the raster's CRS: reprojected to WGS84 for GeoJSON unless
-/// `--geojson-source-crs`; a `.prj` sidecar for OBJ, STL and glTF.
+/// `--geojson-source-crs`; a `.prj` sidecar for OBJ, STL and glTF. `attributes` (one
+/// value per vertex each) and `colours` go where [`tinsmith_formats::MeshRef`] says.
 pub fn write(
     plan: &FormatPlan,
     job: &MeshJob,
     info: &RasterInfo,
-    mut vertices: Vec<[f64; 3]>,
-    triangles: &[[u32; 3]],
+    (mut vertices, triangles): (Vec<[f64; 3]>, &[[u32; 3]]),
+    (attributes, colours): (&[VertexAttribute<'_>], Option<&[[u8; 3]]>),
     feedback: &dyn Feedback,
 ) -> Result<()> {
     let path = out(job);
@@ -317,6 +318,8 @@ pub fn write(
         .with_base(job.export.base)
         .with_normals(job.export.normals);
     let mesh = MeshRef::new(&vertices, triangles)
+        .with_attributes(attributes)
+        .with_colours(colours)
         .with_crs_wkt(crs.wkt)
         .with_epsg(crs.epsg);
     tinsmith_formats::write_mesh_with(path, plan.format, mesh, &options)?;

@@ -9,6 +9,8 @@ use tinsmith_core::DecimationOptions;
 use tinsmith_formats::MeshFormat;
 use tinsmith_raster::VerticalDatum;
 
+use crate::variables::BandVariable;
+
 /// Samples per tile side (shared row and column included) unless a job says otherwise.
 pub const DEFAULT_TILE_SIZE: u32 = tinsmith_tiling::DEFAULT_TILE_SIZE;
 
@@ -32,6 +34,10 @@ pub struct MeshJob {
     /// ellipsoid (see `tinsmith_raster::read_samples_on`); `None` meshes them as they
     /// are.
     pub vertical_datum: Option<VerticalDatum>,
+    /// Other bands decimated with the height, each within its own bound (see
+    /// [`crate::resolve_bands`]); the domain is where every band is valid. Untiled, exact
+    /// error model, PLY or glTF output only.
+    pub variables: Vec<BandVariable>,
     /// Write (column, row, value) instead of georeferenced coordinates.
     pub pixel_coords: bool,
     /// Where to write the JSON report.
@@ -99,6 +105,7 @@ impl MeshJob {
             decimation: DecimationChoices::default(),
             band: 1,
             vertical_datum: None,
+            variables: Vec::new(),
             pixel_coords: false,
             report: None,
             tile_size: DEFAULT_TILE_SIZE,
@@ -198,6 +205,9 @@ pub struct VerifyJob {
     pub max_error: Option<f64>,
     /// Band the mesh was made from, 1-based.
     pub band: usize,
+    /// Other bands the mesh carries per vertex, each checked against its bound (the
+    /// domain is where every band is valid).
+    pub variables: Vec<BandVariable>,
     /// The mesh holds (column, row, value) coordinates.
     pub pixel_coords: bool,
     /// The mesh was made with heights converted from this geoid (`MeshJob::vertical_datum`):
@@ -214,6 +224,7 @@ impl VerifyJob {
             format: None,
             max_error: None,
             band: 1,
+            variables: Vec::new(),
             pixel_coords: false,
             vertical_datum: None,
         }

@@ -42,6 +42,7 @@ mod serve;
 mod tiled_mesh;
 mod tiles;
 mod transform_check;
+mod variables;
 mod verify;
 mod wgs84;
 
@@ -64,4 +65,5 @@ pub use tinsmith_georef::readable;
 pub use tinsmith_points::Duplicates;
 pub use tinsmith_tiling::available_bytes;
 pub use tinsmith_verify::PointsReport;
+pub use variables::{attribute_variables, resolve_bands, BandVariable, VariableReport};
 pub use verify::{verify, Verified};

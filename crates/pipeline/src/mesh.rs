@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 use tinsmith_core::{decimate_with_progress, Grid};
-use tinsmith_formats::MeshFormat;
+use tinsmith_formats::{MeshFormat, VertexAttribute};
 use tinsmith_georef::Placement;
 use tinsmith_tiling::check_tin;
 
@@ -30,6 +30,9 @@ struct MeshReport<'a> {
     sweeps: usize,
     /// Removal attempts in all.
     removal_attempts: usize,
+    /// Each variable's bound and measured error (`--bands`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    variables: Vec<crate::VariableReport>,
     seconds: Seconds,
 }
 
@@ -74,6 +77,14 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         }
     }
     let Some(output) = crate::tiled_mesh::untiled_output(job)? else {
+        if !job.variables.is_empty() {
+            bail!(
+                "{}: --bands meshes several variables in one piece only: not tile by tile \
+                 (--per-tile, or a raster larger than --tile-size {}); raise --tile-size",
+                job.input.display(),
+                job.tile_size
+            );
+        }
         let Some(png) = &job.preview else {
             return crate::tiled_mesh::run(job, feedback);
         };
@@ -106,13 +117,53 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let total = Instant::now();
     // `untiled_output` has checked the output path and its sidecar.
     let format = crate::format_plan::format(job)?;
+    if !job.variables.is_empty() {
+        // OBJ carries three 8-bit bands as vertex colours: checked once they are read.
+        if !format.carries_attributes() && format != MeshFormat::Obj {
+            bail!(
+                "{}: {format} carries heights only; the variables of --bands are written \
+                 to PLY (.ply) or glTF (.glb), one value per vertex and band, or GeoJSON \
+                 and FlatGeobuf (.geojson, .fgb), each triangle's corner mean per band",
+                output.display()
+            );
+        }
+        if job.decimation.has_count_target() {
+            bail!(
+                "{}: --bands takes error bounds (--max-error), not --max-triangles or \
+                 --max-vertices",
+                job.input.display()
+            );
+        }
+    }
     let reserved = reserve_report(job, Some((output, format)))?;
 
     let t = Instant::now();
     let raster = crate::mesh_file::read_raster(&job.input, job.band, job.vertical_datum.as_ref())?;
-    let read_seconds = t.elapsed().as_secs_f64();
     crate::output_paths::note_gcps_unused(&raster.info, job.pixel_coords, feedback);
-    let grid = &Grid::from_samples(raster.samples);
+    let tinsmith_raster::Raster {
+        samples,
+        info: raster_info,
+        ..
+    } = raster;
+    let (grid, variables, rgb) = if job.variables.is_empty() {
+        (Grid::from_samples(samples), Vec::new(), false)
+    } else {
+        crate::variables::read(
+            &job.input,
+            (samples, &raster_info),
+            &job.variables,
+            format.is_float32(),
+        )?
+    };
+    let grid = &grid;
+    if format == MeshFormat::Obj && !variables.is_empty() && !rgb {
+        bail!(
+            "{}: OBJ carries three 8-bit bands as vertex colours (v x y z r g b) and no other \
+             variables; write PLY (.ply) or glTF (.glb) for these",
+            output.display()
+        );
+    }
+    let read_seconds = t.elapsed().as_secs_f64();
     if grid.valid_cell_count() == 0 {
         bail!(
             "{}: band {} has no 2x2 block of valid samples, so there is nothing to triangulate",
@@ -123,9 +174,9 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
 
     let max_error = job.decimation.max_error.unwrap_or(f64::INFINITY);
     let plan =
-        crate::format_plan::FormatPlan::new(format, &raster.info, Some(grid), job, feedback)?;
+        crate::format_plan::FormatPlan::new(format, &raster_info, Some(grid), job, feedback)?;
     // Float32 formats leave the decimator the bound less their height rounding.
-    let heights = raster.info.min.zip(raster.info.max);
+    let heights = raster_info.min.zip(raster_info.max);
     crate::report::note_rounding_margin(&job.input, plan.decimation_bound, heights, feedback);
     let options = job
         .decimation_options(plan.decimation_bound, heights)
@@ -144,11 +195,10 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let tin = &result.tin;
 
     // The promise is checked, independently, before anything is written.
-    let placement = Placement::new(raster.info.transform(), job.pixel_coords);
+    let placement = Placement::new(raster_info.transform(), job.pixel_coords);
     let t = Instant::now();
     // The heights as the file will hold them (float32 formats round them).
     let check = check_tin(grid, tin, |_, v| plan.file_height(v.z), max_error)?;
-    let verify_seconds = t.elapsed().as_secs_f64();
     if !check.passed() {
         bail!(
             "{}: internal error, the decimated mesh failed verification ({}); nothing written",
@@ -156,11 +206,15 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
             check.problems.join("; ")
         );
     }
+    let at_vertices = crate::variables::vertex_values(grid, tin, format.is_float32());
+    let variable_reports =
+        crate::variables::check(&job.input, grid, &variables, tin, &at_vertices)?;
+    let verify_seconds = t.elapsed().as_secs_f64();
 
     // Drawn before anything is written, so that a picture that cannot be made leaves the
     // old outputs alone.
     let picture = match &job.preview {
-        Some(_) => Some(draw_preview(job, output, &raster.info, grid, tin)?),
+        Some(_) => Some(draw_preview(job, output, &raster_info, grid, tin)?),
         None => None,
     };
 
@@ -169,7 +223,27 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         tin.vertices().iter().map(|v| (v.x, v.y, v.z)),
         tin.triangles().iter().copied(),
     );
-    crate::format_plan::write(&plan, job, &raster.info, vertices, &triangles, feedback)?;
+    let attributes: Vec<VertexAttribute<'_>> = variables
+        .iter()
+        .zip(&at_vertices)
+        .map(|((_, name), values)| VertexAttribute { name, values })
+        .filter(|_| format != MeshFormat::Obj)
+        .collect();
+    // Three 8-bit bands are colours too, in the formats that have vertex colours.
+    let colours: Option<Vec<[u8; 3]>> =
+        (rgb && matches!(format, MeshFormat::Ply | MeshFormat::Glb | MeshFormat::Obj)).then(|| {
+            (0..tin.vertices().len())
+                .map(|i| [0, 1, 2].map(|k| at_vertices[k][i] as u8))
+                .collect()
+        });
+    crate::format_plan::write(
+        &plan,
+        job,
+        &raster_info,
+        (vertices, &triangles),
+        (&attributes, colours.as_deref()),
+        feedback,
+    )?;
     if let (Some(png), Some(bytes)) = (&job.preview, &picture) {
         tinsmith_output::write_bytes_atomically(png, bytes)
             .with_context(|| format!("{}: cannot write", png.display()))?;
@@ -179,8 +253,12 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let r = &result.report;
     let outcome = Outcome {
         size: (grid.width(), grid.height()),
-        valid_samples: raster.info.valid_samples,
-        band_count: raster.info.band_count,
+        // With variables, the samples valid in every band.
+        valid_samples: match variables.is_empty() {
+            true => raster_info.valid_samples,
+            false => grid.valid_count() as u64,
+        },
+        band_count: raster_info.band_count,
         before: (r.initial_triangles as u64, r.initial_vertices as u64),
         after: (r.final_triangles as u64, r.final_vertices as u64),
         max_error_bound: r.max_bound,
@@ -193,6 +271,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         start_vertices: r.start_vertices,
         sweeps: r.sweeps,
         removal_attempts: r.attempts,
+        variables: variable_reports,
         seconds: Seconds {
             read: read_seconds,
             initial_mesh: r.seconds_initial_mesh,
@@ -203,6 +282,16 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         },
     };
     report.summary.print("", feedback);
+    for v in &report.variables {
+        feedback.note(&format!(
+            "{}: band {} ({}) measured max error {} <= {}",
+            output.display(),
+            v.band,
+            v.name,
+            tinsmith_georef::readable(v.measured_max_error),
+            tinsmith_georef::readable(v.max_error)
+        ));
+    }
     plan.note_origin(output, feedback);
     if let Some(reserved) = reserved {
         reserved.write(&serde_json::to_vec_pretty(&report)?)?;

@@ -309,6 +309,8 @@ pub(crate) struct MeshOnRaster {
     pub(crate) triangles: Vec<[u32; 3]>,
     /// The winding expected in grid coordinates.
     pub(crate) orientation: Orientation,
+    /// The file's per-vertex attributes (PLY's other vertex properties).
+    pub(crate) attributes: Vec<(String, Vec<f64>)>,
 }
 
 /// Band `band` of `input` read whole, its heights converted from `datum` to heights
@@ -351,6 +353,7 @@ pub(crate) fn read_onto_raster(
         heights: on.heights,
         triangles: on.triangles,
         orientation: on.orientation,
+        attributes: on.attributes,
     })
 }
 
@@ -361,6 +364,8 @@ pub(crate) struct MeshOnLattice {
     pub(crate) triangles: Vec<[u32; 3]>,
     /// The winding expected in grid coordinates.
     pub(crate) orientation: Orientation,
+    /// The file's per-vertex attributes, in vertex order.
+    pub(crate) attributes: Vec<(String, Vec<f64>)>,
 }
 
 /// Reads the mesh file `mesh` (in `format`) onto the lattice of the raster `info`
@@ -375,7 +380,8 @@ pub(crate) fn read_onto_lattice(
 ) -> Result<MeshOnLattice> {
     crate::transform_check::check_transform(info, pixel_coords)?;
     let placement = Placement::new(info.transform(), pixel_coords);
-    let read = read_mesh_file(mesh, format, info, placement)?;
+    let mut read = read_mesh_file(mesh, format, info, placement)?;
+    let attributes = std::mem::take(&mut read.attributes);
     let positions = sample_positions(mesh, &read, format, info, placement)?;
     let heights: Vec<f64> = read.vertices.iter().map(|v| v[2]).collect();
     let orientation = expected_orientation(&placement);
@@ -386,5 +392,6 @@ pub(crate) fn read_onto_lattice(
         heights,
         triangles,
         orientation,
+        attributes,
     })
 }

@@ -66,6 +66,7 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
             heights,
             triangles,
             orientation,
+            attributes,
         } = read_onto_raster(
             &job.input,
             job.band,
@@ -98,6 +99,7 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
             heights,
             triangles,
             orientation,
+            attributes,
         };
         (raster.info, values, mesh, Some(report.max_error))
     } else {

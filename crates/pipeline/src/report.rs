@@ -24,6 +24,9 @@ pub struct MeshSummary<'a> {
     valid_samples: u64,
     /// Bands in the file (the one meshed is `band`).
     band_count: usize,
+    /// Other bands meshed with it (`--bands`), listed in the report's `variables`.
+    #[serde(skip)]
+    variable_count: usize,
     /// Valid samples that are not a corner of any valid cell: not in the domain, so not
     /// meshed (and not checked).
     isolated_samples: u64,
@@ -95,6 +98,7 @@ impl<'a> MeshSummary<'a> {
             vertical_datum: job.vertical_datum.as_ref().map(|d| d.label()),
             isolated_samples: outcome.valid_samples.saturating_sub(vertices_before),
             band_count: outcome.band_count,
+            variable_count: job.variables.len(),
             width: outcome.size.0,
             height: outcome.size.1,
             valid_samples: outcome.valid_samples,
@@ -175,7 +179,7 @@ impl<'a> MeshSummary<'a> {
                 ));
             }
         }
-        if self.band_count > 1 {
+        if self.band_count > 1 && self.variable_count == 0 {
             feedback.note(&format!(
                 "{}: note: meshed band {} of {} (--band picks another)",
                 self.input.display(),

@@ -197,7 +197,14 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
                 triangles,
             );
             let plan = export_plan.expect("planned for -o");
-            crate::format_plan::write(&plan, job, &info, vertices, &triangles, feedback)?;
+            crate::format_plan::write(
+                &plan,
+                job,
+                &info,
+                (vertices, &triangles),
+                (&[], None),
+                feedback,
+            )?;
             let write = report.seconds_sink + t.elapsed().as_secs_f64();
             (report, output.as_path(), write)
         }

@@ -14,6 +14,16 @@ pub struct Verified {
     pub report: Report,
     /// Bands in the raster (a mesh of another band fails).
     pub band_count: usize,
+    /// Each variable of `--bands` (its band, name, bound and measured error) with the
+    /// verifier's report of it; empty without variables.
+    pub variables: Vec<(crate::VariableReport, Report)>,
+}
+
+impl Verified {
+    /// Whether the height and every variable passed (see [`Report::passed`]).
+    pub fn passed(&self) -> bool {
+        self.report.passed() && self.variables.iter().all(|(_, r)| r.passed())
+    }
 }
 
 /// Reads the mesh file back onto its raster (WGS84 GeoJSON transformed back, each vertex
@@ -39,6 +49,7 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
         heights,
         triangles,
         orientation,
+        attributes,
     } = read_onto_raster(
         &job.input,
         job.band,
@@ -47,7 +58,26 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
         format,
         job.pixel_coords,
     )?;
-    let grid = &raster.samples;
+    // With variables the domain is where every band is valid, as `mesh --bands` made it.
+    let joined = match job.variables.is_empty() {
+        true => None,
+        false => Some(crate::variables::read(
+            &job.input,
+            (raster.samples.clone(), &raster.info),
+            &job.variables,
+            false,
+        )?),
+    };
+    let joined_samples;
+    let grid = match &joined {
+        None => &raster.samples,
+        Some((grid, _, _)) => {
+            joined_samples =
+                tinsmith_georef::Samples::new(grid.width(), grid.height(), grid.values().to_vec())
+                    .map_err(tinsmith_core::Error::from)?;
+            &joined_samples
+        }
+    };
     let mut options = VerifyOptions::new().with_orientation(orientation);
     if let Some(e) = job.max_error {
         options = options.with_max_error(e);
@@ -67,8 +97,21 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
             report.valid_samples
         );
     }
+    let variables = match &joined {
+        None => Vec::new(),
+        Some((grid, variables, _)) => crate::variables::verify_file(
+            &job.mesh,
+            grid,
+            variables,
+            &positions,
+            &triangles,
+            &attributes,
+            orientation,
+        )?,
+    };
     Ok(Verified {
         report,
         band_count: raster.info.band_count,
+        variables,
     })
 }

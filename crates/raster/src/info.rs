@@ -28,6 +28,9 @@ pub struct RasterInfo {
     /// GDAL's name of the band's data type (`Byte`, `Int16`, `Float32`, ...). A Byte band
     /// marked `PIXELTYPE=SIGNEDBYTE` is reported as `Int8`.
     pub data_type: String,
+    /// The band's description (GDAL's, e.g. a GeoTIFF band name), when it has one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub description: Option<String>,
     /// The band's declared nodata value, as GDAL reports it (before scale and offset). In
     /// JSON a number, or `"NaN"`, `"inf"`, `"-inf"` (JSON numbers cannot be those), or
     /// `null` when none is declared.

@@ -265,6 +265,7 @@ impl OpenBand {
         let offset = rb.offset().filter(|o| o.is_finite()).unwrap_or(0.0);
         let decoder = SampleDecoder::new(sample_type, nodata, scale, offset);
         let data_type = sample_type.display_name(&gdal_type);
+        let description = rb.description().ok().filter(|d| !d.trim().is_empty());
 
         let srs = dataset.spatial_ref().ok();
         let crs_wkt = srs
@@ -284,6 +285,7 @@ impl OpenBand {
             height,
             band_count: count,
             band,
+            description,
             data_type,
             nodata,
             scale,

@@ -54,6 +54,7 @@ mod problems;
 mod report;
 mod scan_convert;
 mod surface;
+mod variables;
 mod verify;
 
 pub use error::{Result, VerifyError};
@@ -63,4 +64,5 @@ pub use options::{Orientation, VerifyOptions};
 pub use points::{verify_points, PointsReport};
 pub use report::{ErrorLocation, Report};
 pub use surface::{surface, surface_at};
+pub use variables::verify_variable;
 pub use verify::verify;

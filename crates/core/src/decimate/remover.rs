@@ -293,6 +293,11 @@ impl<'g> Remover<'g> {
         if centre.z - hi > self.rules.limit || lo - centre.z > self.rules.limit {
             return None;
         }
+        if self.rules.grid.variable_count() > 0
+            && crate::variables::centre_outside_ring(self.rules.grid, &centre, &self.points)
+        {
+            return None;
+        }
         self.bounds.clear();
         self.bounds
             .extend(star.triangles.iter().map(|&t| mesh.bound(t)));

@@ -54,7 +54,9 @@ pub(super) fn coarse_start(
 ) -> Start {
     let full_border = keep_border.is_some();
     let (w, h) = (grid.width() as usize, grid.height() as usize);
+    // Insertion measures the height alone to pick its samples: no start for variables.
     let no_nodata = limit > 0.0
+        && grid.variable_count() == 0
         && matches!(initial_mesh, InitialMesh::Insert | InitialMesh::Auto)
         && grid.valid_cell_count() == w.saturating_sub(1) * h.saturating_sub(1);
     let mut strips = None;

@@ -13,7 +13,7 @@ use std::process::Command;
 use serde_json::Value;
 
 use crate::util::{
-    assert_fails_naming, fixture, gdaltransform, run_under_ulimit, stderr, stdout, Dir,
+    assert_fails_naming, fixture, gdaltransform, run_under_ulimit, stderr, stdout, venv_python, Dir,
 };
 
 /// The small DEM most tests use: 100 x 80 Float32, EPSG:3857, nodata.
@@ -22,15 +22,6 @@ const E: &str = "0.5";
 
 fn repo() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The Python with trimesh; fails the test when it is missing.
-fn python() -> PathBuf {
-    let path = std::env::var_os("TINSMITH_PYTHON")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join(".venv/bin/python3"));
-    require_oracle(path.exists(), &path.display().to_string());
-    path
 }
 
 /// Fails the test when the glTF validator is missing.
@@ -238,7 +229,7 @@ fn every_tin_format_reads_back_and_verifies() {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn trimesh_reads_ply_obj_stl_and_glb_with_the_same_triangles() {
-    let python = python();
+    let python = venv_python();
     let d = Dir::new();
     let dem = fixture(DEM);
     // Vertices at their samples: STL and glTF decimate to the bound less their float32
@@ -297,7 +288,7 @@ fn stl_base_makes_a_watertight_solid_over_holes_and_components() {
     let report = mesh(&d, &dem, "solid.stl", E, &["--base", "-10"]);
     // The reader drops the walls and the bottom: the top verifies.
     verify(&d, &dem, "solid.stl", E, &[]);
-    let python = python();
+    let python = venv_python();
     let read = trimesh(&python, &d.path("solid.stl"));
     assert_eq!(
         read.json["watertight"], true,
@@ -342,7 +333,7 @@ fn gltf_validator_finds_no_errors() {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn ogrinfo_reads_flatgeobuf_triangles_equal_to_the_ply() {
-    let python = python();
+    let python = venv_python();
     let d = Dir::new();
     let dem = fixture(DEM);
     let report = mesh(&d, &dem, "m.ply", E, &[]);
@@ -368,7 +359,7 @@ fn ogrinfo_reads_flatgeobuf_triangles_equal_to_the_ply() {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn ogrinfo_reads_geojson_in_wgs84_and_in_the_source_crs() {
-    let python = python();
+    let python = venv_python();
     let d = Dir::new();
     let dem = fixture(DEM);
     let report = mesh(&d, &dem, "m.ply", E, &[]);
@@ -421,7 +412,7 @@ fn ogrinfo_reads_geojson_in_wgs84_and_in_the_source_crs() {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn landxml_parses_as_xml_with_northing_easting_points() {
-    let python = python();
+    let python = venv_python();
     let d = Dir::new();
     let dem = fixture(DEM);
     let report = mesh(&d, &dem, "m.ply", E, &[]);

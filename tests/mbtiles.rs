@@ -2,7 +2,7 @@
 //! independent reader (Python's `sqlite3`, with its own SQLite), and the binary that links
 //! the bundled SQLite beside GDAL's.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use serde_json::Value;
@@ -12,19 +12,6 @@ use crate::util::{fixture, pack_mbtiles, pyramid_tiles, stderr, Dir};
 
 fn repo() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The Python of `make deps`; fails the test, saying how to install it, when missing.
-fn python() -> PathBuf {
-    let path = std::env::var_os("TINSMITH_PYTHON")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join(".venv/bin/python3"));
-    assert!(
-        path.exists(),
-        "oracle missing: {}; run `make deps`",
-        path.display()
-    );
-    path
 }
 
 fn hex(bytes: &[u8]) -> String {
@@ -46,7 +33,7 @@ fn python_sqlite3_reads_the_directory_pyramid_back() {
     );
     let before = std::fs::read(&file).unwrap();
 
-    let out = Command::new(python())
+    let out = Command::new(crate::util::venv_python())
         .arg(repo().join("tests/oracles/mbtiles_read.py"))
         .arg(&file)
         .output()
@@ -124,7 +111,7 @@ fn tiles_writes_an_mbtiles_file_holding_the_directory_pyramid() {
         let o = dir.run(&["tiles", &input, "-o", out, "--normals", "-q"]);
         assert!(o.status.success(), "{}", stderr(&o));
     }
-    let out = Command::new(python())
+    let out = Command::new(crate::util::venv_python())
         .arg(repo().join("tests/oracles/mbtiles_read.py"))
         .arg(dir.path("terrain.mbtiles"))
         .output()

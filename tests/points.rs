@@ -389,12 +389,11 @@ fn las_and_laz_read_the_same_classes_and_give_the_same_mesh() {
 
 /// The venv's Python, with laspy and its LAZ backend (lazrs), an independent LAS reader.
 fn laspy() -> std::path::PathBuf {
-    let python = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python3");
-    let ok = python.exists()
-        && std::process::Command::new(&python)
-            .args(["-c", "import laspy, lazrs"])
-            .status()
-            .is_ok_and(|s| s.success());
+    let python = crate::util::venv_python();
+    let ok = std::process::Command::new(&python)
+        .args(["-c", "import laspy, lazrs"])
+        .status()
+        .is_ok_and(|s| s.success());
     assert!(ok, "oracle missing: laspy[lazrs] in .venv; run `make deps`");
     python
 }

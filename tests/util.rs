@@ -245,3 +245,17 @@ pub fn pyramid_tiles(dir: &Path) -> Vec<(u8, u32, u32, PathBuf)> {
     tiles.sort();
     tiles
 }
+
+/// The Python of `.venv` (or `TINSMITH_PYTHON`), where `make deps` installs the oracles;
+/// fails the test, saying how to get it, when it is missing.
+pub fn venv_python() -> PathBuf {
+    let path = std::env::var_os("TINSMITH_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python3"));
+    assert!(
+        path.exists(),
+        "oracle missing: {}; run `make deps`",
+        path.display()
+    );
+    path
+}

@@ -388,19 +388,6 @@ fn bad_band_lists_and_bounds_are_refused_with_nothing_written() {
     assert_eq!(d.files(), ["multi.tif"]);
 }
 
-fn python() -> PathBuf {
-    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let path = std::env::var_os("TINSMITH_PYTHON")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo.join(".venv/bin/python3"));
-    assert!(
-        path.exists(),
-        "oracle missing: {}; run `make deps`",
-        path.display()
-    );
-    path
-}
-
 #[test]
 #[ignore = "needs trimesh in .venv (make deps)"]
 fn trimesh_reads_one_property_per_band() {
@@ -419,7 +406,7 @@ fn trimesh_reads_one_property_per_band() {
         ],
     );
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/oracles/ply_properties.py");
-    let o = Command::new(python())
+    let o = Command::new(crate::util::venv_python())
         .arg(&script)
         .arg(d.path("m.ply"))
         .output()
@@ -689,7 +676,7 @@ fn three_8_bit_bands_are_vertex_colours_in_ply_obj_and_gltf() {
         ]);
         assert!(o.status.success(), "{name}: {}", stderr(&o));
         let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/oracles/vertex_colours.py");
-        let o = Command::new(python())
+        let o = Command::new(crate::util::venv_python())
             .arg(&script)
             .arg(d.path(name))
             .output()

@@ -37,10 +37,14 @@ fn missing_input_file() {
 #[test]
 fn input_that_is_not_a_raster() {
     let d = Dir::new();
+    d.write("notes.doc", "hello, I am not a raster\n");
+    let o = d.run(&["mesh", "notes.doc", "-o", "out.ply", "--max-error", "1"]);
+    assert_fails_naming(&o, &["notes.doc", "raster"]);
+    // A .txt file is read as x y z points: it is refused as text that holds none.
     d.write("notes.txt", "hello, I am not a raster\n");
     let o = d.run(&["mesh", "notes.txt", "-o", "out.ply", "--max-error", "1"]);
-    assert_fails_naming(&o, &["notes.txt", "raster"]);
-    assert_eq!(d.files(), vec!["notes.txt"]);
+    assert_fails_naming(&o, &["notes.txt", "line 1", "columns"]);
+    assert_eq!(d.files(), vec!["notes.doc", "notes.txt"]);
 }
 
 #[cfg(unix)]

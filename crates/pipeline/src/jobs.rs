@@ -125,9 +125,22 @@ impl MeshJob {
         bound: f64,
         heights: Option<(f64, f64)>,
     ) -> crate::Result<DecimationOptions> {
+        use tinsmith_choices::ChoiceError;
         self.decimation
             .decimation_options(bound, heights)
-            .map_err(|e| crate::error::Error::Refused(format!("{}: {e}", self.input.display())))
+            .map_err(|e| {
+                // The choices' refusals in the CLI's own words.
+                let reason = match e {
+                    ChoiceError::NoTarget => {
+                        "give --max-error, or --max-triangles or --max-vertices".to_owned()
+                    }
+                    ChoiceError::RoundsWithCount => "--flip-rounds and --extend-rounds work to \
+                         an error bound, not with --max-triangles or --max-vertices"
+                        .to_owned(),
+                    other => other.to_string(),
+                };
+                crate::error::Error::Refused(format!("{}: {reason}", self.input.display()))
+            })
     }
 }
 

@@ -92,8 +92,21 @@ impl MeshChoices {
         bound: f64,
         heights: Option<(f64, f64)>,
     ) -> PyResult<DecimationOptions> {
+        use tinsmith_choices::ChoiceError;
         self.decimation
             .decimation_options(bound, heights)
-            .map_err(|e| PyValueError::new_err(e.to_string()))
+            .map_err(|e| {
+                // The choices' refusals in the binding's own argument names.
+                PyValueError::new_err(match e {
+                    ChoiceError::NoTarget => {
+                        "give max_error, or a count target (max_triangles or max_vertices)"
+                            .to_owned()
+                    }
+                    ChoiceError::RoundsWithCount => "flip_rounds and extend_rounds work to an \
+                         error bound, not with max_triangles or max_vertices"
+                        .to_owned(),
+                    other => other.to_string(),
+                })
+            })
     }
 }

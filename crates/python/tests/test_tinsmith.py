@@ -213,9 +213,9 @@ def test_bad_options_are_value_errors_with_the_cli_names():
         tinsmith.mesh(z, 1.0, error_model="fast")
     with pytest.raises(ValueError, match="max_error must be a finite number"):
         tinsmith.mesh(z, -1.0)
-    with pytest.raises(ValueError, match="give a maximum error, or a count target"):
+    with pytest.raises(ValueError, match="give max_error, or a count target"):
         tinsmith.mesh(z)
-    with pytest.raises(ValueError, match="flip rounds and extend rounds work to an error bound"):
+    with pytest.raises(ValueError, match="flip_rounds and extend_rounds work to an error bound"):
         tinsmith.mesh(z, max_triangles=10, flip_rounds=1)
     with pytest.raises(ValueError, match="singular"):
         tinsmith.mesh(z, 1.0, transform=(0, 0, 0, 0, 0, 0))

@@ -1,6 +1,6 @@
-//! Existing TINs as input: a DEM meshed exactly, then that mesh (PLY, OBJ, LandXML)
-//! decimated with its own triangles, every original vertex checked by the verifier and
-//! the boundary (outline and a hole) kept; invalid triangulations refused.
+//! Existing TINs as input: a DEM meshed exactly, then that mesh (PLY, OBJ, LandXML,
+//! FlatGeobuf) decimated with its own triangles, every original vertex checked by the
+//! verifier and the boundary (outline and a hole) kept; invalid triangulations refused.
 
 use std::collections::HashMap;
 
@@ -130,11 +130,11 @@ fn a_dem_mesh_decimated_as_a_tin_keeps_the_bound_and_the_boundary() {
 }
 
 #[test]
-fn obj_and_landxml_inputs_give_the_same_tin_as_ply() {
+fn obj_landxml_and_flatgeobuf_inputs_give_the_same_tin_as_ply() {
     let d = Dir::new();
     dem_with_hole(&d);
     let mut counts = Vec::new();
-    for name in ["full.ply", "full.obj", "full.xml"] {
+    for name in ["full.ply", "full.obj", "full.xml", "full.fgb"] {
         exact_mesh(&d, name);
         let out = format!("{name}.small.ply");
         let o = d.run(&["mesh", name, "-o", &out, "--max-error", "0.3", "-q"]);

@@ -203,6 +203,42 @@ fn the_crs_is_carried_from_the_file_or_given() {
     );
 }
 
+#[test]
+fn a_grid_of_no_power_of_ten_is_taken_on_its_own_spacing() {
+    // 3 arc-second cells: positions on no power-of-ten step within 2^31 steps.
+    let d = Dir::new();
+    let mut text = "ncols 40\nnrows 30\nxllcorner -120\nyllcorner 45\n\
+                    cellsize 0.000833333333333333\n"
+        .to_string();
+    for r in 0..30 {
+        let row: Vec<String> = (0..40)
+            .map(|c| format!("{:.2}", 300.0 + 5.0 * ((c * r) as f64 / 50.0).sin()))
+            .collect();
+        text.push_str(&row.join(" "));
+        text.push('\n');
+    }
+    d.write("geo.asc", &text);
+    let o = d.run(&["mesh", "geo.asc", "-o", "geo.ply", "--max-error", "0", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = d.run(&[
+        "mesh",
+        "geo.ply",
+        "-o",
+        "small.ply",
+        "--max-error",
+        "0.5",
+        "--report",
+        "r.json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path("r.json")).unwrap()).unwrap();
+    let spacing = report["lattice_spacing"][0].as_f64().unwrap();
+    assert!((spacing - 1.0 / 1200.0).abs() < 1e-12, "{spacing}");
+    let o = d.run(&["verify", "geo.ply", "small.ply", "--max-error", "0.5"]);
+    assert!(o.status.success(), "{}", stdout(&o));
+}
+
 /// An OBJ of `vertices` (x y z) and 1-based `faces`.
 fn obj(d: &Dir, name: &str, vertices: &[[f64; 3]], faces: &[[u32; 3]]) {
     let mut text = String::new();
@@ -269,9 +305,9 @@ fn duplicate_vertices_and_unusable_coordinates_are_refused() {
     let o = d.run(&["mesh", "copy.obj", "-o", "copy.ply", "--max-error", "0.1"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("merged"), "{}", stderr(&o));
-    // No power-of-ten lattice holds a third.
+    // No power-of-ten lattice and no regular spacing holds these x.
     let mut v = SQUARE.to_vec();
-    v[1][0] = 1.0 / 3.0;
+    v[1][0] = std::f64::consts::PI;
     obj(&d, "third.obj", &v, &[[1, 2, 3], [1, 3, 4]]);
-    refused(&d, "third.obj", &["lattice"]);
+    refused(&d, "third.obj", &["x: ", "regular spacing"]);
 }

@@ -2,11 +2,15 @@
 //! a valid planar triangulation by exact integer predicates.
 //!
 //! # The lattice
-//! The step is the coarsest power of ten `10^-d`, `d` in `0..=12`, on which every x and
-//! y is a lattice point: `|x - k 10^-d| <= 10^-6 10^-d + 8 ε |x|` for an integer `k`
-//! (a millionth of a step, plus `f64` rounding of the written value). Lattice position 0
-//! is the smallest x and y. Coordinates no such step represents, or that span more than
-//! [`MAX_LATTICE`] steps of it, are refused.
+//! Per axis, the step is the coarsest power of ten `10^-d`, `d` in `0..=12`, on which
+//! every coordinate is a lattice point: `|x - k 10^-d| <= 10^-6 10^-d + 8 ε |x|` for an
+//! integer `k` (a millionth of a step, plus `f64` rounding of the written value). When no
+//! power of ten holds them within [`MAX_LATTICE`] steps, the coordinates' own regular
+//! spacing `g` (the smallest gap between distinct values; every value `min + k g` within
+//! a millionth of `g` and `f64` rounding) is the step: a grid of 1/1200 degree, say.
+//! Lattice position 0 is the smallest x and y. Coordinates on neither, or spanning more
+//! than [`MAX_LATTICE`] steps, are refused. Scaling an axis keeps every orientation's
+//! sign, so the exact predicates decide on the lattice what they would on the file.
 
 use std::path::Path;
 
@@ -76,30 +80,16 @@ pub fn tin_points(path: &Path, vertices: &[[f64; 3]], triangles: &[[u32; 3]]) ->
             hi[a] = hi[a].max(vertices[i][a]);
         }
     }
-    let decimals = (0..=MAX_DECIMALS)
-        .find(|&d| {
-            ids.iter()
-                .all(|&i| on_lattice(vertices[i][0], d) && on_lattice(vertices[i][1], d))
-        })
-        .ok_or_else(|| {
-            problem(format!(
-                "vertex x, y are not on a lattice of step 1e-{MAX_DECIMALS} or coarser (a power \
-                 of ten), so the exact integer geometry cannot hold them"
-            ))
-        })?;
-    let per_unit = 10f64.powi(decimals);
-    if (0..2).any(|a| ((hi[a] - lo[a]) * per_unit).round() > MAX_LATTICE as f64) {
-        return Err(problem(format!(
-            "the vertices span {} x {} at a lattice step of 1e-{decimals} (the finest their \
-             coordinates need): more than {MAX_LATTICE} steps, beyond the exact integer geometry",
-            hi[0] - lo[0],
-            hi[1] - lo[1]
-        )));
+    let mut scale = [0.0f64; 2];
+    for a in 0..2 {
+        let values: Vec<f64> = ids.iter().map(|&i| vertices[i][a]).collect();
+        scale[a] = axis_scale(&values, lo[a], hi[a])
+            .map_err(|why| problem(format!("{}: {why}", ["x", "y"][a])))?;
     }
     let lattice = |p: &[f64; 3]| {
         [
-            ((p[0] - lo[0]) * per_unit).round() as i64,
-            ((p[1] - lo[1]) * per_unit).round() as i64,
+            ((p[0] - lo[0]) * scale[0]).round() as i64,
+            ((p[1] - lo[1]) * scale[1]).round() as i64,
         ]
     };
     // Sorted by lattice position (then file order): equal positions are neighbours.
@@ -181,7 +171,7 @@ pub fn tin_points(path: &Path, vertices: &[[f64; 3]], triangles: &[[u32; 3]]) ->
             xy,
             z,
             origin: lo,
-            spacing: [1.0 / per_unit; 2],
+            spacing: [1.0 / scale[0], 1.0 / scale[1]],
             crs: FileCrs::default(),
             classes: ClassChoice::All,
             points_in_file,
@@ -190,6 +180,47 @@ pub fn tin_points(path: &Path, vertices: &[[f64; 3]], triangles: &[[u32; 3]]) ->
         triangles: corners,
         unused,
         merged,
+    })
+}
+
+/// Lattice steps per world unit along one axis of coordinates `values` (smallest `lo`,
+/// largest `hi`): `10^d` for the coarsest power-of-ten step holding every value, else
+/// `1 / g` for the regular spacing `g` of the values (the smallest gap between distinct
+/// values, every value `lo + k g`), with the span at most [`MAX_LATTICE`] steps either
+/// way; why not otherwise.
+fn axis_scale(values: &[f64], lo: f64, hi: f64) -> std::result::Result<f64, String> {
+    let fits = |per_unit: f64| ((hi - lo) * per_unit).round() <= MAX_LATTICE as f64;
+    let decimals = (0..=MAX_DECIMALS).find(|&d| values.iter().all(|&v| on_lattice(v, d)));
+    if let Some(d) = decimals {
+        if fits(10f64.powi(d)) {
+            return Ok(10f64.powi(d));
+        }
+    }
+    // A regular spacing that is no power of ten (a grid of 1/1200 degree, say).
+    let noise = |a: f64, b: f64| 16.0 * f64::EPSILON * (a.abs() + b.abs());
+    let mut sorted = values.to_vec();
+    sorted.sort_unstable_by(f64::total_cmp);
+    let gap = sorted
+        .windows(2)
+        .filter(|w| w[1] - w[0] > noise(w[0], w[1]))
+        .map(|w| w[1] - w[0])
+        .fold(f64::INFINITY, f64::min);
+    let regular = gap.is_finite()
+        && values.iter().all(|&v| {
+            let k = ((v - lo) / gap).round();
+            (v - lo - k * gap).abs() <= 1e-6 * gap + noise(v, lo)
+        });
+    if regular && fits(1.0 / gap) {
+        return Ok(1.0 / gap);
+    }
+    Err(match decimals {
+        Some(d) => format!(
+            "the vertices span {} at a lattice step of 1e-{d} (the coarsest power of ten              holding their coordinates): more than {MAX_LATTICE} steps, beyond the exact              integer geometry, and they are on no coarser regular spacing",
+            hi - lo
+        ),
+        None => format!(
+            "the coordinates are on no power-of-ten step down to 1e-{MAX_DECIMALS} and on no              regular spacing within {MAX_LATTICE} steps, so the exact integer geometry cannot              hold them"
+        ),
     })
 }
 
@@ -361,20 +392,42 @@ mod tests {
     #[test]
     fn lattice_is_the_coarsest_power_of_ten() {
         let t = read(&square(), &[[0, 1, 2], [0, 2, 3]]).unwrap();
-        assert_eq!(t.cloud.spacing, [0.1, 0.1]);
+        assert_eq!(t.cloud.spacing, [0.1, 1.0]);
         assert_eq!(t.cloud.origin, [10.5, 20.0]);
-        assert_eq!(t.cloud.xy, vec![[0, 0], [0, 10], [10, 0], [10, 10]]);
+        assert_eq!(t.cloud.xy, vec![[0, 0], [0, 1], [10, 0], [10, 1]]);
         assert_eq!(t.world[1], [10.5, 21.0, 4.0]);
         assert_eq!(t.triangles.len(), 2);
         let mut v = square();
         v[0][0] = 10.25;
         assert_eq!(
             read(&v, &[[0, 1, 2], [0, 2, 3]]).unwrap().cloud.spacing,
-            [0.01, 0.01]
+            [0.01, 1.0]
         );
-        v[0][0] = 1.0 / 3.0;
+        v[0][0] = 10.0 + std::f64::consts::PI / 10.0;
         let e = read(&v, &[[0, 1, 2], [0, 2, 3]]).unwrap_err().to_string();
-        assert!(e.contains("t.ply") && e.contains("lattice"), "{e}");
+        assert!(
+            e.contains("t.ply") && e.contains("x: ") && e.contains("regular"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_grid_of_no_power_of_ten_gets_its_own_spacing() {
+        // 3 arc-second samples, as a geographic DEM gives them.
+        let step = 1.0 / 1200.0;
+        let mut v = Vec::new();
+        for r in 0..3 {
+            for c in 0..3 {
+                v.push([-120.0 + c as f64 * step, 45.0 + r as f64 * step, 1.0]);
+            }
+        }
+        let t = read(&v, &[[0, 1, 4], [0, 4, 3], [4, 5, 8], [1, 2, 5]]).unwrap();
+        assert!(
+            (t.cloud.spacing[0] - step).abs() < 1e-15,
+            "{:?}",
+            t.cloud.spacing
+        );
+        assert!(t.cloud.xy.iter().all(|p| p[0] <= 2 && p[1] <= 2));
     }
 
     #[test]

@@ -194,13 +194,24 @@ fn the_crs_is_carried_from_the_file_or_given() {
     assert!(o.status.success(), "{}", stderr(&o));
     let o = d.run(&["mesh", "a.ply", "-o", "b.fgb", "--max-error", "1", "-q"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let b = tinsmith_formats::read_mesh(&d.path("b.fgb")).unwrap();
-    assert!(
-        b.crs_wkt.as_deref().is_some_and(|w| w.contains("32633")) || b.epsg == Some(32633),
-        "{:?} {:?}",
-        b.crs_wkt,
-        b.epsg
-    );
+    let has_crs = |name: &str| {
+        let m = tinsmith_formats::read_mesh(&d.path(name)).unwrap();
+        m.crs_wkt.as_deref().is_some_and(|w| w.contains("32633")) || m.epsg == Some(32633)
+    };
+    assert!(has_crs("b.fgb"));
+    // A file without one takes its .prj sidecar.
+    let wkt = tinsmith_formats::read_mesh(&d.path("a.ply"))
+        .unwrap()
+        .crs_wkt
+        .unwrap();
+    obj(&d, "sq.obj", &SQUARE, &[[1, 2, 3], [1, 3, 4]]);
+    let o = d.run(&["mesh", "sq.obj", "-o", "sq.fgb", "--max-error", "0.1", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!has_crs("sq.fgb"));
+    d.write("sq.prj", &wkt);
+    let o = d.run(&["mesh", "sq.obj", "-o", "sq.fgb", "--max-error", "0.1", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(has_crs("sq.fgb"));
 }
 
 #[test]

@@ -18,4 +18,5 @@ mod serve;
 mod shards;
 mod tiled_mesh;
 mod tiles;
+mod tin_input;
 mod variables;

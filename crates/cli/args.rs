@@ -240,8 +240,8 @@ pub struct InfoArgs {
 
 #[derive(Debug, Args)]
 pub struct VerifyArgs {
-    /// The raster the mesh was made from, or its points (.las, .laz, .xyz/.csv/.txt):
-    /// every point is measured against the mesh.
+    /// The raster the mesh was made from, or its points (.las, .laz, .xyz/.csv/.txt) or
+    /// TIN (.ply, .obj, .xml, .fgb): every point or vertex is measured against the mesh.
     pub input: PathBuf,
     /// The mesh to check (.ply, .obj, .stl, .glb, .geojson, .fgb, .xml, or any with
     /// --format); GeoJSON in WGS84 is transformed back to the raster's CRS.

@@ -15,7 +15,8 @@ use super::{parse_finite, parse_interval, parse_max_error};
 pub struct MeshArgs {
     /// Any single-band raster GDAL can read (GeoTIFF, ESRI ASCII, HGT, VRT, PNG...), or
     /// points: .las, .laz, or .xyz/.csv/.txt text (x y z columns), Delaunay-triangulated
-    /// and decimated within --max-error of every point.
+    /// and decimated within --max-error of every point; or an existing TIN (.ply, .obj,
+    /// .xml, .fgb) decimated with its own triangles within --max-error of every vertex.
     pub input: PathBuf,
     /// Output mesh; the format follows the extension (.ply, .obj, .stl, .glb, .geojson,
     /// .fgb, .xml or .landxml for LandXML) unless --format names it. Optional with --per-tile.

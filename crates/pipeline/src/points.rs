@@ -1,6 +1,7 @@
 //! `tinsmith mesh` and `tinsmith verify` on point files (LAS/LAZ, XYZ/CSV text): read,
 //! merge duplicates, Delaunay-triangulate, decimate with every point within the bound,
-//! verify independently, write.
+//! verify independently, write. Existing TINs (PLY, OBJ, LandXML, FlatGeobuf) go the
+//! same way with their own triangles instead of the Delaunay triangulation.
 
 use std::path::Path;
 use std::time::Instant;
@@ -13,13 +14,15 @@ use tinsmith_verify::{verify_points, PointsReport};
 
 use crate::error::{bail, Context};
 use crate::jobs::{MeshJob, PointChoices};
+use crate::tin_input::{is_tin_input, read_tin};
 use crate::Feedback;
 use crate::Result;
 
 /// Whether `path` is read as points (by its extension: `.las`, `.laz`, `.xyz`, `.csv`,
-/// `.txt`) rather than as a raster.
+/// `.txt`) or as an existing TIN whose vertices are the points (`.ply`, `.obj`, `.xml`,
+/// `.fgb`) rather than as a raster.
 pub fn is_point_input(path: &Path) -> bool {
-    tinsmith_points::is_point_file(path)
+    tinsmith_points::is_point_file(path) || is_tin_input(path)
 }
 
 /// The points of `path` after the class filter and the duplicates rule, and how many
@@ -127,7 +130,12 @@ struct PointsMeshReport<'a> {
     duplicates_rule: &'static str,
     classes: String,
     lattice_spacing: [f64; 2],
-    delaunay_triangles: usize,
+    /// The Delaunay triangulation's triangles (point files).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    delaunay_triangles: Option<usize>,
+    /// The input TIN's triangles (mesh files).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    input_triangles: Option<usize>,
     triangles: usize,
     vertices: usize,
     max_error_bound: f64,
@@ -176,20 +184,41 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     let reserved = crate::mesh::reserve_report(job, Some((output, format)))?;
 
     let t = Instant::now();
-    let (cloud, merged) = read(input, &job.points, feedback)?;
-    let crs = resolve_crs(input, &cloud, job.points.crs.as_deref())?;
+    let tin_input = is_tin_input(input);
+    let (cloud, merged, crs, tin) = if tin_input {
+        if job.points.classes.is_some() || job.points.no_withheld {
+            feedback.note(&format!(
+                "{}: --classes and --no-withheld apply to LAS and LAZ only",
+                input.display()
+            ));
+        }
+        let (tin, file_crs) = read_tin(input, feedback)?;
+        let crs = match job.points.crs.as_deref() {
+            Some(text) => Some(tinsmith_raster::crs_wkt(text)?),
+            None => file_crs,
+        };
+        let cloud = tin.cloud.clone();
+        (cloud, tin.merged, crs, Some((tin.world, tin.triangles)))
+    } else {
+        let (cloud, merged) = read(input, &job.points, feedback)?;
+        let crs = resolve_crs(input, &cloud, job.points.crs.as_deref())?;
+        (cloud, merged, crs, None)
+    };
     let read_seconds = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let triangles = match tinsmith_points::delaunay(&cloud) {
-        Ok(triangles) => triangles,
-        Err(e) => bail!("{}: cannot triangulate: {e}", input.display()),
+    let (points, triangles) = match tin {
+        // The TIN's own triangles; its vertices exactly as the file has them.
+        Some((world, triangles)) => (world, triangles),
+        None => match tinsmith_points::delaunay(&cloud) {
+            Ok(triangles) => (world_points(&cloud), triangles),
+            Err(e) => bail!("{}: cannot triangulate: {e}", input.display()),
+        },
     };
     let triangulate_seconds = t.elapsed().as_secs_f64();
-    let delaunay_triangles = triangles.len();
+    let input_triangles = triangles.len();
 
     let t = Instant::now();
-    let points = world_points(&cloud);
     // Float32 formats store positions and heights relative to the points' middle: the
     // decimator keeps the heights' rounding, measured at every point, off the bound.
     let origin = format.is_float32().then(|| LocalOrigin::of_points(&points));
@@ -267,11 +296,12 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     let write_seconds = t.elapsed().as_secs_f64();
 
     feedback.note(&format!(
-        "{}: {} points ({} Delaunay triangles) -> {} triangles, {} vertices; largest error \
+        "{}: {} points ({} {} triangles) -> {} triangles, {} vertices; largest error \
          {} (bound {max_error}), verified at every point",
         output.display(),
         points_read,
-        delaunay_triangles,
+        input_triangles,
+        if tin_input { "input" } else { "Delaunay" },
         report.final_triangles,
         report.final_vertices,
         crate::readable(check.max_error),
@@ -283,14 +313,19 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
         points_in_file,
         points_read,
         duplicates_merged: merged,
-        duplicates_rule: duplicates_name(job.points.duplicates),
+        duplicates_rule: if tin_input {
+            "identical copies only"
+        } else {
+            duplicates_name(job.points.duplicates)
+        },
         classes: match classes {
             ClassChoice::All => "all".into(),
             ClassChoice::DefaultGround => "2 (ground, the default)".into(),
             ClassChoice::Listed(list) => format!("{list:?}"),
         },
         lattice_spacing: spacing,
-        delaunay_triangles,
+        delaunay_triangles: (!tin_input).then_some(input_triangles),
+        input_triangles: tin_input.then_some(input_triangles),
         triangles: report.final_triangles,
         vertices: report.final_vertices,
         max_error_bound: report.max_bound,
@@ -367,8 +402,11 @@ pub fn verify_points_file(
     choices: &PointChoices,
     feedback: &dyn Feedback,
 ) -> Result<PointsReport> {
-    let (cloud, _) = read(points_path, choices, feedback)?;
-    let points = world_points(&cloud);
+    let points = if is_tin_input(points_path) {
+        read_tin(points_path, feedback)?.0.world
+    } else {
+        world_points(&read(points_path, choices, feedback)?.0)
+    };
     let format = crate::mesh_file::mesh_format(mesh_path, format)?;
     if format == MeshFormat::GeoJson {
         bail!(

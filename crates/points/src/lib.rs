@@ -1,6 +1,7 @@
 //! Point clouds in: LAS/LAZ (the `las` crate, LAZ through its `laz` feature) and XYZ/CSV
 //! text, streamed into compact lattice arrays (16 bytes of position and 8 of height per
-//! point), deduplicated by a rule, and Delaunay-triangulated with spade.
+//! point), deduplicated by a rule, and Delaunay-triangulated with spade; or an existing
+//! TIN's vertices put on a lattice with its own triangles checked ([`tin_points`]).
 //!
 //! Positions are kept as integers on a lattice: a LAS file's own integers (`X`, `Y`,
 //! shifted to start at 0), or for text the lattice of spacing `10^-d`, `d` the most
@@ -25,6 +26,7 @@ mod delaunay;
 mod error;
 mod las_file;
 mod text;
+mod tin;
 
 use std::path::Path;
 
@@ -32,6 +34,7 @@ pub use cloud::{ClassChoice, FileCrs, PointCloud, MAX_LATTICE};
 pub use dedupe::{dedupe, Duplicates};
 pub use delaunay::{delaunay, TriangulationError};
 pub use error::{Error, Result};
+pub use tin::{tin_points, TinPoints};
 
 /// Which points of a LAS file to read (text files have no classes).
 #[derive(Debug, Clone, Default, PartialEq)]

@@ -17,5 +17,6 @@ mod preview;
 mod serve;
 mod shards;
 mod tiled_mesh;
+mod tiled_variables;
 mod tiles;
 mod variables;

@@ -1,0 +1,237 @@
+//! Several variables over one mesh, tile by tile (`mesh --bands` on a raster larger than
+//! `--tile-size`): every band within its bound by the independent verifier, the welded
+//! mesh crack-free (shared edges decided once for all bands), the same bytes for any
+//! thread count, and the bands' bounds deciding the shared edges' vertices.
+
+use std::path::Path;
+
+use serde_json::Value;
+
+use crate::tiled_mesh::assert_crack_free;
+use crate::util::{assert_fails_naming, stderr, stdout, Dir};
+use crate::variables::{field, mesh_ok, stack, three_bands, write_band, H, W};
+
+/// Tiles of 16 samples: 3 x 2 tiles on the 40 x 30 fixtures, shared edges at columns 15
+/// and 30 and row 15.
+const TILE: &str = "16";
+
+/// Vertices of a mesh written with `--pixel-coords` that lie on a shared tile edge.
+fn on_shared_edges(mesh: &Path) -> usize {
+    let file = tinsmith_formats::read_mesh(mesh).expect("mesh");
+    file.vertices
+        .iter()
+        .filter(|v| {
+            let (x, y) = (v[0] as usize, v[1] as usize);
+            (x == 15 || x == 30 || y == 15) && x < W && y < H
+        })
+        .count()
+}
+
+fn verify_bands(d: &Dir, mesh: &str, bands: &str, bounds: &str) -> Value {
+    let o = d.run(&[
+        "verify",
+        "multi.tif",
+        mesh,
+        "--bands",
+        bands,
+        "--max-error",
+        bounds,
+        "--pixel-coords",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    serde_json::from_str(&stdout(&o)).expect("JSON")
+}
+
+#[test]
+fn tiled_bands_keep_every_bound_and_weld_without_cracks() {
+    let d = Dir::new();
+    three_bands(&d);
+    let r = mesh_ok(
+        &d,
+        &[
+            "-o",
+            "m.ply",
+            "--bands",
+            "1,2,3",
+            "--max-error",
+            "1,0.5,0.25",
+            "--tile-size",
+            TILE,
+            "--pixel-coords",
+        ],
+    );
+    assert_eq!(r["tiles"]["count"], 6, "{r}");
+    let vars = r["variables"].as_array().expect("variables in the report");
+    for (v, (band, bound)) in vars.iter().zip([(2, 0.5), (3, 0.25)]) {
+        assert_eq!(v["band"], band);
+        let measured = v["measured_max_error"].as_f64().expect("measured");
+        assert!(measured <= bound && measured > 0.0, "{v}");
+    }
+    let json = verify_bands(&d, "m.ply", "1,2,3", "1,0.5,0.25");
+    assert_eq!(
+        json["variables"].as_array().map(Vec::len),
+        Some(2),
+        "{json}"
+    );
+    assert_eq!(r["triangles_after"], json["height"]["triangles"], "{json}");
+    assert_eq!(json["height"]["overlapping_edges"], 0, "{json}");
+    assert_eq!(json["height"]["uncovered_samples"], 0, "{json}");
+    assert_crack_free(d.path("multi.tif").to_str().unwrap(), &d.path("m.ply"));
+    // Each band is measured on its own values: a bound below band 3's error fails it.
+    let o = d.run(&[
+        "verify",
+        "multi.tif",
+        "m.ply",
+        "--bands",
+        "1,2,3",
+        "--max-error",
+        "1,0.5,0.01",
+        "--pixel-coords",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
+}
+
+#[test]
+fn tiled_identical_bands_give_the_single_band_tiled_mesh() {
+    let d = Dir::new();
+    write_band(&d, "a.asc", field(0.7));
+    write_band(&d, "b.asc", field(0.7));
+    stack(&d, "multi.tif", &["a.asc", "b.asc"]);
+    let flags = [
+        "--vertex-heights",
+        "samples",
+        "--initial-mesh",
+        "rtin",
+        "--tile-size",
+        TILE,
+        "--pixel-coords",
+    ];
+    let mut args = vec!["-o", "one.ply", "--max-error", "0.5"];
+    args.extend_from_slice(&flags);
+    let one = mesh_ok(&d, &args);
+    let mut args = vec!["-o", "two.ply", "--bands", "1,2", "--max-error", "0.5"];
+    args.extend_from_slice(&flags);
+    let two = mesh_ok(&d, &args);
+    assert_eq!(one["tiles"]["count"], 6);
+    assert_eq!(one["triangles_after"], two["triangles_after"]);
+    assert_eq!(one["vertices_after"], two["vertices_after"]);
+    let (a, b) = (
+        tinsmith_formats::read_mesh(&d.path("one.ply")).expect("one"),
+        tinsmith_formats::read_mesh(&d.path("two.ply")).expect("two"),
+    );
+    assert_eq!(a.vertices, b.vertices);
+    assert_eq!(a.triangles, b.triangles);
+}
+
+#[test]
+fn tiled_bands_give_the_same_bytes_for_any_thread_count() {
+    let d = Dir::new();
+    three_bands(&d);
+    let mut bytes = Vec::new();
+    for threads in ["1", "2"] {
+        let name = format!("m{threads}.ply");
+        mesh_ok(
+            &d,
+            &[
+                "-o",
+                &name,
+                "--bands",
+                "1,2,3",
+                "--max-error",
+                "1,0.5,0.25",
+                "--tile-size",
+                TILE,
+                "--threads",
+                threads,
+            ],
+        );
+        bytes.push(std::fs::read(d.path(&name)).unwrap());
+    }
+    assert_eq!(bytes[0], bytes[1]);
+}
+
+#[test]
+fn a_tighter_band_keeps_more_vertices_on_shared_edges() {
+    let d = Dir::new();
+    three_bands(&d);
+    let mut counts = Vec::new();
+    for bounds in ["1,20", "1,0.5", "1,0.05"] {
+        let name = format!("m{bounds}.ply");
+        mesh_ok(
+            &d,
+            &[
+                "-o",
+                &name,
+                "--bands",
+                "1,2",
+                "--max-error",
+                bounds,
+                "--tile-size",
+                TILE,
+                "--pixel-coords",
+            ],
+        );
+        verify_bands(&d, &name, "1,2", bounds);
+        assert_crack_free(d.path("multi.tif").to_str().unwrap(), &d.path(&name));
+        counts.push(on_shared_edges(&d.path(&name)));
+    }
+    assert!(counts[0] < counts[1] && counts[1] < counts[2], "{counts:?}");
+}
+
+#[test]
+fn tiled_nodata_in_one_band_only_shrinks_the_domain_across_tiles() {
+    let d = Dir::new();
+    write_band(&d, "a.asc", field(0.3));
+    // A hole straddling the shared edges at column 15 and row 15.
+    write_band(&d, "b.asc", |x, y| {
+        if (12..19).contains(&x) && (10..20).contains(&y) {
+            f64::NAN
+        } else {
+            field(1.1)(x, y)
+        }
+    });
+    stack(&d, "multi.tif", &["a.asc", "b.asc"]);
+    mesh_ok(
+        &d,
+        &[
+            "-o",
+            "m.ply",
+            "--bands",
+            "1,2",
+            "--max-error",
+            "1,0.5",
+            "--tile-size",
+            TILE,
+            "--pixel-coords",
+        ],
+    );
+    verify_bands(&d, "m.ply", "1,2", "1,0.5");
+    let file = tinsmith_formats::read_mesh(&d.path("m.ply")).expect("mesh");
+    let inside = |v: &[f64; 3]| (13.0..18.0).contains(&v[0]) && (11.0..19.0).contains(&v[1]);
+    assert!(!file.vertices.iter().any(inside));
+}
+
+#[test]
+fn tiled_bands_refuse_per_tile_and_heights_only_formats() {
+    let d = Dir::new();
+    three_bands(&d);
+    let base = [
+        "mesh",
+        "multi.tif",
+        "--bands",
+        "1,2",
+        "--max-error",
+        "1",
+        "--tile-size",
+        TILE,
+    ];
+    let mut args = base.to_vec();
+    args.extend_from_slice(&["--per-tile", "tiles"]);
+    assert_fails_naming(&d.run(&args), &["multi.tif", "--per-tile"]);
+    assert!(!d.path("tiles").exists());
+    let mut args = base.to_vec();
+    args.extend_from_slice(&["-o", "m.glb"]);
+    assert_fails_naming(&d.run(&args), &["multi.tif", "glTF"]);
+    assert!(!d.path("m.glb").exists());
+}

@@ -313,7 +313,7 @@ fn the_same_bytes_for_any_thread_count() {
 fn bad_band_lists_and_bounds_are_refused_with_nothing_written() {
     let d = Dir::new();
     three_bands(&d);
-    let cases: [(&[&str], &[&str]); 7] = [
+    let cases: [(&[&str], &[&str]); 6] = [
         (
             &["--bands", "1,2,3", "--max-error", "1,2"],
             &["multi.tif", "2 bounds for the 3 bands"],

@@ -3,6 +3,7 @@
 //! mesh crack-free (shared edges decided once for all bands), the same bytes for any
 //! thread count, and the bands' bounds deciding the shared edges' vertices.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use serde_json::Value;
@@ -213,7 +214,75 @@ fn tiled_nodata_in_one_band_only_shrinks_the_domain_across_tiles() {
 }
 
 #[test]
-fn tiled_bands_refuse_per_tile_and_heights_only_formats() {
+fn per_tile_files_share_their_edge_vertices_with_every_band() {
+    let d = Dir::new();
+    three_bands(&d);
+    let flags = [
+        "--bands",
+        "1,2,3",
+        "--max-error",
+        "1,0.5,0.25",
+        "--tile-size",
+        TILE,
+        "--pixel-coords",
+    ];
+    let mut args = vec!["--per-tile", "tiles"];
+    args.extend_from_slice(&flags);
+    mesh_ok(&d, &args);
+    let mut args = vec!["-o", "m.ply"];
+    args.extend_from_slice(&flags);
+    mesh_ok(&d, &args);
+    // Every vertex: its height and bands 2 and 3, the same in every file that has it.
+    let mut seen: HashMap<(i64, i64), [f64; 3]> = HashMap::new();
+    let mut tiles: HashMap<(usize, usize), Vec<(i64, i64)>> = HashMap::new();
+    for row in 0..2 {
+        for col in 0..3 {
+            let path = d.path("tiles").join(format!("tile_r{row}_c{col}.ply"));
+            let m = tinsmith_formats::read_mesh(&path).expect("tile mesh");
+            let names: Vec<&str> = m.attributes.iter().map(|(n, _)| n.as_str()).collect();
+            assert_eq!(names, ["band_2", "band_3"], "{}", path.display());
+            for (i, v) in m.vertices.iter().enumerate() {
+                let key = (v[0] as i64, v[1] as i64);
+                let values = [v[2], m.attributes[0].1[i], m.attributes[1].1[i]];
+                assert_eq!(*seen.entry(key).or_insert(values), values, "{key:?}");
+                tiles.entry((row, col)).or_default().push(key);
+            }
+        }
+    }
+    let on = |tile: (usize, usize), line: &dyn Fn(&(i64, i64)) -> bool| {
+        let mut keys: Vec<(i64, i64)> = tiles[&tile].iter().copied().filter(line).collect();
+        keys.sort_unstable();
+        keys
+    };
+    for row in 0..2 {
+        for (col, x) in [(0, 15), (1, 30)] {
+            let (ymin, ymax) = (15 * row as i64, 15 * row as i64 + 15);
+            let line = |k: &(i64, i64)| k.0 == x && (ymin..=ymax).contains(&k.1);
+            let (left, right) = (on((row, col), &line), on((row, col + 1), &line));
+            assert!(left.len() >= 2);
+            assert_eq!(left, right, "shared edge x = {x}, tile row {row}");
+        }
+    }
+    for col in 0..3 {
+        let line =
+            |k: &(i64, i64)| k.1 == 15 && (15 * col as i64..=15 * col as i64 + 15).contains(&k.0);
+        assert_eq!(
+            on((0, col), &line),
+            on((1, col), &line),
+            "tile column {col}"
+        );
+    }
+    // The welded mesh has exactly the tiles' vertices, with the same values.
+    let welded = tinsmith_formats::read_mesh(&d.path("m.ply")).expect("welded");
+    assert_eq!(welded.vertices.len(), seen.len());
+    for (i, v) in welded.vertices.iter().enumerate() {
+        let values = [v[2], welded.attributes[0].1[i], welded.attributes[1].1[i]];
+        assert_eq!(seen[&(v[0] as i64, v[1] as i64)], values);
+    }
+}
+
+#[test]
+fn tiled_bands_refuse_obj_tiles_and_heights_only_formats() {
     let d = Dir::new();
     three_bands(&d);
     let base = [
@@ -227,8 +296,8 @@ fn tiled_bands_refuse_per_tile_and_heights_only_formats() {
         TILE,
     ];
     let mut args = base.to_vec();
-    args.extend_from_slice(&["--per-tile", "tiles"]);
-    assert_fails_naming(&d.run(&args), &["multi.tif", "--per-tile"]);
+    args.extend_from_slice(&["--per-tile", "tiles", "--tile-format", "obj"]);
+    assert_fails_naming(&d.run(&args), &["multi.tif", "OBJ"]);
     assert!(!d.path("tiles").exists());
     let mut args = base.to_vec();
     args.extend_from_slice(&["-o", "m.glb"]);

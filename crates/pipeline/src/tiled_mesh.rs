@@ -241,7 +241,9 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
                 TileFormat::Ply => MeshFormat::Ply,
                 TileFormat::Obj => MeshFormat::Obj,
             };
-            let mut writer = PerTileWriter::create(dir, format, crs, placement)?;
+            let names = variables.iter().map(|(_, name)| name.clone()).collect();
+            let mut writer =
+                PerTileWriter::create(dir, format, crs, placement)?.with_variable_names(names);
             let report = meshed(
                 mesh_tiles(&source, &options, &mut writer, &mut progress)
                     .naming_file(&job.input)?,

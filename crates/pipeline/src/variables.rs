@@ -228,16 +228,19 @@ pub(crate) fn read(
     Ok((grid, variables.iter().cloned().zip(names).collect(), rgb))
 }
 
-/// Refuses what a tiled run with variables does not do: `--per-tile` (one file per tile
-/// carries heights only), formats without per-vertex values, and float32 formats (their
+/// Refuses what a tiled run with variables does not do: OBJ tiles (`--per-tile
+/// --tile-format obj`), formats without per-vertex values, and float32 formats (their
 /// rounding of each band would need the whole band first).
 pub(crate) fn check_tiled(job: &crate::MeshJob) -> Result<()> {
     let input = job.input.display();
     if job.per_tile.is_some() {
-        bail!(
-            "{input}: --bands writes one welded mesh tile by tile (-o), not --per-tile; \
-             give -o OUT.ply"
-        );
+        if job.tile_format == Some(crate::TileFormat::Obj) {
+            bail!(
+                "{input}: --per-tile with --bands writes PLY tiles (one property per band); \
+                 OBJ carries no variables"
+            );
+        }
+        return Ok(());
     }
     if job.decimation.has_count_target() {
         bail!("{input}: --bands takes error bounds (--max-error), not --max-triangles or --max-vertices");

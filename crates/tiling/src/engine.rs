@@ -508,6 +508,97 @@ impl TileJob {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::{GridSource, MeshCollector};
+    use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
+
+    /// The grid, the welded vertices and triangles, and the variable's vertex values.
+    type Run = (Grid, Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<f64>);
+
+    /// A 37 x 29 grid (tiles of 8: shared edges at multiples of 7) with one variable of
+    /// other detail within `bound`, meshed in tiles on `threads` threads.
+    fn two_variable_run(bound: f64, threads: usize) -> Run {
+        let (w, h) = (37u32, 29u32);
+        let at = |f: &dyn Fn(f64, f64) -> f64| -> Samples {
+            let values = (0..h).flat_map(|y| (0..w).map(move |x| (f64::from(x), f64::from(y))));
+            Samples::new(w, h, values.map(|(x, y)| f(x, y)).collect()).expect("samples")
+        };
+        let height = at(&|x, y| (0.3 * x).sin() * 4.0 + 0.1 * y);
+        let variable = at(&|x, y| {
+            if x == 20.0 || y == 13.0 {
+                3.0
+            } else {
+                (0.5 * y).cos()
+            }
+        });
+        let grid =
+            Grid::with_variables(height, vec![Variable::new(variable, bound).expect("bound")])
+                .expect("grid");
+        let options = TileOptions::new(DecimationOptions::new(0.5))
+            .with_tile_size(8)
+            .with_threads(threads)
+            .with_variable_errors(vec![bound]);
+        let mut collector = MeshCollector::new();
+        let report = mesh_tiles(
+            &GridSource::new(&grid),
+            &options,
+            &mut collector,
+            &mut |_| {},
+        )
+        .expect("tiles");
+        assert!(report.variables_measured_max_error[0] <= bound);
+        let mut variables = collector.take_variables();
+        let (vertices, triangles) = collector.into_parts();
+        (grid, vertices, triangles, variables.remove(0))
+    }
+
+    #[test]
+    fn variables_keep_their_bound_over_welded_tiles() {
+        for bound in [0.05, 0.5, f64::INFINITY] {
+            let (grid, vertices, triangles, values) = two_variable_run(bound, 2);
+            assert_eq!(values.len(), vertices.len());
+            let positions: Vec<[i64; 2]> = vertices
+                .iter()
+                .map(|v| [v[0] as i64, v[1] as i64])
+                .collect();
+            let heights: Vec<f64> = vertices.iter().map(|v| v[2]).collect();
+            let domain = GridRef::new(grid.width(), grid.height(), grid.values());
+            let report = tinsmith_verify::verify(
+                domain,
+                MeshRef::new(&positions, &heights, &triangles),
+                &VerifyOptions::new().with_max_error(0.5),
+            )
+            .expect("verify");
+            assert!(report.passed(), "{:?}", report.problems);
+            let mut options = VerifyOptions::new();
+            if bound.is_finite() {
+                options = options.with_max_error(bound);
+            }
+            let report = tinsmith_verify::verify_variable(
+                domain,
+                grid.variable(0).0,
+                MeshRef::new(&positions, &[], &triangles),
+                &values,
+                &options,
+            )
+            .expect("verify the variable");
+            assert!(report.passed(), "bound {bound}: {:?}", report.problems);
+        }
+        let one = two_variable_run(0.05, 1);
+        let two = two_variable_run(0.05, 2);
+        assert_eq!((one.1, one.2, one.3), (two.1, two.2, two.3));
+    }
+
+    #[test]
+    fn a_tight_variable_keeps_more_shared_edge_vertices() {
+        let on_edges = |bound: f64| {
+            let (_, vertices, _, _) = two_variable_run(bound, 1);
+            let shared = |c: f64| c > 0.0 && c < 36.0 && c % 7.0 == 0.0;
+            (vertices.iter())
+                .filter(|v| shared(v[0]) || (shared(v[1]) && v[1] < 28.0))
+                .count()
+        };
+        assert!(on_edges(0.05) > on_edges(f64::INFINITY));
+    }
 
     #[test]
     fn workers_are_no_more_than_cores_or_jobs() {

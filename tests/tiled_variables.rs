@@ -304,3 +304,48 @@ fn tiled_bands_refuse_obj_tiles_and_heights_only_formats() {
     assert_fails_naming(&d.run(&args), &["multi.tif", "glTF"]);
     assert!(!d.path("m.glb").exists());
 }
+
+#[test]
+fn tiled_attributes_from_another_raster_on_the_same_grid() {
+    let d = Dir::new();
+    write_band(&d, "dem.asc", field(0.3));
+    write_band(&d, "other.asc", field(1.7));
+    let base = [
+        "mesh",
+        "dem.asc",
+        "--max-error",
+        "1",
+        "--attribute-error",
+        "0.5",
+        "--tile-size",
+        TILE,
+        "--report",
+        "r.json",
+        "-q",
+    ];
+    let mut args = base.to_vec();
+    args.extend_from_slice(&["-o", "m.ply", "--attributes", "other.asc"]);
+    let o = d.run(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r = crate::variables::report(&d);
+    assert_eq!(r["tiles"]["count"], 6, "{r}");
+    assert_eq!(r["variables"][0]["name"], "other_band_1", "{r}");
+    let o = d.run(&[
+        "verify",
+        "dem.asc",
+        "m.ply",
+        "--max-error",
+        "1",
+        "--attributes",
+        "other.asc:1",
+        "--attribute-error",
+        "0.5",
+    ]);
+    assert!(o.status.success(), "{} {}", stdout(&o), stderr(&o));
+    // On another grid: refused, naming the file, nothing written.
+    crate::variables::write_band_at(&d, "finer.asc", (1000.0, 2000.0, 5.0), field(1.0));
+    let mut args = base.to_vec();
+    args.extend_from_slice(&["-o", "n.ply", "--attributes", "finer.asc"]);
+    assert_fails_naming(&d.run(&args), &["finer.asc", "gdalwarp"]);
+    assert!(!d.path("n.ply").exists());
+}

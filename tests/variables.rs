@@ -523,7 +523,7 @@ fn geojson_and_flatgeobuf_carry_each_triangles_corner_means_as_gdal_reads_them()
 
 /// Writes band `name` as ESRI ASCII with its lower-left corner at `(x0, y0)` and cells of
 /// `cell`.
-fn write_band_at(
+pub(crate) fn write_band_at(
     d: &Dir,
     name: &str,
     (x0, y0, cell): (f64, f64, f64),

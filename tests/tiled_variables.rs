@@ -193,7 +193,7 @@ fn tiled_nodata_in_one_band_only_shrinks_the_domain_across_tiles() {
         }
     });
     stack(&d, "multi.tif", &["a.asc", "b.asc"]);
-    mesh_ok(
+    let r = mesh_ok(
         &d,
         &[
             "-o",
@@ -207,6 +207,8 @@ fn tiled_nodata_in_one_band_only_shrinks_the_domain_across_tiles() {
             "--pixel-coords",
         ],
     );
+    // The samples valid in both bands, each counted once across tiles.
+    assert_eq!(r["valid_samples"], (W * H - 7 * 10) as u64, "{r}");
     verify_bands(&d, "m.ply", "1,2", "1,0.5");
     let file = tinsmith_formats::read_mesh(&d.path("m.ply")).expect("mesh");
     let inside = |v: &[f64; 3]| (13.0..18.0).contains(&v[0]) && (11.0..19.0).contains(&v[1]);

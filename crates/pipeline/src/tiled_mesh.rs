@@ -324,7 +324,11 @@ fn tiled_report<'a>(
 ) -> TiledMeshReport<'a> {
     let outcome = Outcome {
         size: (info.width, info.height),
-        valid_samples: info.valid_samples,
+        // With variables, the samples valid in every band.
+        valid_samples: match job.variables.is_empty() {
+            true => info.valid_samples,
+            false => r.valid_samples,
+        },
         band_count: info.band_count,
         before: (r.initial_triangles, r.initial_vertices),
         after: (r.final_triangles, r.final_vertices),

@@ -95,6 +95,9 @@ pub struct TilesReport {
     pub plan: TilePlan,
     /// Worker threads used.
     pub threads: usize,
+    /// Valid samples of the raster (with variables, valid in every band), each counted
+    /// once.
+    pub valid_samples: u64,
     /// Vertices of the full mesh of the whole raster (domain samples, each counted once).
     pub initial_vertices: u64,
     /// Triangles of the full mesh (two per valid cell).
@@ -236,6 +239,7 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
     let mut report = TilesReport {
         plan,
         threads,
+        valid_samples: 0,
         initial_vertices: 0,
         initial_triangles: 0,
         final_vertices: 0,
@@ -279,6 +283,7 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
             report.seconds_sink += t.elapsed().as_secs_f64();
             let r = &tile.report;
             report.initial_vertices += done.owned_domain_samples;
+            report.valid_samples += done.owned_valid_samples;
             report.initial_triangles += r.initial_triangles as u64;
             report.final_triangles += r.final_triangles as u64;
             report.max_bound = report.max_bound.max(r.max_bound);
@@ -344,6 +349,7 @@ struct DoneTile {
     /// Each variable's largest error the verifier measured.
     variables_measured_max_error: Vec<f64>,
     owned_domain_samples: u64,
+    owned_valid_samples: u64,
     seconds_read: f64,
     seconds_verify: f64,
 }
@@ -499,6 +505,7 @@ impl TileJob {
             variables,
             variables_measured_max_error,
             owned_domain_samples: input.owned_domain_samples,
+            owned_valid_samples: input.owned_valid_samples,
             seconds_read,
             seconds_verify,
         })

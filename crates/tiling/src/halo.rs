@@ -39,6 +39,8 @@ pub(crate) struct TileInput {
     /// Samples the tile owns (see [`TileInput::cut`]) that are corners of a valid cell of
     /// the raster: summed over tiles, the full mesh's vertex count.
     pub(crate) owned_domain_samples: u64,
+    /// Valid samples the tile owns (valid in every band): summed over tiles, the raster's.
+    pub(crate) owned_valid_samples: u64,
 }
 
 impl TileInput {
@@ -106,9 +108,11 @@ impl TileInput {
             window.y0 + 1
         };
         let mut owned_domain_samples = 0;
+        let mut owned_valid_samples = 0;
         for y in owned_y0..=window.y1() {
             for x in owned_x0..=window.x1() {
                 owned_domain_samples += u64::from(view.is_domain_sample(x, y));
+                owned_valid_samples += u64::from(view.sample(x, y).is_finite());
             }
         }
         let rows = |y: u32| {
@@ -154,6 +158,7 @@ impl TileInput {
             right: columns(window.x1()),
             variables,
             owned_domain_samples,
+            owned_valid_samples,
         }
     }
 }
@@ -295,6 +300,8 @@ mod tests {
             let (_, inputs) = inputs(&g, size);
             let total: u64 = inputs.iter().map(|i| i.owned_domain_samples).sum();
             assert_eq!(total as usize, g.domain_sample_count(), "size {size}");
+            let valid: u64 = inputs.iter().map(|i| i.owned_valid_samples).sum();
+            assert_eq!(valid as usize, g.valid_count(), "size {size}");
         }
     }
 

@@ -193,7 +193,9 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     };
 
     let (report, output, write_seconds) = match (&job.output, welded_format, &job.per_tile) {
-        (Some(output), Some(format), _) if !streams(format) || !variables.is_empty() => {
+        (Some(output), Some(format), _)
+            if !streams(format) || (!variables.is_empty() && format != MeshFormat::Ply) =>
+        {
             let mut collector = MeshCollector::new();
             let report = meshed(
                 mesh_tiles(&source, &options, &mut collector, &mut progress)
@@ -224,7 +226,9 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
             (report, output.as_path(), write)
         }
         (Some(output), Some(format), _) => {
-            let mut writer = WeldedWriter::create(output, format, crs, placement)?;
+            let names = variables.iter().map(|(_, name)| name.clone()).collect();
+            let mut writer =
+                WeldedWriter::create(output, format, crs, placement)?.with_variable_names(names)?;
             let report = meshed(
                 mesh_tiles(&source, &options, &mut writer, &mut progress)
                     .naming_file(&job.input)?,

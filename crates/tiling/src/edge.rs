@@ -466,5 +466,37 @@ mod tests {
             // Deterministic: the same profile gives the same answer.
             prop_assert_eq!(keep, EdgeProfile::new(values, open).simplify(limit, max_span));
         }
+
+        #[test]
+        fn every_variable_is_within_its_limit_along_the_joint_edge(
+            (values, open) in profile(),
+            seeds in prop::collection::vec((1u32..7, -4i32..4), 1..4),
+            height_limit in 0.0f64..6.0,
+            max_span in prop_oneof![Just(usize::MAX), 1usize..8],
+        ) {
+            let n = values.len();
+            // Variables: other integer patterns over the same samples, each with a limit.
+            let variables: Vec<Vec<f64>> = (seeds.iter())
+                .map(|&(p, s)| (0..n).map(|i| f64::from((i as i32 * s).rem_euclid(p as i32 + 1)) * 0.5).collect())
+                .collect();
+            let limits: Vec<f64> = seeds.iter().map(|&(p, _)| f64::from(p) * 0.2 - 0.2).collect();
+            let edge = EdgeProfile::new(values.clone(), open.clone()).with_variables(variables.clone());
+            let keep = edge.simplify_joint(EdgeRule::Limit(height_limit), &limits, max_span);
+            prop_assert!(keep[0] && keep[n - 1]);
+            let kept: Vec<usize> = (0..n).filter(|&i| keep[i]).collect();
+            for pair in kept.windows(2) {
+                let (a, b) = (pair[0], pair[1]);
+                prop_assert!(b - a <= max_span.max(1));
+                let series = std::iter::once((&values, height_limit)).chain(variables.iter().zip(limits.iter().copied()));
+                for (v, limit) in series {
+                    for m in a + 1..b {
+                        let t = (m - a) as f64 / (b - a) as f64;
+                        let line = v[a] + t * (v[b] - v[a]);
+                        prop_assert!(limit > 0.0 || v.as_ptr() == values.as_ptr(), "a zero limit skipped {m}");
+                        prop_assert!((v[m] - line).abs() <= limit, "sample {m}: {} vs line {line}", v[m]);
+                    }
+                }
+            }
+        }
     }
 }

@@ -351,3 +351,33 @@ fn tiled_attributes_from_another_raster_on_the_same_grid() {
     assert_fails_naming(&d.run(&args), &["finer.asc", "gdalwarp"]);
     assert!(!d.path("n.ply").exists());
 }
+
+#[test]
+fn tiled_bands_to_flatgeobuf_carry_each_band_per_triangle() {
+    let d = Dir::new();
+    three_bands(&d);
+    let r = mesh_ok(
+        &d,
+        &[
+            "-o",
+            "m.fgb",
+            "--bands",
+            "1,2,3",
+            "--max-error",
+            "1,0.5,0.25",
+            "--tile-size",
+            TILE,
+        ],
+    );
+    assert_eq!(r["tiles"]["count"], 6, "{r}");
+    let o = std::process::Command::new("ogrinfo")
+        .args(["-so", "-al"])
+        .arg(d.path("m.fgb"))
+        .output()
+        .expect("ogrinfo (GDAL) must be on PATH");
+    let info = String::from_utf8_lossy(&o.stdout);
+    assert!(info.contains("band_2: Real"), "{info}");
+    assert!(info.contains("band_3: Real"), "{info}");
+    let count = format!("Feature Count: {}", r["triangles_after"]);
+    assert!(info.contains(&count), "{info}");
+}

@@ -17,6 +17,7 @@ mod preview;
 mod serve;
 mod shards;
 mod tiled_mesh;
+mod tiled_variables;
 mod tiles;
 mod tin_input;
 mod variables;

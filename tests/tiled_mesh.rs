@@ -33,7 +33,7 @@ fn verify(d: &Dir, input: &str, mesh: &str, e: &str, pixel: bool) -> serde_json:
 /// Every edge of the mesh (written with `--pixel-coords`) is used by at most two
 /// triangles, and an edge used once lies on the outline of the raster's domain: along
 /// cell sides, with no valid cell on the side away from its triangle.
-fn assert_crack_free(input: &str, mesh: &Path) {
+pub(crate) fn assert_crack_free(input: &str, mesh: &Path) {
     let raster = tinsmith_raster::read_samples(Path::new(input), 1).expect("raster");
     let grid = &raster.samples;
     let (w, h) = (grid.width() as i64, grid.height() as i64);

@@ -59,6 +59,8 @@ pub struct MeshStreamWriter {
     triangles: Spool,
     vertex_count: usize,
     triangle_count: usize,
+    /// Names of the per-vertex `double` properties after x, y, z (PLY).
+    attribute_names: Vec<String>,
 }
 
 impl MeshStreamWriter {
@@ -114,7 +116,26 @@ impl MeshStreamWriter {
             triangles: spool()?,
             vertex_count: 0,
             triangle_count: 0,
+            attribute_names: Vec::new(),
         })
+    }
+
+    /// The writer with one `double` vertex property per name after x, y, z, as
+    /// [`crate::write_mesh`] writes [`crate::VertexAttribute`]s (same header and records):
+    /// vertices are then appended with [`Self::write_vertices_with_attributes`]. PLY only.
+    ///
+    /// # Errors
+    /// [`Error::Unsupported`] for OBJ (it carries no per-vertex values).
+    pub fn with_attribute_names(mut self, names: Vec<String>) -> Result<MeshStreamWriter> {
+        if !names.is_empty() && self.format != MeshFormat::Ply {
+            return Err(Error::Unsupported {
+                path: self.path.clone(),
+                format: self.format,
+                feature: "streamed per-vertex values are written as PLY only".into(),
+            });
+        }
+        self.attribute_names = names;
+        Ok(self)
     }
 
     /// The target path.
@@ -139,6 +160,34 @@ impl MeshStreamWriter {
     /// [`Error::TooManyVertices`] (PLY), [`Error::Io`]. After an error the writer should
     /// be dropped.
     pub fn write_vertices(&mut self, vertices: &[[f64; 3]]) -> Result<()> {
+        self.write_vertices_with_attributes(vertices, &[])
+    }
+
+    /// Appends vertices with their values of each attribute named by
+    /// [`Self::with_attribute_names`] (`attributes[k][i]`: attribute `k` of vertex `i`).
+    ///
+    /// # Errors
+    /// As [`Self::write_vertices`]; [`Error::Io`] (`InvalidInput`) when `attributes` does
+    /// not hold one list of one value per vertex for each name.
+    pub fn write_vertices_with_attributes(
+        &mut self,
+        vertices: &[[f64; 3]],
+        attributes: &[&[f64]],
+    ) -> Result<()> {
+        if attributes.len() != self.attribute_names.len()
+            || attributes.iter().any(|a| a.len() != vertices.len())
+        {
+            let problem = format!(
+                "{} attribute lists for {} names and {} vertices",
+                attributes.len(),
+                self.attribute_names.len(),
+                vertices.len()
+            );
+            return Err(self.io_error(
+                "write",
+                io::Error::new(io::ErrorKind::InvalidInput, problem),
+            ));
+        }
         if let Some(i) = vertices
             .iter()
             .position(|v| !v.iter().all(|c| c.is_finite()))
@@ -161,6 +210,19 @@ impl MeshStreamWriter {
         }
         let w = &mut self.vertices.writer;
         let result = match self.format {
+            MeshFormat::Ply if !attributes.is_empty() => {
+                let mut record = vec![0u8; 8 * (3 + attributes.len())];
+                vertices.iter().enumerate().try_for_each(|(i, vertex)| {
+                    let values = vertex
+                        .iter()
+                        .copied()
+                        .chain(attributes.iter().map(|a| a[i]));
+                    for (bytes, value) in record.chunks_exact_mut(8).zip(values) {
+                        bytes.copy_from_slice(&value.to_le_bytes());
+                    }
+                    w.write_all(&record)
+                })
+            }
             MeshFormat::Ply => vertices.iter().try_for_each(|vertex| {
                 let mut record = [0u8; 24];
                 for (bytes, coordinate) in record.chunks_exact_mut(8).zip(vertex) {
@@ -269,9 +331,15 @@ impl MeshStreamWriter {
                 }
                 header.push_str(&format!(
                     "element vertex {}\nproperty double x\nproperty double y\n\
-                     property double z\nelement face {}\nproperty list uchar int \
-                     vertex_indices\nend_header\n",
-                    self.vertex_count, self.triangle_count
+                     property double z\n",
+                    self.vertex_count
+                ));
+                for name in &self.attribute_names {
+                    header.push_str(&format!("property double {name}\n"));
+                }
+                header.push_str(&format!(
+                    "element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+                    self.triangle_count
                 ));
                 header
             }
@@ -324,7 +392,7 @@ mod tests {
 
     /// The formats the stream writer writes; it refuses the others.
     const STREAMED: [MeshFormat; 2] = [MeshFormat::Ply, MeshFormat::Obj];
-    use crate::write_mesh;
+    use crate::{write_mesh, VertexAttribute};
 
     fn entries(dir: &Path) -> Vec<PathBuf> {
         let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
@@ -341,6 +409,50 @@ mod tests {
             .collect();
         let triangles = (0..37).map(|i| [i, i + 1, i + 2]).collect();
         (vertices, triangles)
+    }
+
+    #[test]
+    fn pieces_with_attributes_give_the_bytes_write_mesh_gives() -> Result<()> {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let (vertices, triangles) = sample_mesh();
+        let a: Vec<f64> = (0..40).map(|i| f64::from(i) * 0.5 - 3.0).collect();
+        let b: Vec<f64> = (0..40).map(|i| f64::from(i * i) / 7.0).collect();
+        let attributes = [
+            VertexAttribute {
+                name: "band_2",
+                values: &a,
+            },
+            VertexAttribute {
+                name: "temp",
+                values: &b,
+            },
+        ];
+        let whole = dir.path().join("whole.ply");
+        let pieces = dir.path().join("pieces.ply");
+        write_mesh(
+            &whole,
+            MeshFormat::Ply,
+            MeshRef::new(&vertices, &triangles).with_attributes(&attributes),
+        )?;
+        let mut w = MeshStreamWriter::create(&pieces, MeshFormat::Ply, None)?
+            .with_attribute_names(vec!["band_2".into(), "temp".into()])?;
+        w.write_vertices_with_attributes(&vertices[..3], &[&a[..3], &b[..3]])?;
+        w.write_triangles(&triangles[..1])?;
+        w.write_vertices_with_attributes(&vertices[3..], &[&a[3..], &b[3..]])?;
+        w.write_triangles(&triangles[1..])?;
+        // A list short of the vertices, or none at all, is refused.
+        assert!(w.write_vertices(&vertices[..1]).is_err());
+        assert!(w
+            .write_vertices_with_attributes(&vertices[..2], &[&a[..2], &b[..1]])
+            .is_err());
+        w.finish()?;
+        assert_eq!(
+            std::fs::read(&whole).expect("whole"),
+            std::fs::read(&pieces).expect("pieces")
+        );
+        let obj = MeshStreamWriter::create(&dir.path().join("m.obj"), MeshFormat::Obj, None)?;
+        assert!(obj.with_attribute_names(vec!["band_2".into()]).is_err());
+        Ok(())
     }
 
     #[test]

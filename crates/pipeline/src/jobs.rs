@@ -35,8 +35,9 @@ pub struct MeshJob {
     /// are.
     pub vertical_datum: Option<VerticalDatum>,
     /// Other bands decimated with the height, each within its own bound (see
-    /// [`crate::resolve_bands`]); the domain is where every band is valid. Untiled, exact
-    /// error model, PLY or glTF output only.
+    /// [`crate::resolve_bands`]); the domain is where every band is valid. Exact error
+    /// model, formats that carry per-vertex values (tiled: PLY, GeoJSON, FlatGeobuf; no
+    /// `--per-tile`).
     pub variables: Vec<BandVariable>,
     /// Write (column, row, value) instead of georeferenced coordinates.
     pub pixel_coords: bool,

@@ -78,12 +78,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     }
     let Some(output) = crate::tiled_mesh::untiled_output(job)? else {
         if !job.variables.is_empty() {
-            bail!(
-                "{}: --bands meshes several variables in one piece only: not tile by tile \
-                 (--per-tile, or a raster larger than --tile-size {}); raise --tile-size",
-                job.input.display(),
-                job.tile_size
-            );
+            crate::variables::check_tiled(job)?;
         }
         let Some(png) = &job.preview else {
             return crate::tiled_mesh::run(job, feedback);

@@ -87,6 +87,9 @@ struct TiledMeshReport<'a> {
     /// The format and float32 fields, for `-o`.
     #[serde(flatten)]
     output_format: Option<crate::format_plan::PlanReport>,
+    /// Each variable's bound and measured error (`--bands`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    variables: Vec<crate::VariableReport>,
     seconds: Seconds,
     tiles: Tiles,
 }
@@ -139,6 +142,11 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         crate::scan::scan_raster(&job.input, job.band, job.vertical_datum.as_ref(), feedback)?;
     crate::output_paths::note_gcps_unused(&info, job.pixel_coords, feedback);
     let source = RasterSource::new(&info)?;
+    let (source, variables) = if job.variables.is_empty() {
+        (source, Vec::new())
+    } else {
+        crate::variables::tiled_source(&job.input, (source, &info), &job.variables)?
+    };
     let scan_seconds = t.elapsed().as_secs_f64();
     let plan = TilePlan::new(info.width, info.height, job.tile_size).naming_file(&job.input)?;
     feedback.tiles_start("tiles");
@@ -161,7 +169,8 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         decimation.raises_vertex_heights(info.max_abs_value().unwrap_or(0.0));
     let options = TileOptions::new(decimation)
         .with_tile_size(job.tile_size)
-        .with_threads(job.threads.map_or(0, |n| n as usize));
+        .with_threads(job.threads.map_or(0, |n| n as usize))
+        .with_variable_errors(variables.iter().map(|(v, _)| v.max_error).collect());
     let placement = Placement::new(info.transform(), job.pixel_coords);
     let crs = if job.pixel_coords {
         None
@@ -184,32 +193,42 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     };
 
     let (report, output, write_seconds) = match (&job.output, welded_format, &job.per_tile) {
-        (Some(output), Some(format), _) if !streams(format) => {
+        (Some(output), Some(format), _)
+            if !streams(format) || (!variables.is_empty() && format != MeshFormat::Ply) =>
+        {
             let mut collector = MeshCollector::new();
             let report = meshed(
                 mesh_tiles(&source, &options, &mut collector, &mut progress)
                     .naming_file(&job.input)?,
             )?;
             let t = Instant::now();
+            let at_vertices = collector.take_variables();
             let (vertices, triangles) = collector.into_parts();
             let (vertices, triangles) = placement.file_mesh(
                 vertices.iter().map(|&[x, y, z]| (x as u32, y as u32, z)),
                 triangles,
             );
             let plan = export_plan.expect("planned for -o");
+            let attributes: Vec<tinsmith_formats::VertexAttribute<'_>> = variables
+                .iter()
+                .zip(&at_vertices)
+                .map(|((_, name), values)| tinsmith_formats::VertexAttribute { name, values })
+                .collect();
             crate::format_plan::write(
                 &plan,
                 job,
                 &info,
                 (vertices, &triangles),
-                (&[], None),
+                (&attributes, None),
                 feedback,
             )?;
             let write = report.seconds_sink + t.elapsed().as_secs_f64();
             (report, output.as_path(), write)
         }
         (Some(output), Some(format), _) => {
-            let mut writer = WeldedWriter::create(output, format, crs, placement)?;
+            let names = variables.iter().map(|(_, name)| name.clone()).collect();
+            let mut writer =
+                WeldedWriter::create(output, format, crs, placement)?.with_variable_names(names)?;
             let report = meshed(
                 mesh_tiles(&source, &options, &mut writer, &mut progress)
                     .naming_file(&job.input)?,
@@ -226,7 +245,9 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
                 TileFormat::Ply => MeshFormat::Ply,
                 TileFormat::Obj => MeshFormat::Obj,
             };
-            let mut writer = PerTileWriter::create(dir, format, crs, placement)?;
+            let names = variables.iter().map(|(_, name)| name.clone()).collect();
+            let mut writer =
+                PerTileWriter::create(dir, format, crs, placement)?.with_variable_names(names);
             let report = meshed(
                 mesh_tiles(&source, &options, &mut writer, &mut progress)
                     .naming_file(&job.input)?,
@@ -245,7 +266,7 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         write: write_seconds,
         total: total.elapsed().as_secs_f64(),
     };
-    let json = tiled_report(
+    let mut json = tiled_report(
         job,
         output,
         &info,
@@ -254,10 +275,29 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         vertex_heights_raised,
         wall,
     );
+    json.variables = (variables.iter())
+        .zip(&report.variables_measured_max_error)
+        .map(|((v, name), &measured)| crate::VariableReport {
+            band: v.band,
+            name: name.clone(),
+            max_error: v.max_error,
+            measured_max_error: measured,
+        })
+        .collect();
     json.summary.print(
         &format!(" in {} tiles of {}", json.tiles.count, json.tiles.size),
         feedback,
     );
+    for v in &json.variables {
+        feedback.note(&format!(
+            "{}: band {} ({}) measured max error {} <= {}",
+            output.display(),
+            v.band,
+            v.name,
+            tinsmith_georef::readable(v.measured_max_error),
+            tinsmith_georef::readable(v.max_error)
+        ));
+    }
     if let (Some(plan), Some(output)) = (export_plan, &job.output) {
         plan.note_origin(output, feedback);
     }
@@ -288,7 +328,11 @@ fn tiled_report<'a>(
 ) -> TiledMeshReport<'a> {
     let outcome = Outcome {
         size: (info.width, info.height),
-        valid_samples: info.valid_samples,
+        // With variables, the samples valid in every band.
+        valid_samples: match job.variables.is_empty() {
+            true => info.valid_samples,
+            false => r.valid_samples,
+        },
         band_count: info.band_count,
         before: (r.initial_triangles, r.initial_vertices),
         after: (r.final_triangles, r.final_vertices),
@@ -299,6 +343,7 @@ fn tiled_report<'a>(
     TiledMeshReport {
         summary: MeshSummary::new(job, output, outcome),
         output_format: export_plan.map(|p| p.report()),
+        variables: Vec::new(),
         seconds: Seconds {
             read: wall.scan + r.seconds_read,
             initial_mesh: 0.0,

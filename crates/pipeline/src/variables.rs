@@ -228,6 +228,75 @@ pub(crate) fn read(
     Ok((grid, variables.iter().cloned().zip(names).collect(), rgb))
 }
 
+/// Refuses what a tiled run with variables does not do: OBJ tiles (`--per-tile
+/// --tile-format obj`), formats without per-vertex values, and float32 formats (their
+/// rounding of each band would need the whole band first).
+pub(crate) fn check_tiled(job: &crate::MeshJob) -> Result<()> {
+    let input = job.input.display();
+    if job.per_tile.is_some() {
+        if job.tile_format == Some(crate::TileFormat::Obj) {
+            bail!(
+                "{input}: --per-tile with --bands writes PLY tiles (one property per band); \
+                 OBJ carries no variables"
+            );
+        }
+        return Ok(());
+    }
+    if job.decimation.has_count_target() {
+        bail!("{input}: --bands takes error bounds (--max-error), not --max-triangles or --max-vertices");
+    }
+    let format = crate::format_plan::format(job)?;
+    if !format.carries_attributes() || format.is_float32() {
+        bail!(
+            "{input}: a raster larger than --tile-size {} is meshed tile by tile, and then \
+             --bands writes PLY (.ply), GeoJSON or FlatGeobuf (.geojson, .fgb); {format} is \
+             not among them (or raise --tile-size to mesh it in one piece)",
+            job.tile_size
+        );
+    }
+    Ok(())
+}
+
+/// The tiled engine's source for `height` with every variable's band (each scanned once
+/// for its statistics, windows read per tile), and each variable's band, bound and name.
+pub(crate) fn tiled_source(
+    input: &Path,
+    height: (tinsmith_tiling::RasterSource, &RasterInfo),
+    variables: &[BandVariable],
+) -> Result<(tinsmith_tiling::RasterSource, Vec<Named>)> {
+    let (mut source, info) = height;
+    let mut names: Vec<String> = Vec::new();
+    for v in variables {
+        let file = v.file.as_deref().unwrap_or(input);
+        let band = tinsmith_raster::open_info(file, v.band)?;
+        if v.file.is_some() {
+            check_same_grid(file, &band, input, info)?;
+        } else if (band.width, band.height) != (info.width, info.height) {
+            bail!(
+                "{}: band {} is not the height band's size",
+                input.display(),
+                v.band
+            );
+        }
+        let fallback = match &v.file {
+            None => format!("band_{}", v.band),
+            Some(file) => format!(
+                "{}_band_{}",
+                file.file_stem()
+                    .map_or("attribute".into(), |s| s.to_string_lossy()),
+                v.band
+            ),
+        };
+        names.push(property_name(
+            band.description.as_deref(),
+            &fallback,
+            &names,
+        ));
+        source = source.with_variable(&band).naming_file(file)?;
+    }
+    Ok((source, variables.iter().cloned().zip(names).collect()))
+}
+
 /// The name a file gives a band's values: its description made a PLY property name
 /// (whitespace and anything but ASCII letters, digits, `_` and `-` as `_`), or `band_N`
 /// when it has none, it would read as a position (`x`, `y`, `z`), or another band took it.

@@ -10,6 +10,7 @@ use crate::sink::{FinishedTile, SinkError, TileSink};
 pub struct MeshCollector {
     vertices: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
+    variables: Vec<Vec<f64>>,
 }
 
 impl MeshCollector {
@@ -22,6 +23,12 @@ impl MeshCollector {
     pub fn into_parts(self) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
         (self.vertices, self.triangles)
     }
+
+    /// Takes each variable's values at the welded mesh's vertices, in vertex order (one
+    /// list per variable; empty without variables), leaving none.
+    pub fn take_variables(&mut self) -> Vec<Vec<f64>> {
+        std::mem::take(&mut self.variables)
+    }
 }
 
 impl TileSink for MeshCollector {
@@ -32,6 +39,12 @@ impl TileSink for MeshCollector {
                 .map(|v| [f64::from(v.x), f64::from(v.y), v.z]),
         );
         self.triangles.extend(tile.welded_triangles());
+        if self.variables.len() < tile.variables().len() {
+            self.variables.resize(tile.variables().len(), Vec::new());
+        }
+        for (k, values) in self.variables.iter_mut().enumerate() {
+            values.extend(tile.new_variable_values(k));
+        }
         Ok(())
     }
 }

@@ -14,8 +14,12 @@ const EDGE_MARGIN: f64 = 1.0 / (1u64 << 40) as f64;
 ///
 /// `max_abs_value` must be the one every tile's
 /// [`tinsmith_core::DecimationOptions::max_abs_value`] is set to (the raster's largest
-/// |value|).
+/// |value|). An infinite `max_error` (a variable carried, never constraining) gives an
+/// infinite limit.
 pub fn edge_limit(max_error: f64, max_abs_value: f64) -> f64 {
+    if max_error == f64::INFINITY {
+        return f64::INFINITY;
+    }
     let limit =
         effective_limit(max_error, max_abs_value) - EDGE_MARGIN * (max_error + max_abs_value);
     if limit > 0.0 {
@@ -49,10 +53,16 @@ pub fn edge_span(max_edge_length: Option<u32>) -> usize {
 /// The two tiles that share the edge build the same profile from the same samples (each
 /// reads a one-sample halo around its window to see the other side's cells), so
 /// [`EdgeProfile::simplify`] gives them the same kept samples without any exchange.
+///
+/// A profile may carry the same samples of further variables
+/// ([`EdgeProfile::with_variables`]): [`EdgeProfile::simplify_joint`] then skips a sample
+/// only when every variable allows it, so the edge's kept samples are decided once for all
+/// of them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EdgeProfile {
     values: Vec<f64>,
     open: Vec<bool>,
+    variables: Vec<Vec<f64>>,
 }
 
 impl EdgeProfile {
@@ -72,7 +82,31 @@ impl EdgeProfile {
         for (k, o) in open.iter_mut().enumerate() {
             *o = *o && values[k].is_finite() && values[k + 1].is_finite();
         }
-        EdgeProfile { values, open }
+        EdgeProfile {
+            values,
+            open,
+            variables: Vec::new(),
+        }
+    }
+
+    /// The profile with `variables`' samples along the same edge (each as many as the
+    /// heights). Steps are open or not as the heights say: the caller makes a height
+    /// nodata wherever a variable is.
+    ///
+    /// # Panics
+    /// When a variable has another number of samples than the heights.
+    pub fn with_variables(mut self, variables: Vec<Vec<f64>>) -> EdgeProfile {
+        assert!(
+            variables.iter().all(|v| v.len() == self.values.len()),
+            "an edge's variables have as many samples as its heights"
+        );
+        self.variables = variables;
+        self
+    }
+
+    /// The variables' samples, in the order given to [`EdgeProfile::with_variables`].
+    pub fn variables(&self) -> &[Vec<f64>] {
+        &self.variables
     }
 
     /// The samples, in increasing raster coordinate.
@@ -119,6 +153,52 @@ impl EdgeProfile {
         self.simplify_with(max_span, collinear_reach)
     }
 
+    /// Which samples the edge keeps when the heights follow `height` and every variable
+    /// `k` (see [`EdgeProfile::with_variables`]) must stay within `variable_limits[k]`
+    /// (its [`edge_limit`]; 0 keeps every sample as far as that variable is concerned):
+    /// from each kept sample the next is the farthest that every variable and the height
+    /// reach, so a sample is skipped only when dropping it keeps all of them within their
+    /// limits along the edge. Without variables, the same as [`EdgeProfile::simplify`],
+    /// [`EdgeProfile::simplify_collinear`] or keeping every sample.
+    ///
+    /// # Guarantee
+    /// As [`EdgeProfile::simplify`], for the heights at `height`'s rule and for each
+    /// variable at its limit.
+    ///
+    /// # Panics
+    /// When `variable_limits` does not have one limit per variable.
+    pub fn simplify_joint(
+        &self,
+        height: EdgeRule,
+        variable_limits: &[f64],
+        max_span: usize,
+    ) -> Vec<bool> {
+        assert_eq!(
+            variable_limits.len(),
+            self.variables.len(),
+            "one limit per variable"
+        );
+        self.simplify_with(max_span, |v, a, end| {
+            let mut b = match height {
+                EdgeRule::Limit(limit) => chord_reach(v, a, end, limit),
+                EdgeRule::Collinear => collinear_reach(v, a, end),
+                EdgeRule::KeepAll => a + 1,
+            };
+            // Each reach is a prefix of `a + 1..=end`: the joint one is the shortest.
+            for (values, &limit) in self.variables.iter().zip(variable_limits) {
+                if b == a + 1 {
+                    break;
+                }
+                b = if limit > 0.0 {
+                    chord_reach(values, a, b, limit)
+                } else {
+                    a + 1
+                };
+            }
+            b
+        })
+    }
+
     /// The kept samples, given `reach(values, a, end)`: the sample in `a + 1..=end` that
     /// the kept sample `a` is joined to, all samples between them skipped.
     fn simplify_with(
@@ -152,6 +232,17 @@ impl EdgeProfile {
         }
         keep
     }
+}
+
+/// How [`EdgeProfile::simplify_joint`] treats the heights.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EdgeRule {
+    /// Within this 1-D limit, as [`EdgeProfile::simplify`].
+    Limit(f64),
+    /// Only exactly collinear samples skipped, as [`EdgeProfile::simplify_collinear`].
+    Collinear,
+    /// Every sample kept.
+    KeepAll,
 }
 
 /// The farthest `b` in `a + 1..=end` such that for every `c` in `a + 2..=b` the straight
@@ -301,6 +392,31 @@ mod tests {
     }
 
     #[test]
+    fn every_variable_decides_the_kept_samples() {
+        let flat = vec![0.0; 7];
+        let bump = vec![0.0, 0.0, 0.0, 5.0, 0.0, 0.0, 0.0];
+        let edge = EdgeProfile::new(flat.clone(), vec![true; 6]);
+        let alone = edge.simplify(1.0, usize::MAX);
+        assert_eq!(
+            edge.simplify_joint(EdgeRule::Limit(1.0), &[], usize::MAX),
+            alone
+        );
+        let kept = |limits: &[f64]| -> Vec<usize> {
+            let edge = EdgeProfile::new(flat.clone(), vec![true; 6])
+                .with_variables(vec![flat.clone(), bump.clone()]);
+            let keep = edge.simplify_joint(EdgeRule::Limit(1.0), limits, usize::MAX);
+            (0..7).filter(|&i| keep[i]).collect()
+        };
+        // The bump in the second variable is kept at its tight bound only.
+        assert_eq!(kept(&[1.0, 1.0]), vec![0, 2, 3, 4, 6]);
+        assert_eq!(kept(&[1.0, 5.0]), vec![0, 6]);
+        assert_eq!(kept(&[1.0, f64::INFINITY]), vec![0, 6]);
+        // A limit of 0 keeps every sample.
+        assert_eq!(kept(&[0.0, 5.0]), (0..7).collect::<Vec<_>>());
+        assert_eq!(edge_limit(f64::INFINITY, 10.0), f64::INFINITY);
+    }
+
+    #[test]
     #[should_panic(expected = "an edge of 1 samples")]
     fn a_single_sample_is_not_an_edge() {
         EdgeProfile::new(vec![1.0], vec![]);
@@ -349,6 +465,38 @@ mod tests {
             }
             // Deterministic: the same profile gives the same answer.
             prop_assert_eq!(keep, EdgeProfile::new(values, open).simplify(limit, max_span));
+        }
+
+        #[test]
+        fn every_variable_is_within_its_limit_along_the_joint_edge(
+            (values, open) in profile(),
+            seeds in prop::collection::vec((1u32..7, -4i32..4), 1..4),
+            height_limit in 0.0f64..6.0,
+            max_span in prop_oneof![Just(usize::MAX), 1usize..8],
+        ) {
+            let n = values.len();
+            // Variables: other integer patterns over the same samples, each with a limit.
+            let variables: Vec<Vec<f64>> = (seeds.iter())
+                .map(|&(p, s)| (0..n).map(|i| f64::from((i as i32 * s).rem_euclid(p as i32 + 1)) * 0.5).collect())
+                .collect();
+            let limits: Vec<f64> = seeds.iter().map(|&(p, _)| f64::from(p) * 0.2 - 0.2).collect();
+            let edge = EdgeProfile::new(values.clone(), open.clone()).with_variables(variables.clone());
+            let keep = edge.simplify_joint(EdgeRule::Limit(height_limit), &limits, max_span);
+            prop_assert!(keep[0] && keep[n - 1]);
+            let kept: Vec<usize> = (0..n).filter(|&i| keep[i]).collect();
+            for pair in kept.windows(2) {
+                let (a, b) = (pair[0], pair[1]);
+                prop_assert!(b - a <= max_span.max(1));
+                let series = std::iter::once((&values, height_limit)).chain(variables.iter().zip(limits.iter().copied()));
+                for (v, limit) in series {
+                    for m in a + 1..b {
+                        let t = (m - a) as f64 / (b - a) as f64;
+                        let line = v[a] + t * (v[b] - v[a]);
+                        prop_assert!(limit > 0.0 || v.as_ptr() == values.as_ptr(), "a zero limit skipped {m}");
+                        prop_assert!((v[m] - line).abs() <= limit, "sample {m}: {} vs line {line}", v[m]);
+                    }
+                }
+            }
         }
     }
 }

@@ -3,13 +3,14 @@
 
 use std::time::Instant;
 
-use crate::tin_check::check_tin;
+use crate::tin_check::{check_tin, check_variable};
 use tinsmith_core::{
     decimate_with_border, effective_limit, DecimationOptions, DecimationReport, ErrorModel, Grid,
-    TinVertex, MAX_ABS_HEIGHT,
+    TinVertex, Variable, MAX_ABS_HEIGHT,
 };
+use tinsmith_georef::Samples;
 
-use crate::edge::{edge_limit, edge_span, EdgeProfile};
+use crate::edge::{edge_limit, edge_span, EdgeProfile, EdgeRule};
 use crate::error::{Error, Result};
 use crate::halo::{halo_window, TileInput};
 use crate::ordered_pool::run_ordered;
@@ -42,6 +43,10 @@ pub struct TileOptions {
     /// Worker threads; 0 means one per core. No more than there are cores or tiles are
     /// started (see [`worker_count`]).
     pub threads: usize,
+    /// The bound of each of the source's variables ([`TileSource::variable_count`]), in
+    /// order (`f64::INFINITY`: carried, never constraining); empty for a source without
+    /// variables. Each tile is decimated with them (`Grid::with_variables`, paper §6).
+    pub variable_errors: Vec<f64>,
 }
 
 impl TileOptions {
@@ -51,7 +56,14 @@ impl TileOptions {
             decimation,
             tile_size: DEFAULT_TILE_SIZE,
             threads: 0,
+            variable_errors: Vec::new(),
         }
+    }
+
+    /// Sets the bounds of the source's variables, one per variable.
+    pub fn with_variable_errors(mut self, variable_errors: Vec<f64>) -> TileOptions {
+        self.variable_errors = variable_errors;
+        self
     }
 
     /// Sets the tile size.
@@ -83,6 +95,9 @@ pub struct TilesReport {
     pub plan: TilePlan,
     /// Worker threads used.
     pub threads: usize,
+    /// Valid samples of the raster (with variables, valid in every band), each counted
+    /// once.
+    pub valid_samples: u64,
     /// Vertices of the full mesh of the whole raster (domain samples, each counted once).
     pub initial_vertices: u64,
     /// Triangles of the full mesh (two per valid cell).
@@ -95,6 +110,8 @@ pub struct TilesReport {
     pub max_bound: f64,
     /// Largest |sample - TIN| the verifier measured, over all tiles.
     pub measured_max_error: f64,
+    /// For each variable, the largest |sample - TIN| the verifier measured, over all tiles.
+    pub variables_measured_max_error: Vec<f64>,
     /// Seconds spent reading tiles, summed over tiles (thread-seconds).
     pub seconds_read: f64,
     /// Seconds spent decimating tiles (initial mesh included), summed over tiles.
@@ -126,6 +143,11 @@ pub struct TilesReport {
 /// - **Bound.** Every tile passed the verifier at `options.decimation.max_error` before
 ///   reaching the sink, and every cell of the raster lies in exactly one tile: every domain
 ///   sample of the raster is within the bound of the welded TIN.
+/// - **Variables.** With variables, the domain is where every band is valid; each shared
+///   edge skips a sample only when the height and every variable stay within their own
+///   limits along the edge (one decision for all of them, [`EdgeProfile::simplify_joint`]),
+///   each tile is decimated with its windows of every variable, and every variable of
+///   every tile passed the verifier at its own bound.
 /// - **Crack-free.** Tiles have identical vertices along shared edges, so the welded mesh
 ///   is conforming: every edge is used by one or two triangles, and by one only on the
 ///   outline of the raster's domain.
@@ -159,6 +181,18 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
              work with tiles",
         ));
     }
+    if options.variable_errors.len() != source.variable_count() {
+        return Err(Error::Options(
+            "give one bound per variable of the source (TileOptions::variable_errors)",
+        ));
+    }
+    if options
+        .variable_errors
+        .iter()
+        .any(|e| e.is_nan() || *e < 0.0)
+    {
+        return Err(Error::Options("variable bounds must be >= 0"));
+    }
     let plan = TilePlan::new(source.width(), source.height(), options.tile_size)?;
     // More workers than cores or tiles would only start threads that wait.
     let workers = worker_count(options.threads, plan.len());
@@ -184,6 +218,10 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
             ..d.clone()
         },
         edge_limit: edge_limit(d.max_error, max_abs_value),
+        variable_errors: options.variable_errors.clone(),
+        variable_limits: (options.variable_errors.iter().enumerate())
+            .map(|(k, &e)| edge_limit(e, source.variable_max_abs_value(k)))
+            .collect(),
         edge_span: edge_span(d.max_edge_length),
         // At a bound of 0 every tile's core decides planarity exactly when the raster's
         // heights are integers and a tile (halo included) is small enough for that; the
@@ -201,12 +239,14 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
     let mut report = TilesReport {
         plan,
         threads,
+        valid_samples: 0,
         initial_vertices: 0,
         initial_triangles: 0,
         final_vertices: 0,
         final_triangles: 0,
         max_bound: 0.0,
         measured_max_error: 0.0,
+        variables_measured_max_error: vec![0.0; options.variable_errors.len()],
         seconds_read: 0.0,
         seconds_decimation: 0.0,
         seconds_verify: 0.0,
@@ -231,6 +271,7 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
                 triangles: done.triangles,
                 ids,
                 first_new_id,
+                variables: done.variables,
                 report: done.report,
                 measured_max_error: done.measured_max_error,
             };
@@ -242,10 +283,16 @@ pub fn mesh_tiles<S: TileSource, K: TileSink>(
             report.seconds_sink += t.elapsed().as_secs_f64();
             let r = &tile.report;
             report.initial_vertices += done.owned_domain_samples;
+            report.valid_samples += done.owned_valid_samples;
             report.initial_triangles += r.initial_triangles as u64;
             report.final_triangles += r.final_triangles as u64;
             report.max_bound = report.max_bound.max(r.max_bound);
             report.measured_max_error = report.measured_max_error.max(tile.measured_max_error);
+            for (m, e) in (report.variables_measured_max_error.iter_mut())
+                .zip(&done.variables_measured_max_error)
+            {
+                *m = m.max(*e);
+            }
             report.seconds_read += done.seconds_read;
             report.seconds_decimation += r.seconds_initial_mesh + r.seconds_decimation;
             report.seconds_verify += done.seconds_verify;
@@ -278,6 +325,10 @@ struct TileJob {
     plan: TilePlan,
     options: DecimationOptions,
     edge_limit: f64,
+    /// The bound of each variable.
+    variable_errors: Vec<f64>,
+    /// The 1-D limit of each variable along shared edges (see [`edge_limit`]).
+    variable_limits: Vec<f64>,
     /// Longest skip along a shared edge (see [`edge_span`]).
     edge_span: usize,
     /// At `edge_limit` 0: skip exactly collinear edge samples (integer heights).
@@ -293,7 +344,12 @@ struct DoneTile {
     triangles: Vec<[u32; 3]>,
     report: DecimationReport,
     measured_max_error: f64,
+    /// Each variable's values at the vertices (one list per variable).
+    variables: Vec<Vec<f64>>,
+    /// Each variable's largest error the verifier measured.
+    variables_measured_max_error: Vec<f64>,
     owned_domain_samples: u64,
+    owned_valid_samples: u64,
     seconds_read: f64,
     seconds_verify: f64,
 }
@@ -320,12 +376,25 @@ impl TileJob {
             let grid = reader
                 .read_window(halo.x0, halo.y0, halo.width, halo.height)
                 .map_err(read_error)?;
-            TileInput::cut(&self.plan, index, &grid, halo)
+            let variables = (0..self.variable_errors.len())
+                .map(|k| reader.read_variable_window(k, halo.x0, halo.y0, halo.width, halo.height))
+                .collect::<std::result::Result<Vec<Samples>, _>>()
+                .map_err(read_error)?;
+            TileInput::cut(&self.plan, index, &grid, &variables, halo)
         };
         let seconds_read = t.elapsed().as_secs_f64();
 
         let keep = |edge: &EdgeProfile| {
-            if self.edge_limit > 0.0 {
+            if !self.variable_limits.is_empty() {
+                let rule = if self.edge_limit > 0.0 {
+                    EdgeRule::Limit(self.edge_limit)
+                } else if self.exact_zero_edges {
+                    EdgeRule::Collinear
+                } else {
+                    EdgeRule::KeepAll
+                };
+                edge.simplify_joint(rule, &self.variable_limits, self.edge_span)
+            } else if self.edge_limit > 0.0 {
                 edge.simplify(self.edge_limit, self.edge_span)
             } else if self.exact_zero_edges {
                 edge.simplify_collinear(self.edge_span)
@@ -351,29 +420,69 @@ impl TileJob {
                 true
             }
         };
-        let decimation =
-            decimate_with_border(&input.grid, &self.options, &keep_border, &mut |_| {}).map_err(
-                |source| Error::Decimate {
+        let joined;
+        let grid = if input.variables.is_empty() {
+            &input.grid
+        } else {
+            let height =
+                Samples::new(w, h, input.grid.values().to_vec()).expect("the tile's own samples");
+            let variables = (input.variables.iter().zip(&self.variable_errors))
+                .map(|(samples, &e)| Variable::new(samples.clone(), e))
+                .collect::<tinsmith_core::Result<Vec<Variable>>>()
+                .and_then(|variables| Grid::with_variables(height, variables))
+                .map_err(|source| Error::Decimate {
                     tile: index,
                     source,
-                },
-            )?;
+                })?;
+            joined = variables;
+            &joined
+        };
+        let decimation = decimate_with_border(grid, &self.options, &keep_border, &mut |_| {})
+            .map_err(|source| Error::Decimate {
+                tile: index,
+                source,
+            })?;
 
         // The promise is checked, independently, before the tile goes anywhere.
         let t = Instant::now();
         let tin = &decimation.tin;
-        let check =
-            check_tin(&input.grid, tin, |_, v| v.z, self.options.max_error).map_err(|source| {
-                Error::Verify {
-                    tile: index,
-                    source,
-                }
-            })?;
+        let check = check_tin(grid, tin, |_, v| v.z, self.options.max_error).map_err(|source| {
+            Error::Verify {
+                tile: index,
+                source,
+            }
+        })?;
         if !check.passed() {
             return Err(Error::VerifyFailed {
                 tile: index,
                 problems: check.problems.join("; "),
             });
+        }
+        let mut variables = Vec::with_capacity(input.variables.len());
+        let mut variables_measured_max_error = Vec::with_capacity(input.variables.len());
+        for (k, samples) in input.variables.iter().enumerate() {
+            let values: Vec<f64> = (tin.vertices().iter())
+                .map(|v| samples.values()[(v.y * w + v.x) as usize])
+                .collect();
+            let check = check_variable(
+                grid,
+                samples.values(),
+                tin,
+                &values,
+                self.variable_errors[k],
+            )
+            .map_err(|source| Error::Verify {
+                tile: index,
+                source,
+            })?;
+            if !check.passed() {
+                return Err(Error::VerifyFailed {
+                    tile: index,
+                    problems: format!("variable {}: {}", k + 1, check.problems.join("; ")),
+                });
+            }
+            variables.push(values);
+            variables_measured_max_error.push(check.max_error);
         }
         let seconds_verify = t.elapsed().as_secs_f64();
 
@@ -393,7 +502,10 @@ impl TileJob {
             triangles: tin.triangles().to_vec(),
             report: decimation.report,
             measured_max_error: check.max_error,
+            variables,
+            variables_measured_max_error,
             owned_domain_samples: input.owned_domain_samples,
+            owned_valid_samples: input.owned_valid_samples,
             seconds_read,
             seconds_verify,
         })
@@ -403,6 +515,97 @@ impl TileJob {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::{GridSource, MeshCollector};
+    use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
+
+    /// The grid, the welded vertices and triangles, and the variable's vertex values.
+    type Run = (Grid, Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<f64>);
+
+    /// A 37 x 29 grid (tiles of 8: shared edges at multiples of 7) with one variable of
+    /// other detail within `bound`, meshed in tiles on `threads` threads.
+    fn two_variable_run(bound: f64, threads: usize) -> Run {
+        let (w, h) = (37u32, 29u32);
+        let at = |f: &dyn Fn(f64, f64) -> f64| -> Samples {
+            let values = (0..h).flat_map(|y| (0..w).map(move |x| (f64::from(x), f64::from(y))));
+            Samples::new(w, h, values.map(|(x, y)| f(x, y)).collect()).expect("samples")
+        };
+        let height = at(&|x, y| (0.3 * x).sin() * 4.0 + 0.1 * y);
+        let variable = at(&|x, y| {
+            if x == 20.0 || y == 13.0 {
+                3.0
+            } else {
+                (0.5 * y).cos()
+            }
+        });
+        let grid =
+            Grid::with_variables(height, vec![Variable::new(variable, bound).expect("bound")])
+                .expect("grid");
+        let options = TileOptions::new(DecimationOptions::new(0.5))
+            .with_tile_size(8)
+            .with_threads(threads)
+            .with_variable_errors(vec![bound]);
+        let mut collector = MeshCollector::new();
+        let report = mesh_tiles(
+            &GridSource::new(&grid),
+            &options,
+            &mut collector,
+            &mut |_| {},
+        )
+        .expect("tiles");
+        assert!(report.variables_measured_max_error[0] <= bound);
+        let mut variables = collector.take_variables();
+        let (vertices, triangles) = collector.into_parts();
+        (grid, vertices, triangles, variables.remove(0))
+    }
+
+    #[test]
+    fn variables_keep_their_bound_over_welded_tiles() {
+        for bound in [0.05, 0.5, f64::INFINITY] {
+            let (grid, vertices, triangles, values) = two_variable_run(bound, 2);
+            assert_eq!(values.len(), vertices.len());
+            let positions: Vec<[i64; 2]> = vertices
+                .iter()
+                .map(|v| [v[0] as i64, v[1] as i64])
+                .collect();
+            let heights: Vec<f64> = vertices.iter().map(|v| v[2]).collect();
+            let domain = GridRef::new(grid.width(), grid.height(), grid.values());
+            let report = tinsmith_verify::verify(
+                domain,
+                MeshRef::new(&positions, &heights, &triangles),
+                &VerifyOptions::new().with_max_error(0.5),
+            )
+            .expect("verify");
+            assert!(report.passed(), "{:?}", report.problems);
+            let mut options = VerifyOptions::new();
+            if bound.is_finite() {
+                options = options.with_max_error(bound);
+            }
+            let report = tinsmith_verify::verify_variable(
+                domain,
+                grid.variable(0).0,
+                MeshRef::new(&positions, &[], &triangles),
+                &values,
+                &options,
+            )
+            .expect("verify the variable");
+            assert!(report.passed(), "bound {bound}: {:?}", report.problems);
+        }
+        let one = two_variable_run(0.05, 1);
+        let two = two_variable_run(0.05, 2);
+        assert_eq!((one.1, one.2, one.3), (two.1, two.2, two.3));
+    }
+
+    #[test]
+    fn a_tight_variable_keeps_more_shared_edge_vertices() {
+        let on_edges = |bound: f64| {
+            let (_, vertices, _, _) = two_variable_run(bound, 1);
+            let shared = |c: f64| c > 0.0 && c < 36.0 && c % 7.0 == 0.0;
+            (vertices.iter())
+                .filter(|v| shared(v[0]) || (shared(v[1]) && v[1] < 28.0))
+                .count()
+        };
+        assert!(on_edges(0.05) > on_edges(f64::INFINITY));
+    }
 
     #[test]
     fn workers_are_no_more_than_cores_or_jobs() {

@@ -33,9 +33,14 @@ pub(crate) struct TileInput {
     pub(crate) bottom: EdgeProfile,
     pub(crate) left: EdgeProfile,
     pub(crate) right: EdgeProfile,
+    /// Each variable's samples of the tile's window (NaN = nodata), empty without
+    /// variables; the edge profiles carry theirs too.
+    pub(crate) variables: Vec<Samples>,
     /// Samples the tile owns (see [`TileInput::cut`]) that are corners of a valid cell of
     /// the raster: summed over tiles, the full mesh's vertex count.
     pub(crate) owned_domain_samples: u64,
+    /// Valid samples the tile owns (valid in every band): summed over tiles, the raster's.
+    pub(crate) owned_valid_samples: u64,
 }
 
 impl TileInput {
@@ -43,13 +48,43 @@ impl TileInput {
     ///
     /// A tile *owns* its samples except those on its top row (below tile row 0) and left
     /// column (right of tile column 0), which belong to earlier tiles.
+    ///
+    /// `variables` are the same halo of each variable: the height is then nodata wherever
+    /// a variable is (the domain is where every band is valid), and the tile's windows and
+    /// edge profiles carry the variables' samples.
     pub(crate) fn cut(
         plan: &TilePlan,
         index: TileIndex,
         halo: &Samples,
+        variables: &[Samples],
         halo_window: TileWindow,
     ) -> TileInput {
         let window = plan.window(index);
+        let masked;
+        let halo = if variables.is_empty() {
+            halo
+        } else {
+            let mut values = halo.values().to_vec();
+            for v in variables {
+                for (h, x) in values.iter_mut().zip(v.values()) {
+                    if !x.is_finite() {
+                        *h = f64::NAN;
+                    }
+                }
+            }
+            masked = Samples::new(halo.width(), halo.height(), values)
+                .expect("the same size as the halo read");
+            &masked
+        };
+        let views: Vec<HaloView<'_>> = variables
+            .iter()
+            .map(|grid| HaloView {
+                grid,
+                window: halo_window,
+                raster_width: plan.width(),
+                raster_height: plan.height(),
+            })
+            .collect();
         let view = HaloView {
             grid: halo,
             window: halo_window,
@@ -73,18 +108,57 @@ impl TileInput {
             window.y0 + 1
         };
         let mut owned_domain_samples = 0;
+        let mut owned_valid_samples = 0;
         for y in owned_y0..=window.y1() {
             for x in owned_x0..=window.x1() {
                 owned_domain_samples += u64::from(view.is_domain_sample(x, y));
+                owned_valid_samples += u64::from(view.sample(x, y).is_finite());
             }
         }
+        let rows = |y: u32| {
+            let profile = view.row_profile(y, window.x0, window.x1());
+            if views.is_empty() {
+                return profile;
+            }
+            profile.with_variables(
+                views
+                    .iter()
+                    .map(|v| (window.x0..=window.x1()).map(|x| v.sample(x, y)).collect())
+                    .collect(),
+            )
+        };
+        let columns = |x: u32| {
+            let profile = view.column_profile(x, window.y0, window.y1());
+            if views.is_empty() {
+                return profile;
+            }
+            profile.with_variables(
+                views
+                    .iter()
+                    .map(|v| (window.y0..=window.y1()).map(|y| v.sample(x, y)).collect())
+                    .collect(),
+            )
+        };
+        let variables = views
+            .iter()
+            .map(|v| {
+                let values = (window.y0..=window.y1())
+                    .flat_map(|y| (window.x0..=window.x1()).map(move |x| (x, y)))
+                    .map(|(x, y)| v.sample(x, y))
+                    .collect();
+                Samples::new(window.width, window.height, values)
+                    .expect("a tile window has at least 2x2 samples")
+            })
+            .collect();
         TileInput {
             grid,
-            top: view.row_profile(window.y0, window.x0, window.x1()),
-            bottom: view.row_profile(window.y1(), window.x0, window.x1()),
-            left: view.column_profile(window.x0, window.y0, window.y1()),
-            right: view.column_profile(window.x1(), window.y0, window.y1()),
+            top: rows(window.y0),
+            bottom: rows(window.y1()),
+            left: columns(window.x0),
+            right: columns(window.x1()),
+            variables,
             owned_domain_samples,
+            owned_valid_samples,
         }
     }
 }
@@ -182,7 +256,7 @@ mod tests {
             .indices()
             .map(|index| {
                 let halo = halo_window(&plan, plan.window(index));
-                TileInput::cut(&plan, index, &crop(g, halo), halo)
+                TileInput::cut(&plan, index, &crop(g, halo), &[], halo)
             })
             .collect();
         (plan, inputs)
@@ -226,6 +300,8 @@ mod tests {
             let (_, inputs) = inputs(&g, size);
             let total: u64 = inputs.iter().map(|i| i.owned_domain_samples).sum();
             assert_eq!(total as usize, g.domain_sample_count(), "size {size}");
+            let valid: u64 = inputs.iter().map(|i| i.owned_valid_samples).sum();
+            assert_eq!(valid as usize, g.valid_count(), "size {size}");
         }
     }
 

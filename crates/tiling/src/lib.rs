@@ -56,7 +56,7 @@ mod vertex_ids;
 mod welded_writer;
 
 pub use collector::MeshCollector;
-pub use edge::{edge_limit, edge_span, EdgeProfile};
+pub use edge::{edge_limit, edge_span, EdgeProfile, EdgeRule};
 pub use engine::{
     mesh_tiles, worker_count, TileOptions, TileProgress, TilesReport, DEFAULT_TILE_SIZE,
 };
@@ -68,8 +68,8 @@ pub use memory::{
 pub use per_tile_writer::PerTileWriter;
 pub use plan::{TileIndex, TilePlan, TileWindow};
 #[cfg(feature = "raster")]
-pub use raster_source::RasterSource;
+pub use raster_source::{RasterReader, RasterSource};
 pub use sink::{FinishedTile, SinkError, TileSink};
 pub use source::{GridSource, ReadError, TileSource, WindowRead};
-pub use tin_check::check_tin;
+pub use tin_check::{check_tin, check_variable};
 pub use welded_writer::WeldedWriter;

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use tinsmith_formats::{write_mesh, MeshFormat, MeshRef};
+use tinsmith_formats::{write_mesh, MeshFormat, MeshRef, VertexAttribute};
 use tinsmith_output::StagedDir;
 
 use crate::error::{Error, Result};
@@ -13,7 +13,8 @@ use tinsmith_georef::Placement;
 /// Writes each tile as its own mesh file, [`PerTileWriter::file_name`], into a directory.
 ///
 /// Each file holds all of its tile's vertices (shared edge vertices appear in every tile
-/// that has them, at identical coordinates) with indices local to the file; tiles without
+/// that has them, at identical coordinates, and with the same values of every variable)
+/// with indices local to the file; tiles without
 /// any triangle (all nodata) are written as empty meshes, so there is one file per tile.
 ///
 /// The directory appears, complete, when [`PerTileWriter::finish`] succeeds: files go to a
@@ -29,6 +30,8 @@ pub struct PerTileWriter {
     placement: Placement,
     vertices: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
+    /// The names the files give the run's variables, in order.
+    variable_names: Vec<String>,
 }
 
 impl PerTileWriter {
@@ -76,7 +79,16 @@ impl PerTileWriter {
             placement,
             vertices: Vec::new(),
             triangles: Vec::new(),
+            variable_names: Vec::new(),
         })
+    }
+
+    /// Writes the run's variables too, one per-vertex attribute each, under these names
+    /// (in the variables' order; the format must carry attributes, as PLY does). A tile
+    /// with fewer variables than names is an error of the sink.
+    pub fn with_variable_names(mut self, names: Vec<String>) -> PerTileWriter {
+        self.variable_names = names;
+        self
     }
 
     /// The file name of tile `index`: `tile_r{row}_c{col}.{extension}`.
@@ -116,8 +128,21 @@ impl TileSink for PerTileWriter {
             // The temporary directory is being removed: add nothing to it.
             return Err(std::io::Error::from(std::io::ErrorKind::Interrupted).into());
         }
-        let mesh =
-            MeshRef::new(&self.vertices, &self.triangles).with_crs_wkt(self.crs_wkt.as_deref());
+        if tile.variables().len() < self.variable_names.len() {
+            return Err(format!(
+                "the tile has {} variables, {} were named",
+                tile.variables().len(),
+                self.variable_names.len()
+            )
+            .into());
+        }
+        let attributes: Vec<VertexAttribute<'_>> = (self.variable_names.iter())
+            .zip(tile.variables())
+            .map(|(name, values)| VertexAttribute { name, values })
+            .collect();
+        let mesh = MeshRef::new(&self.vertices, &self.triangles)
+            .with_crs_wkt(self.crs_wkt.as_deref())
+            .with_attributes(&attributes);
         write_mesh(&path, self.format, mesh)?;
         Ok(())
     }

@@ -12,7 +12,8 @@ use crate::source::{ReadError, TileSource, WindowRead};
 /// One band of a raster file, read through GDAL, a window at a time.
 ///
 /// Samples are decoded as `tinsmith_raster::read_samples` decodes them (nodata compared in
-/// the band's own type, NaN and infinities as nodata, scale and offset applied).
+/// the band's own type, NaN and infinities as nodata, scale and offset applied). Further
+/// bands on the same grid may come with it as variables ([`RasterSource::with_variable`]).
 #[derive(Debug, Clone)]
 pub struct RasterSource {
     path: PathBuf,
@@ -23,6 +24,8 @@ pub struct RasterSource {
     integral_heights: bool,
     /// The datum whose heights the readers turn into ellipsoidal ones, as `info` was read.
     converted_from: Option<VerticalDatum>,
+    /// Each variable's file, band and max |value|.
+    variables: Vec<(PathBuf, usize, f64)>,
 }
 
 impl RasterSource {
@@ -45,7 +48,25 @@ impl RasterSource {
             max_abs_value,
             integral_heights: info.integral_heights,
             converted_from: info.converted_from.clone(),
+            variables: Vec::new(),
         })
+    }
+
+    /// The source with one more variable: the band described by `info` (from
+    /// `tinsmith_raster::open_info`, for its statistics), read as it is (no datum
+    /// conversion). It must be on the height's grid: the caller checks that; windows of
+    /// the same pixel coordinates are read.
+    ///
+    /// # Errors
+    /// [`Error::AllNodata`] when the band has no valid sample.
+    pub fn with_variable(mut self, info: &RasterInfo) -> Result<RasterSource> {
+        let max_abs_value = info.max_abs_value().ok_or_else(|| Error::AllNodata {
+            path: info.path.clone(),
+            band: info.band,
+        })?;
+        self.variables
+            .push((info.path.clone(), info.band, max_abs_value));
+        Ok(self)
     }
 
     /// Opens band `band` (1-based) of the raster at `path` and scans it once for its
@@ -68,8 +89,15 @@ impl RasterSource {
     }
 }
 
+/// The readers of one worker thread: the height's band and each variable's.
+#[derive(Debug)]
+pub struct RasterReader {
+    height: WindowReader,
+    variables: Vec<WindowReader>,
+}
+
 impl TileSource for RasterSource {
-    type Reader = WindowReader;
+    type Reader = RasterReader;
 
     fn width(&self) -> u32 {
         self.width
@@ -87,14 +115,27 @@ impl TileSource for RasterSource {
         self.integral_heights
     }
 
-    fn reader(&self) -> std::result::Result<WindowReader, ReadError> {
+    fn variable_count(&self) -> usize {
+        self.variables.len()
+    }
+
+    fn variable_max_abs_value(&self, k: usize) -> f64 {
+        self.variables[k].2
+    }
+
+    fn reader(&self) -> std::result::Result<RasterReader, ReadError> {
         let datum = self.converted_from.as_ref();
         let datum = datum.unwrap_or(&VerticalDatum::Ellipsoid);
-        Ok(WindowReader::open_on(&self.path, self.band, datum)?)
+        Ok(RasterReader {
+            height: WindowReader::open_on(&self.path, self.band, datum)?,
+            variables: (self.variables.iter())
+                .map(|(path, band, _)| WindowReader::open(path, *band))
+                .collect::<std::result::Result<_, _>>()?,
+        })
     }
 }
 
-impl WindowRead for WindowReader {
+impl WindowRead for RasterReader {
     fn read_window(
         &mut self,
         x0: u32,
@@ -102,6 +143,20 @@ impl WindowRead for WindowReader {
         width: u32,
         height: u32,
     ) -> std::result::Result<Samples, ReadError> {
-        Ok(WindowReader::read_window(self, x0, y0, width, height)?)
+        Ok(self.height.read_window(x0, y0, width, height)?)
+    }
+
+    fn read_variable_window(
+        &mut self,
+        k: usize,
+        x0: u32,
+        y0: u32,
+        width: u32,
+        height: u32,
+    ) -> std::result::Result<Samples, ReadError> {
+        match self.variables.get_mut(k) {
+            Some(reader) => Ok(reader.read_window(x0, y0, width, height)?),
+            None => Err(format!("no variable {k}").into()),
+        }
     }
 }

@@ -41,6 +41,7 @@ pub struct FinishedTile {
     pub(crate) triangles: Vec<[u32; 3]>,
     pub(crate) ids: Vec<u32>,
     pub(crate) first_new_id: u32,
+    pub(crate) variables: Vec<Vec<f64>>,
     pub(crate) report: DecimationReport,
     pub(crate) measured_max_error: f64,
 }
@@ -109,6 +110,24 @@ impl FinishedTile {
             self.first_new_id
         )
         .into())
+    }
+
+    /// Each variable's values at [`FinishedTile::vertices`] (one list per variable, in
+    /// vertex order); empty without variables.
+    pub fn variables(&self) -> &[Vec<f64>] {
+        &self.variables
+    }
+
+    /// Variable `k`'s values at the tile's new vertices, in welded-id order.
+    ///
+    /// # Panics
+    /// When the run has fewer than `k + 1` variables.
+    pub fn new_variable_values(&self, k: usize) -> impl Iterator<Item = f64> + '_ {
+        self.variables[k]
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| self.is_new(i))
+            .map(|(_, &x)| x)
     }
 
     /// The decimation's counts and timings for this tile.

@@ -35,6 +35,20 @@ pub trait TileSource: Sync {
         false
     }
 
+    /// How many variables (further bands on the same grid) the source has besides the
+    /// height: each tile reads its window of each ([`WindowRead::read_variable_window`]).
+    /// 0 unless the source says otherwise.
+    fn variable_count(&self) -> usize {
+        0
+    }
+
+    /// The largest |value| of any valid sample of variable `k` over the whole raster: the
+    /// shared edges' limit for that variable is computed from it (see
+    /// [`crate::edge_limit`]).
+    fn variable_max_abs_value(&self, _k: usize) -> f64 {
+        0.0
+    }
+
     /// A reader for the calling thread.
     ///
     /// # Errors
@@ -56,10 +70,27 @@ pub trait WindowRead {
         width: u32,
         height: u32,
     ) -> std::result::Result<Samples, ReadError>;
+
+    /// The same window of variable `k` (see [`TileSource::variable_count`]), NaN = nodata.
+    ///
+    /// # Errors
+    /// When reading fails; by default, always (a source without variables).
+    fn read_variable_window(
+        &mut self,
+        k: usize,
+        x0: u32,
+        y0: u32,
+        width: u32,
+        height: u32,
+    ) -> std::result::Result<Samples, ReadError> {
+        let _ = (x0, y0, width, height);
+        Err(format!("this source has no variable {k}").into())
+    }
 }
 
 /// A grid in memory, cut into tiles like a raster file (for tests, and for callers who
-/// want tiles of a grid they already hold).
+/// want tiles of a grid they already hold). A grid with variables
+/// (`Grid::with_variables`) gives them as the source's variables.
 #[derive(Debug, Clone, Copy)]
 pub struct GridSource<'a> {
     grid: &'a Grid,
@@ -107,6 +138,19 @@ impl<'a> TileSource for GridSource<'a> {
         self.integral_heights
     }
 
+    fn variable_count(&self) -> usize {
+        self.grid.variable_count()
+    }
+
+    fn variable_max_abs_value(&self, k: usize) -> f64 {
+        self.grid
+            .variable(k)
+            .0
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0, |m: f64, v| m.max(v.abs()))
+    }
+
     fn reader(&self) -> std::result::Result<GridSource<'a>, ReadError> {
         Ok(*self)
     }
@@ -120,20 +164,39 @@ impl WindowRead for GridSource<'_> {
         width: u32,
         height: u32,
     ) -> std::result::Result<Samples, ReadError> {
-        let w = self.grid.width();
-        if x0 + width > w || y0 + height > self.grid.height() {
-            return Err(
-                format!("window {width}x{height} at ({x0}, {y0}) is outside the grid").into(),
-            );
-        }
-        let values = (y0..y0 + height)
-            .flat_map(|y| {
-                let row = (y * w + x0) as usize;
-                self.grid.values()[row..row + width as usize]
-                    .iter()
-                    .copied()
-            })
-            .collect();
-        Ok(Samples::new(width, height, values)?)
+        cut_window(self.grid, self.grid.values(), (x0, y0, width, height))
     }
+
+    fn read_variable_window(
+        &mut self,
+        k: usize,
+        x0: u32,
+        y0: u32,
+        width: u32,
+        height: u32,
+    ) -> std::result::Result<Samples, ReadError> {
+        if k >= self.grid.variable_count() {
+            return Err(format!("the grid has no variable {k}").into());
+        }
+        cut_window(self.grid, self.grid.variable(k).0, (x0, y0, width, height))
+    }
+}
+
+/// The window `(x0, y0, width, height)` of `values`, samples on `grid`'s raster.
+fn cut_window(
+    grid: &Grid,
+    values: &[f64],
+    (x0, y0, width, height): (u32, u32, u32, u32),
+) -> std::result::Result<Samples, ReadError> {
+    let w = grid.width();
+    if x0 + width > w || y0 + height > grid.height() {
+        return Err(format!("window {width}x{height} at ({x0}, {y0}) is outside the grid").into());
+    }
+    let values = (y0..y0 + height)
+        .flat_map(|y| {
+            let row = (y * w + x0) as usize;
+            values[row..row + width as usize].iter().copied()
+        })
+        .collect();
+    Ok(Samples::new(width, height, values)?)
 }

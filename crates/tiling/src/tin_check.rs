@@ -32,3 +32,31 @@ pub fn check_tin(
         &VerifyOptions::new().with_max_error(max_error),
     )
 }
+
+/// Measures variable `values` (samples on `grid`, whose nodata is the domain) on `tin`,
+/// the variable's value at each vertex being `at_vertices[i]`, with the independent
+/// verifier, against `max_error` (infinite: measured, never failing).
+pub fn check_variable(
+    grid: &Grid,
+    values: &[f64],
+    tin: &Tin,
+    at_vertices: &[f64],
+    max_error: f64,
+) -> tinsmith_verify::Result<Report> {
+    let positions: Vec<[i64; 2]> = tin
+        .vertices()
+        .iter()
+        .map(|v| [i64::from(v.x), i64::from(v.y)])
+        .collect();
+    let mut options = VerifyOptions::new();
+    if max_error.is_finite() {
+        options = options.with_max_error(max_error);
+    }
+    tinsmith_verify::verify_variable(
+        GridRef::new(grid.width(), grid.height(), grid.values()),
+        values,
+        MeshRef::new(&positions, &[], tin.triangles()),
+        at_vertices,
+        &options,
+    )
+}

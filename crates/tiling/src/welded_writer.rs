@@ -23,6 +23,8 @@ pub struct WeldedWriter {
     placement: Placement,
     vertices: Vec<[f64; 3]>,
     triangles: Vec<[u32; 3]>,
+    /// Each variable's values at the tile's new vertices (with variable names).
+    variables: Vec<Vec<f64>>,
 }
 
 impl WeldedWriter {
@@ -42,7 +44,20 @@ impl WeldedWriter {
             placement,
             vertices: Vec::new(),
             triangles: Vec::new(),
+            variables: Vec::new(),
         })
+    }
+
+    /// Writes the run's variables too, one `double` vertex property each under these
+    /// names, in the variables' order (PLY only; the values of
+    /// [`FinishedTile::new_variable_values`]).
+    ///
+    /// # Errors
+    /// [`crate::Error::Write`] for OBJ, which carries no per-vertex values.
+    pub fn with_variable_names(mut self, names: Vec<String>) -> Result<WeldedWriter> {
+        self.variables = vec![Vec::new(); names.len()];
+        self.stream = self.stream.with_attribute_names(names)?;
+        Ok(self)
     }
 
     /// Vertices written so far.
@@ -72,7 +87,25 @@ impl TileSink for WeldedWriter {
             let [x, y] = self.placement.file_position(v.x, v.y);
             [x, y, v.z]
         }));
-        self.stream.write_vertices(&self.vertices)?;
+        if self.variables.is_empty() {
+            self.stream.write_vertices(&self.vertices)?;
+        } else {
+            if tile.variables().len() < self.variables.len() {
+                return Err(format!(
+                    "the tile has {} variables, {} were named",
+                    tile.variables().len(),
+                    self.variables.len()
+                )
+                .into());
+            }
+            for (k, values) in self.variables.iter_mut().enumerate() {
+                values.clear();
+                values.extend(tile.new_variable_values(k));
+            }
+            let lists: Vec<&[f64]> = self.variables.iter().map(Vec::as_slice).collect();
+            self.stream
+                .write_vertices_with_attributes(&self.vertices, &lists)?;
+        }
         self.triangles.clear();
         self.triangles
             .extend(tile.welded_triangles().map(|t| self.placement.orient(t)));

@@ -220,3 +220,52 @@ fn bad_variables_are_refused() {
         Err(Error::VariablesUnsupported(_))
     ));
 }
+
+/// A flat height with a variable held at 0 error that its full cells cannot keep (its
+/// stars carry infinite bounds): ears' ring-edge errors meet those bounds, and every
+/// variable still holds. Found by `every_variable_within_its_bound`.
+#[test]
+fn a_variable_beyond_its_limit_in_the_start_is_left_as_it_is() {
+    let spec = GridSpec {
+        width: 2,
+        height: 3,
+        values: vec![8.833108082136427; 6],
+    };
+    let other = GridSpec {
+        width: 2,
+        height: 3,
+        values: vec![
+            -434.1381659372532,
+            -173.44175884180288,
+            143.10328245598248,
+            62.27499232529169,
+            338.25492746876137,
+            162.6423939532723,
+        ],
+    };
+    let mix = 0.2146527761007418;
+    let grid = Grid::with_variables(
+        samples(&spec),
+        vec![
+            Variable::new(
+                Samples::new(2, 3, variable_like(&spec, &other, mix, 1.0)).unwrap(),
+                0.0,
+            )
+            .unwrap(),
+            Variable::new(
+                Samples::new(2, 3, variable_like(&spec, &other, 1.0 - mix, 1.0)).unwrap(),
+                0.02,
+            )
+            .unwrap(),
+        ],
+    )
+    .unwrap();
+    for options in options_to_try(0.01) {
+        let tin = decimate(&grid, &options).unwrap().tin;
+        let (height, variables) = reports(&grid, &tin, 0.01);
+        assert!(height.passed(), "{options:?}: {:?}", height.problems);
+        for report in &variables {
+            assert!(report.passed(), "{options:?}: {:?}", report.problems);
+        }
+    }
+}

@@ -13,7 +13,8 @@ TOOLS := .tools
 # pyramid (tools/dask_tiles.py, tests/dask.rs); PyYAML reads deploy/; Pillow reads the
 # previews back (tests/preview.rs); maturin builds the Python package (crates/python),
 # pytest runs its tests (make python-test), which hand it affine's transforms and ask it
-# for shapely's lines; rasterio and rioxarray run the README's Python examples.
+# for shapely's lines; rasterio and rioxarray run the README's Python examples;
+# laspy (with its lazrs LAZ backend) reads our point fixtures back (tests/points.rs).
 PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
   azure-storage-blob==12.27.1 dask[distributed]==2026.8.0 pyyaml==6.0.4 pillow==11.3.0 \
   maturin==1.16.0 pytest==9.2.0 affine==3.0.1 shapely==2.2.0 rasterio==1.4.4 \

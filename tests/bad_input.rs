@@ -840,7 +840,7 @@ fn output_that_is_the_input_is_refused_and_the_input_kept() {
     ];
     for (args, named) in cases {
         let o = d.run(args);
-        assert_fails_naming(&o, &[named, "input raster"]);
+        assert_fails_naming(&o, &[named, "input file"]);
     }
     assert_eq!(std::fs::read(&copy).unwrap(), before);
     assert!(!d.path("m.ply").exists());

@@ -71,9 +71,9 @@ pub enum Error {
         /// The output as given.
         path: PathBuf,
     },
-    /// The output is the input raster itself.
+    /// The output is the input file itself (a raster, points or a TIN).
     #[error(
-        "{}: is the input raster {}; writing there would destroy it",
+        "{}: is the input file {}; writing there would destroy it",
         .path.display(),
         .input.display()
     )]

@@ -190,7 +190,7 @@ mod tests {
         assert_eq!(
             err.to_string(),
             format!(
-                "{0}: is the input raster {0}; writing there would destroy it",
+                "{0}: is the input file {0}; writing there would destroy it",
                 input.display()
             )
         );

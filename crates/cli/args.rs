@@ -263,18 +263,8 @@ pub struct VerifyArgs {
     /// name, each within its --max-error, over the domain where every band is valid.
     #[arg(long, value_delimiter = ',', num_args = 1, value_name = "B,B,...")]
     pub bands: Vec<usize>,
-    /// With --bands: the band that is the height [default: the first].
-    #[arg(long, value_name = "N", requires = "bands")]
-    pub height_band: Option<usize>,
-    /// Variables from another raster on the input's grid (same size and geotransform;
-    /// refused, naming it, when it does not overlap or would need resampling): FILE's
-    /// bands B,... (all without :B,...), each within --attribute-error, as --bands' are.
-    #[arg(long, value_name = "FILE[:B,B,...]", requires = "attribute_error")]
-    pub attributes: Option<String>,
-    /// The bound of each --attributes band: one for all, or a comma-separated one per band.
-    #[arg(long, value_name = "E", value_parser = parse_max_error, allow_hyphen_values = true,
-          value_delimiter = ',', num_args = 1, requires = "attributes")]
-    pub attribute_error: Vec<f64>,
+    #[command(flatten)]
+    pub variables: mesh::VariableArgs,
     /// The mesh holds (column, row, value) coordinates (it was written with --pixel-coords).
     #[arg(long)]
     pub pixel_coords: bool,
@@ -295,23 +285,12 @@ impl VerifyArgs {
     pub fn job(&self) -> tinsmith_pipeline::Result<VerifyJob> {
         let mut job = VerifyJob::new(&self.input, &self.mesh);
         job.format = self.format;
-        let (band, max_error, variables) = tinsmith_pipeline::resolve_bands(
-            &self.input,
-            &self.bands,
-            &self.max_error,
-            self.height_band,
-        )?;
+        let (band, max_error, variables) =
+            self.variables
+                .resolve(&self.input, self.band, &self.bands, &self.max_error)?;
         job.max_error = max_error;
-        job.band = if self.bands.is_empty() {
-            self.band
-        } else {
-            band
-        };
+        job.band = band;
         job.variables = variables;
-        if let Some(spec) = &self.attributes {
-            let more = tinsmith_pipeline::attribute_variables(spec, &self.attribute_error)?;
-            job.variables.extend(more);
-        }
         job.pixel_coords = self.pixel_coords;
         job.vertical_datum = self.vertical_datum.clone();
         Ok(job)

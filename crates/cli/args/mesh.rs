@@ -53,21 +53,11 @@ pub struct MeshArgs {
     /// written per vertex (PLY: a property named after the band's description or band_N;
     /// glTF: a _NAME attribute; three 8-bit bands also as vertex colours, OBJ included),
     /// or per triangle (GeoJSON, FlatGeobuf: corner means). The domain is where every
-    /// band is valid. Exact error model, untiled.
+    /// band is valid. Exact error model; tiled runs write PLY, GeoJSON or FlatGeobuf.
     #[arg(long, value_delimiter = ',', num_args = 1, value_name = "B,B,...")]
     pub bands: Vec<usize>,
-    /// With --bands: the band that is the height (listed in --bands) [default: the first].
-    #[arg(long, value_name = "N", requires = "bands")]
-    pub height_band: Option<usize>,
-    /// Variables from another raster on the input's grid (same size and geotransform;
-    /// refused, naming it, when it does not overlap or would need resampling): FILE's
-    /// bands B,... (all without :B,...), each within --attribute-error, as --bands' are.
-    #[arg(long, value_name = "FILE[:B,B,...]", requires = "attribute_error")]
-    pub attributes: Option<String>,
-    /// The bound of each --attributes band: one for all, or a comma-separated one per band.
-    #[arg(long, value_name = "E", value_parser = parse_max_error, allow_hyphen_values = true,
-          value_delimiter = ',', num_args = 1, requires = "attributes")]
-    pub attribute_error: Vec<f64>,
+    #[command(flatten)]
+    pub variables: VariableArgs,
     /// Error model.
     #[arg(long, value_enum, default_value_t = ErrorModelArg::Exact)]
     pub error_model: ErrorModelArg,
@@ -239,23 +229,12 @@ impl MeshArgs {
         let mut job = MeshJob::new(&self.input);
         job.output = self.output.clone();
         job.export = self.export.choices();
-        let (band, max_error, variables) = tinsmith_pipeline::resolve_bands(
-            &self.input,
-            &self.bands,
-            &self.max_error,
-            self.height_band,
-        )?;
-        job.band = if self.bands.is_empty() {
-            self.band
-        } else {
-            band
-        };
+        let (band, max_error, variables) =
+            self.variables
+                .resolve(&self.input, self.band, &self.bands, &self.max_error)?;
+        job.band = band;
         job.vertical_datum = self.vertical_datum.clone();
         job.variables = variables;
-        if let Some(spec) = &self.attributes {
-            let more = tinsmith_pipeline::attribute_variables(spec, &self.attribute_error)?;
-            job.variables.extend(more);
-        }
         let choices = &mut job.decimation;
         choices.max_error = max_error;
         choices.max_triangles = self.max_triangles;
@@ -304,5 +283,46 @@ pub fn parse_datum(text: &str) -> Result<tinsmith_raster::VerticalDatum, String>
     match text.trim() {
         "" => Err("give egm96, egm2008, ellipsoid or a geoid grid file".into()),
         text => Ok(tinsmith_raster::VerticalDatum::parse(text)),
+    }
+}
+
+/// `--height-band`, `--attributes` and `--attribute-error`: what `mesh` and `verify` take
+/// besides `--bands` to make or check several variables over one mesh.
+#[derive(Debug, Args)]
+pub struct VariableArgs {
+    /// With --bands: the band that is the height (listed in --bands) [default: the first].
+    #[arg(long, value_name = "N", requires = "bands")]
+    pub height_band: Option<usize>,
+    /// Variables from another raster on the input's grid (same size and geotransform;
+    /// refused, naming it, when it does not overlap or would need resampling): FILE's
+    /// bands B,... (all without :B,...), each within --attribute-error, as --bands' are.
+    #[arg(long, value_name = "FILE[:B,B,...]", requires = "attribute_error")]
+    pub attributes: Option<String>,
+    /// The bound of each --attributes band: one for all, or a comma-separated one per band.
+    #[arg(long, value_name = "E", value_parser = parse_max_error, allow_hyphen_values = true,
+          value_delimiter = ',', num_args = 1, requires = "attributes")]
+    pub attribute_error: Vec<f64>,
+}
+
+impl VariableArgs {
+    /// The height's band (`band` without `bands`), its bound and the variables that
+    /// `bands`, `max_error` (one bound, or one per band) and these flags ask for.
+    pub fn resolve(
+        &self,
+        input: &std::path::Path,
+        band: usize,
+        bands: &[usize],
+        max_error: &[f64],
+    ) -> tinsmith_pipeline::Result<(usize, Option<f64>, Vec<tinsmith_pipeline::BandVariable>)> {
+        let (height, max_error, mut variables) =
+            tinsmith_pipeline::resolve_bands(input, bands, max_error, self.height_band)?;
+        if let Some(spec) = &self.attributes {
+            variables.extend(tinsmith_pipeline::attribute_variables(
+                spec,
+                &self.attribute_error,
+            )?);
+        }
+        let band = if bands.is_empty() { band } else { height };
+        Ok((band, max_error, variables))
     }
 }

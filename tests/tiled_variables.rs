@@ -302,9 +302,56 @@ fn tiled_bands_refuse_obj_tiles_and_heights_only_formats() {
     assert_fails_naming(&d.run(&args), &["multi.tif", "OBJ"]);
     assert!(!d.path("tiles").exists());
     let mut args = base.to_vec();
-    args.extend_from_slice(&["-o", "m.glb"]);
-    assert_fails_naming(&d.run(&args), &["multi.tif", "glTF"]);
-    assert!(!d.path("m.glb").exists());
+    args.extend_from_slice(&["-o", "m.stl"]);
+    assert_fails_naming(&d.run(&args), &["multi.tif", "STL"]);
+    assert!(!d.path("m.stl").exists());
+}
+
+#[test]
+fn tiled_bands_in_gltf_keep_each_bound_as_float32_holds_them() {
+    let d = Dir::new();
+    three_bands(&d);
+    let bounds = "1,0.5,0.25";
+    let r = mesh_ok(
+        &d,
+        &[
+            "-o",
+            "m.glb",
+            "--bands",
+            "1,2,3",
+            "--max-error",
+            bounds,
+            "--tile-size",
+            TILE,
+            "--pixel-coords",
+        ],
+    );
+    assert!(r["tiles"]["count"].as_u64().unwrap() > 1, "{r}");
+    assert_eq!(r["variables"].as_array().unwrap().len(), 2, "{r}");
+    // Read back from the file: each band against its float32 attribute.
+    let v = verify_bands(&d, "m.glb", "1,2,3", bounds);
+    assert_eq!(v["variables"].as_array().unwrap().len(), 2, "{v}");
+    // A bound float32's rounding alone would use up is refused, naming the band.
+    write_band(&d, "big.asc", |x, y| 1.0e9 + (x * 7 + y) as f64);
+    stack(&d, "big.tif", &["big.asc"]);
+    let o = d.run(&[
+        "mesh",
+        "multi.tif",
+        "-o",
+        "n.glb",
+        "--bands",
+        "1",
+        "--attributes",
+        "big.tif",
+        "--attribute-error",
+        "1",
+        "--max-error",
+        "1",
+        "--tile-size",
+        TILE,
+    ]);
+    assert_fails_naming(&o, &["multi.tif", "float32 rounds"]);
+    assert!(!d.path("n.glb").exists());
 }
 
 #[test]

@@ -503,6 +503,28 @@ fn gltf_carries_each_band_as_an_attribute_the_validator_accepts() {
     ]);
     assert!(o.status.success(), "{} {}", stdout(&o), stderr(&o));
     assert!(stdout(&o).contains("band 2 (band_2)"), "{}", stdout(&o));
+    // Tiled: the welded mesh's bands, as valid.
+    mesh_ok(
+        &d,
+        &[
+            "-o",
+            "t.glb",
+            "--bands",
+            "1,2,3",
+            "--max-error",
+            "1,0.5,0.25",
+            "--tile-size",
+            "16",
+        ],
+    );
+    let o = Command::new("node")
+        .arg(&script)
+        .arg(d.path("t.glb"))
+        .output()
+        .expect("node runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: Value = serde_json::from_slice(&o.stdout).expect("validator JSON");
+    assert_eq!(report["issues"]["numErrors"], 0, "{report:#}");
 }
 
 #[test]

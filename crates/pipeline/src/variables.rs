@@ -250,8 +250,7 @@ pub(crate) fn read(
 }
 
 /// Refuses what a tiled run with variables does not do: OBJ tiles (`--per-tile
-/// --tile-format obj`), formats without per-vertex values, and float32 formats (their
-/// rounding of each band would need the whole band first).
+/// --tile-format obj`), formats without per-vertex values, and count targets.
 pub(crate) fn check_tiled(job: &crate::MeshJob) -> Result<()> {
     let input = job.input.display();
     if job.per_tile.is_some() {
@@ -267,33 +266,73 @@ pub(crate) fn check_tiled(job: &crate::MeshJob) -> Result<()> {
         bail!("{input}: --bands takes error bounds (--max-error), not --max-triangles or --max-vertices");
     }
     let format = crate::format_plan::format(job)?;
-    if !format.carries_attributes() || format.is_float32() {
+    if !format.carries_attributes() {
         bail!(
             "{input}: a raster larger than --tile-size {} is meshed tile by tile, and then \
-             --bands writes PLY (.ply), GeoJSON or FlatGeobuf (.geojson, .fgb); {format} is \
-             not among them (or raise --tile-size to mesh it in one piece)",
+             --bands writes PLY (.ply), glTF (.glb, .gltf), GeoJSON or FlatGeobuf (.geojson, \
+             .fgb); {format} is not among them (or raise --tile-size to mesh it in one piece)",
             job.tile_size
         );
     }
     Ok(())
 }
 
+/// The bound each variable is decimated within in a tiled run: its own, less what float32
+/// may round its values by when the file holds them as float32 (`float32`): at most half
+/// a unit in the last place of its largest |value| (the band's statistics), 2^-24 of it,
+/// since a tiled run never holds a whole band to measure the rounding exactly. Refuses,
+/// naming the band, a bound that rounding alone would use up.
+pub(crate) fn tiled_variable_errors(
+    input: &Path,
+    variables: &[Named],
+    largest: &[f64],
+    float32: bool,
+) -> Result<Vec<f64>> {
+    variables
+        .iter()
+        .zip(largest)
+        .map(|((v, name), &largest)| {
+            if !float32 {
+                return Ok(v.max_error);
+            }
+            let rounding = largest / f64::from(1u32 << 24);
+            if rounding >= v.max_error {
+                bail!(
+                    "{}: band {} ({name}): float32 rounds its values by up to {rounding} \
+                     (2^-24 of its largest |value| {largest}), not less than its bound {}; \
+                     write PLY (double) instead",
+                    input.display(),
+                    v.band,
+                    v.max_error
+                );
+            }
+            Ok(v.max_error - rounding)
+        })
+        .collect()
+}
+
+/// The variables of a tiled run: the engine's source reading every band, each variable's
+/// band, bound and name, each one's largest |value|, and the resampled files the source
+/// reads from, to keep until the run ends.
+pub(crate) struct TiledVariables {
+    pub(crate) source: tinsmith_tiling::RasterSource,
+    pub(crate) named: Vec<Named>,
+    pub(crate) largest: Vec<f64>,
+    pub(crate) resampled: Vec<ResampledFile>,
+}
+
 /// The tiled engine's source for `height` with every variable's band (each scanned once
-/// for its statistics, windows read per tile), each variable's band, bound and name, and
-/// the resampled files the source reads from, to keep until the run ends.
+/// for its statistics, windows read per tile).
 pub(crate) fn tiled_source(
     input: &Path,
     height: (tinsmith_tiling::RasterSource, &RasterInfo),
     variables: &[BandVariable],
-) -> Result<(
-    tinsmith_tiling::RasterSource,
-    Vec<Named>,
-    Vec<ResampledFile>,
-)> {
+) -> Result<TiledVariables> {
     let (mut source, info) = height;
     let mut names: Vec<String> = Vec::new();
     let mut variables = variables.to_vec();
     let mut kept = Vec::new();
+    let mut largest = Vec::new();
     for v in &mut variables {
         let file = v.file.clone().unwrap_or_else(|| input.to_path_buf());
         let band = if v.file.is_some() {
@@ -336,9 +375,15 @@ pub(crate) fn tiled_source(
             &fallback,
             &names,
         ));
+        largest.push(band.max_abs_value().unwrap_or(0.0));
         source = source.with_variable(&band).naming_file(&file)?;
     }
-    Ok((source, variables.into_iter().zip(names).collect(), kept))
+    Ok(TiledVariables {
+        source,
+        named: variables.into_iter().zip(names).collect(),
+        largest,
+        resampled: kept,
+    })
 }
 
 /// The name a file gives a band's values: its description made a PLY property name

@@ -8,6 +8,8 @@
 mod blocks;
 mod budget;
 mod error;
+mod glb_tile;
+mod implicit;
 mod layer;
 mod plan;
 mod pyramid;
@@ -23,11 +25,13 @@ mod writer;
 
 pub use budget::LEVEL_ZERO_ERROR;
 pub use error::{TerrainError, TerrainResult};
+pub use glb_tile::{GlbTile, TileBounds, TILE_EDGES_EXTENSION};
+pub use implicit::SUBTREE_LEVELS;
 pub use layer::METADATA_AVAILABILITY;
 pub use plan::Shard;
 pub use pyramid::{
     build_terrain, build_terrain_in, streaming_bytes, LevelReport, Progress, TerrainOptions,
-    TerrainReport, MAX_LEVEL,
+    TerrainReport, TileFormat, MAX_LEVEL,
 };
 pub use quantized_mesh::{
     geodetic_to_ecef, gzip, oct_encode, surface_normal, EncodeError, GeoRectangle,

@@ -17,15 +17,26 @@ use serde_json::json;
 use crate::glb_tile::TileBounds;
 use crate::LEVEL_ZERO_ERROR;
 
-/// Levels per subtree: a subtree file holds the availability and metadata of 4 levels
-/// (85 tiles) and says which of the 256 subtrees below it exist.
-pub const SUBTREE_LEVELS: u8 = 4;
+/// The most levels per subtree: a subtree file then holds the availability and metadata
+/// of 8 levels (up to 21,845 tiles, 2.7 KB of availability bits) and says which of the
+/// 65,536 subtrees below it exist (8 KB of bits, or a constant when none does).
+pub const MAX_SUBTREE_LEVELS: u8 = 8;
+
+/// Levels per subtree in a pyramid whose deepest level is `max_level`: all of them up to
+/// [`MAX_SUBTREE_LEVELS`], so that a small pyramid is two subtree files, not one per tile
+/// of its last level.
+pub(super) fn subtree_levels(max_level: u8) -> u8 {
+    (max_level + 1).min(MAX_SUBTREE_LEVELS)
+}
 
 /// The metadata class of every tile.
 const TILE_CLASS: &str = "tile";
 
 /// Each tile's metadata, by TMS address.
 pub(super) type TileMetadata = BTreeMap<(u8, u32, u32), TileBounds>;
+
+/// A file to write: its name and bytes.
+type File = (String, Vec<u8>);
 
 /// Root (0: west, 1: east) and implicit column of TMS tile column `x` of level `z`.
 fn implicit(z: u8, x: u32) -> (u32, u32) {
@@ -58,6 +69,7 @@ fn morton(x: u32, y: u32) -> u64 {
 
 /// The text of `tileset.json` for tiles down to `max_level` whose metadata is `tiles`.
 pub(super) fn tileset_json(tiles: &TileMetadata, max_level: u8) -> String {
+    let levels = subtree_levels(max_level);
     let (lo, hi) = tiles.values().fold((0.0f64, 0.0f64), |(lo, hi), t| {
         (lo.min(t.min_height), hi.max(t.max_height))
     });
@@ -82,7 +94,7 @@ pub(super) fn tileset_json(tiles: &TileMetadata, max_level: u8) -> String {
             "content": {"uri": format!("tiles/{root}/{{level}}/{{x}}/{{y}}.glb")},
             "implicitTiling": {
                 "subdivisionScheme": "QUADTREE",
-                "subtreeLevels": SUBTREE_LEVELS,
+                "subtreeLevels": levels,
                 "availableLevels": u32::from(max_level) + 1,
                 "subtrees": {"uri": format!("subtrees/{root}/{{level}}/{{x}}/{{y}}.subtree")},
             },
@@ -110,13 +122,12 @@ struct Subtree {
     children: Vec<u64>,
 }
 
-/// Every subtree file (name, bytes) of the tiles in `tiles`, whose parents are all in
-/// `tiles` too (a tile without its parent could not be reached).
+/// Every subtree file (name, bytes) of the tiles in `tiles`, `s` levels each, whose
+/// parents are all in `tiles` too (a tile without its parent could not be reached).
 ///
 /// # Errors
 /// The address of a tile whose parent is missing.
-pub(super) fn subtrees(tiles: &TileMetadata) -> Result<Vec<(String, Vec<u8>)>, (u8, u32, u32)> {
-    let s = SUBTREE_LEVELS;
+pub(super) fn subtrees(tiles: &TileMetadata, s: u8) -> Result<Vec<File>, (u8, u32, u32)> {
     let mut by_root: BTreeMap<(u32, u8, u32, u32), Subtree> = BTreeMap::new();
     for (&(z, x, y), &bounds) in tiles {
         if z > 0 && !tiles.contains_key(&(z - 1, x / 2, y / 2)) {
@@ -144,14 +155,14 @@ pub(super) fn subtrees(tiles: &TileMetadata) -> Result<Vec<(String, Vec<u8>)>, (
     Ok(by_root
         .into_iter()
         .map(|((root, level, x, y), subtree)| {
-            (subtree_path(root, level, x, y), subtree_bytes(&subtree))
+            (subtree_path(root, level, x, y), subtree_bytes(&subtree, s))
         })
         .collect())
 }
 
 /// The binary subtree (`subt`, version 1) of `subtree`.
-fn subtree_bytes(subtree: &Subtree) -> Vec<u8> {
-    let s = u32::from(SUBTREE_LEVELS);
+fn subtree_bytes(subtree: &Subtree, levels: u8) -> Vec<u8> {
+    let s = u32::from(levels);
     let tile_bits = ((1u64 << (2 * s)) - 1) / 3;
     let child_bits = 1u64 << (2 * s);
     let mut bin: Vec<u8> = Vec::new();
@@ -254,28 +265,31 @@ mod tests {
     #[test]
     fn deep_tiles_open_child_subtrees_and_orphans_are_refused() {
         let mut tiles = TileMetadata::new();
-        // A chain from root 1 down to level SUBTREE_LEVELS, along the south-west corner.
-        for z in 0..=SUBTREE_LEVELS {
+        // A chain from root 1 down to level S, along the south-west corner.
+        const S: u8 = 3;
+        for z in 0..=S {
             tiles.insert((z, 1 << z, 0), bounds(f64::from(z)));
         }
         tiles.insert((0, 0, 0), bounds(0.0));
-        let files = subtrees(&tiles).unwrap();
+        let files = subtrees(&tiles, S).unwrap();
         let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
         assert_eq!(
             names,
             [
                 "subtrees/0/0/0/0.subtree".to_string(),
                 "subtrees/1/0/0/0.subtree".to_string(),
-                format!("subtrees/1/{SUBTREE_LEVELS}/0/0.subtree"),
+                format!("subtrees/1/{S}/0/0.subtree"),
             ]
         );
         let root1 = &files[1].1;
         assert_eq!(&root1[..4], b"subt");
         let json_length = u64::from_le_bytes(root1[8..16].try_into().unwrap()) as usize;
         let doc: serde_json::Value = serde_json::from_slice(&root1[24..24 + json_length]).unwrap();
-        assert_eq!(doc["propertyTables"][0]["count"], u64::from(SUBTREE_LEVELS));
+        assert_eq!(doc["propertyTables"][0]["count"], u64::from(S));
         assert_eq!(doc["childSubtreeAvailability"]["availableCount"], 1);
         tiles.insert((3, 7, 7), bounds(0.0));
-        assert_eq!(subtrees(&tiles).unwrap_err(), (3, 7, 7));
+        assert_eq!(subtrees(&tiles, S).unwrap_err(), (3, 7, 7));
+        assert_eq!(subtree_levels(4), 5);
+        assert_eq!(subtree_levels(15), MAX_SUBTREE_LEVELS);
     }
 }

@@ -3,7 +3,9 @@
 //! in the south), each decimated within `quality x e(level)` (Cesium's geometric error at
 //! the level) and checked by the independent verifier, with shared edges simplified once
 //! so that same-level neighbours keep identical edge vertices, and `layer.json` with the
-//! tiles' availability. The pyramid is staged and moved into place whole.
+//! tiles' availability. The pyramid is staged and moved into place whole. The same tiles
+//! can be written as 3D Tiles 1.1 terrain instead ([`TileFormat::ThreeDTiles`]: one GLB per
+//! tile, [`GlbTile`], implicit subtrees and `tileset.json`).
 
 mod blocks;
 mod budget;
@@ -26,7 +28,7 @@ mod writer;
 pub use budget::LEVEL_ZERO_ERROR;
 pub use error::{TerrainError, TerrainResult};
 pub use glb_tile::{GlbTile, TileBounds, TILE_EDGES_EXTENSION};
-pub use implicit::SUBTREE_LEVELS;
+pub use implicit::MAX_SUBTREE_LEVELS;
 pub use layer::METADATA_AVAILABILITY;
 pub use plan::Shard;
 pub use pyramid::{

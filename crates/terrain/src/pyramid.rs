@@ -9,7 +9,7 @@ use tinsmith_raster::{geographic_bounds, GeoBounds};
 
 use crate::blocks::{block_level, block_window, blocks, domain, reach_margin, Cut, SplitSamples};
 use crate::budget::LevelBudget;
-use crate::implicit::{subtrees, tileset_json};
+use crate::implicit::{subtree_levels, subtrees, tileset_json};
 use crate::layer::{layer_json, Available};
 use crate::records::{
     block_name, gzip_samples, options_key, put_record, read_record, top_name, BlockRecord, Entries,
@@ -898,7 +898,8 @@ pub(super) fn finish_pyramid(
 
 /// Writes the subtrees of the 3D Tiles tiles in `written`, then `tileset.json`.
 fn write_tileset(written: &Written, store: &dyn TileStore) -> TerrainResult<()> {
-    let files = subtrees(&written.metadata).map_err(|(z, x, y)| {
+    let deepest = written.metadata.keys().map(|k| k.0).max().unwrap_or(0);
+    let files = subtrees(&written.metadata, subtree_levels(deepest)).map_err(|(z, x, y)| {
         TerrainError::Options(format!(
             "tile {z}/{x}/{y} was written without its parent tile, so no 3D Tiles client \
              could reach it"
@@ -907,7 +908,6 @@ fn write_tileset(written: &Written, store: &dyn TileStore) -> TerrainResult<()> 
     for (name, bytes) in files {
         store.put_file(&name, &bytes)?;
     }
-    let deepest = written.metadata.keys().map(|k| k.0).max().unwrap_or(0);
     let tileset = tileset_json(&written.metadata, deepest);
     store.put_file("tileset.json", tileset.as_bytes())?;
     Ok(())

@@ -275,11 +275,12 @@ fn cesiumjs_samples_the_3dtiles_pyramid_as_the_quantized_mesh_one() {
         }
         heights.push(got);
     }
-    // The same tiles: the same heights but for float32 positions and Cesium's own
-    // cartographic conversion.
+    // The same tiles: the same heights but for CesiumJS's own handling of each format
+    // (float32 positions turned back into longitude, latitude and height for 3D Tiles);
+    // about 1 cm apart at most here, where the bound is 2.35 m.
     for (k, (a, b)) in heights[0].iter().zip(&heights[1]).enumerate() {
         assert!(
-            (a - b).abs() < 1e-2,
+            (a - b).abs() < 1e-2 * bound,
             "point {k}: quantized-mesh {a}, 3D Tiles {b}"
         );
     }

@@ -36,11 +36,12 @@ pub const TILE_EDGES_EXTENSION: &str = "CESIUM_tile_edges";
 /// What the subtree's tile metadata says of a tile (the semantics CesiumJS reads).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TileBounds {
-    /// `TILE_MINIMUM_HEIGHT`: the lowest vertex height (m above the ellipsoid).
+    /// `TILE_MINIMUM_HEIGHT`: at or below the lowest vertex height (m above the
+    /// ellipsoid), float32 rounding of the positions included.
     pub min_height: f64,
-    /// `TILE_MAXIMUM_HEIGHT`: the highest vertex height.
+    /// `TILE_MAXIMUM_HEIGHT`: at or above the highest vertex height, likewise.
     pub max_height: f64,
-    /// `TILE_BOUNDING_SPHERE`: ECEF centre and radius holding every vertex.
+    /// `TILE_BOUNDING_SPHERE`: ECEF centre and radius holding every vertex, likewise.
     pub sphere: [f64; 4],
     /// `TILE_HORIZON_OCCLUSION_POINT`: in ellipsoid-scaled ECEF, as quantized-mesh's.
     pub horizon_occlusion_point: [f64; 3],
@@ -220,10 +221,14 @@ impl<'a> GlbTile<'a> {
             "bufferViews": bin.views,
             "buffers": [{"byteLength": bin.bytes.len()}],
         });
+        // Rounding an offset of at most `radius` to float32 moves a vertex by at most
+        // `radius x 2^-24`: the bounds are widened by twice that, so that they hold the
+        // vertices the client decodes, not only the exact ones.
+        let pad = radius * f64::from(f32::EPSILON);
         let bounds = TileBounds {
-            min_height,
-            max_height,
-            sphere: [centre[0], centre[1], centre[2], radius],
+            min_height: min_height - pad,
+            max_height: max_height + pad,
+            sphere: [centre[0], centre[1], centre[2], radius + pad],
             horizon_occlusion_point: hop,
         };
         Ok((glb(&document, &bin.bytes), bounds))
@@ -360,7 +365,9 @@ mod tests {
             let accessor = edges[side].as_u64().unwrap() as usize;
             assert_eq!(doc["accessors"][accessor]["count"], 2, "{side}");
         }
-        assert_eq!((bounds.min_height, bounds.max_height), (100.0, 400.0));
+        let pad = bounds.sphere[3] * f64::from(f32::EPSILON);
+        assert!(bounds.min_height < 100.0 && bounds.min_height >= 100.0 - pad);
+        assert!(bounds.max_height > 400.0 && bounds.max_height <= 400.0 + pad);
         // The first position, back in ECEF, is the south-west corner.
         let m = doc["nodes"][0]["matrix"].as_array().unwrap();
         let t: Vec<f64> = m[12..15].iter().map(|v| v.as_f64().unwrap()).collect();

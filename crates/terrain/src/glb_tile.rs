@@ -386,6 +386,34 @@ mod tests {
     }
 
     #[test]
+    fn from_65535_vertices_indices_are_32_bit() {
+        // A 256 x 256 lattice: 65,536 vertices, all used.
+        let n = 256u32;
+        let at = |i: u32| (i * u32::from(QUANTIZED_MAX) / (n - 1)) as u16;
+        let vertices: Vec<[u16; 3]> = (0..n * n).map(|k| [at(k % n), at(k / n), 0]).collect();
+        let heights = vec![0.0; vertices.len()];
+        let triangles: Vec<[u32; 3]> = (0..n - 1)
+            .flat_map(|j| (0..n - 1).map(move |i| (i, j)))
+            .flat_map(|(i, j)| {
+                let k = j * n + i;
+                [[k, k + 1, k + n + 1], [k, k + n + 1, k + n]]
+            })
+            .collect();
+        let (bytes, _) = GlbTile::new(rect(), &vertices, &heights, &triangles)
+            .encode()
+            .unwrap();
+        let doc = document(&bytes);
+        let primitive = &doc["meshes"][0]["primitives"][0];
+        let indices = primitive["indices"].as_u64().unwrap() as usize;
+        assert_eq!(doc["accessors"][indices]["componentType"], UNSIGNED_INT);
+        let left = primitive["extensions"][TILE_EDGES_EXTENSION]["left"]
+            .as_u64()
+            .unwrap() as usize;
+        assert_eq!(doc["accessors"][left]["componentType"], UNSIGNED_INT);
+        assert_eq!(doc["accessors"][left]["count"], n);
+    }
+
+    #[test]
     fn a_tile_without_a_vertex_on_an_edge_is_refused() {
         let m = QUANTIZED_MAX;
         let vertices = [[0, 0, 0], [m, 0, 0], [0, 100, 0]];

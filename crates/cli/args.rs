@@ -10,6 +10,7 @@ use clap::{Args, Parser, Subcommand};
 use tinsmith_formats::MeshFormat;
 use tinsmith_pipeline::{PreviewJob, ServeOptions, VerifyJob};
 use tinsmith_terrain::TerrainOptions;
+use values::TilingArg;
 
 pub use contour::ContourArgs;
 pub use mesh::MeshArgs;
@@ -156,6 +157,9 @@ pub struct TilesArgs {
     /// shows the whole globe with the data on it.
     #[arg(long)]
     pub data_only: bool,
+    /// How tiles divide the globe (layer.json's projection).
+    #[arg(long, value_enum, default_value_t = TilingArg::Geographic)]
+    pub tiling: TilingArg,
     /// Coarsest level written.
     #[arg(long, default_value_t = 0)]
     pub min_zoom: u8,
@@ -314,6 +318,7 @@ impl TilesArgs {
             vertical_datum: tinsmith_raster::VerticalDatum::Ellipsoid,
             water: None,
             whole_globe: !self.data_only,
+            tiling: self.tiling.into(),
         }
     }
 }

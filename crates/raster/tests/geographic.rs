@@ -29,6 +29,7 @@ fn lattice_over(path: &Path, coarser: f64) -> GeoLattice {
     let i0 = (((bounds.west + 180.0) / d).floor() - 1.0).max(0.0);
     let j0 = (((bounds.south + 90.0) / d).floor() - 1.0).max(0.0);
     GeoLattice {
+        latitudes: tinsmith_raster::Latitudes::Uniform,
         west: -180.0,
         south: -90.0,
         step: d,
@@ -243,6 +244,7 @@ fn a_global_raster_samples_alike_in_0_to_360_minus_360_to_0_and_minus_180_to_180
     for step in [1.25, 4.5, 11.0] {
         let width = (360.0 / step) as u32 + 1;
         let lattice = GeoLattice {
+            latitudes: tinsmith_raster::Latitudes::Uniform,
             west: -180.0,
             south: -88.0,
             step,
@@ -322,6 +324,7 @@ fn a_raster_east_of_180_samples_as_the_same_raster_west_of_it() {
     let (east, west) = (write("east.tif", 185.0), write("west.tif", -175.0));
     for lon0 in [-176.0, 184.0] {
         let lattice = GeoLattice {
+            latitudes: tinsmith_raster::Latitudes::Uniform,
             west: lon0,
             south: -36.0,
             step: 0.0625,
@@ -477,6 +480,7 @@ fn samples_agree_with_gdalwarp_wherever_the_four_pixels_are_valid() {
     let dir = tempfile::tempdir().expect("tempdir");
     let [east, _, _] = global_rasters(dir.path());
     let lattice = GeoLattice {
+        latitudes: tinsmith_raster::Latitudes::Uniform,
         west: 100.0,
         south: -80.0,
         step: 0.7,

@@ -296,6 +296,7 @@ impl RowSource for Hills {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tms::Tiling;
     use tinsmith_raster::GeoBounds;
 
     /// The next coarser level of a whole finer level, as the pipeline made it before it
@@ -423,15 +424,15 @@ mod tests {
         let (min_zoom, max_zoom) = (2, 5);
         // The whole levels, made at once.
         let mut whole = Vec::new();
-        let finest = LevelRows::new(TileRect::covering(&bounds, max_zoom));
+        let finest = LevelRows::new(TileRect::covering(&bounds, Tiling::Geographic, max_zoom));
         whole.push(
             source
                 .rows(&finest, 0..finest.height, 0..finest.width)
                 .unwrap(),
         );
         for z in (min_zoom..max_zoom).rev() {
-            let fine = LevelRows::new(TileRect::covering(&bounds, z + 1));
-            let coarse = LevelRows::new(TileRect::covering(&bounds, z));
+            let fine = LevelRows::new(TileRect::covering(&bounds, Tiling::Geographic, z + 1));
+            let coarse = LevelRows::new(TileRect::covering(&bounds, Tiling::Geographic, z));
             let values = whole_coarser(&fine, whole.last().unwrap(), &coarse);
             whole.push(values);
         }
@@ -449,7 +450,7 @@ mod tests {
             let mut recorder = Recorder {
                 levels: (0..=max_zoom)
                     .map(|z| {
-                        let l = LevelRows::new(TileRect::covering(&bounds, z));
+                        let l = LevelRows::new(TileRect::covering(&bounds, Tiling::Geographic, z));
                         Record {
                             values: vec![f32::NAN; l.width * l.height],
                             ty0: l.ty0,
@@ -463,7 +464,7 @@ mod tests {
             };
             stream_levels(
                 &source,
-                &|z| LevelRows::new(TileRect::covering(&bounds, z)),
+                &|z| LevelRows::new(TileRect::covering(&bounds, Tiling::Geographic, z)),
                 (min_zoom, max_zoom),
                 band_rows,
                 &pool,
@@ -494,7 +495,7 @@ mod tests {
             north: 50.0,
             resolution: 0.1,
         };
-        let level = LevelRows::new(TileRect::covering(&bounds, 3));
+        let level = LevelRows::new(TileRect::covering(&bounds, Tiling::Geographic, 3));
         assert_eq!(level.tiles_y, 3);
         let n = TILE_CELLS as usize;
         assert_eq!(

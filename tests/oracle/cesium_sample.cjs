@@ -2,7 +2,8 @@
 // Chromium (driven by playwright-core), through CesiumTerrainProvider.fromUrl, and samples
 // it with sampleTerrainMostDetailed.
 // Usage: node cesium_sample.cjs PAGE_URL TERRAIN_URL POINTS_JSON_FILE [Z/X/Y]
-// Prints {heights, consoleErrors, failedRequests, levels}; with Z/X/Y, the provider asks
+// Prints {heights, consoleErrors, failedRequests, levels, tiles, tiling} (each point's
+// tile at its level, and the provider's tiling scheme); with Z/X/Y, the provider asks
 // for water masks too and the result adds that tile's (TMS numbering) {hasWaterMask,
 // waterMask} as CesiumJS decoded it. Exit code 3: Chromium cannot
 // start (the caller may skip); any other non-zero code is a failure.
@@ -44,8 +45,18 @@ const { chromium } = require(path.join(root, '.tools', 'node_modules', 'playwrig
       });
       const positions = points.map((p) => Cesium.Cartographic.fromDegrees(p[0], p[1], NaN));
       const levels = positions.map((c) => provider.availability.computeMaximumLevelAtPosition(c));
+      // The tile of each point at its level, as the provider's tiling scheme has it:
+      // [x, y (from the north), west, south, east, north (degrees)].
+      const scheme = provider.tilingScheme;
+      const tiles = positions.map((c, k) => {
+        const xy = scheme.positionToTileXY(c, levels[k]);
+        const r = scheme.tileXYToRectangle(xy.x, xy.y, levels[k]);
+        return [xy.x, xy.y, r.west, r.south, r.east, r.north].map(
+          (v, i) => (i < 2 ? v : Cesium.Math.toDegrees(v)));
+      });
+      const tiling = scheme instanceof Cesium.WebMercatorTilingScheme ? 'mercator' : 'geographic';
       await Cesium.sampleTerrainMostDetailed(provider, positions);
-      const out = { heights: positions.map((c) => c.height), levels };
+      const out = { heights: positions.map((c) => c.height), levels, tiles, tiling };
       if (waterTile) {
         const [z, x, y] = waterTile.split('/').map(Number);
         // Z/X/Y as the pyramid names it (TMS, y = 0 in the south); CesiumJS counts rows

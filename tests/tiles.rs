@@ -1831,3 +1831,37 @@ fn a_regional_pyramid_draws_the_whole_globe_with_its_data_on_it() {
         "the same tiles but the root without data"
     );
 }
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn web_mercator_tiles_the_part_of_a_raster_within_85_degrees_and_refuses_one_beyond() {
+    let dir = Dir::new();
+    let hills = |lon: f64, lat: f64| 500.0 + 300.0 * (lon * 3.0).sin() * (lat * 5.0).cos();
+    // 83..88°N: the part up to 85.0511° (Web Mercator's edge) is tiled.
+    let arctic = ascii_grid(&dir, "arctic.asc", (10.0, 83.0, 0.02), (200, 250), hills);
+    pyramid(&dir, &arctic, "p", &["--tiling", "mercator", "-q"]);
+    let (layer, bounds) = layer_json(&dir.path("p"));
+    assert_eq!(layer["projection"], "EPSG:3857");
+    let edge = Tiling::Mercator.rectangle(0, 0, 0)[3];
+    assert!((edge - 85.051_128_779_806_6).abs() < 1e-9, "{edge}");
+    assert!(
+        (bounds[3] - edge).abs() < 1e-9 && bounds[1] == 83.0,
+        "{bounds:?}"
+    );
+    let max_zoom = layer["maxzoom"].as_u64().unwrap() as u32;
+    let tiles = decode_pyramid(&dir.path("p"));
+    let mut top_row = 0;
+    for (&(z, x, y), t) in tiles.range((max_zoom, 0, 0)..) {
+        top_row += usize::from(y + 1 == 1 << z);
+        let samples = tiled_gdal_samples(&dir, &arctic, Tiling::Mercator, z, x, y);
+        let bound = Tiling::Mercator.level_error(z);
+        let e = max_error(t, &samples);
+        assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
+    }
+    assert!(top_row > 0, "no tile reaches the edge");
+    // 86..89°N: nothing to tile.
+    let pole = ascii_grid(&dir, "pole.asc", (10.0, 86.0, 0.02), (100, 150), hills);
+    let o = dir.run(&["tiles", &pole, "-o", "q", "--tiling", "mercator"]);
+    assert_fails_naming(&o, &["pole.asc", "85.0511", "--tiling geographic"]);
+    assert!(!dir.path("q").exists());
+}

@@ -1,6 +1,7 @@
 //! A Cesium quantized-mesh terrain pyramid: geographic TMS tiles (EPSG:4326, 2x1 root
-//! tiles, y = 0 in the south), each decimated within `quality x e(level)`, with shared
-//! edges simplified once so that same-level neighbours keep identical edge vertices.
+//! tiles, y = 0 in the south) or Web Mercator ones (EPSG:3857, 1x1, see [`Tiling`]), each
+//! decimated within `quality x e(level)`, with shared edges simplified once so that
+//! same-level neighbours keep identical edge vertices.
 
 use std::path::Path;
 

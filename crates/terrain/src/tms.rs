@@ -294,3 +294,74 @@ impl TileRect {
         dx < i64::from(self.width) && y >= self.y0 && y - self.y0 < self.height
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The largest |position among level `level + 1`'s rows - index| over the rows of
+    /// the lattice half as fine as `level`'s (what the coarser filter reads), over the
+    /// tiles `tiles` of `level`.
+    fn row_offset(level: u8, tiles: impl Iterator<Item = u64>) -> f64 {
+        let cells = u64::from(TILE_CELLS);
+        let n = 1u64 << level;
+        let mut worst = 0.0f64;
+        for t in tiles {
+            for h in 0..=2 * cells {
+                let row = 2 * cells * t + h;
+                let half = GeoLattice {
+                    latitudes: Latitudes::WebMercatorTiles {
+                        cells: 2 * TILE_CELLS,
+                        tiles: n,
+                    },
+                    first_row: row,
+                    ..Tiling::Mercator.lattice(level, 0, 0, 1, 1)
+                };
+                let position = Tiling::Mercator.row_position(level + 1, half.lat(0));
+                worst = worst.max((position - row as f64).abs());
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn tiles_split_at_their_mercator_middle_by_a_bounded_offset() {
+        // Run with --nocapture for the table of offsets (rows of the finer level).
+        for level in 0..=12u8 {
+            let n = 1u64 << level;
+            // Every tile up to level 6, then the northern 64 (the worst) and the equator.
+            let tiles: Vec<u64> = if n <= 64 {
+                (0..n).collect()
+            } else {
+                (n - 64..n).chain(n / 2 - 2..n / 2 + 2).collect()
+            };
+            let offset = row_offset(level, tiles.into_iter());
+            println!("level {level}: {offset:.2} rows");
+            assert!(
+                offset <= Tiling::Mercator.max_row_offset(level) as f64,
+                "{level}"
+            );
+            if level == 1 {
+                // Rows taken as every other finer row would sit 100+ rows off.
+                assert!(offset > 100.0);
+            }
+        }
+        assert_eq!(Tiling::Geographic.max_row_offset(3), 0);
+    }
+
+    #[test]
+    fn mercator_rectangles_meet_and_end_at_85_degrees() {
+        let top = Tiling::Mercator.tile_rectangle(3, 5, 7);
+        assert!((top.north - 85.051_128_779_806_59).abs() < 1e-12);
+        assert_eq!(Tiling::Mercator.tile_rectangle(1, 0, 0).north, 0.0);
+        let (a, b) = (
+            Tiling::Mercator.tile_rectangle(9, 3, 300),
+            Tiling::Mercator.tile_rectangle(9, 3, 301),
+        );
+        assert_eq!(a.north, b.south);
+        // The lattice's edge rows are the rectangles' edges, to the bit.
+        let row = |r: i64| Tiling::Mercator.row_latitude(9, r);
+        assert_eq!(row(301 * i64::from(TILE_CELLS)), b.south);
+        assert_eq!(row(302 * i64::from(TILE_CELLS)), b.north);
+    }
+}

@@ -27,7 +27,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 PICTURES = [("bigtujunga", 30.0, 800), ("fuji", 20.0, 560)]
 # (name, DEM under ../shared/data, terrain directory, camera: lon, lat, height m, heading,
 # pitch, vertical exaggeration; variant: none, "below-0" for a water mask of the DEM's
-# samples below 0 m, or "data-only" for `--data-only`)
+# samples below 0 m, "data-only" for `--data-only`, or "mercator" for `--tiling mercator`)
 CESIUM = [
     ("cesium-global", "dem/etopo5_global_5arcmin.tif", "etopo5",
      (85, 25, 11_000_000, 0, -90, 20), None),
@@ -39,6 +39,10 @@ CESIUM = [
      (-118.19, 34.16, 15_000_000, 0, -90, 1), None),
     ("cesium-regional-data-only", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga-data-only",
      (-118.19, 34.16, 15_000_000, 0, -90, 1), "data-only"),
+    ("cesium-mercator-global", "dem/etopo5_global_5arcmin.tif", "etopo5-mercator",
+     (85, 25, 11_000_000, 0, -90, 20), "mercator"),
+    ("cesium-mercator-close", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga-mercator",
+     (-118.19, 34.16, 9_000, 20, -30, 1), "mercator"),
 ]
 PAGE = ("<!doctype html><html><head><link rel=\"icon\" href=\"data:,\">"
         "<script>window.CESIUM_BASE_URL = '/cesium/';</script>"
@@ -121,7 +125,8 @@ def cesium_pictures(args, data, out, tmp):
         if terrain in built:
             continue
         built.add(terrain)
-        extra = ["--data-only"] if variant == "data-only" else []
+        extra = {"data-only": ["--data-only"], "mercator": ["--tiling", "mercator"]}.get(
+            variant, [])
         if variant == "below-0":
             # 255 (water) where the DEM is below 0 m, 0 elsewhere: -scale maps 0 m to 0
             # and -1 m to 255, and Byte clips the rest.
@@ -167,6 +172,14 @@ def cesium_pictures(args, data, out, tmp):
         "|---|---|",
         "| ![the whole globe](images/cesium-regional-globe.png) "
         "| ![a speck, no globe](images/cesium-regional-data-only.png) |",
+        "",
+        "The first two pyramids with `--tiling mercator` (Web Mercator tiles, EPSG:3857; "
+        "ETOPO5 to level 5, its own), at the same cameras:",
+        "",
+        "| ETOPO5, Web Mercator | Big Tujunga, Web Mercator |",
+        "|---|---|",
+        "| ![ETOPO5 in Web Mercator tiles](images/cesium-mercator-global.png) "
+        "| ![Big Tujunga in Web Mercator tiles](images/cesium-mercator-close.png) |",
         "",
     ]
 

@@ -227,7 +227,7 @@ impl LevelReport {
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct TerrainReport {
     /// The input's extent in EPSG:4326, `[west, south, east, north]`: west > east across
-    /// the antimeridian.
+    /// the antimeridian; Web Mercator tiles' only up to their ±85.0511° latitude.
     pub bounds: [f64; 4],
     /// Coarsest level.
     pub min_zoom: u8,
@@ -245,12 +245,13 @@ pub struct TerrainReport {
 /// # Guarantees
 /// - **A tile is a function of its own data.** The bytes of tile z/x/y depend only on the
 ///   input, z/x/y and the options that shape tiles (band, quality, normals, metadata,
-///   gzip): not on `--min-zoom`, `--max-zoom` (except the metadata extension of levels
+///   gzip, tiling...): not on `--min-zoom`, `--max-zoom` (except the metadata extension of levels
 ///   0, 10 and 20, which lists the tiles below down to `--max-zoom`), the threads, or
 ///   which other tiles a run (or a shard of one, [`crate::build_shard`]) builds. Level L's
 ///   lattice is defined once: the raster's own level is sampled from the raster (bilinear,
 ///   each sample from its position alone), each coarser level is the finer one filtered
-///   (binomial 5 x 5) and halved, and each finer level is sampled alone.
+///   (binomial 5 x 5) and halved (Web Mercator: filtered from the finer rows resampled
+///   in latitude, see [`Tiling::Mercator`]), and each finer level is sampled alone.
 /// - **Bound.** At every valid sample of a tile's grid (its `(TILE_CELLS + 1)^2` lattice
 ///   points of its level), the decoded tile (float32 min/max, 16-bit heights) is within
 ///   `quality x e(level)` of the sample, or within half the level's height quantum and

@@ -142,8 +142,9 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         crate::scan::scan_raster(&job.input, job.band, job.vertical_datum.as_ref(), feedback)?;
     crate::output_paths::note_gcps_unused(&info, job.pixel_coords, feedback);
     let source = RasterSource::new(&info)?;
-    let (source, variables) = if job.variables.is_empty() {
-        (source, Vec::new())
+    // `_resampled`: the --attributes files put on the input's grid, read until the end.
+    let (source, variables, _resampled) = if job.variables.is_empty() {
+        (source, Vec::new(), Vec::new())
     } else {
         crate::variables::tiled_source(&job.input, (source, &info), &job.variables)?
     };
@@ -277,12 +278,7 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     );
     json.variables = (variables.iter())
         .zip(&report.variables_measured_max_error)
-        .map(|((v, name), &measured)| crate::VariableReport {
-            band: v.band,
-            name: name.clone(),
-            max_error: v.max_error,
-            measured_max_error: measured,
-        })
+        .map(|((v, name), &measured)| crate::VariableReport::new(v, name, measured))
         .collect();
     json.summary.print(
         &format!(" in {} tiles of {}", json.tiles.count, json.tiles.size),

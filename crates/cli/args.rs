@@ -153,7 +153,7 @@ pub struct TilesArgs {
     pub water: Option<String>,
     /// Only the raster's data: no triangles beyond it, no root tile it does not reach
     /// (a layer to draw over another pyramid). Without it, the globe beyond the raster is
-    /// flat at height 0 (the ellipsoid) and both root tiles are written, so that a client
+    /// flat at height 0 (the ellipsoid) and every root tile is written, so that a client
     /// shows the whole globe with the data on it.
     #[arg(long)]
     pub data_only: bool,

@@ -27,8 +27,8 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 PICTURES = [("bigtujunga", 30.0, 800), ("fuji", 20.0, 560)]
 # (name, DEM under ../shared/data, terrain directory, camera: lon, lat, height m, heading,
 # pitch, vertical exaggeration; variant: none, "below-0" for a water mask of the DEM's
-# samples below 0 m, "data-only" for `--data-only`, or "3dtiles" for `--format 3dtiles`,
-# loaded through Cesium3DTilesTerrainProvider)
+# samples below 0 m, "data-only" for `--data-only`, "mercator" for `--tiling mercator`, or
+# "3dtiles" for `--format 3dtiles`, loaded through Cesium3DTilesTerrainProvider)
 CESIUM = [
     ("cesium-global", "dem/etopo5_global_5arcmin.tif", "etopo5",
      (85, 25, 11_000_000, 0, -90, 20), None),
@@ -46,6 +46,10 @@ CESIUM = [
      (-118.19, 34.16, 60_000, 20, -60, 1), None),
     ("cesium-60km-3dtiles", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga-3dtiles",
      (-118.19, 34.16, 60_000, 20, -60, 1), "3dtiles"),
+    ("cesium-mercator-global", "dem/etopo5_global_5arcmin.tif", "etopo5-mercator",
+     (85, 25, 11_000_000, 0, -90, 20), "mercator"),
+    ("cesium-mercator-close", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga-mercator",
+     (-118.19, 34.16, 9_000, 20, -30, 1), "mercator"),
 ]
 PAGE = ("<!doctype html><html><head><link rel=\"icon\" href=\"data:,\">"
         "<script>window.CESIUM_BASE_URL = '/cesium/';</script>"
@@ -128,7 +132,8 @@ def cesium_pictures(args, data, out, tmp):
         if terrain in built:
             continue
         built.add(terrain)
-        extra = {"data-only": ["--data-only"], "3dtiles": ["--format", "3dtiles"]}.get(variant, [])
+        extra = {"data-only": ["--data-only"], "mercator": ["--tiling", "mercator"],
+                 "3dtiles": ["--format", "3dtiles"]}.get(variant, [])
         if variant == "below-0":
             # 255 (water) where the DEM is below 0 m, 0 elsewhere: -scale maps 0 m to 0
             # and -1 m to 255, and Byte clips the rest.
@@ -191,6 +196,14 @@ def cesium_pictures(args, data, out, tmp):
         "| ![quantized-mesh](images/cesium-60km.png) "
         "| ![3D Tiles](images/cesium-60km-3dtiles.png) "
         "| ![3D Tiles, close](images/cesium-close-3dtiles.png) |",
+        "",
+        "The first two pyramids with `--tiling mercator` (Web Mercator tiles, EPSG:3857; "
+        "ETOPO5 to level 5, its own), at the same cameras:",
+        "",
+        "| ETOPO5, Web Mercator | Big Tujunga, Web Mercator |",
+        "|---|---|",
+        "| ![ETOPO5 in Web Mercator tiles](images/cesium-mercator-global.png) "
+        "| ![Big Tujunga in Web Mercator tiles](images/cesium-mercator-close.png) |",
         "",
     ]
 

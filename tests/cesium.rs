@@ -2,7 +2,8 @@
 //! (`CesiumTerrainProvider.fromUrl`, `sampleTerrainMostDetailed`), from the directory
 //! `tinsmith tiles` wrote and from the same pyramid in an MBTiles file (served by a second
 //! server, so the page loads it across origins, through CORS), and a pyramid of EGM96
-//! heights turned into ellipsoidal ones (`--vertical-datum egm96`). A missing CesiumJS or
+//! heights turned into ellipsoidal ones (`--vertical-datum egm96`), and a Web Mercator
+//! pyramid (`--tiling mercator`). A missing CesiumJS or
 //! Chromium install, or a Chromium that cannot start, fails. `#[ignore]`d so that `cargo
 //! test` passes with only GDAL installed; `make test` runs it (`--include-ignored`).
 
@@ -11,7 +12,9 @@ use std::process::Command;
 
 use serde_json::Value;
 
-use crate::tiles::{ascii_grid, decode_pyramid, egm96_undulations, gdal_samples};
+use crate::tiles::{
+    ascii_grid, decode_pyramid, egm96_undulations, gdal_samples, tiled_gdal_samples, Tiling,
+};
 use crate::util::{fixture, serve, stderr, Dir};
 
 /// `DIR/site/`: CesiumJS (linked from `.tools`) and a page that loads it, beside the
@@ -288,4 +291,112 @@ fn cesiumjs_samples_the_3dtiles_pyramid_as_the_quantized_mesh_one() {
         "quantized-mesh {:?}\n3D Tiles       {:?}",
         heights[0], heights[1]
     );
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn cesiumjs_samples_a_web_mercator_pyramid_within_the_bound() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = Dir::new();
+    // At 49°N, where a Web Mercator tile's rows (even in latitude) are far from even in
+    // Web Mercator y at coarse levels.
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    let o = dir.run(&[
+        "tiles",
+        &input,
+        "-o",
+        "site/terrain",
+        "--normals",
+        "--tiling",
+        "mercator",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    cesium_page(&dir);
+    let layer: Value =
+        serde_json::from_slice(&std::fs::read(dir.path("site/terrain/layer.json")).unwrap())
+            .unwrap();
+    assert_eq!(layer["projection"], "EPSG:3857");
+    let z = layer["maxzoom"].as_u64().unwrap() as u32;
+    let tiles = decode_pyramid(&dir.path("site/terrain"));
+    let finest: Vec<(u32, u32)> = tiles
+        .keys()
+        .filter(|k| k.0 == z)
+        .map(|k| (k.1, k.2))
+        .collect();
+    assert!(finest.len() > 1);
+
+    // Points on the finest tiles' sample lattices (even in longitude and in latitude
+    // across each tile), away from their edges, with GDAL's warp of the same lattice.
+    let mut points = Vec::new();
+    let mut expected = Vec::new();
+    let mut tile_of = Vec::new();
+    for &(x, y) in &finest {
+        let samples = tiled_gdal_samples(&dir, &input, Tiling::Mercator, z, x, y);
+        let [west, south, east, north] = Tiling::Mercator.rectangle(z, x, y);
+        let valid: Vec<(usize, usize)> = (3..215)
+            .flat_map(|j| (3..215).map(move |i| (i, j)))
+            .filter(|&(i, j)| samples[j][i].is_finite())
+            .collect();
+        for k in 0..4 {
+            let Some(&(i, j)) = valid.get(k * valid.len() / 4 + valid.len() / 8) else {
+                continue;
+            };
+            let (u, v) = (i as f64 / 217.0, j as f64 / 217.0);
+            points.push([west + u * (east - west), south + v * (north - south)]);
+            expected.push(samples[j][i]);
+            tile_of.push((x, y));
+        }
+    }
+    assert!(points.len() >= 6, "too few sample points with data");
+    let points_file = dir.write("points.json", &serde_json::to_string(&points).unwrap());
+    let (_server, base) = serve(&dir, &["site"]);
+    let out = Command::new("node")
+        .arg(repo.join("tests/oracle/cesium_sample.cjs"))
+        .arg(format!("{base}index.html"))
+        .arg(format!("{base}terrain/"))
+        .arg(&points_file)
+        .output()
+        .expect("node runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let result: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
+    assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
+    assert_eq!(result["tiling"], "mercator", "{result}");
+    let bound = Tiling::Mercator.level_error(z);
+    for (k, want) in expected.iter().enumerate() {
+        assert_eq!(result["levels"][k].as_u64(), Some(z as u64), "{result}");
+        // CesiumJS's tile of the point is the one whose lattice it was taken from, with
+        // the same rectangle.
+        let tile: Vec<f64> = result["tiles"][k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let (x, y) = tile_of[k];
+        assert_eq!(
+            (tile[0], tile[1]),
+            (x as f64, ((1u64 << z) - 1 - y as u64) as f64),
+            "point {k}"
+        );
+        let ours = Tiling::Mercator.rectangle(z, x, y);
+        for (a, b) in ours.iter().zip(&tile[2..]) {
+            assert!(
+                (a - b).abs() < 1e-9,
+                "point {k}: rectangle {ours:?} vs {tile:?}"
+            );
+        }
+        let got = result["heights"][k]
+            .as_f64()
+            .unwrap_or_else(|| panic!("point {k} has no height: {result}"));
+        assert!(
+            (got - want).abs() <= bound + 1e-3,
+            "point {k}: CesiumJS {got}, DEM {want}, bound {bound}"
+        );
+    }
 }

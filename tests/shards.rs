@@ -87,6 +87,30 @@ fn shards_keep_the_vertical_datum_through_the_merge() {
 }
 
 #[test]
+fn web_mercator_shards_and_updates_are_the_one_process_pyramid_and_keep_their_tiling() {
+    let dir = Dir::new();
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    let mercator = ["--tiling", "mercator", "--normals"];
+    check_shards(&dir, &input, &mercator, &[2, 7]);
+    // The tiling shapes the tiles: a geographic shard is another plan, refused before it
+    // writes into the Web Mercator one.
+    let before = pyramid_files(&dir.path("sharded-2"));
+    let o = dir.run(&["tiles", &input, "-o", "sharded-2", "--shard", "0/2", "-q"]);
+    assert_fails_naming(&o, &["another plan", "tiling", "mercator"]);
+    assert!(pyramid_files(&dir.path("sharded-2")) == before);
+    // An update to the other tiling rebuilds every tile and leaves none of the old one:
+    // the pyramid is the one built afresh.
+    run_ok(
+        &dir,
+        &["tiles", &input, "-o", "geographic", "--normals", "-q"],
+    );
+    let mut args = vec!["tiles", input.as_str(), "-o", "one", "--update", "-q"];
+    args.extend_from_slice(&["--normals"]);
+    run_ok(&dir, &args);
+    assert!(pyramid_files(&dir.path("one")) == pyramid_files(&dir.path("geographic")));
+}
+
+#[test]
 fn shards_of_a_globe_meet_across_the_antimeridian() {
     let dir = Dir::new();
     let input = fixture("etopo5_2deg_i16.tif");

@@ -444,12 +444,16 @@ fn a_3dtiles_pyramid_anywhere_but_a_whole_new_directory_is_refused() {
             &["-o", "d", "--shard", "0/2"][..],
             &["shards", "3dtiles"][..],
         ),
+        (
+            &["-o", "e", "--tiling", "mercator"][..],
+            &["--tiling mercator", "3dtiles"][..],
+        ),
     ] {
         let mut args = vec!["tiles", input.as_str(), "--format", "3dtiles"];
         args.extend_from_slice(extra);
         let o = dir.run(&args);
         assert_fails_naming(&o, names);
-        for out in ["t.mbtiles", "a", "b", "c"] {
+        for out in ["t.mbtiles", "a", "b", "c", "e"] {
             assert!(!dir.path(out).exists(), "{out} was written");
         }
     }

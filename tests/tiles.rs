@@ -261,12 +261,76 @@ pub(crate) fn max_error(t: &Tile, samples: &[Vec<f64>]) -> f64 {
     err.values().fold(0.0, |m, &e| m.max(e))
 }
 
-/// The tile's lattice warped by the gdalwarp program (bilinear), row 0 the southernmost.
+/// How a pyramid's tiles divide the globe (`--tiling`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Tiling {
+    Geographic,
+    Mercator,
+}
+
+impl Tiling {
+    /// The `--tiling` value.
+    pub(crate) fn arg(self) -> &'static str {
+        match self {
+            Tiling::Geographic => "geographic",
+            Tiling::Mercator => "mercator",
+        }
+    }
+
+    /// Tile `z/x/y` (TMS y) as `[west, south, east, north]` degrees. A Web Mercator tile
+    /// is square in EPSG:3857 (spherical: y = ln tan(pi/4 + lat/2)); its southern and
+    /// northern edges are the latitudes of its y edges.
+    pub(crate) fn rectangle(self, z: u32, x: u32, y: u32) -> [f64; 4] {
+        let n = (1u64 << z) as f64;
+        match self {
+            Tiling::Geographic => {
+                let size = 180.0 / n;
+                let (west, south) = (-180.0 + x as f64 * size, -90.0 + y as f64 * size);
+                [west, south, west + size, south + size]
+            }
+            Tiling::Mercator => {
+                let lat = |k: f64| {
+                    let y = std::f64::consts::PI * (2.0 * k / n - 1.0);
+                    y.sinh().atan().to_degrees()
+                };
+                let size = 360.0 / n;
+                let west = -180.0 + x as f64 * size;
+                [west, lat(y as f64), west + size, lat(y as f64 + 1.0)]
+            }
+        }
+    }
+
+    /// Cesium's geometric error of level `z`: its level-0 error divides by the root
+    /// tiles' columns (2 geographic, 1 Web Mercator).
+    pub(crate) fn level_error(self, z: u32) -> f64 {
+        let e0 = match self {
+            Tiling::Geographic => E0,
+            Tiling::Mercator => 2.0 * E0,
+        };
+        e0 / (1u64 << z) as f64
+    }
+}
+
+/// The geographic tile's lattice warped by the gdalwarp program (bilinear), row 0 the
+/// southernmost.
 pub(crate) fn gdal_samples(dir: &Dir, input: &str, z: u32, x: u32, y: u32) -> Vec<Vec<f64>> {
-    let size = 180.0 / (1u64 << z) as f64;
-    let d = size / CELLS as f64;
-    let (west, south) = (-180.0 + x as f64 * size, -90.0 + y as f64 * size);
-    let out = dir.path(&format!("warp_{z}_{x}_{y}.asc"));
+    tiled_gdal_samples(dir, input, Tiling::Geographic, z, x, y)
+}
+
+/// The lattice of tile `z/x/y` of `tiling` (218 x 218 points evenly spaced in longitude and
+/// in latitude across the tile's rectangle, as CesiumJS places `u` and `v`) warped by the
+/// gdalwarp program (bilinear), row 0 the southernmost.
+pub(crate) fn tiled_gdal_samples(
+    dir: &Dir,
+    input: &str,
+    tiling: Tiling,
+    z: u32,
+    x: u32,
+    y: u32,
+) -> Vec<Vec<f64>> {
+    let [west, south, east, north] = tiling.rectangle(z, x, y);
+    let (dx, dy) = ((east - west) / CELLS as f64, (north - south) / CELLS as f64);
+    let out = dir.path(&format!("warp_{}_{z}_{x}_{y}.asc", tiling.arg()));
     let status = Command::new("gdalwarp")
         .args([
             "-q",
@@ -283,10 +347,10 @@ pub(crate) fn gdal_samples(dir: &Dir, input: &str, z: u32, x: u32, y: u32) -> Ve
         .args(["-of", "AAIGrid", "-dstnodata", "-99999", "-te"])
         .args(
             [
-                west - d / 2.0,
-                south - d / 2.0,
-                west + size + d / 2.0,
-                south + size + d / 2.0,
+                west - dx / 2.0,
+                south - dy / 2.0,
+                east + dx / 2.0,
+                north + dy / 2.0,
             ]
             .map(|v| format!("{v:.17}")),
         )
@@ -361,30 +425,35 @@ pub(crate) fn all_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
 
 /// Checks the pyramid of `input` at `quality`; `flat_roots` root tiles have no data.
 fn check_pyramid(input: &str, quality: f64, flat_roots: usize) {
+    check_tiled_pyramid(input, quality, flat_roots, Tiling::Geographic);
+}
+
+/// Checks the pyramid of `input` at `quality` with `tiling`; `flat_roots` root tiles have
+/// no data.
+fn check_tiled_pyramid(input: &str, quality: f64, flat_roots: usize, tiling: Tiling) {
     let dir = Dir::new();
     let q = quality.to_string();
     let report = dir.path("one.json").to_string_lossy().into_owned();
+    let common = [
+        "--quality",
+        &q,
+        "--normals",
+        "--metadata",
+        "--tiling",
+        tiling.arg(),
+    ];
+    let with = |extra: &[&'static str]| [&common[..], extra].concat();
     pyramid(
         &dir,
         input,
         "one",
         &[
-            "--quality",
-            &q,
-            "--normals",
-            "--metadata",
-            "--threads",
-            "1",
-            "--report",
-            &report,
-        ],
+            &with(&["--threads", "1", "--report"])[..],
+            &[report.as_str()],
+        ]
+        .concat(),
     );
-    pyramid(
-        &dir,
-        input,
-        "two",
-        &["--quality", &q, "--normals", "--metadata", "--threads", "2"],
-    );
+    pyramid(&dir, input, "two", &with(&["--threads", "2"]));
     let (one, two) = (all_files(&dir.path("one")), all_files(&dir.path("two")));
     assert!(one == two, "1 and 2 threads wrote different bytes");
     #[cfg(unix)]
@@ -407,6 +476,11 @@ fn check_pyramid(input: &str, quality: f64, flat_roots: usize) {
     let layer: Value = serde_json::from_slice(&one[Path::new("layer.json")]).unwrap();
     assert_eq!(layer["format"], "quantized-mesh-1.0");
     assert_eq!(layer["scheme"], "tms");
+    let projection = match tiling {
+        Tiling::Geographic => "EPSG:4326",
+        Tiling::Mercator => "EPSG:3857",
+    };
+    assert_eq!(layer["projection"], projection);
     assert_eq!(layer["metadataAvailability"], 10);
     let max_zoom = layer["maxzoom"].as_u64().unwrap() as u32;
 
@@ -433,8 +507,13 @@ fn check_pyramid(input: &str, quality: f64, flat_roots: usize) {
     // Both root tiles are written (the whole globe; CesiumJS requests both with
     // metadataAvailability too): one the raster does not reach is flat at height 0, with
     // no tile below it.
-    let empty: Vec<_> = [(0u32, 0u32, 0u32), (0, 1, 0)]
-        .into_iter()
+    let roots: &[(u32, u32, u32)] = match tiling {
+        Tiling::Geographic => &[(0, 0, 0), (0, 1, 0)],
+        Tiling::Mercator => &[(0, 0, 0)],
+    };
+    let empty: Vec<_> = roots
+        .iter()
+        .copied()
         .filter(|&(_, x, _)| !tiles.keys().any(|&(z, cx, _)| z == 1 && cx / 2 == x))
         .collect();
     assert_eq!(
@@ -509,8 +588,8 @@ fn check_pyramid(input: &str, quality: f64, flat_roots: usize) {
     // The finest level against GDAL's own warp of each tile's lattice.
     let mut checked = 0;
     for (&(z, x, y), t) in tiles.range((max_zoom, 0, 0)..) {
-        let bound = quality * E0 / (1u64 << z) as f64;
-        let samples = gdal_samples(&dir, input, z, x, y);
+        let bound = quality * tiling.level_error(z);
+        let samples = tiled_gdal_samples(&dir, input, tiling, z, x, y);
         let e = max_error(t, &samples);
         assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
         checked += 1;
@@ -528,6 +607,25 @@ fn a_mercator_pyramid_decodes_stitches_and_keeps_its_bound() {
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn an_albers_pyramid_decodes_stitches_and_keeps_its_bound() {
     check_pyramid(&fixture("becmodel_dem_bc_albers_50m.tif"), 0.5, 1);
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn web_mercator_pyramids_decode_stitch_and_keep_their_bound() {
+    // At 49°N a Web Mercator tile's latitude middle is well south of its Web Mercator
+    // middle, where it splits; the lattice stays even in latitude inside each tile.
+    check_tiled_pyramid(
+        &fixture("becmodel_dem_bc_albers_50m.tif"),
+        0.5,
+        0,
+        Tiling::Mercator,
+    );
+    check_tiled_pyramid(
+        &fixture("tintn_valid_raster_3857.tif"),
+        1.0,
+        0,
+        Tiling::Mercator,
+    );
 }
 
 /// Great-circle angle, in radians, between two decoded vertices of tile `z/x/y`.
@@ -1733,4 +1831,38 @@ fn a_regional_pyramid_draws_the_whole_globe_with_its_data_on_it() {
         data.keys().collect::<Vec<_>>()[..],
         "the same tiles but the root without data"
     );
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn web_mercator_tiles_the_part_of_a_raster_within_85_degrees_and_refuses_one_beyond() {
+    let dir = Dir::new();
+    let hills = |lon: f64, lat: f64| 500.0 + 300.0 * (lon * 3.0).sin() * (lat * 5.0).cos();
+    // 83..88°N: the part up to 85.0511° (Web Mercator's edge) is tiled.
+    let arctic = ascii_grid(&dir, "arctic.asc", (10.0, 83.0, 0.02), (200, 250), hills);
+    pyramid(&dir, &arctic, "p", &["--tiling", "mercator", "-q"]);
+    let (layer, bounds) = layer_json(&dir.path("p"));
+    assert_eq!(layer["projection"], "EPSG:3857");
+    let edge = Tiling::Mercator.rectangle(0, 0, 0)[3];
+    assert!((edge - 85.051_128_779_806_6).abs() < 1e-9, "{edge}");
+    assert!(
+        (bounds[3] - edge).abs() < 1e-9 && bounds[1] == 83.0,
+        "{bounds:?}"
+    );
+    let max_zoom = layer["maxzoom"].as_u64().unwrap() as u32;
+    let tiles = decode_pyramid(&dir.path("p"));
+    let mut top_row = 0;
+    for (&(z, x, y), t) in tiles.range((max_zoom, 0, 0)..) {
+        top_row += usize::from(y + 1 == 1 << z);
+        let samples = tiled_gdal_samples(&dir, &arctic, Tiling::Mercator, z, x, y);
+        let bound = Tiling::Mercator.level_error(z);
+        let e = max_error(t, &samples);
+        assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
+    }
+    assert!(top_row > 0, "no tile reaches the edge");
+    // 86..89°N: nothing to tile.
+    let pole = ascii_grid(&dir, "pole.asc", (10.0, 86.0, 0.02), (100, 150), hills);
+    let o = dir.run(&["tiles", &pole, "-o", "q", "--tiling", "mercator"]);
+    assert_fails_naming(&o, &["pole.asc", "85.0511", "--tiling geographic"]);
+    assert!(!dir.path("q").exists());
 }

@@ -10,6 +10,7 @@ use clap::{Args, Parser, Subcommand};
 use tinsmith_formats::MeshFormat;
 use tinsmith_pipeline::{PreviewJob, ServeOptions, VerifyJob};
 use tinsmith_terrain::{TerrainOptions, TileFormat};
+use values::TilingArg;
 
 pub use contour::ContourArgs;
 pub use mesh::MeshArgs;
@@ -152,10 +153,13 @@ pub struct TilesArgs {
     pub water: Option<String>,
     /// Only the raster's data: no triangles beyond it, no root tile it does not reach
     /// (a layer to draw over another pyramid). Without it, the globe beyond the raster is
-    /// flat at height 0 (the ellipsoid) and both root tiles are written, so that a client
+    /// flat at height 0 (the ellipsoid) and every root tile is written, so that a client
     /// shows the whole globe with the data on it.
     #[arg(long)]
     pub data_only: bool,
+    /// How tiles divide the globe (layer.json's projection).
+    #[arg(long, value_enum, default_value_t = TilingArg::Geographic)]
+    pub tiling: TilingArg,
     /// Coarsest level written.
     #[arg(long, default_value_t = 0)]
     pub min_zoom: u8,
@@ -329,6 +333,7 @@ impl TilesArgs {
             water: None,
             whole_globe: !self.data_only,
             format: self.format,
+            tiling: self.tiling.into(),
         }
     }
 }

@@ -4,7 +4,8 @@
 // terrain, loaded through Cesium3DTilesTerrainProvider.fromUrl (its levels are read after
 // sampling: its availability comes with the subtrees the sampling loads).
 // Usage: node cesium_sample.cjs PAGE_URL TERRAIN_URL POINTS_JSON_FILE [Z/X/Y]
-// Prints {heights, consoleErrors, failedRequests, levels}; with Z/X/Y, the provider asks
+// Prints {heights, consoleErrors, failedRequests, levels, tiles, tiling} (each point's
+// tile at its level, and the provider's tiling scheme); with Z/X/Y, the provider asks
 // for water masks too and the result adds that tile's (TMS numbering) {hasWaterMask,
 // waterMask} as CesiumJS decoded it. Exit code 3: Chromium cannot
 // start (the caller may skip); any other non-zero code is a failure.
@@ -48,10 +49,21 @@ const { chromium } = require(path.join(root, '.tools', 'node_modules', 'playwrig
         : await Cesium.CesiumTerrainProvider.fromUrl(terrainUrl, options);
       const positions = points.map((p) => Cesium.Cartographic.fromDegrees(p[0], p[1], NaN));
       const levelsOf = () => positions.map((c) => provider.availability.computeMaximumLevelAtPosition(c));
+      // 3D Tiles availability is known only once the subtrees are loaded.
       let levels = tiles3d ? null : levelsOf();
       await Cesium.sampleTerrainMostDetailed(provider, positions);
       if (tiles3d) levels = levelsOf();
-      const out = { heights: positions.map((c) => c.height), levels };
+      // The tile of each point at its level, as the provider's tiling scheme has it:
+      // [x, y (from the north), west, south, east, north (degrees)].
+      const scheme = provider.tilingScheme;
+      const tiles = positions.map((c, k) => {
+        const xy = scheme.positionToTileXY(c, levels[k]);
+        const r = scheme.tileXYToRectangle(xy.x, xy.y, levels[k]);
+        return [xy.x, xy.y, r.west, r.south, r.east, r.north].map(
+          (v, i) => (i < 2 ? v : Cesium.Math.toDegrees(v)));
+      });
+      const tiling = scheme instanceof Cesium.WebMercatorTilingScheme ? 'mercator' : 'geographic';
+      const out = { heights: positions.map((c) => c.height), levels, tiles, tiling };
       if (waterTile) {
         const [z, x, y] = waterTile.split('/').map(Number);
         // Z/X/Y as the pyramid names it (TMS, y = 0 in the south); CesiumJS counts rows

@@ -148,3 +148,22 @@ mod tests {
         check::<VertexHeightsArg, _>(VertexHeights::from, VertexHeights::name);
     }
 }
+
+#[derive(Debug, Clone, Copy, Default, ValueEnum)]
+pub enum TilingArg {
+    /// EPSG:4326 (CesiumJS's default): two root tiles, tiles square in degrees.
+    #[default]
+    Geographic,
+    /// EPSG:3857 (Web Mercator): one root tile, tiles square in Web Mercator; the part of
+    /// the raster beyond ±85.0511° latitude is left out.
+    Mercator,
+}
+
+impl From<TilingArg> for tinsmith_terrain::Tiling {
+    fn from(t: TilingArg) -> tinsmith_terrain::Tiling {
+        match t {
+            TilingArg::Geographic => tinsmith_terrain::Tiling::Geographic,
+            TilingArg::Mercator => tinsmith_terrain::Tiling::Mercator,
+        }
+    }
+}

@@ -29,11 +29,12 @@ pub struct GeoBounds {
     pub resolution: f64,
 }
 
-/// A regular lattice of sample positions in EPSG:4326, a window of a larger one: column
-/// `i`, row `j` is the larger lattice's column `first_column + i`, row `first_row + j`, at
-/// longitude `west + (first_column + i) * step`, latitude `south + (first_row + j) * step`
-/// (row 0 is the southernmost). A point's position depends only on its index in the larger
-/// lattice, never on the window: [`GeoLattice::lon`] and [`GeoLattice::lat`] compute it.
+/// A lattice of sample positions in EPSG:4326, a window of a larger one: column `i`, row
+/// `j` is the larger lattice's column `first_column + i`, row `first_row + j`, at longitude
+/// `west + (first_column + i) * step` and, with [`Latitudes::Uniform`] rows, latitude
+/// `south + (first_row + j) * step` (row 0 is the southernmost). A point's position depends
+/// only on its index in the larger lattice, never on the window: [`GeoLattice::lon`] and
+/// [`GeoLattice::lat`] compute it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GeoLattice {
     /// Longitude of the larger lattice's column 0.
@@ -50,6 +51,44 @@ pub struct GeoLattice {
     pub width: u32,
     /// Rows.
     pub height: u32,
+    /// How the larger lattice's rows are spaced in latitude.
+    pub latitudes: Latitudes,
+}
+
+/// How a [`GeoLattice`]'s rows are spaced in latitude.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Latitudes {
+    /// Row `r` of the larger lattice at `south + r * step`.
+    #[default]
+    Uniform,
+    /// Web Mercator tiles (EPSG:3857), `tiles` of them from the south edge (about
+    /// -85.05°) to the north edge, each `cells` rows spaced evenly in latitude between its
+    /// southern and northern edges (each edge at [`web_mercator_latitude`] of its Web
+    /// Mercator y): row `cells t + j` lies `j / cells` of the way up tile `t`. Two tiles
+    /// share the row on their common edge (it is the same latitude, to the bit).
+    /// `south` is not used.
+    WebMercatorTiles {
+        /// Rows a tile.
+        cells: u32,
+        /// Tiles from south to north.
+        tiles: u64,
+    },
+}
+
+/// The latitude (degrees) of Web Mercator `y`, in turns from the south edge of the square
+/// world (0: about -85.0511°, 1/2: the equator, 1: about 85.0511°), as CesiumJS's
+/// `WebMercatorProjection.mercatorAngleToGeodeticLatitude` computes it (spherical).
+pub fn web_mercator_latitude(y: f64) -> f64 {
+    let angle = std::f64::consts::PI * (2.0 * y - 1.0);
+    (std::f64::consts::FRAC_PI_2 - 2.0 * (-angle).exp().atan()).to_degrees()
+}
+
+/// The Web Mercator `y` of latitude `lat` (degrees), in turns from the south edge (see
+/// [`web_mercator_latitude`]): below 0 or above 1 beyond about ±85.0511°.
+pub fn web_mercator_y(lat: f64) -> f64 {
+    let phi = lat.to_radians();
+    let angle = (std::f64::consts::FRAC_PI_4 + phi / 2.0).tan().ln();
+    (angle / std::f64::consts::PI + 1.0) / 2.0
 }
 
 impl GeoLattice {
@@ -66,9 +105,21 @@ impl GeoLattice {
         self.west + column as f64 * self.step
     }
 
-    /// The latitude of row `j`: `south + (first_row + j) * step`.
+    /// The latitude of row `j`: `south + (first_row + j) * step` for uniform rows, else
+    /// as [`Latitudes`] places it.
     pub fn lat(&self, j: u32) -> f64 {
-        self.south + (self.first_row + u64::from(j)) as f64 * self.step
+        let row = self.first_row + u64::from(j);
+        match self.latitudes {
+            Latitudes::Uniform => self.south + row as f64 * self.step,
+            Latitudes::WebMercatorTiles { cells, tiles } => {
+                let cells = u64::from(cells);
+                let tile = (row / cells).min(tiles.saturating_sub(1));
+                let k = row - tile * cells;
+                let south = web_mercator_latitude(tile as f64 / tiles as f64);
+                let north = web_mercator_latitude((tile + 1) as f64 / tiles as f64);
+                south + (north - south) * (k as f64 / cells as f64)
+            }
+        }
     }
 }
 

@@ -77,7 +77,10 @@ pub use coverage::{coverage, Coverage};
 pub use datum::{declared_vertical_datum, Geoid, VerticalDatum};
 pub use error::{Error, Result};
 pub use files::input_files;
-pub use geographic::{geographic_bounds, heights_may_exceed_f32, GeoBounds, GeoLattice};
+pub use geographic::{
+    geographic_bounds, heights_may_exceed_f32, web_mercator_latitude, web_mercator_y, GeoBounds,
+    GeoLattice, Latitudes,
+};
 pub use info::{Raster, RasterInfo};
 pub use polygons::{burn_polygons, is_vector};
 pub use quiet::{silence_gdal_errors, take_gdal_warnings};

@@ -29,6 +29,7 @@ fn lattice_over(path: &Path, coarser: f64) -> GeoLattice {
     let i0 = (((bounds.west + 180.0) / d).floor() - 1.0).max(0.0);
     let j0 = (((bounds.south + 90.0) / d).floor() - 1.0).max(0.0);
     GeoLattice {
+        latitudes: tinsmith_raster::Latitudes::Uniform,
         west: -180.0,
         south: -90.0,
         step: d,
@@ -243,6 +244,7 @@ fn a_global_raster_samples_alike_in_0_to_360_minus_360_to_0_and_minus_180_to_180
     for step in [1.25, 4.5, 11.0] {
         let width = (360.0 / step) as u32 + 1;
         let lattice = GeoLattice {
+            latitudes: tinsmith_raster::Latitudes::Uniform,
             west: -180.0,
             south: -88.0,
             step,
@@ -322,6 +324,7 @@ fn a_raster_east_of_180_samples_as_the_same_raster_west_of_it() {
     let (east, west) = (write("east.tif", 185.0), write("west.tif", -175.0));
     for lon0 in [-176.0, 184.0] {
         let lattice = GeoLattice {
+            latitudes: tinsmith_raster::Latitudes::Uniform,
             west: lon0,
             south: -36.0,
             step: 0.0625,
@@ -477,6 +480,7 @@ fn samples_agree_with_gdalwarp_wherever_the_four_pixels_are_valid() {
     let dir = tempfile::tempdir().expect("tempdir");
     let [east, _, _] = global_rasters(dir.path());
     let lattice = GeoLattice {
+        latitudes: tinsmith_raster::Latitudes::Uniform,
         west: 100.0,
         south: -80.0,
         step: 0.7,
@@ -492,4 +496,47 @@ fn samples_agree_with_gdalwarp_wherever_the_four_pixels_are_valid() {
     };
     let compared = check_against_gdalwarp(&east, &lattice, (72.0, 36.0), valid);
     assert!(compared > 40_000, "{compared} points compared");
+}
+
+#[test]
+fn web_mercator_lattices_are_even_in_latitude_inside_each_tile() {
+    use tinsmith_raster::{web_mercator_latitude, web_mercator_y, Latitudes};
+    // The square world's edges, the equator, and the inverse.
+    assert!((web_mercator_latitude(1.0) - 85.051_128_779_806_6).abs() < 1e-12);
+    assert_eq!(web_mercator_latitude(0.5), 0.0);
+    for y in [0.0, 0.1, 0.37, 0.5, 0.93, 1.0] {
+        assert!(
+            (web_mercator_y(web_mercator_latitude(y)) - y).abs() < 1e-12,
+            "{y}"
+        );
+    }
+    // 4 tiles of 8 rows: rows 8 k are the tiles' edges, the rows between them evenly
+    // spaced, and a window's rows are the larger lattice's.
+    let lattice = GeoLattice {
+        west: -180.0,
+        south: -90.0,
+        step: 1.0,
+        first_column: 0,
+        first_row: 0,
+        width: 1,
+        height: 33,
+        latitudes: Latitudes::WebMercatorTiles { cells: 8, tiles: 4 },
+    };
+    for t in 0..4u32 {
+        let (south, north) = (
+            web_mercator_latitude(f64::from(t) / 4.0),
+            web_mercator_latitude(f64::from(t + 1) / 4.0),
+        );
+        assert_eq!(lattice.lat(8 * t), south);
+        for j in 1..8 {
+            let want = south + (north - south) * f64::from(j) / 8.0;
+            assert!((lattice.lat(8 * t + j) - want).abs() < 1e-12);
+        }
+    }
+    assert_eq!(lattice.lat(32), web_mercator_latitude(1.0));
+    let window = GeoLattice {
+        first_row: 13,
+        ..lattice
+    };
+    assert_eq!(window.lat(2), lattice.lat(15));
 }

@@ -11,7 +11,7 @@ use tinsmith_raster::GeoBounds;
 
 use crate::rows::{LevelRows, Reach};
 use crate::stream::RowSource;
-use crate::tms::{tile_column, TileRect, TILE_CELLS};
+use crate::tms::{TileRect, Tiling, TILE_CELLS};
 use crate::TerrainResult;
 
 /// The most levels from a block's tile down to the raster's own level: a block's window
@@ -21,6 +21,8 @@ pub(super) const BLOCK_DEPTH: u8 = 4;
 /// Where the pyramid is cut.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) struct Cut {
+    /// The pyramid's tiling.
+    pub(super) tiling: Tiling,
     /// The raster's own level: it is sampled from the raster, and every coarser level is
     /// filtered from it; finer levels are each sampled alone.
     pub(super) anchor: u8,
@@ -31,26 +33,52 @@ pub(super) struct Cut {
 
 impl Cut {
     /// The coarsest split the block depth allows: the fewest blocks.
-    pub(super) fn coarsest(anchor: u8) -> Cut {
+    pub(super) fn coarsest(tiling: Tiling, anchor: u8) -> Cut {
         Cut {
+            tiling,
             anchor,
-            split: anchor.saturating_sub(BLOCK_DEPTH),
+            split: lowest_split(tiling, anchor),
         }
     }
 }
 
+/// The coarsest level a pyramid anchored at `anchor` may be split at: [`BLOCK_DEPTH`]
+/// levels above the anchor. A Web Mercator pyramid's rows reach further (see
+/// [`reach_margin`]): where the margin at the anchor would pass a block window's ring of
+/// one tile, it is split at level 0 instead (one block, whose window is the whole
+/// domain), which happens only for anchors up to level 7 (tiles of 2.8° and coarser).
+pub(super) fn lowest_split(tiling: Tiling, anchor: u8) -> u8 {
+    let split = anchor.saturating_sub(BLOCK_DEPTH);
+    if split_fits(tiling, split, anchor) {
+        split
+    } else {
+        0
+    }
+}
+
+/// Whether a pyramid anchored at `anchor` may be split at `split`: level 0 (a single
+/// block), or at most [`BLOCK_DEPTH`] levels above the anchor with the reach at the
+/// anchor ([`reach_margin`]) within a block window's ring of one tile.
+pub(super) fn split_fits(tiling: Tiling, split: u8, anchor: u8) -> bool {
+    split == 0
+        || (split <= anchor
+            && split + BLOCK_DEPTH >= anchor
+            && reach_margin(tiling, split, anchor).1 <= TILE_CELLS as usize)
+}
+
 /// The tiles of `level` a pyramid over `bounds` covers.
-pub(super) fn domain(bounds: &GeoBounds, level: u8) -> TileRect {
-    TileRect::covering(bounds, level)
+pub(super) fn domain(bounds: &GeoBounds, tiling: Tiling, level: u8) -> TileRect {
+    TileRect::covering(bounds, tiling, level)
 }
 
 /// The blocks of a cut: every tile of the split level's domain, in TMS row then column
 /// order, as 1 x 1 rectangles.
 pub(super) fn blocks(bounds: &GeoBounds, cut: Cut) -> Vec<TileRect> {
-    let d = domain(bounds, cut.split);
+    let d = domain(bounds, cut.tiling, cut.split);
     (d.y0..d.y0 + d.height)
         .flat_map(|y| {
             (d.x0..d.x0 + d.width).map(move |x| TileRect {
+                tiling: cut.tiling,
                 level: cut.split,
                 x0: x,
                 y0: y,
@@ -69,9 +97,9 @@ pub(super) fn blocks(bounds: &GeoBounds, cut: Cut) -> Vec<TileRect> {
 /// read (at most [`reach_margin`] of [`BLOCK_DEPTH`] levels, 46 of the ring's 217 samples,
 /// which is all [`block_level`] makes of it).
 pub(super) fn block_window(bounds: &GeoBounds, block: TileRect, level: u8) -> TileRect {
-    let d = domain(bounds, level);
+    let d = domain(bounds, block.tiling, level);
     let f = level - block.level;
-    let turn = 2i64 << level;
+    let turn = block.tiling.columns(level) as i64;
     let mut x0 = (i64::from(block.x0) << f) - 1;
     let mut x1 = (i64::from(block.x0 + block.width) << f) + 1;
     let y0 = ((i64::from(block.y0) << f) - 1).max(i64::from(d.y0));
@@ -113,6 +141,7 @@ pub(super) fn block_window(bounds: &GeoBounds, block: TileRect, level: u8) -> Ti
         }
     }
     TileRect {
+        tiling: block.tiling,
         level,
         x0: x0 as u32,
         y0: y0 as u32,
@@ -121,36 +150,44 @@ pub(super) fn block_window(bounds: &GeoBounds, block: TileRect, level: u8) -> Ti
     }
 }
 
-/// How far (in samples of `level`) beyond a block's tiles the block's levels down to
-/// `top` read, where `level` is at or below `top`: a tile reads one sample past its edges
-/// (edges, normals, fingerprint), and a sample of level `z` is filtered from samples of
-/// `z + 1` up to two steps either side of its double, so the reach doubles and grows by
-/// two per level: 1, 4, 10, 22, 46 samples.
-pub(super) fn reach_margin(top: u8, level: u8) -> usize {
-    3 * (1usize << (level - top)) - 2
+/// How far (in samples of `level`: columns, rows) beyond a block's tiles the block's
+/// levels down to `top` read, where `level` is at or below `top`: a tile reads one sample
+/// past its edges (edges, normals, fingerprint), and a sample of level `z` is filtered
+/// from samples of `z + 1` up to two steps either side of its double, so the reach
+/// doubles and grows by two per level: 1, 4, 10, 22, 46 samples. Web Mercator rows are
+/// filtered from rows resampled in latitude ([`LevelRows::coarser_rows`]): each level's
+/// row reach grows by the resampling's offset ([`Tiling::max_row_offset`]) and the row
+/// interpolated beside it, too.
+pub(super) fn reach_margin(tiling: Tiling, top: u8, level: u8) -> (usize, usize) {
+    let columns = 3 * (1usize << (level - top)) - 2;
+    let rows = (top..level).fold(1usize, |m, z| match tiling {
+        Tiling::Geographic => 2 * m + 2,
+        Tiling::Mercator => 2 * m + 3 + tiling.max_row_offset(z),
+    });
+    (columns, rows)
 }
 
 /// The lattice of `level` a block is built from: its window ([`block_window`]), made only
-/// within `margin` samples of the block's tiles (as [`reach_margin`] gives it): the ring
-/// beyond is never sampled, nor filtered.
+/// within `margin` (columns, rows) samples of the block's tiles (as [`reach_margin`] gives
+/// it): the ring beyond is never sampled, nor filtered.
 pub(super) fn block_level(
     bounds: &GeoBounds,
     block: TileRect,
     level: u8,
-    margin: usize,
+    margin: (usize, usize),
 ) -> LevelRows {
     let window = block_window(bounds, block, level);
     let rows = LevelRows::new(window);
     let cells = i64::from(TILE_CELLS);
     let f = level - block.level;
-    let margin = margin as i64;
+    let (margin, row_margin) = (margin.0 as i64, margin.1 as i64);
     // The block's samples, global lattice columns and rows, widened by the margin.
     let west = (i64::from(block.x0) << f) * cells - margin;
     let span = (i64::from(block.width) << f) * cells + 2 * margin;
-    let south = (i64::from(block.y0) << f) * cells - margin;
-    let north = (i64::from(block.y0 + block.height) << f) * cells + margin;
+    let south = (i64::from(block.y0) << f) * cells - row_margin;
+    let north = (i64::from(block.y0 + block.height) << f) * cells + row_margin;
     // Columns compare round the globe: a window may lie a turn east of its block.
-    let turn = (2i64 << level) * cells;
+    let turn = block.tiling.columns(level) as i64 * cells;
     let columns = (0..rows.width as i64)
         .map(|i| {
             let column = i64::from(window.x0) * cells + i;
@@ -188,7 +225,7 @@ impl RowSource for SplitSamples {
             let oj = j - tj * n;
             let y = level.ty0 + tj as u32;
             for ti in 0..level.tiles_x as usize {
-                let x = tile_column(level.level, level.tx0 + ti as u32);
+                let x = level.tiling.tile_column(level.level, level.tx0 + ti as u32);
                 let Some(tile) = self.tiles.get(&(x, y)) else {
                     continue;
                 };
@@ -225,13 +262,14 @@ mod tests {
     fn windows_ring_their_block_within_the_domain() {
         let b = bounds(0.5, 20.0);
         let block = TileRect {
+            tiling: Tiling::Geographic,
             level: 3,
             x0: 8,
             y0: 3,
             width: 1,
             height: 1,
         };
-        let d = domain(&b, 5);
+        let d = domain(&b, Tiling::Geographic, 5);
         let w = block_window(&b, block, 5);
         // Tiles 32..36 with a ring, clipped to the domain's columns and rows.
         assert_eq!(w.x0, d.x0.max(31));
@@ -256,6 +294,7 @@ mod tests {
             resolution: 0.05,
         };
         let block = TileRect {
+            tiling: Tiling::Geographic,
             level: 2,
             x0: 0,
             y0: 1,
@@ -263,7 +302,7 @@ mod tests {
             height: 1,
         };
         let n = TILE_CELLS as usize;
-        for (level, margin) in [(2, 1), (4, reach_margin(2, 4))] {
+        for (level, margin) in [(2, (1, 1)), (4, reach_margin(Tiling::Geographic, 2, 4))] {
             let rows = block_level(&globe, block, level, margin);
             let reach = rows.reach().expect("a block's level has a reach");
             let core = n << (level - 2);
@@ -272,14 +311,14 @@ mod tests {
             let first = n;
             assert_eq!(
                 reach.column_runs(),
-                vec![first - margin..first + core + margin + 1],
+                vec![first - margin.0..first + core + margin.0 + 1],
                 "level {level}"
             );
             // The block's southern row, local to the window (which may start at the domain).
             let block_south = ((1usize << (level - 2)) - rows.ty0 as usize) * n;
             assert_eq!(
                 reach.rows,
-                block_south - margin..block_south + core + margin + 1
+                block_south - margin.1..block_south + core + margin.1 + 1
             );
         }
     }
@@ -294,6 +333,7 @@ mod tests {
             resolution: 0.05,
         };
         let block = TileRect {
+            tiling: Tiling::Geographic,
             level: 2,
             x0: 0,
             y0: 1,

@@ -5,12 +5,22 @@
 //! own samples only, never on other tiles: a tile is a function of its own data.
 
 use crate::quantized_mesh::QUANTIZED_MAX;
-use crate::tms::max_edge_length;
+use crate::tms::{max_edge_length, Tiling};
 
 /// Cesium's level-zero geometric error for the geographic scheme, in metres:
 /// `maximumRadius * 2 pi * 0.25 / (65 * 2)` (`TerrainProvider`
 /// `getEstimatedLevelZeroGeometricErrorForAHeightmap`). Level L allows `e0 / 2^L`.
 pub const LEVEL_ZERO_ERROR: f64 = 77_067.339_771_939_23;
+
+/// Cesium's level-zero geometric error of `tiling`: it divides by the level's tile
+/// columns, so Web Mercator's (one column) is twice the geographic one. A Web Mercator
+/// tile of level L is as wide as a geographic one of level L - 1, and allows as much.
+pub(super) fn level_zero_error(tiling: Tiling) -> f64 {
+    match tiling {
+        Tiling::Geographic => LEVEL_ZERO_ERROR,
+        Tiling::Mercator => 2.0 * LEVEL_ZERO_ERROR,
+    }
+}
 
 /// The smallest height quantum (2^-8 m), so that tile minima stay exact in float32.
 const MIN_HEIGHT_STEP: f64 = 1.0 / 256.0;
@@ -41,9 +51,9 @@ pub(super) struct LevelBudget {
 }
 
 impl LevelBudget {
-    /// The budget of `level` at `quality`.
-    pub(super) fn new(level: u8, quality: f64) -> LevelBudget {
-        let bound = quality * LEVEL_ZERO_ERROR / (1u64 << level) as f64;
+    /// The budget of `level` of `tiling` at `quality`.
+    pub(super) fn new(tiling: Tiling, level: u8, quality: f64) -> LevelBudget {
+        let bound = quality * level_zero_error(tiling) / (1u64 << level) as f64;
         let mut step = MIN_HEIGHT_STEP;
         while step * 2.0 <= bound / STEP_SHARE && step < MAX_HEIGHT_STEP {
             step *= 2.0;
@@ -51,7 +61,7 @@ impl LevelBudget {
         LevelBudget {
             bound,
             step,
-            max_edge: max_edge_length(level, bound),
+            max_edge: max_edge_length(tiling, level, bound),
         }
     }
 
@@ -120,7 +130,7 @@ mod tests {
     fn the_step_is_a_power_of_two_within_a_sixteenth_of_the_bound_and_a_metre() {
         for level in 0..=24 {
             for quality in [0.05, 0.3, 1.0, 4.0] {
-                let b = LevelBudget::new(level, quality);
+                let b = LevelBudget::new(Tiling::Mercator, level, quality);
                 assert_eq!(b.step.log2().fract(), 0.0);
                 assert!(b.step == MIN_HEIGHT_STEP || b.step <= b.bound / STEP_SHARE);
                 assert!(b.step * 2.0 > b.bound / STEP_SHARE || b.step == MAX_HEIGHT_STEP);

@@ -151,7 +151,7 @@ pub(super) fn layer_json(
         "version": "1.0.0",
         "format": "quantized-mesh-1.0",
         "scheme": "tms",
-        "projection": "EPSG:4326",
+        "projection": options.tiling.projection(),
         "tiles": ["{z}/{x}/{y}.terrain?v={version}"],
         "minzoom": options.min_zoom,
         "maxzoom": max_zoom,

@@ -1,7 +1,8 @@
 //! Cesium quantized-mesh terrain: the tile encoder ([`QuantizedMeshTile`]) and whole
 //! pyramids ([`build_terrain`]): geographic TMS tiles (EPSG:4326, 2x1 root tiles, y = 0
-//! in the south), each decimated within `quality x e(level)` (Cesium's geometric error at
-//! the level) and checked by the independent verifier, with shared edges simplified once
+//! in the south) or Web Mercator ones ([`Tiling::Mercator`], EPSG:3857, 1x1), each
+//! decimated within `quality x e(level)` (Cesium's geometric error at the level for the
+//! tiling) and checked by the independent verifier, with shared edges simplified once
 //! so that same-level neighbours keep identical edge vertices, and `layer.json` with the
 //! tiles' availability. The pyramid is staged and moved into place whole. The same tiles
 //! can be written as 3D Tiles 1.1 terrain instead ([`TileFormat::ThreeDTiles`]: one GLB per
@@ -41,5 +42,5 @@ pub use quantized_mesh::{
     QUANTIZED_MAX, WGS84_A, WGS84_B,
 };
 pub use shards::{build_shard, merge_shards, ShardReport};
-pub use tms::{tile_rectangle, TILE_CELLS};
+pub use tms::{tile_rectangle, Tiling, TILE_CELLS};
 pub use water::{Water, MASK_CELLS};

@@ -9,9 +9,9 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use tinsmith_raster::GeoBounds;
 
-use crate::blocks::{blocks, domain, Cut, BLOCK_DEPTH};
+use crate::blocks::{blocks, domain, lowest_split, split_fits, Cut};
 use crate::records::hex;
-use crate::tms::{tile_column, TileRect};
+use crate::tms::{TileRect, Tiling};
 use crate::{TerrainOptions, TerrainResult};
 
 /// Cells a side of the coarse read that fingerprints the input and weighs the blocks.
@@ -73,6 +73,14 @@ pub(super) struct TileOptions {
     /// [`TerrainOptions::whole_globe`]; absent when false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub(super) whole_globe: bool,
+    /// [`TerrainOptions::tiling`]; absent when geographic.
+    #[serde(default, skip_serializing_if = "is_geographic")]
+    pub(super) tiling: Tiling,
+}
+
+/// Whether `tiling` is the geographic one (which plans leave unsaid).
+fn is_geographic(tiling: &Tiling) -> bool {
+    *tiling == Tiling::Geographic
 }
 
 impl TileOptions {
@@ -90,6 +98,7 @@ impl TileOptions {
                 .then(|| options.vertical_datum.spec()),
             water: options.water.clone(),
             whole_globe: options.whole_globe,
+            tiling: options.tiling,
         }
     }
 
@@ -114,6 +123,7 @@ impl TileOptions {
             whole_globe: self.whole_globe,
             // Shards are refused for 3D Tiles (see `build_shard`).
             format: crate::TileFormat::QuantizedMesh,
+            tiling: self.tiling,
         }
     }
 }
@@ -172,7 +182,8 @@ impl Plan {
             .map(|(&c, _)| c)
             .collect();
         let cells = (coverage.width * coverage.height) as u64;
-        let (split, weights) = split_and_weights(bounds, anchor, shards, &centres, cells);
+        let tiling = options.tiling;
+        let (split, weights) = split_and_weights(bounds, tiling, anchor, shards, &centres, cells);
         Ok(Plan {
             input: input.display().to_string(),
             name: input
@@ -208,6 +219,7 @@ impl Plan {
 
     pub(super) fn cut(&self) -> Cut {
         Cut {
+            tiling: self.options.tiling,
             anchor: self.anchor,
             split: self.split,
         }
@@ -249,31 +261,42 @@ impl Plan {
 /// each block's weight: one, plus the coarse read's cells with data (`centres`, WGS84
 /// longitude and latitude, out of `cells` in all) that fall in it.
 ///
-/// The split is the coarsest level (at most [`BLOCK_DEPTH`] above the anchor) that gives
+/// The split is the coarsest level (at most [`crate::blocks::BLOCK_DEPTH`] above the anchor) that gives
 /// every shard [`BLOCKS_PER_SHARD`] blocks; then finer while the heaviest block weighs
 /// more than a quarter of a shard's share (whole blocks are the unit a shard's share is
 /// made of: a land DEM's blocks of sea weigh 1 and of land up to 17) and the coarse read
 /// still has 4 cells a block.
 pub(super) fn split_and_weights(
     bounds: &GeoBounds,
+    tiling: Tiling,
     anchor: u8,
     shards: u32,
     centres: &[[f64; 2]],
     cells: u64,
 ) -> (u8, Vec<u64>) {
-    let lowest = anchor.saturating_sub(BLOCK_DEPTH);
+    let lowest = lowest_split(tiling, anchor);
+    let cut = |split: u8| Cut {
+        tiling,
+        anchor,
+        split,
+    };
+    // Splits whose blocks' reach fits their windows (every geographic one from the
+    // lowest; a Web Mercator pyramid anchored at level 8 or coarser splits at 0 or near
+    // the anchor).
+    let fits = |s: &u8| split_fits(tiling, *s, anchor);
     let mut split = (lowest..=anchor)
-        .find(|&s| domain(bounds, s).tiles() >= BLOCKS_PER_SHARD * u64::from(shards))
+        .filter(fits)
+        .find(|&s| domain(bounds, tiling, s).tiles() >= BLOCKS_PER_SHARD * u64::from(shards))
         .unwrap_or(anchor);
-    let mut weights = block_weights(bounds, Cut { anchor, split }, centres);
-    while split < anchor && cells >= 4 * domain(bounds, split + 1).tiles() {
+    let mut weights = block_weights(bounds, cut(split), centres);
+    while split < anchor && cells >= 4 * domain(bounds, tiling, split + 1).tiles() {
         let total: u64 = weights.iter().sum();
         let heaviest = weights.iter().copied().max().unwrap_or(0);
         if heaviest * 4 * u64::from(shards) <= total {
             break;
         }
-        split += 1;
-        weights = block_weights(bounds, Cut { anchor, split }, centres);
+        split = (split + 1..=anchor).find(fits).unwrap_or(anchor);
+        weights = block_weights(bounds, cut(split), centres);
     }
     (split, weights)
 }
@@ -286,15 +309,20 @@ fn block_weights(bounds: &GeoBounds, cut: Cut, centres: &[[f64; 2]]) -> Vec<u64>
     let index: std::collections::HashMap<(u32, u32), usize> = all
         .iter()
         .enumerate()
-        .map(|(k, b)| ((tile_column(split, b.x0), b.y0), k))
+        .map(|(k, b)| ((cut.tiling.tile_column(split, b.x0), b.y0), k))
         .collect();
     let mut weights = vec![1u64; all.len()];
-    let size = 180.0 / (1u64 << split) as f64;
+    let size = 360.0 / cut.tiling.columns(split) as f64;
     for centre in centres {
         let x = ((centre[0] + 180.0) / size)
             .floor()
-            .rem_euclid(f64::from(2u32 << split));
-        let y = ((centre[1] + 90.0) / size).floor();
+            .rem_euclid(cut.tiling.columns(split) as f64);
+        let y = match cut.tiling {
+            Tiling::Geographic => ((centre[1] + 90.0) / size).floor(),
+            Tiling::Mercator => {
+                (tinsmith_raster::web_mercator_y(centre[1]) * (1u64 << split) as f64).floor()
+            }
+        };
         if y < 0.0 || y >= f64::from(1u32 << split) {
             continue;
         }
@@ -355,18 +383,19 @@ mod tests {
         };
         let cells = 128 * 64;
         // Data everywhere: the coarsest split with 8 blocks a shard (level 2: 32 blocks).
-        let (split, weights) = split_and_weights(&globe, 6, 4, &grid(&|_, _| true), cells);
+        let (split, weights) =
+            split_and_weights(&globe, Tiling::Geographic, 6, 4, &grid(&|_, _| true), cells);
         assert_eq!((split, weights.len()), (2, 32));
         // Data in one corner: finer, until the heaviest block is at most a quarter of a
         // shard's share, or the coarse read has fewer than 4 cells a block.
         let corner = grid(&|lon, lat| lon < -135.0 && lat < -45.0);
-        let (split, weights) = split_and_weights(&globe, 6, 4, &corner, cells);
+        let (split, weights) = split_and_weights(&globe, Tiling::Geographic, 6, 4, &corner, cells);
         // Level 2: one block of 257 in 288; level 3: four of 65 in 384; level 4: sixteen
         // of 17 in 768, and 17 x 4 shards x 4 <= 768.
         let total: u64 = weights.iter().sum();
         assert_eq!((split, weights.iter().max(), total), (4, Some(&17), 768));
         // No finer than the coarse read allows: 4 cells a block (level 4 has 512).
-        let (split, _) = split_and_weights(&globe, 6, 4, &corner, 2047);
+        let (split, _) = split_and_weights(&globe, Tiling::Geographic, 6, 4, &corner, 2047);
         assert_eq!(split, 3);
     }
 

@@ -1,6 +1,7 @@
 //! A Cesium quantized-mesh terrain pyramid: geographic TMS tiles (EPSG:4326, 2x1 root
-//! tiles, y = 0 in the south), each decimated within `quality x e(level)`, with shared
-//! edges simplified once so that same-level neighbours keep identical edge vertices.
+//! tiles, y = 0 in the south) or Web Mercator ones (EPSG:3857, 1x1, see [`Tiling`]), each
+//! decimated within `quality x e(level)`, with shared edges simplified once so that
+//! same-level neighbours keep identical edge vertices.
 
 use std::path::Path;
 
@@ -17,7 +18,7 @@ use crate::records::{
 };
 use crate::rows::LevelRows;
 use crate::stream::{band_tile_rows, stream_levels, RowSource, Warp};
-use crate::tms::{bounds_array, step, tile_column, TileRect, TILE_CELLS};
+use crate::tms::{bounds_array, TileRect, Tiling, TILE_CELLS};
 use crate::writer::{Scope, TileWriter, Written};
 use crate::{TerrainError, TerrainResult};
 use tinsmith_store::{DirectoryStore, TileStore};
@@ -68,6 +69,9 @@ pub struct TerrainOptions {
     pub whole_globe: bool,
     /// How tiles are encoded and laid out. Part of every tile's identity.
     pub format: TileFormat,
+    /// How tiles divide the globe. A Web Mercator pyramid tiles the part of the raster
+    /// within its latitudes (about ±85.0511°).
+    pub tiling: Tiling,
 }
 
 /// How a pyramid's tiles are encoded and laid out.
@@ -123,14 +127,16 @@ impl Default for TerrainOptions {
             water: None,
             whole_globe: false,
             format: TileFormat::QuantizedMesh,
+            tiling: Tiling::Geographic,
         }
     }
 }
 
-/// The raster's own level: the first whose lattice is at least as fine as the raster.
-fn own_level(bounds: &GeoBounds) -> u8 {
+/// The raster's own level: the first whose lattice is at least as fine as the raster
+/// (in longitude; a Web Mercator tile's rows are closer).
+fn own_level(bounds: &GeoBounds, tiling: Tiling) -> u8 {
     (0..MAX_LEVEL)
-        .find(|&l| step(l) <= bounds.resolution * (1.0 + 1e-9))
+        .find(|&l| tiling.step(l) <= bounds.resolution * (1.0 + 1e-9))
         .unwrap_or(MAX_LEVEL)
 }
 
@@ -141,8 +147,8 @@ fn own_level(bounds: &GeoBounds) -> u8 {
 /// split level; and the record of every tile written (for `layer.json`'s availability,
 /// about 48 bytes a tile). An estimate for refusing hopeless runs (a small raster at a far
 /// finer level than its own, a raster too wide), not a bound.
-pub fn streaming_bytes(bounds: &GeoBounds, max_zoom: u8, threads: usize) -> u64 {
-    let cut = Cut::coarsest(own_level(bounds));
+pub fn streaming_bytes(bounds: &GeoBounds, tiling: Tiling, max_zoom: u8, threads: usize) -> u64 {
+    let cut = Cut::coarsest(tiling, own_level(bounds, tiling));
     let finest = max_zoom.max(cut.anchor);
     let cells = u64::from(TILE_CELLS + 1);
     let bands = threads.max(1) as u64 + 3;
@@ -152,14 +158,13 @@ pub fn streaming_bytes(bounds: &GeoBounds, max_zoom: u8, threads: usize) -> u64 
             .saturating_mul(bands)
             .saturating_mul(4)
     };
-    let domain_wide = u64::from(domain(bounds, finest).width);
+    let domain = |level: u8| domain(bounds, tiling, level);
+    let domain_wide = u64::from(domain(finest).width);
     let window_wide = domain_wide.min((1u64 << (finest - cut.split).min(40)) + 2);
     let blocks = band_bytes(window_wide);
-    let top = band_bytes(u64::from(domain(bounds, cut.split).width));
-    let split_samples = domain(bounds, cut.split)
-        .tiles()
-        .saturating_mul(cells * cells * 4);
-    let records = domain(bounds, finest).tiles().saturating_mul(48);
+    let top = band_bytes(u64::from(domain(cut.split).width));
+    let split_samples = domain(cut.split).tiles().saturating_mul(cells * cells * 4);
+    let records = domain(finest).tiles().saturating_mul(48);
     blocks
         .max(top)
         .saturating_add(split_samples)
@@ -214,8 +219,8 @@ pub struct LevelReport {
 
 impl LevelReport {
     /// The report of a level with no tile yet.
-    pub(crate) fn empty(level: u8, quality: f64) -> LevelReport {
-        let budget = LevelBudget::new(level, quality);
+    pub(crate) fn empty(tiling: Tiling, level: u8, quality: f64) -> LevelReport {
+        let budget = LevelBudget::new(tiling, level, quality);
         LevelReport {
             level,
             bound: budget.bound,
@@ -250,7 +255,7 @@ impl LevelReport {
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct TerrainReport {
     /// The input's extent in EPSG:4326, `[west, south, east, north]`: west > east across
-    /// the antimeridian.
+    /// the antimeridian; Web Mercator tiles' only up to their ±85.0511° latitude.
     pub bounds: [f64; 4],
     /// Coarsest level.
     pub min_zoom: u8,
@@ -268,12 +273,13 @@ pub struct TerrainReport {
 /// # Guarantees
 /// - **A tile is a function of its own data.** The bytes of tile z/x/y depend only on the
 ///   input, z/x/y and the options that shape tiles (band, quality, normals, metadata,
-///   gzip): not on `--min-zoom`, `--max-zoom` (except the metadata extension of levels
+///   gzip, tiling...): not on `--min-zoom`, `--max-zoom` (except the metadata extension of levels
 ///   0, 10 and 20, which lists the tiles below down to `--max-zoom`), the threads, or
 ///   which other tiles a run (or a shard of one, [`crate::build_shard`]) builds. Level L's
 ///   lattice is defined once: the raster's own level is sampled from the raster (bilinear,
 ///   each sample from its position alone), each coarser level is the finer one filtered
-///   (binomial 5 x 5) and halved, and each finer level is sampled alone.
+///   (binomial 5 x 5) and halved (Web Mercator: filtered from the finer rows resampled
+///   in latitude, see [`Tiling::Mercator`]), and each finer level is sampled alone.
 /// - **Bound.** At every valid sample of a tile's grid (its `(TILE_CELLS + 1)^2` lattice
 ///   points of its level), the decoded tile (float32 min/max, 16-bit heights) is within
 ///   `quality x e(level)` of the sample, or within half the level's height quantum and
@@ -367,8 +373,13 @@ fn build_into(
         datum: &options.vertical_datum,
         outside: options.outside(),
     };
-    let cut = Cut::coarsest(own_level);
-    let pool = worker_pool(&bounds, max_zoom.max(cut.anchor), options.threads)?;
+    let cut = Cut::coarsest(options.tiling, own_level);
+    let pool = worker_pool(
+        &bounds,
+        cut.tiling,
+        max_zoom.max(cut.anchor),
+        options.threads,
+    )?;
     let all = blocks(&bounds, cut);
     let total = all.len();
     let (written, samples) = build_recorded_blocks(
@@ -493,7 +504,7 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
             options.quality
         )));
     }
-    let bounds = geographic_bounds(input, options.band)?;
+    let mut bounds = geographic_bounds(input, options.band)?;
     if bounds.south >= bounds.north {
         return Err(TerrainError::Options(
             "the raster lies outside latitudes -90..90 in EPSG:4326: no tile can hold it \
@@ -501,6 +512,23 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
                 .into(),
         ));
     }
+    // Web Mercator tiles end short of the poles: the part of the raster beyond is left
+    // out, and a raster wholly beyond is refused.
+    let [south, north] = options.tiling.latitude_range();
+    if bounds.south >= north || bounds.north <= south {
+        return Err(TerrainError::Options(format!(
+            "{}: the raster lies within latitudes {:.4}..{:.4}, wholly beyond the {:.4}..{:.4} \
+             that --tiling {} covers; use --tiling geographic",
+            input.display(),
+            bounds.south,
+            bounds.north,
+            south,
+            north,
+            options.tiling.name(),
+        )));
+    }
+    bounds.south = bounds.south.max(south);
+    bounds.north = bounds.north.min(north);
     // Refused as `mesh` and `contour` refuse it: a warp to a lattice finer than the raster
     // would fill a block from a single sample, and every coarser level is made from it.
     if !tinsmith_raster::WindowReader::open(input, options.band)?.has_valid_cell()? {
@@ -511,7 +539,7 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
         )));
     }
     // The first level whose lattice is at least as fine as the raster.
-    let own_level = own_level(&bounds);
+    let own_level = own_level(&bounds, options.tiling);
     let max_zoom = options.max_zoom.unwrap_or(own_level);
     if options.metadata && options.min_zoom > 0 {
         return Err(TerrainError::Options(format!(
@@ -531,6 +559,10 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
                 "--water (not written as 3D Tiles yet)",
             ),
             (options.update, "--update"),
+            (
+                options.tiling != Tiling::Geographic,
+                "--tiling mercator (Cesium3DTilesTerrainProvider tiles the globe geographically)",
+            ),
         ];
         if let Some((_, what)) = clash.iter().find(|(on, _)| *on) {
             return Err(TerrainError::Options(format!(
@@ -558,15 +590,15 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
             options.min_zoom
         )));
     }
-    let tiles_at = |level: u8| domain(&bounds, level).tiles();
+    let tiles_at = |level: u8| domain(&bounds, options.tiling, level).tiles();
     let threads = match options.threads {
         0 => rayon::current_num_threads(),
         n => n,
     };
     let fits = |level: u8| {
-        options
-            .memory_limit
-            .is_none_or(|limit| streaming_bytes(&bounds, level.max(own_level), threads) <= limit)
+        options.memory_limit.is_none_or(|limit| {
+            streaming_bytes(&bounds, options.tiling, level.max(own_level), threads) <= limit
+        })
     };
     let not_overzoomed = |level: u8| {
         level <= own_level.saturating_add(OVERZOOM_LEVELS) || tiles_at(level) <= OVERZOOM_TILES
@@ -595,8 +627,8 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
     if let Some(limit) = options.memory_limit {
         // Levels up to the raster's own are filtered from it, so it is always streamed.
         let streamed = max_zoom.max(own_level);
-        let need = streaming_bytes(&bounds, streamed, threads);
-        if need > limit && streaming_bytes(&bounds, streamed, 1) <= limit {
+        let need = streaming_bytes(&bounds, options.tiling, streamed, threads);
+        if need > limit && streaming_bytes(&bounds, options.tiling, streamed, 1) <= limit {
             return Err(TerrainError::Options(format!(
                 "{threads} threads would need about {:.1} GB in memory (each warps a band of \
                  level {streamed}) and {:.1} GB is available; use fewer --threads",
@@ -610,7 +642,7 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
                  {} tiles) and {:.1} GB is available (the raster's own resolution is level \
                  {own_level}, which every coarser level is filtered from); {}",
                 need as f64 / 1e9,
-                domain(&bounds, streamed).width,
+                domain(&bounds, options.tiling, streamed).width,
                 limit as f64 / 1e9,
                 suggestion()
             )));
@@ -665,12 +697,14 @@ pub(super) fn build_block(
     // levels filtered from it, down to the block's own.
     for z in (cut.anchor + 1..=max_zoom).rev() {
         let level = |z: u8| {
-            block_level(bounds, block, z, reach_margin(z, z)).filled_with(options.outside())
+            block_level(bounds, block, z, reach_margin(cut.tiling, z, z))
+                .filled_with(options.outside())
         };
         stream_levels(source, &level, (z, z), band(z), pool, &mut writer)?;
     }
     let level = |z: u8| {
-        block_level(bounds, block, z, reach_margin(cut.split, z)).filled_with(options.outside())
+        block_level(bounds, block, z, reach_margin(cut.tiling, cut.split, z))
+            .filled_with(options.outside())
     };
     let zooms = (cut.split, cut.anchor);
     stream_levels(source, &level, zooms, band(cut.anchor), pool, &mut writer)?;
@@ -684,11 +718,12 @@ pub(super) fn build_block(
 /// The worker pool of a pyramid whose finest streamed level over `bounds` is `finest`.
 pub(super) fn worker_pool(
     bounds: &GeoBounds,
+    tiling: Tiling,
     finest: u8,
     threads: usize,
 ) -> TerrainResult<rayon::ThreadPool> {
     // The finest level has the most tiles: more workers than that would idle.
-    let tiles = domain(bounds, finest).tiles();
+    let tiles = domain(bounds, tiling, finest).tiles();
     let workers = tinsmith_tiling::worker_count(threads, tiles as usize);
     rayon::ThreadPoolBuilder::new()
         .num_threads(workers)
@@ -719,7 +754,7 @@ pub(super) fn write_flat_roots(
     };
     let available = written.available.clone();
     let mut writer = TileWriter::new(scope, max_zoom, available, known, store, options, pool);
-    for x in 0..2 {
+    for x in 0..options.tiling.columns(0) as u32 {
         if !written.available[0].contains(&(x, 0)) {
             writer.write_flat_root(x)?;
         }
@@ -742,7 +777,7 @@ pub(super) fn level_reports(
                 .get(usize::from(z))
                 .cloned()
                 .flatten()
-                .unwrap_or_else(|| LevelReport::empty(z, options.quality))
+                .unwrap_or_else(|| LevelReport::empty(options.tiling, z, options.quality))
         })
         .collect()
 }
@@ -770,8 +805,9 @@ pub(super) fn build_top(
         under: None,
     };
     let mut writer = TileWriter::new(scope, max_zoom, available, known, store, options, pool);
-    let level = |z: u8| LevelRows::new(domain(bounds, z)).filled_with(options.outside());
-    let band = band_tile_rows(domain(bounds, cut.split));
+    let level =
+        |z: u8| LevelRows::new(domain(bounds, cut.tiling, z)).filled_with(options.outside());
+    let band = band_tile_rows(domain(bounds, cut.tiling, cut.split));
     stream_levels(
         samples,
         &level,
@@ -807,7 +843,7 @@ pub(super) fn build_recorded_blocks(
         let (built, values) = build_block(
             source, bounds, cut, max_zoom, block, None, store, options, pool, known,
         )?;
-        let id = [tile_column(cut.split, block.x0), block.y0];
+        let id = [cut.tiling.tile_column(cut.split, block.x0), block.y0];
         let name = block_name(cut.split, id);
         if let Some(values) = &values {
             store.put_file(&format!("{name}.samples"), &gzip_samples(values))?;
@@ -946,7 +982,7 @@ pub(super) fn recorded_entries(store: &dyn TileStore) -> TerrainResult<Entries> 
 fn remove_stale_records(store: &dyn TileStore, cut: Cut, blocks: &[TileRect]) -> TerrainResult<()> {
     let wanted: std::collections::HashSet<String> = blocks
         .iter()
-        .map(|b| block_name(cut.split, [tile_column(cut.split, b.x0), b.y0]))
+        .map(|b| block_name(cut.split, [cut.tiling.tile_column(cut.split, b.x0), b.y0]))
         .collect();
     for name in store.list_files(&format!("{RECORDS_DIR}/blocks/"))? {
         let stem = name
@@ -1029,14 +1065,17 @@ mod tests {
     #[test]
     fn coarse_levels_cap_edges_by_the_ellipsoid_sag() {
         // Level 0: bound 77 km allows an arc of 17.8 degrees; a lattice step is 0.83.
-        let l0 = max_edge_length(0, LEVEL_ZERO_ERROR).unwrap();
+        let l0 = max_edge_length(Tiling::Geographic, 0, LEVEL_ZERO_ERROR).unwrap();
         assert_eq!(l0, 21);
-        let arc = f64::from(l0) * step(0).to_radians();
+        let arc = f64::from(l0) * Tiling::Geographic.step(0).to_radians();
         assert!(EARTH_RADIUS * (1.0 - (arc / 2.0).cos()) <= LEVEL_ZERO_ERROR);
-        let arc = f64::from(l0 + 1) * step(0).to_radians();
+        let arc = f64::from(l0 + 1) * Tiling::Geographic.step(0).to_radians();
         assert!(EARTH_RADIUS * (1.0 - (arc / 2.0).cos()) > LEVEL_ZERO_ERROR);
         // Deep levels: no cap.
-        assert_eq!(max_edge_length(12, LEVEL_ZERO_ERROR / 4096.0), None);
+        assert_eq!(
+            max_edge_length(Tiling::Geographic, 12, LEVEL_ZERO_ERROR / 4096.0),
+            None
+        );
     }
 
     #[test]
@@ -1089,9 +1128,6 @@ mod tests {
             north: 45.11,
             resolution: 0.0002,
         };
-        let source = crate::stream::Hills {
-            hole: [10.06, 45.04, 0.015],
-        };
         let options = TerrainOptions {
             min_zoom: 9,
             max_zoom: Some(12),
@@ -1100,16 +1136,83 @@ mod tests {
             threads: 2,
             ..TerrainOptions::default()
         };
+        let levels = same_bytes_for_every_cut(&bounds, &options, &[8, 10, 12, 11]);
+        assert_eq!(levels[3].tiles, 12);
+    }
+
+    #[test]
+    fn a_mercator_pyramid_is_the_same_for_every_cut() {
+        // Web Mercator, far north (where a tile's Web Mercator middle is furthest from its
+        // latitude middle) and at the equator, cut at the coarsest split and finer ones: the
+        // resampled filter reads rows beyond the geographic reach.
+        // Near the pole, split 4 levels up from level 9.
+        let cases: [([f64; 4], u8, &[u8]); 3] = [
+            ([10.01, 69.8, 10.4, 70.3], 11, &[7, 9, 11, 8]),
+            ([10.01, -0.2, 10.4, 0.15], 11, &[7, 9, 11, 8]),
+            ([10.01, 79.5, 11.5, 80.2], 9, &[5, 6, 9, 7]),
+        ];
+        for ([west, south, east, north], max_zoom, splits) in cases {
+            let options = TerrainOptions {
+                min_zoom: 0,
+                max_zoom: Some(max_zoom),
+                normals: true,
+                metadata: true,
+                whole_globe: true,
+                threads: 2,
+                tiling: Tiling::Mercator,
+                ..TerrainOptions::default()
+            };
+            let bounds = GeoBounds {
+                west,
+                south,
+                east,
+                north,
+                resolution: 0.0007,
+            };
+            let levels = same_bytes_for_every_cut(&bounds, &options, splits);
+            let finest = &levels[usize::from(max_zoom)];
+            assert!(finest.tiles > 4 && levels[0].tiles == 1, "{levels:?}");
+        }
+    }
+
+    /// Builds the pyramid of made-up hills over `bounds` with `options`, cut at each of
+    /// the `splits` (the first with bands of one tile row, the others of 100, 1 and 3 in
+    /// turn), and checks they all write the same bytes and counts: returns the level
+    /// reports.
+    fn same_bytes_for_every_cut(
+        bounds: &GeoBounds,
+        options: &TerrainOptions,
+        splits: &[u8],
+    ) -> Vec<LevelReport> {
+        let source = crate::stream::Hills {
+            hole: [
+                (bounds.west + bounds.east) / 2.0,
+                bounds.south * 0.7 + bounds.north * 0.3,
+                (bounds.north - bounds.south) * 0.15,
+            ],
+        };
+        let max_zoom = options.max_zoom.expect("a max zoom");
         let mut outputs = Vec::new();
-        for (split, band_rows) in [(8, 1), (8, 100), (10, 1), (12, 100), (11, 3)] {
+        for (k, &split) in splits.iter().enumerate() {
+            let band_rows = [1, 100, 1, 3][k % 4];
             let dir = tempfile::tempdir().unwrap();
-            let cut = Cut { anchor: 12, split };
-            let (levels, files) =
-                build_in(&source, &bounds, cut, 12, band_rows, dir.path(), &options);
+            let cut = Cut {
+                tiling: options.tiling,
+                anchor: max_zoom,
+                split,
+            };
+            let (levels, files) = build_in(
+                &source,
+                bounds,
+                cut,
+                max_zoom,
+                band_rows,
+                dir.path(),
+                options,
+            );
             outputs.push((files, levels));
         }
         let (files, levels) = &outputs[0];
-        assert_eq!(levels[3].tiles, 12);
         let tiles = |level: &str| {
             files
                 .keys()
@@ -1117,14 +1220,28 @@ mod tests {
                 .count() as u64
         };
         assert_eq!(
-            (9..=12).map(|z| tiles(&z.to_string())).sum::<u64>(),
+            (options.min_zoom..=max_zoom)
+                .map(|z| tiles(&z.to_string()))
+                .sum::<u64>(),
             levels.iter().map(|l| l.tiles).sum::<u64>()
         );
-        assert!(tiles("10") > 0 && tiles("12") > 0);
+        assert!(tiles(&(max_zoom - 2).to_string()) > 0 && tiles(&max_zoom.to_string()) > 0);
         for (k, output) in outputs.iter().enumerate().skip(1) {
-            assert!(output.0 == outputs[0].0, "case {k}: other bytes");
-            assert!(output.1 == outputs[0].1, "case {k}: other counts");
+            let differ: Vec<_> = (output.0.keys().chain(outputs[0].0.keys()))
+                .filter(|p| output.0.get(*p) != outputs[0].0.get(*p))
+                .collect();
+            assert!(
+                differ.is_empty(),
+                "split {}: other bytes in {differ:?}",
+                splits[k]
+            );
+            assert!(
+                output.1 == outputs[0].1,
+                "split {}: other counts",
+                splits[k]
+            );
         }
+        outputs.swap_remove(0).1
     }
 
     /// The pyramid of `source` cut at `cut`, streamed in bands of `band_rows` tile rows,
@@ -1142,7 +1259,7 @@ mod tests {
         std::collections::BTreeMap<PathBuf, Vec<u8>>,
     ) {
         let store = DirectoryStore::open(dir).unwrap();
-        let pool = worker_pool(bounds, max_zoom.max(cut.anchor), 2).unwrap();
+        let pool = worker_pool(bounds, cut.tiling, max_zoom.max(cut.anchor), 2).unwrap();
         let known = Entries::new();
         let mut written = Written::default();
         let mut samples = SplitSamples::default();
@@ -1161,9 +1278,10 @@ mod tests {
             )
             .unwrap();
             if let Some(values) = values {
-                samples
-                    .tiles
-                    .insert((tile_column(cut.split, block.x0), block.y0), values);
+                samples.tiles.insert(
+                    (cut.tiling.tile_column(cut.split, block.x0), block.y0),
+                    values,
+                );
             }
             written.absorb(built);
         }
@@ -1213,9 +1331,10 @@ mod tests {
                 threads: 2,
                 ..TerrainOptions::default()
             };
-            let anchor = own_level(&bounds);
-            let coarsest = Cut::coarsest(anchor);
+            let anchor = own_level(&bounds, Tiling::Geographic);
+            let coarsest = Cut::coarsest(Tiling::Geographic, anchor);
             let finer = Cut {
+                tiling: Tiling::Geographic,
                 anchor,
                 split: (coarsest.split + 2).min(anchor),
             };
@@ -1234,7 +1353,7 @@ mod tests {
             }
             let finest = outputs[0].0.last().unwrap();
             assert!(
-                finest.tiles > 2 && domain(&bounds, max_zoom).height > 2,
+                finest.tiles > 2 && domain(&bounds, Tiling::Geographic, max_zoom).height > 2,
                 "{}",
                 input.display()
             );
@@ -1272,7 +1391,11 @@ mod tests {
             .iter()
             .map(|&(split, band_rows)| {
                 let dir = tempfile::tempdir().unwrap();
-                let cut = Cut { anchor: 2, split };
+                let cut = Cut {
+                    tiling: Tiling::Geographic,
+                    anchor: 2,
+                    split,
+                };
                 build_in(&source, &bounds, cut, 2, band_rows, dir.path(), &options)
             })
             .collect();

@@ -83,6 +83,10 @@ pub(super) fn options_key(options: &TerrainOptions) -> String {
     if options.format != crate::TileFormat::QuantizedMesh {
         text["tile_format"] = options.format.label().into();
     }
+    // Absent for the geographic tiling, so that its pyramids keep their key.
+    if options.tiling != crate::tms::Tiling::Geographic {
+        text["tiling"] = options.tiling.name().into();
+    }
     hex(&Sha256::digest(text.to_string().as_bytes()))
 }
 

@@ -8,7 +8,7 @@ use crate::quantized_mesh::surface_normal;
 use rayon::prelude::*;
 use tinsmith_raster::GeoLattice;
 
-use crate::tms::{step, TileRect, TILE_CELLS};
+use crate::tms::{TileRect, Tiling, TILE_CELLS};
 use tinsmith_tiling::EdgeProfile;
 
 /// `TILE_CELLS` as a row or column count.
@@ -31,6 +31,8 @@ const TAPS: [(i64, f64); 5] = [(-2, 1.0), (-1, 4.0), (0, 6.0), (1, 4.0), (2, 1.0
 /// `0..height`, `0..width`) exactly as the whole raster did, so a tile reads the same
 /// samples, edges and normals whatever else is held.
 pub(super) struct LevelRows {
+    /// The pyramid's tiling.
+    pub(super) tiling: Tiling,
     pub(super) level: u8,
     /// First tile column and TMS row covered.
     pub(super) tx0: u32,
@@ -83,6 +85,7 @@ impl LevelRows {
     /// outside `rect` counts as the level's border (no data).
     pub(super) fn new(rect: TileRect) -> LevelRows {
         LevelRows {
+            tiling: rect.tiling,
             level: rect.level,
             tx0: rect.x0,
             ty0: rect.y0,
@@ -127,9 +130,10 @@ impl LevelRows {
 
     /// Tile `x`, `y` of `level` alone, at height 0 everywhere (the ellipsoid), every row
     /// held: a root tile CesiumJS expects that the raster does not reach (`--metadata`).
-    pub(super) fn flat_tile(level: u8, x: u32, y: u32) -> LevelRows {
+    pub(super) fn flat_tile(tiling: Tiling, level: u8, x: u32, y: u32) -> LevelRows {
         let side = CELLS + 1;
         LevelRows {
+            tiling,
             level,
             tx0: x,
             ty0: y,
@@ -156,19 +160,24 @@ impl LevelRows {
     }
 
     /// Lattice rows `rows`, columns `columns` (level-wide), as a window of the global
-    /// lattice of the level (column 0 at -180°, row 0 at -90°): each point's position
-    /// depends on its global indices only, whatever the window.
+    /// lattice of the level (column 0 at -180°, row 0 at the tiling's southern edge, see
+    /// [`Tiling::lattice`]): each point's position depends on its global indices only,
+    /// whatever the window.
     pub(super) fn lattice(&self, rows: Range<usize>, columns: Range<usize>) -> GeoLattice {
         let cells = u64::from(TILE_CELLS);
-        GeoLattice {
-            west: -180.0,
-            south: -90.0,
-            step: step(self.level),
-            first_column: u64::from(self.tx0) * cells + columns.start as u64,
-            first_row: u64::from(self.ty0) * cells + rows.start as u64,
-            width: columns.len() as u32,
-            height: rows.len() as u32,
-        }
+        self.tiling.lattice(
+            self.level,
+            u64::from(self.tx0) * cells + columns.start as u64,
+            u64::from(self.ty0) * cells + rows.start as u64,
+            columns.len() as u32,
+            rows.len() as u32,
+        )
+    }
+
+    /// The latitude of row `j` (level-wide, may lie outside the level).
+    fn row_latitude(&self, j: i64) -> f64 {
+        let row = i64::from(self.ty0) * TILE_CELLS as i64 + j;
+        self.tiling.row_latitude(self.level, row)
     }
 
     /// Appends whole rows after the last one held.
@@ -359,7 +368,7 @@ impl LevelRows {
     /// On a pole's row, where every sample is the same point, the east-west difference is
     /// left out: its spacing is zero, and it made normals up to 90 degrees off vertical.
     pub(super) fn normal(&self, i: usize, j: usize, lon: f64, lat: f64) -> [f64; 3] {
-        let d = step(self.level).to_radians();
+        let d = self.tiling.step(self.level).to_radians();
         let z = self.at(i, j);
         let sample = |a: i64, b: i64| -> Option<f64> {
             let a = self.column(a)?;
@@ -368,20 +377,35 @@ impl LevelRows {
             }
             Some(self.at(a, b as usize)).filter(|v| v.is_finite())
         };
-        let slope = |lo: Option<f64>, hi: Option<f64>, spacing: f64| match (lo, hi) {
-            (Some(a), Some(b)) => (b - a) / (2.0 * spacing),
-            (None, Some(b)) => (b - z) / spacing,
-            (Some(a), None) => (z - a) / spacing,
+        // Spacings to the samples before and after.
+        let slope = |lo: Option<f64>, hi: Option<f64>, (before, after): (f64, f64)| match (lo, hi) {
+            (Some(a), Some(b)) => (b - a) / (before + after),
+            (None, Some(b)) => (b - z) / after,
+            (Some(a), None) => (z - a) / before,
             (None, None) => 0.0,
         };
         let (ii, jj) = (i as i64, j as i64);
         let dx = crate::quantized_mesh::WGS84_A * d * lat.to_radians().cos().max(1e-6);
-        let dy = crate::quantized_mesh::WGS84_A * d;
+        let dy = match self.tiling {
+            Tiling::Geographic => {
+                let dy = crate::quantized_mesh::WGS84_A * d;
+                (dy, dy)
+            }
+            // Rows are evenly spaced inside a tile only: the spacings either side differ
+            // on a tile's edge.
+            Tiling::Mercator => {
+                let spacing = |a: i64, b: i64| {
+                    crate::quantized_mesh::WGS84_A
+                        * (self.row_latitude(b) - self.row_latitude(a)).to_radians()
+                };
+                (spacing(jj - 1, jj), spacing(jj, jj + 1))
+            }
+        };
         let at_pole = lat.abs() >= 90.0 - 1e-9;
         let ge = if at_pole {
             0.0
         } else {
-            slope(sample(ii - 1, jj), sample(ii + 1, jj), dx)
+            slope(sample(ii - 1, jj), sample(ii + 1, jj), (dx, dx))
         };
         let gn = slope(sample(ii, jj - 1), sample(ii, jj + 1), dy);
         let (e, n, u) = (-ge, -gn, 1.0);
@@ -401,19 +425,76 @@ impl LevelRows {
         2 * i64::from(coarser.ty0) * cells - i64::from(self.ty0) * cells
     }
 
+    /// Where coarser row `J` (local) reads this level's rows, one entry per vertical tap
+    /// of the filter: a row here (local; outside the level it reads the globe beyond) and
+    /// the weight of the row after it, `None` past the tiling's edge. Geographic: rows
+    /// `2 J + offset - 2 ..= 2 J + offset + 2`, weight 0. Web Mercator: the rows of a
+    /// lattice half as fine as the coarser one's (`2 TILE_CELLS` rows a coarser tile,
+    /// evenly spaced in latitude), around `2 J`, each placed in latitude among this
+    /// level's rows (whose tiles split the coarser tile at its Web Mercator middle, not its
+    /// latitude middle) and interpolated linearly in latitude between the two around it.
+    fn vertical_taps(&self, coarser: &LevelRows, row: usize) -> [Option<(i64, f64)>; 5] {
+        match self.tiling {
+            Tiling::Geographic => {
+                let centre = 2 * row as i64 + self.offset_to(coarser);
+                TAPS.map(|(dy, _)| Some((centre + dy, 0.0)))
+            }
+            Tiling::Mercator => {
+                let cells = i64::from(TILE_CELLS);
+                let tiles = 1u64 << coarser.level;
+                let half = 2 * (i64::from(coarser.ty0) * cells + row as i64);
+                let first = i64::from(self.ty0) * cells;
+                TAPS.map(|(dy, _)| {
+                    let h = half + dy;
+                    if h < 0 || h > 2 * cells * tiles as i64 {
+                        return None;
+                    }
+                    let half_lattice = tinsmith_raster::GeoLattice {
+                        latitudes: tinsmith_raster::Latitudes::WebMercatorTiles {
+                            cells: 2 * TILE_CELLS,
+                            tiles,
+                        },
+                        first_row: h as u64,
+                        ..self.tiling.lattice(coarser.level, 0, 0, 1, 1)
+                    };
+                    let position = self.tiling.row_position(self.level, half_lattice.lat(0));
+                    let below = position.floor();
+                    Some((below as i64 - first, position - below))
+                })
+            }
+        }
+    }
+
+    /// The lowest and highest rows here (local) that coarser row `J` reads.
+    fn rows_read(&self, coarser: &LevelRows, row: usize) -> (i64, i64) {
+        let taps = self.vertical_taps(coarser, row);
+        let mut range = (i64::MAX, i64::MIN);
+        for (r, w) in taps.into_iter().flatten() {
+            range = (range.0.min(r), range.1.max(r + i64::from(w > 0.0)));
+        }
+        range
+    }
+
     /// One past the last row of `coarser` that can be made from the rows pushed here so
-    /// far: row `J` reads rows `2 J + offset - 2 ..= 2 J + offset + 2` of this level (those
-    /// outside it count as nodata).
+    /// far: row `J` reads the rows [`LevelRows::vertical_taps`] names (those outside this
+    /// level count as nodata).
     pub(super) fn coarser_rows_ready(&self, coarser: &LevelRows) -> usize {
         if self.complete() {
             return coarser.height;
         }
-        // 2 J + offset + 2 < end, so J <= (end - offset - 3) / 2.
-        let limit = self.end() as i64 - self.offset_to(coarser) - 3;
-        if limit < 0 {
-            return 0;
+        if self.tiling == Tiling::Geographic {
+            // 2 J + offset + 2 < end, so J <= (end - offset - 3) / 2.
+            let limit = self.end() as i64 - self.offset_to(coarser) - 3;
+            if limit < 0 {
+                return 0;
+            }
+            return (limit as usize / 2 + 1).min(coarser.height);
         }
-        (limit as usize / 2 + 1).min(coarser.height)
+        let mut ready = coarser.end();
+        while ready < coarser.height && self.rows_read(coarser, ready).1 < self.end() as i64 {
+            ready += 1;
+        }
+        ready
     }
 
     /// The first row here that `coarser`'s next row (its `end()`) reads.
@@ -421,8 +502,7 @@ impl LevelRows {
         if coarser.complete() {
             return self.height;
         }
-        let row = 2 * coarser.end() as i64 + self.offset_to(coarser) - 2;
-        row.max(0) as usize
+        self.rows_read(coarser, coarser.end()).0.max(0) as usize
     }
 
     /// Rows `rows` of the next coarser level: lattice point (X, Y) there is this level's
@@ -445,7 +525,7 @@ impl LevelRows {
         let cy0 = i64::from(coarser.ty0) * cells;
         let width = coarser.width;
         // Lattice columns in a whole turn of this level.
-        let turn = (2i64 << self.level) * cells;
+        let turn = self.tiling.columns(self.level) as i64 * cells;
         // The column here of each tap of each coarse column, `None` outside this level:
         // the same for every row, so worked out once.
         let columns: Vec<[Option<usize>; 5]> = (0..width)
@@ -463,6 +543,10 @@ impl LevelRows {
             None => (0..coarser.height, &all),
         };
         let mut out = vec![f32::NAN; width * rows.len()];
+        if self.tiling == Tiling::Mercator {
+            self.resampled_coarser_rows(coarser, rows, &columns, &mut out);
+            return out;
+        }
         out.par_chunks_mut(width).enumerate().for_each(|(k, row)| {
             if !reach_rows.contains(&(rows.start + k)) {
                 return;
@@ -496,5 +580,72 @@ impl LevelRows {
             }
         });
         out
+    }
+
+    /// [`LevelRows::coarser_rows`] of a Web Mercator level: the filter over rows resampled
+    /// in latitude ([`LevelRows::vertical_taps`]); a resampled sample between a valid and
+    /// a nodata one is the valid one, so the domain grows as the geographic filter's does.
+    /// `columns` are each coarse column's taps here.
+    fn resampled_coarser_rows(
+        &self,
+        coarser: &LevelRows,
+        rows: Range<usize>,
+        columns: &[[Option<usize>; 5]],
+        out: &mut [f32],
+    ) {
+        let width = coarser.width;
+        let all = vec![true; width];
+        let (reach_rows, reach_columns) = match &coarser.reach {
+            Some(reach) => (reach.rows.clone(), &reach.columns),
+            None => (0..coarser.height, &all),
+        };
+        let outside = f64::from(self.outside);
+        out.par_chunks_mut(width).enumerate().for_each(|(k, row)| {
+            if !reach_rows.contains(&(rows.start + k)) {
+                return;
+            }
+            let lines = self
+                .vertical_taps(coarser, rows.start + k)
+                .map(|tap| tap.map(|(r, w)| (self.row(r), (w > 0.0).then(|| self.row(r + 1)), w)));
+            for ((slot, taps), _) in row
+                .iter_mut()
+                .zip(columns)
+                .zip(reach_columns)
+                .filter(|(_, &in_reach)| in_reach)
+            {
+                let (mut sum, mut weight) = (0.0f64, 0.0f64);
+                for (line, (_, wy)) in lines.iter().zip(TAPS) {
+                    for (column, (_, wx)) in taps.iter().zip(TAPS) {
+                        let v = match (line, column) {
+                            (None, _) => f64::NAN,
+                            (Some((below, above, w)), Some(c)) => {
+                                let at =
+                                    |r: &Option<&[f32]>| r.map_or(outside, |r| f64::from(r[*c]));
+                                let a = at(below);
+                                match above {
+                                    None => a,
+                                    Some(above) => {
+                                        let b = at(above);
+                                        match (a.is_finite(), b.is_finite()) {
+                                            (true, true) => a + (b - a) * w,
+                                            (true, false) => a,
+                                            _ => b,
+                                        }
+                                    }
+                                }
+                            }
+                            (Some(_), None) => outside,
+                        };
+                        if v.is_finite() {
+                            sum += wx * wy * v;
+                            weight += wx * wy;
+                        }
+                    }
+                }
+                if weight > 0.0 {
+                    *slot = (sum / weight) as f32;
+                }
+            }
+        });
     }
 }

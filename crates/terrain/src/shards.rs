@@ -20,7 +20,7 @@ use crate::records::{
     ShardRecord, RECORDS_DIR,
 };
 use crate::stream::Warp;
-use crate::tms::{bounds_array, tile_column};
+use crate::tms::bounds_array;
 use crate::writer::Written;
 use crate::{LevelReport, TerrainError, TerrainOptions, TerrainReport, TerrainResult};
 
@@ -100,7 +100,12 @@ pub fn build_shard(
         shard_blocks: mine.len(),
         share: plan.weights[mine.clone()].iter().sum::<u64>() as f64 / total_weight as f64,
     });
-    let pool = worker_pool(&bounds, max_zoom.max(cut.anchor), options.threads)?;
+    let pool = worker_pool(
+        &bounds,
+        cut.tiling,
+        max_zoom.max(cut.anchor),
+        options.threads,
+    )?;
     let source = Warp {
         path: input,
         band: options.band,
@@ -110,7 +115,7 @@ pub fn build_shard(
     let key = options_key(options);
     let mut known = Entries::new();
     for block in &blocks {
-        let id = [tile_column(cut.split, block.x0), block.y0];
+        let id = [cut.tiling.tile_column(cut.split, block.x0), block.y0];
         known.extend(known_tiles(dest, cut.split, id, &key)?);
     }
     let total = blocks.len();
@@ -132,7 +137,7 @@ pub fn build_shard(
         shard,
         blocks: blocks
             .iter()
-            .map(|b| [tile_column(cut.split, b.x0), b.y0])
+            .map(|b| [cut.tiling.tile_column(cut.split, b.x0), b.y0])
             .collect(),
     };
     let json = serde_json::to_vec_pretty(&record).expect("a record serializes");
@@ -289,7 +294,7 @@ pub fn merge_shards(
     for (path, record) in &records {
         let expected: Vec<[u32; 2]> = plan.blocks()[plan.shard_blocks(record.shard.index)]
             .iter()
-            .map(|b| [tile_column(cut.split, b.x0), b.y0])
+            .map(|b| [cut.tiling.tile_column(cut.split, b.x0), b.y0])
             .collect();
         if record.blocks != expected {
             return Err(TerrainError::Options(format!(
@@ -318,9 +323,9 @@ pub fn merge_shards(
                 if tile.written {
                     one.available[usize::from(tile.z)].insert((tile.x, tile.y));
                 }
-                let quality = options.quality;
+                let (tiling, quality) = (options.tiling, options.quality);
                 let report = one.reports[usize::from(tile.z)]
-                    .get_or_insert_with(|| LevelReport::empty(tile.z, quality));
+                    .get_or_insert_with(|| LevelReport::empty(tiling, tile.z, quality));
                 crate::records::count(report, tile);
             }
             written.absorb(one);
@@ -335,7 +340,7 @@ pub fn merge_shards(
             .filter(|r| r.options == key)
             .map(|r| r.tiles.into_iter().map(|t| ((t.z, t.x, t.y), t)).collect())
             .unwrap_or_default();
-    let pool = worker_pool(&bounds, max_zoom.max(cut.anchor), threads)?;
+    let pool = worker_pool(&bounds, cut.tiling, max_zoom.max(cut.anchor), threads)?;
     let (levels, tiles_kept) = finish_pyramid(
         &plan.name, written, &samples, &bounds, cut, max_zoom, dest, &options, &pool, &known,
         progress,

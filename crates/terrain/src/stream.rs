@@ -296,6 +296,7 @@ impl RowSource for Hills {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tms::Tiling;
     use tinsmith_raster::GeoBounds;
 
     /// The next coarser level of a whole finer level, as the pipeline made it before it
@@ -417,22 +418,50 @@ mod tests {
             north: 52.0,
             resolution: 0.02,
         };
-        let source = Hills {
-            hole: [11.25, 45.0, 1.5],
+        check_streamed_levels(Tiling::Geographic, &bounds, [11.25, 45.0, 1.5], (2, 5));
+    }
+
+    #[test]
+    fn streamed_web_mercator_levels_equal_whole_levels_resampled_alike() {
+        // Web Mercator tiles from 35 to 68 degrees north (where a tile's Web Mercator
+        // middle is far from its latitude middle, coarse rows read finer rows tens of rows
+        // away), a hole across tile edges.
+        let bounds = GeoBounds {
+            west: 10.3,
+            south: 35.0,
+            east: 30.0,
+            north: 68.0,
+            resolution: 0.04,
         };
-        let (min_zoom, max_zoom) = (2, 5);
+        check_streamed_levels(Tiling::Mercator, &bounds, [22.5, 55.77, 1.5], (1, 5));
+    }
+
+    /// Streams made-up hills over `bounds` (with a nodata disc `hole`) for `zooms` in
+    /// `tiling`, in several band heights and thread counts, and checks every level against
+    /// the whole levels made at once (Web Mercator: within float rounding, the reference
+    /// placing rows by another computation).
+    fn check_streamed_levels(
+        tiling: Tiling,
+        bounds: &GeoBounds,
+        hole: [f64; 3],
+        (min_zoom, max_zoom): (u8, u8),
+    ) {
+        let source = Hills { hole };
+        let level = |z: u8| LevelRows::new(TileRect::covering(bounds, tiling, z));
         // The whole levels, made at once.
         let mut whole = Vec::new();
-        let finest = LevelRows::new(TileRect::covering(&bounds, max_zoom));
+        let finest = level(max_zoom);
         whole.push(
             source
                 .rows(&finest, 0..finest.height, 0..finest.width)
                 .unwrap(),
         );
         for z in (min_zoom..max_zoom).rev() {
-            let fine = LevelRows::new(TileRect::covering(&bounds, z + 1));
-            let coarse = LevelRows::new(TileRect::covering(&bounds, z));
-            let values = whole_coarser(&fine, whole.last().unwrap(), &coarse);
+            let (fine, coarse) = (level(z + 1), level(z));
+            let values = match tiling {
+                Tiling::Geographic => whole_coarser(&fine, whole.last().unwrap(), &coarse),
+                Tiling::Mercator => whole_coarser_mercator(&fine, whole.last().unwrap(), &coarse),
+            };
             whole.push(values);
         }
         whole.reverse(); // coarsest first, index z - min_zoom
@@ -449,7 +478,7 @@ mod tests {
             let mut recorder = Recorder {
                 levels: (0..=max_zoom)
                     .map(|z| {
-                        let l = LevelRows::new(TileRect::covering(&bounds, z));
+                        let l = level(z);
                         Record {
                             values: vec![f32::NAN; l.width * l.height],
                             ty0: l.ty0,
@@ -463,7 +492,7 @@ mod tests {
             };
             stream_levels(
                 &source,
-                &|z| LevelRows::new(TileRect::covering(&bounds, z)),
+                &level,
                 (min_zoom, max_zoom),
                 band_rows,
                 &pool,
@@ -477,12 +506,103 @@ mod tests {
             for z in min_zoom..=max_zoom {
                 let streamed = &recorder.levels[usize::from(z)].values;
                 let reference = &whole[usize::from(z - min_zoom)];
+                let agree = match tiling {
+                    Tiling::Geographic => same(streamed, reference),
+                    Tiling::Mercator => close(streamed, reference),
+                };
                 assert!(
-                    same(streamed, reference),
+                    agree,
                     "level {z}, bands of {band_rows} tile rows, {threads} threads"
                 );
             }
         }
+    }
+
+    /// Within float rounding of each other, NaN where the other is.
+    fn close(a: &[f32], b: &[f32]) -> bool {
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .all(|(x, y)| (x.is_nan() && y.is_nan()) || (x - y).abs() <= 1e-3 * (1.0 + x.abs()))
+    }
+
+    /// The next coarser level of a whole finer Web Mercator level: each coarse row's
+    /// filter taps are rows of a lattice half as fine as its own (even in latitude inside
+    /// the coarse tile), each interpolated in latitude between the two finer rows around
+    /// it, found by bisecting the finer rows' latitudes (not by inverting Web Mercator as
+    /// [`LevelRows::coarser_rows`] does); the valid one of the two when only one is.
+    fn whole_coarser_mercator(
+        fine: &LevelRows,
+        fine_values: &[f32],
+        coarse: &LevelRows,
+    ) -> Vec<f32> {
+        let c = i64::from(TILE_CELLS);
+        let (fx0, fy0) = (i64::from(fine.tx0) * c, i64::from(fine.ty0) * c);
+        let (cx0, cy0) = (i64::from(coarse.tx0) * c, i64::from(coarse.ty0) * c);
+        let coarse_tiles = 1i64 << coarse.level;
+        let fine_rows = 2 * coarse_tiles * c + 1;
+        let fine_lat: Vec<f64> = (0..fine_rows)
+            .map(|r| Tiling::Mercator.row_latitude(fine.level, r))
+            .collect();
+        let at = |gx: i64, gy: i64| -> f32 {
+            let (i, j) = (gx - fx0, gy - fy0);
+            if i < 0 || j < 0 || i >= fine.width as i64 || j >= fine.height as i64 {
+                f32::NAN
+            } else {
+                fine_values[j as usize * fine.width + i as usize]
+            }
+        };
+        let half_lat = |h: i64| {
+            let t = (h / (2 * c)).min(coarse_tiles - 1);
+            let k = h - 2 * c * t;
+            let edge =
+                |t: i64| tinsmith_raster::web_mercator_latitude(t as f64 / coarse_tiles as f64);
+            edge(t) + (edge(t + 1) - edge(t)) * (k as f64 / (2 * c) as f64)
+        };
+        let taps = [(-2, 1.0), (-1, 4.0), (0, 6.0), (1, 4.0), (2, 1.0)];
+        let mut out = vec![f32::NAN; coarse.width * coarse.height];
+        for j in 0..coarse.height {
+            for i in 0..coarse.width {
+                let gx = 2 * (cx0 + i as i64);
+                let (mut sum, mut weight) = (0.0f64, 0.0f64);
+                for (dy, wy) in taps {
+                    let h = 2 * (cy0 + j as i64) + dy;
+                    if h < 0 || h > 2 * c * coarse_tiles {
+                        continue;
+                    }
+                    let lat = half_lat(h);
+                    let below = (fine_lat.partition_point(|&l| l <= lat) as i64 - 1).max(0);
+                    let above = (below + 1).min(fine_rows - 1);
+                    let w = if below == above {
+                        0.0
+                    } else {
+                        (lat - fine_lat[below as usize])
+                            / (fine_lat[above as usize] - fine_lat[below as usize])
+                    };
+                    for (dx, wx) in taps {
+                        let a = f64::from(at(gx + dx, below));
+                        let v = if w <= 0.0 {
+                            a
+                        } else {
+                            let b = f64::from(at(gx + dx, above));
+                            match (a.is_finite(), b.is_finite()) {
+                                (true, true) => a + (b - a) * w,
+                                (true, false) => a,
+                                _ => b,
+                            }
+                        };
+                        if v.is_finite() {
+                            sum += wx * wy * v;
+                            weight += wx * wy;
+                        }
+                    }
+                }
+                if weight > 0.0 {
+                    out[j * coarse.width + i] = (sum / weight) as f32;
+                }
+            }
+        }
+        out
     }
 
     #[test]
@@ -494,7 +614,7 @@ mod tests {
             north: 50.0,
             resolution: 0.1,
         };
-        let level = LevelRows::new(TileRect::covering(&bounds, 3));
+        let level = LevelRows::new(TileRect::covering(&bounds, Tiling::Geographic, 3));
         assert_eq!(level.tiles_y, 3);
         let n = TILE_CELLS as usize;
         assert_eq!(

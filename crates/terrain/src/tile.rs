@@ -9,7 +9,7 @@ use tinsmith_tiling::check_tin;
 use crate::budget::{quanta_per_step, slack_scale, LevelBudget};
 use crate::layer::{metadata_json, Available};
 use crate::rows::LevelRows;
-use crate::tms::{step, tile_column, tile_rectangle, TILE_CELLS, U_PER_CELL};
+use crate::tms::{Tiling, TILE_CELLS, U_PER_CELL};
 use crate::{TerrainError, TerrainOptions, TerrainResult, TileFormat};
 use tinsmith_tiling::{edge_limit, edge_span, EdgeProfile};
 
@@ -37,7 +37,7 @@ pub(super) fn build_tile(
 ) -> TerrainResult<Option<TileOut>> {
     let z = raster.level;
     // Where the tile is written (`x` may be a turn east, see `tile_range`).
-    let column = tile_column(z, x);
+    let column = raster.tiling.tile_column(z, x);
     let n = TILE_CELLS as usize;
     let (i0, j0) = raster.tile_origin(x, y);
     let values = raster.tile_values(x, y);
@@ -163,9 +163,14 @@ pub(super) fn build_tile(
     }
 
     // At its own column's longitudes, as a window that does not wrap places it.
-    let rect = tile_rectangle(z, column, y);
+    let rect = raster.tiling.tile_rectangle(z, column, y);
     let normals: Option<Vec<[f64; 3]>> = options.normals.then(|| {
-        let d = step(z);
+        let d = raster.tiling.step(z);
+        // Rows are evenly spaced in latitude inside the tile, as CesiumJS places `v`.
+        let d_lat = match raster.tiling {
+            Tiling::Geographic => d,
+            Tiling::Mercator => (rect.north - rect.south) / f64::from(TILE_CELLS),
+        };
         tin.vertices()
             .iter()
             .map(|v| {
@@ -174,7 +179,7 @@ pub(super) fn build_tile(
                     gi,
                     gj,
                     rect.west + f64::from(v.x) * d,
-                    rect.south + f64::from(v.y) * d,
+                    rect.south + f64::from(v.y) * d_lat,
                 )
             })
             .collect()

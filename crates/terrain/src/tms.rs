@@ -1,8 +1,165 @@
-//! The TMS geographic tiling (EPSG:4326, two level-0 tiles) and each tile's lattice of
-//! `TILE_CELLS` cells a side.
+//! The tilings (TMS geographic, EPSG:4326 with two level-0 tiles; Web Mercator, EPSG:3857
+//! with one) and each tile's lattice of `TILE_CELLS` cells a side.
 
 use crate::quantized_mesh::{GeoRectangle, QUANTIZED_MAX};
-use tinsmith_raster::GeoBounds;
+use tinsmith_raster::{web_mercator_latitude, web_mercator_y, GeoBounds, GeoLattice, Latitudes};
+
+/// How a pyramid's tiles divide the globe (`layer.json`'s `projection`). Part of every
+/// tile's identity: a pyramid, its shards and its updates have one tiling.
+///
+/// Either way a tile's lattice has `TILE_CELLS + 1` columns evenly spaced in longitude and
+/// as many rows evenly spaced in latitude between the tile's southern and northern edges,
+/// which is how CesiumJS places a quantized-mesh vertex (`u`, `v` linear in longitude and
+/// latitude across the tile's rectangle), so the surface it draws is linear in longitude
+/// and latitude inside each triangle, as the lattice the bound is measured on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Tiling {
+    /// EPSG:4326: 2 x 1 tiles at level 0, each level's tiles 180 / 2^level degrees square.
+    #[default]
+    Geographic,
+    /// EPSG:3857 (Web Mercator, CesiumJS's `WebMercatorTilingScheme`): 1 x 1 tile at level
+    /// 0 covering latitudes up to about ±85.0511°, each level splitting a tile at its
+    /// middle in longitude and in Web Mercator y (not in latitude). Rows stay evenly
+    /// spaced in latitude inside each tile, so a tile's rows are not every other row of
+    /// the finer level's.
+    Mercator,
+}
+
+impl Tiling {
+    /// `layer.json`'s `projection`.
+    pub fn projection(self) -> &'static str {
+        match self {
+            Tiling::Geographic => "EPSG:4326",
+            Tiling::Mercator => "EPSG:3857",
+        }
+    }
+
+    /// The option's name (`--tiling`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Tiling::Geographic => "geographic",
+            Tiling::Mercator => "mercator",
+        }
+    }
+
+    /// Tile columns of level `z`: a whole turn of longitude.
+    pub fn columns(self, z: u8) -> u64 {
+        match self {
+            Tiling::Geographic => 2u64 << z,
+            Tiling::Mercator => 1u64 << z,
+        }
+    }
+
+    /// The southernmost and northernmost latitudes tiles reach.
+    pub fn latitude_range(self) -> [f64; 2] {
+        match self {
+            Tiling::Geographic => [-90.0, 90.0],
+            Tiling::Mercator => [web_mercator_latitude(0.0), web_mercator_latitude(1.0)],
+        }
+    }
+
+    /// Lattice spacing of a level in longitude, degrees (in latitude too, geographic).
+    pub(super) fn step(self, level: u8) -> f64 {
+        match self {
+            Tiling::Geographic => step(level),
+            Tiling::Mercator => 360.0 / (f64::from(TILE_CELLS) * (1u64 << level) as f64),
+        }
+    }
+
+    /// The tile column of lattice tile column `x` (which is past the last column across
+    /// the antimeridian, see [`tile_range`]).
+    pub(super) fn tile_column(self, z: u8, x: u32) -> u32 {
+        (u64::from(x) % self.columns(z)) as u32
+    }
+
+    /// The tile rectangle `z/x/y` (TMS y, from the south) in degrees (east of 180 for
+    /// `x` past the last column: the same tile a turn east). Web Mercator tiles' southern
+    /// and northern edges are their Web Mercator y's latitudes, as CesiumJS's
+    /// `WebMercatorTilingScheme.tileXYToRectangle` has them.
+    pub fn tile_rectangle(self, z: u8, x: u32, y: u32) -> GeoRectangle {
+        match self {
+            Tiling::Geographic => tile_rectangle(z, x, y),
+            Tiling::Mercator => {
+                let n = (1u64 << z) as f64;
+                let size = 360.0 / n;
+                GeoRectangle {
+                    west: -180.0 + f64::from(x) * size,
+                    south: web_mercator_latitude(f64::from(y) / n),
+                    east: -180.0 + f64::from(x + 1) * size,
+                    north: web_mercator_latitude(f64::from(y + 1) / n),
+                }
+            }
+        }
+    }
+
+    /// The latitude of global lattice row `row` of `level` (row 0 the southern edge of
+    /// the tiling), as [`Tiling::lattice`] places it.
+    pub(super) fn row_latitude(self, level: u8, row: i64) -> f64 {
+        self.lattice(level, 0, row.max(0) as u64, 1, 1).lat(0)
+    }
+
+    /// Columns `first_column ..`, rows `first_row ..` (`width` x `height`) of the global
+    /// lattice of `level` (column 0 at -180°, row 0 at the tiling's southern edge): each
+    /// point's position depends on its global indices only, whatever the window.
+    pub(super) fn lattice(
+        self,
+        level: u8,
+        first_column: u64,
+        first_row: u64,
+        width: u32,
+        height: u32,
+    ) -> GeoLattice {
+        let latitudes = match self {
+            Tiling::Geographic => Latitudes::Uniform,
+            Tiling::Mercator => Latitudes::WebMercatorTiles {
+                cells: TILE_CELLS,
+                tiles: 1u64 << level,
+            },
+        };
+        GeoLattice {
+            west: -180.0,
+            south: -90.0,
+            step: self.step(level),
+            first_column,
+            first_row,
+            width,
+            height,
+            latitudes,
+        }
+    }
+
+    /// Where latitude `lat` falls among the global lattice rows of `level`, as a
+    /// fractional row index (rows spaced evenly in latitude inside each tile), clamped to
+    /// the level's rows.
+    pub(super) fn row_position(self, level: u8, lat: f64) -> f64 {
+        let cells = f64::from(TILE_CELLS);
+        let n = (1u64 << level) as f64;
+        match self {
+            Tiling::Geographic => ((lat + 90.0) / step(level)).clamp(0.0, n * cells),
+            Tiling::Mercator => {
+                let tile = (web_mercator_y(lat) * n).floor().clamp(0.0, n - 1.0);
+                let south = web_mercator_latitude(tile / n);
+                let north = web_mercator_latitude((tile + 1.0) / n);
+                (cells * (tile + (lat - south) / (north - south))).clamp(0.0, n * cells)
+            }
+        }
+    }
+
+    /// The most, in lattice rows of level `level + 1`, by which a row position of the
+    /// half-spaced lattice of `level` (see [`crate::rows::LevelRows::coarser_rows`]) lies
+    /// away from the same index of the finer level: 0 geographic (the lattices nest), and
+    /// for Web Mercator a tile's latitude middle is away from its Web Mercator middle
+    /// (about 122 rows at level 1, 79 at 2, 42 at 3, halving each level; measured with
+    /// `tiles_split_at_their_mercator_middle_by_a_bounded_offset`), bounded here with room.
+    pub(super) fn max_row_offset(self, level: u8) -> usize {
+        match self {
+            Tiling::Geographic => 0,
+            Tiling::Mercator if level == 0 => 1,
+            Tiling::Mercator => 2 + (340usize >> level.min(16)),
+        }
+    }
+}
 
 /// Cells along each side of a tile's sample grid: each tile samples
 /// `(TILE_CELLS + 1)^2` lattice points. 217 divides 32767 (= 7 x 31 x 151), so sample `i`
@@ -12,8 +169,8 @@ pub const TILE_CELLS: u32 = 217;
 /// `u` (and `v`) per cell of the tile grid.
 pub(super) const U_PER_CELL: u32 = QUANTIZED_MAX as u32 / TILE_CELLS;
 
-/// Lattice spacing of a level, in degrees.
-pub(super) fn step(level: u8) -> f64 {
+/// Lattice spacing of a geographic level, in degrees.
+fn step(level: u8) -> f64 {
     180.0 / (f64::from(TILE_CELLS) * (1u64 << level) as f64)
 }
 
@@ -26,9 +183,9 @@ pub(super) const EARTH_RADIUS: f64 = 6_378_137.0;
 /// surface, an error the height check (made in longitude/latitude) does not see. Measured
 /// along the equator (where a lattice step spans the most arc); `None` when even the
 /// tile's diagonal is short enough.
-pub(super) fn max_edge_length(level: u8, bound: f64) -> Option<u32> {
+pub(super) fn max_edge_length(tiling: Tiling, level: u8, bound: f64) -> Option<u32> {
     let arc = 2.0 * (1.0 - (bound / EARTH_RADIUS).min(1.0)).acos();
-    let spacing = step(level).to_radians();
+    let spacing = tiling.step(level).to_radians();
     let length = (arc / spacing).floor();
     if length >= f64::from(TILE_CELLS) * std::f64::consts::SQRT_2 {
         None
@@ -55,14 +212,8 @@ pub(super) fn bounds_array(bounds: &GeoBounds) -> [f64; 4] {
     ]
 }
 
-/// The tile column of lattice tile column `x` (which is past the last column across the
-/// antimeridian, see [`tile_range`]).
-pub(super) fn tile_column(z: u8, x: u32) -> u32 {
-    x % (2u32 << z)
-}
-
-/// The tile rectangle `z/x/y` (TMS y) in degrees (east of 180 for `x` past the last
-/// column: the same tile a turn east).
+/// The geographic tile rectangle `z/x/y` (TMS y) in degrees (east of 180 for `x` past the
+/// last column: the same tile a turn east); [`Tiling::tile_rectangle`] for either tiling.
 pub fn tile_rectangle(z: u8, x: u32, y: u32) -> GeoRectangle {
     let size = 180.0 / (1u64 << z) as f64;
     GeoRectangle {
@@ -74,20 +225,27 @@ pub fn tile_rectangle(z: u8, x: u32, y: u32) -> GeoRectangle {
 }
 
 /// The tiles of `level` that the bounds touch: columns and rows, inclusive. Across the
-/// antimeridian the last column is past the level's last (`2^(level+1)` columns): column
-/// `x` is then tile `x mod 2^(level+1)` (see [`tile_column`]), at most one full turn.
-pub(super) fn tile_range(bounds: &GeoBounds, level: u8) -> ([u32; 2], [u32; 2]) {
-    let n = 1u64 << level;
-    let size = 180.0 / n as f64;
+/// antimeridian the last column is past the level's last ([`Tiling::columns`]): column
+/// `x` is then tile `x mod columns` (see [`Tiling::tile_column`]), at most one full turn.
+/// Web Mercator rows hold only latitudes within ±85.0511°: the part of the bounds beyond
+/// is not tiled.
+pub(super) fn tile_range(bounds: &GeoBounds, tiling: Tiling, level: u8) -> ([u32; 2], [u32; 2]) {
+    let columns = tiling.columns(level);
+    let rows = 1u64 << level;
+    let size = 360.0 / columns as f64;
     let clamp = |v: f64, max: u64| (v.floor().max(0.0) as u64).min(max - 1) as u32;
-    let west = clamp((bounds.west + 180.0) / size, 2 * n);
+    let west = clamp((bounds.west + 180.0) / size, columns);
     let x = [
         west,
-        clamp((bounds.east + 180.0) / size, u64::from(west) + 2 * n),
+        clamp((bounds.east + 180.0) / size, u64::from(west) + columns),
     ];
+    let row = |lat: f64| match tiling {
+        Tiling::Geographic => (lat + 90.0) / size,
+        Tiling::Mercator => web_mercator_y(lat) * rows as f64,
+    };
     let y = [
-        clamp((bounds.south + 90.0) / size, n),
-        clamp((bounds.north + 90.0) / size, n),
+        clamp(row(bounds.south), rows),
+        clamp(row(bounds.north), rows),
     ];
     (x, y)
 }
@@ -97,6 +255,7 @@ pub(super) fn tile_range(bounds: &GeoBounds, level: u8) -> ([u32; 2], [u32; 2]) 
 /// height`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) struct TileRect {
+    pub(super) tiling: Tiling,
     pub(super) level: u8,
     pub(super) x0: u32,
     pub(super) y0: u32,
@@ -106,9 +265,10 @@ pub(super) struct TileRect {
 
 impl TileRect {
     /// The tiles of `level` that `bounds` touches (see [`tile_range`]).
-    pub(super) fn covering(bounds: &GeoBounds, level: u8) -> TileRect {
-        let ([x0, x1], [y0, y1]) = tile_range(bounds, level);
+    pub(super) fn covering(bounds: &GeoBounds, tiling: Tiling, level: u8) -> TileRect {
+        let ([x0, x1], [y0, y1]) = tile_range(bounds, tiling, level);
         TileRect {
+            tiling,
             level,
             x0,
             y0,
@@ -119,7 +279,7 @@ impl TileRect {
 
     /// Whether the rectangle goes all the way round the globe.
     pub(super) fn wraps(&self) -> bool {
-        u64::from(self.width) == 2u64 << self.level
+        u64::from(self.width) == self.tiling.columns(self.level)
     }
 
     /// Tiles in the rectangle.
@@ -129,8 +289,79 @@ impl TileRect {
 
     /// Whether tile `x`, `y` (any turn) lies in the rectangle.
     pub(super) fn contains(&self, x: u32, y: u32) -> bool {
-        let turn = 2i64 << self.level;
+        let turn = self.tiling.columns(self.level) as i64;
         let dx = (i64::from(x) - i64::from(self.x0)).rem_euclid(turn);
         dx < i64::from(self.width) && y >= self.y0 && y - self.y0 < self.height
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The largest |position among level `level + 1`'s rows - index| over the rows of
+    /// the lattice half as fine as `level`'s (what the coarser filter reads), over the
+    /// tiles `tiles` of `level`.
+    fn row_offset(level: u8, tiles: impl Iterator<Item = u64>) -> f64 {
+        let cells = u64::from(TILE_CELLS);
+        let n = 1u64 << level;
+        let mut worst = 0.0f64;
+        for t in tiles {
+            for h in 0..=2 * cells {
+                let row = 2 * cells * t + h;
+                let half = GeoLattice {
+                    latitudes: Latitudes::WebMercatorTiles {
+                        cells: 2 * TILE_CELLS,
+                        tiles: n,
+                    },
+                    first_row: row,
+                    ..Tiling::Mercator.lattice(level, 0, 0, 1, 1)
+                };
+                let position = Tiling::Mercator.row_position(level + 1, half.lat(0));
+                worst = worst.max((position - row as f64).abs());
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn tiles_split_at_their_mercator_middle_by_a_bounded_offset() {
+        // Run with --nocapture for the table of offsets (rows of the finer level).
+        for level in 0..=12u8 {
+            let n = 1u64 << level;
+            // Every tile up to level 6, then the northern 64 (the worst) and the equator.
+            let tiles: Vec<u64> = if n <= 64 {
+                (0..n).collect()
+            } else {
+                (n - 64..n).chain(n / 2 - 2..n / 2 + 2).collect()
+            };
+            let offset = row_offset(level, tiles.into_iter());
+            println!("level {level}: {offset:.2} rows");
+            assert!(
+                offset <= Tiling::Mercator.max_row_offset(level) as f64,
+                "{level}"
+            );
+            if level == 1 {
+                // Rows taken as every other finer row would sit 100+ rows off.
+                assert!(offset > 100.0);
+            }
+        }
+        assert_eq!(Tiling::Geographic.max_row_offset(3), 0);
+    }
+
+    #[test]
+    fn mercator_rectangles_meet_and_end_at_85_degrees() {
+        let top = Tiling::Mercator.tile_rectangle(3, 5, 7);
+        assert!((top.north - 85.051_128_779_806_59).abs() < 1e-12);
+        assert_eq!(Tiling::Mercator.tile_rectangle(1, 0, 0).north, 0.0);
+        let (a, b) = (
+            Tiling::Mercator.tile_rectangle(9, 3, 300),
+            Tiling::Mercator.tile_rectangle(9, 3, 301),
+        );
+        assert_eq!(a.north, b.south);
+        // The lattice's edge rows are the rectangles' edges, to the bit.
+        let row = |r: i64| Tiling::Mercator.row_latitude(9, r);
+        assert_eq!(row(301 * i64::from(TILE_CELLS)), b.south);
+        assert_eq!(row(302 * i64::from(TILE_CELLS)), b.north);
     }
 }

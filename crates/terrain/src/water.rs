@@ -87,6 +87,7 @@ pub(crate) fn mask(water: &Water, rect: GeoRectangle) -> TerrainResult<Mask> {
     let step = (rect.east - rect.west) / f64::from(MASK_CELLS);
     // Cell centres, one ring beyond the tile for the shore rule: row 0 the southernmost.
     let lattice = |ring: u32| GeoLattice {
+        latitudes: tinsmith_raster::Latitudes::Uniform,
         west: rect.west + step / 2.0 - f64::from(ring) * step,
         south: rect.south + step / 2.0 - f64::from(ring) * step,
         step,

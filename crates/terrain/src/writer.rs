@@ -16,7 +16,7 @@ use crate::records::{count, options_key, tile_sum, Entries, TileEntry};
 use crate::rows::LevelRows;
 use crate::stream::LevelSink;
 use crate::tile::{build_tile, TileOut};
-use crate::tms::{tile_column, TileRect};
+use crate::tms::TileRect;
 use crate::{
     LevelReport, TerrainError, TerrainOptions, TerrainResult, TileFormat, METADATA_AVAILABILITY,
 };
@@ -45,6 +45,7 @@ impl Scope {
             Some(block) if z >= block.level => {
                 let f = z - block.level;
                 let below = TileRect {
+                    tiling: block.tiling,
                     level: z,
                     x0: block.x0 << f,
                     y0: block.y0 << f,
@@ -139,7 +140,7 @@ impl<'a> TileWriter<'a> {
             options,
             pool,
             budgets: (0..=max_zoom)
-                .map(|z| LevelBudget::new(z, options.quality))
+                .map(|z| LevelBudget::new(options.tiling, z, options.quality))
                 .collect(),
             written: Written {
                 reports: vec![None; levels],
@@ -159,8 +160,9 @@ impl<'a> TileWriter<'a> {
 
     /// The report of level `z`, started when first needed.
     fn report(&mut self, z: u8) -> &mut LevelReport {
-        let quality = self.options.quality;
-        self.written.reports[usize::from(z)].get_or_insert_with(|| LevelReport::empty(z, quality))
+        let (tiling, quality) = (self.options.tiling, self.options.quality);
+        self.written.reports[usize::from(z)]
+            .get_or_insert_with(|| LevelReport::empty(tiling, z, quality))
     }
 
     /// Builds root tile `x` flat (the raster does not reach it) and writes it, unless the
@@ -174,7 +176,7 @@ impl<'a> TileWriter<'a> {
         let outcome = match self.known.get(&(0, x, 0)) {
             Some(entry) if entry.sum == sum => Outcome::Kept(entry.clone()),
             _ => {
-                let flat = LevelRows::flat_tile(0, x, 0);
+                let flat = LevelRows::flat_tile(self.options.tiling, 0, x, 0);
                 let tile = build_tile(&flat, x, 0, &self.budgets[0], self.options, available)?;
                 Outcome::Built(0, x, 0, sum, tile)
             }
@@ -312,7 +314,7 @@ impl LevelSink for TileWriter<'_> {
             tiles
                 .par_iter()
                 .map(|&(x, y)| {
-                    let column = tile_column(z, x);
+                    let column = level.tiling.tile_column(z, x);
                     let metadata = metadata_available.map(|a| metadata_json(a, z, column, y));
                     let sum = tile_sum(key, (z, column, y), metadata.as_deref(), |h| {
                         level.hash_tile_window(x, y, h)

@@ -42,6 +42,7 @@
 //! # }
 //! ```
 
+mod breaklines;
 mod coverage;
 mod edges;
 mod error;
@@ -57,6 +58,7 @@ mod surface;
 mod variables;
 mod verify;
 
+pub use breaklines::{verify_breaklines, BreaklinesReport};
 pub use error::{Result, VerifyError};
 pub use grid::GridRef;
 pub use mesh::MeshRef;

@@ -3,6 +3,7 @@
 mod util;
 
 mod bad_input;
+mod breaklines;
 mod cesium;
 mod cli_reference;
 mod contour;

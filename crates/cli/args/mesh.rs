@@ -164,6 +164,12 @@ pub struct PointArgs {
     /// input", for how the default was chosen).
     #[arg(long, value_enum, default_value_t = DuplicatesArg::Lowest, help_heading = "Point input")]
     pub duplicates: DuplicatesArg,
+    /// Point files only: keep the segments of this OGR line or polygon layer (GeoPackage,
+    /// Shapefile, GeoJSON, FlatGeobuf...) as TIN edges, in the points' CRS. Lines with Z
+    /// keep their heights, 2D lines take the points'; vertices go on the points' lattice;
+    /// crossing lines are split where they cross.
+    #[arg(long, value_name = "FILE", help_heading = "Point input")]
+    pub breaklines: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -191,6 +197,7 @@ impl PointArgs {
             DuplicatesArg::First => Duplicates::First,
         };
         choices.crs = crs;
+        choices.breaklines = self.breaklines.clone();
         choices
     }
 }

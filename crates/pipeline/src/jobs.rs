@@ -70,6 +70,9 @@ pub struct PointChoices {
     pub duplicates: tinsmith_points::Duplicates,
     /// The CRS to write (anything GDAL's `SetFromUserInput` takes), instead of the file's.
     pub crs: Option<String>,
+    /// A line or polygon layer whose segments the TIN keeps as edges (constrained
+    /// Delaunay triangulation; their vertices are never removed).
+    pub breaklines: Option<std::path::PathBuf>,
 }
 
 /// The format of the files a per-tile run writes.

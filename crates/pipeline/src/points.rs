@@ -1,16 +1,18 @@
 //! `tinsmith mesh` and `tinsmith verify` on point files (LAS/LAZ, XYZ/CSV text): read,
 //! merge duplicates, Delaunay-triangulate, decimate with every point within the bound,
 //! verify independently, write. Existing TINs (PLY, OBJ, LandXML, FlatGeobuf) go the
-//! same way with their own triangles instead of the Delaunay triangulation.
+//! same way with their own triangles instead of the Delaunay triangulation. Breaklines
+//! (`--breaklines`, an OGR line or polygon layer) make it a constrained Delaunay
+//! triangulation whose constrained edges the decimator keeps and the verifier checks.
 
 use std::path::Path;
 use std::time::Instant;
 
 use serde::Serialize;
-use tinsmith_core::{decimate_scatter, DecimationOptions, Scatter};
+use tinsmith_core::{decimate_scatter_constrained, DecimationOptions, Scatter};
 use tinsmith_formats::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
 use tinsmith_points::{ClassChoice, PointCloud, ReadOptions};
-use tinsmith_verify::{verify_points, PointsReport};
+use tinsmith_verify::{verify_breaklines, verify_points, PointsReport};
 
 use crate::error::{bail, Context};
 use crate::jobs::{MeshJob, PointChoices};
@@ -136,6 +138,8 @@ struct PointsMeshReport<'a> {
     /// The input TIN's triangles (mesh files).
     #[serde(skip_serializing_if = "Option::is_none")]
     input_triangles: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    breaklines: Option<BreaklinesSummary<'a>>,
     triangles: usize,
     vertices: usize,
     max_error_bound: f64,
@@ -143,6 +147,23 @@ struct PointsMeshReport<'a> {
     sweeps: usize,
     removal_attempts: usize,
     seconds: PointsSeconds,
+}
+
+/// The breaklines of a point run, in its `--report`.
+#[derive(Debug, Serialize)]
+struct BreaklinesSummary<'a> {
+    file: &'a Path,
+    lines: usize,
+    /// "the file's" for a layer with Z, else "interpolated from the points".
+    heights: &'static str,
+    /// Vertices the lines added to the points (their own and crossings).
+    vertices_added: usize,
+    crossings: usize,
+    constrained_edges: usize,
+    /// Vertices that end a constrained edge: never removed.
+    locked_vertices: usize,
+    /// Segments checked present as chains of mesh edges.
+    segments_verified: usize,
 }
 
 #[derive(Debug, Serialize)]
@@ -206,15 +227,48 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     };
     let read_seconds = t.elapsed().as_secs_f64();
 
+    let breaklines = match &job.points.breaklines {
+        Some(_) if tin_input => bail!(
+            "{}: --breaklines applies to point files (LAS, LAZ, XYZ, CSV), not to a TIN",
+            input.display()
+        ),
+        Some(path) => Some((
+            path.as_path(),
+            read_breaklines(path, input, crs.as_deref())?,
+        )),
+        None => None,
+    };
+    let mut cloud = cloud;
+
     let t = Instant::now();
-    let (points, triangles) = match tin {
+    let mut constrained = None;
+    let (points, triangles, constrained_edges) = match (tin, &breaklines) {
         // The TIN's own triangles; its vertices exactly as the file has them.
-        Some((world, triangles)) => (world, triangles),
-        None => match tinsmith_points::delaunay(&cloud) {
-            Ok(triangles) => (world_points(&cloud), triangles),
+        (Some((world, triangles)), _) => (world, triangles, Vec::new()),
+        (None, None) => match tinsmith_points::delaunay(&cloud) {
+            Ok(triangles) => (world_points(&cloud), triangles, Vec::new()),
             Err(e) => bail!("{}: cannot triangulate: {e}", input.display()),
         },
+        (None, Some((path, layer))) => {
+            match tinsmith_points::constrained_delaunay(&mut cloud, &layer.lines, layer.has_z) {
+                Ok(mut c) => {
+                    let (triangles, edges) = (
+                        std::mem::take(&mut c.triangles),
+                        std::mem::take(&mut c.edges),
+                    );
+                    constrained = Some((c, edges.len()));
+                    (world_points(&cloud), triangles, edges)
+                }
+                Err(tinsmith_points::BreaklineError::Points(e)) => {
+                    bail!("{}: cannot triangulate: {e}", input.display())
+                }
+                Err(e) => bail!("{}: {e}", path.display()),
+            }
+        }
     };
+    // The points the file gave (after the duplicates rule): the breaklines' vertices
+    // follow them and are kept, not measured.
+    let measured = constrained.as_ref().map_or(points.len(), |(c, _)| c.points);
     let triangulate_seconds = t.elapsed().as_secs_f64();
     let input_triangles = triangles.len();
 
@@ -244,10 +298,12 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
         classes,
         ..
     } = cloud;
-    let points_read = xy.len();
+    let points_read = measured;
+    let points_read_total = xy.len();
     let scatter = Scatter::new(xy, z).with_context(|| format!("{}", input.display()))?;
-    let (tin, report) = decimate_scatter(&scatter, triangles, &options)
-        .with_context(|| format!("{}", input.display()))?;
+    let (tin, report) =
+        decimate_scatter_constrained(&scatter, triangles, &constrained_edges, &options)
+            .with_context(|| format!("{}", input.display()))?;
     let decimate_seconds = t.elapsed().as_secs_f64();
 
     let mut vertices: Vec<[f64; 3]> = tin.vertices().iter().map(|&v| points[v as usize]).collect();
@@ -259,7 +315,21 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     }
     let t = Instant::now();
     let tolerance = position_tolerance(format, &vertices);
-    let check = verify_points(&points, &vertices, tin.triangles(), max_error, tolerance);
+    let mut check = verify_points(
+        &points[..measured],
+        &vertices,
+        tin.triangles(),
+        max_error,
+        tolerance,
+    );
+    if let Some((_, layer)) = &breaklines {
+        check.breaklines = Some(verify_breaklines(
+            &plan_lines(layer),
+            &vertices,
+            tin.triangles(),
+            breakline_tolerance(spacing, tolerance),
+        ));
+    }
     let verify_seconds = t.elapsed().as_secs_f64();
     if !check.passed() {
         bail!(
@@ -301,11 +371,31 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
         output.display(),
         points_read,
         input_triangles,
-        if tin_input { "input" } else { "Delaunay" },
+        if tin_input {
+            "input"
+        } else if constrained.is_some() {
+            "constrained Delaunay"
+        } else {
+            "Delaunay"
+        },
         report.final_triangles,
         report.final_vertices,
         crate::readable(check.max_error),
     ));
+    if let (Some((path, layer)), Some((c, edges))) = (&breaklines, &constrained) {
+        feedback.note(&format!(
+            "{}: {} lines ({} heights), {edges} constrained edges ({} crossings split), \
+             every segment a chain of mesh edges",
+            path.display(),
+            layer.lines.len(),
+            if layer.has_z {
+                "their own"
+            } else {
+                "the points'"
+            },
+            c.crossings
+        ));
+    }
     let summary = PointsMeshReport {
         input,
         output,
@@ -324,6 +414,22 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
             ClassChoice::Listed(list) => format!("{list:?}"),
         },
         lattice_spacing: spacing,
+        breaklines: breaklines.as_ref().zip(constrained.as_ref()).map(
+            |((path, layer), (c, edges))| BreaklinesSummary {
+                file: path,
+                lines: layer.lines.len(),
+                heights: if layer.has_z {
+                    "the file's"
+                } else {
+                    "interpolated from the points"
+                },
+                vertices_added: points_read_total - c.points,
+                crossings: c.crossings,
+                constrained_edges: *edges,
+                locked_vertices: report.locked_vertices,
+                segments_verified: check.breaklines.as_ref().map_or(0, |b| b.segments),
+            },
+        ),
         delaunay_triangles: (!tin_input).then_some(input_triangles),
         input_triangles: tin_input.then_some(input_triangles),
         triangles: report.final_triangles,
@@ -345,6 +451,44 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     }
     tinsmith_output::mark_finished();
     Ok(())
+}
+
+/// The breaklines file at `path` as lines, refused when its CRS is not the points'
+/// (`points_crs`, from `input`): breaklines are not reprojected.
+fn read_breaklines(
+    path: &Path,
+    input: &Path,
+    points_crs: Option<&str>,
+) -> Result<tinsmith_raster::LineLayer> {
+    let layer = tinsmith_raster::read_lines(path)?;
+    if let (Some(lines), Some(points)) = (layer.crs_wkt.as_deref(), points_crs) {
+        if !tinsmith_raster::same_crs(lines, points)
+            && tinsmith_raster::epsg_code(lines) != tinsmith_raster::epsg_code(points)
+        {
+            bail!(
+                "{}: its CRS is not the one of {}; reproject the breaklines to it first                  (ogr2ogr -t_srs)",
+                path.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(layer)
+}
+
+/// The lines' x, y.
+fn plan_lines(layer: &tinsmith_raster::LineLayer) -> Vec<Vec<[f64; 2]>> {
+    layer
+        .lines
+        .iter()
+        .map(|l| l.iter().map(|p| [p[0], p[1]]).collect())
+        .collect()
+}
+
+/// How far a breakline's vertex may be from the mesh vertex that stands for it: half a
+/// lattice cell's diagonal (vertices are rounded to the points' lattice), plus the
+/// format's position rounding.
+fn breakline_tolerance(spacing: [f64; 2], position_tolerance: f64) -> f64 {
+    0.5 * spacing[0].hypot(spacing[1]) + position_tolerance
 }
 
 /// How far a float32 format may move a position (x, y): its rounding of the TIN's extent,
@@ -387,6 +531,14 @@ fn describe(r: &PointsReport) -> String {
             ));
         }
     }
+    if let Some(b) = r.breaklines.as_ref().filter(|b| !b.passed()) {
+        let [a, e] = b.first_missing.unwrap_or_default();
+        parts.push(format!(
+            "{} of {} breakline segments are not chains of mesh edges, the first from \
+             ({}, {}) to ({}, {})",
+            b.missing, b.segments, a[0], a[1], e[0], e[1]
+        ));
+    }
     parts.join("; ")
 }
 
@@ -402,10 +554,21 @@ pub fn verify_points_file(
     choices: &PointChoices,
     feedback: &dyn Feedback,
 ) -> Result<PointsReport> {
-    let points = if is_tin_input(points_path) {
-        read_tin(points_path, feedback)?.0.world
+    let (points, spacing) = if is_tin_input(points_path) {
+        if choices.breaklines.is_some() {
+            bail!(
+                "{}: --breaklines applies to point files (LAS, LAZ, XYZ, CSV), not to a TIN",
+                points_path.display()
+            );
+        }
+        (read_tin(points_path, feedback)?.0.world, [0.0; 2])
     } else {
-        world_points(&read(points_path, choices, feedback)?.0)
+        let cloud = read(points_path, choices, feedback)?.0;
+        (world_points(&cloud), cloud.spacing)
+    };
+    let breaklines = match &choices.breaklines {
+        Some(path) => Some(plan_lines(&tinsmith_raster::read_lines(path)?)),
+        None => None,
     };
     let format = crate::mesh_file::mesh_format(mesh_path, format)?;
     if format == MeshFormat::GeoJson {
@@ -417,20 +580,32 @@ pub fn verify_points_file(
     }
     let mesh = tinsmith_formats::read_mesh_as(mesh_path, format)?;
     let tolerance = position_tolerance(format, &mesh.vertices);
-    Ok(verify_points(
+    let mut report = verify_points(
         &points,
         &mesh.vertices,
         &mesh.triangles,
         max_error,
         tolerance,
-    ))
+    );
+    if let Some(lines) = breaklines {
+        report.breaklines = Some(verify_breaklines(
+            &lines,
+            &mesh.vertices,
+            &mesh.triangles,
+            breakline_tolerance(spacing, tolerance),
+        ));
+    }
+    Ok(report)
 }
 
 /// Text for a points verification, as `tinsmith verify` prints it.
 pub fn points_summary(r: &PointsReport) -> String {
     if r.passed() {
+        let lines = r.breaklines.as_ref().map_or(String::new(), |b| {
+            format!(", {} breakline segments present", b.segments)
+        });
         format!(
-            "{} points, largest error {} <= {}: passed",
+            "{} points, largest error {} <= {}{lines}: passed",
             r.points,
             crate::readable(r.max_error),
             r.bound

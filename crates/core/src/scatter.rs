@@ -714,8 +714,8 @@ mod tests {
         for v in cdt.vertices() {
             let p = v.position();
             let p = [p.x as i64, p.y as i64];
-            if !index.contains_key(&p) {
-                index.insert(p, xy.len() as u32);
+            if let std::collections::btree_map::Entry::Vacant(e) = index.entry(p) {
+                e.insert(xy.len() as u32);
                 xy.push(p);
                 z.push(f(p[0] as f64, p[1] as f64));
             }

@@ -230,3 +230,195 @@ fn bad_breaklines_are_refused_naming_the_file() {
     );
     assert_eq!(dir.files(), before);
 }
+
+/// A square polygon ring `[x0, y0]`-`[x1, y1]` (metres on the fixture's square).
+fn ring(x0: f64, y0: f64, x1: f64, y1: f64) -> String {
+    let p = |x: f64, y: f64| format!("[{},{}]", 500_000.0 + x, 4_000_000.0 + y);
+    format!(
+        "[{},{},{},{},{}]",
+        p(x0, y0),
+        p(x1, y0),
+        p(x1, y1),
+        p(x0, y1),
+        p(x0, y0)
+    )
+}
+
+#[test]
+fn a_boundary_clips_the_tin_and_its_holes_and_verify_measures_the_points_inside() {
+    let dir = Dir::new();
+    dir.write("pts.csv", &step_points(3000));
+    let polygon = format!(
+        r#"{{"type":"Polygon","coordinates":[{},{}]}}"#,
+        ring(20.0, 20.0, 180.0, 180.0),
+        ring(80.0, 120.0, 120.0, 160.0)
+    );
+    dir.write("outline.geojson", &feature_collection(&[&polygon]));
+    // A breakline inside the outline, touching neither ring.
+    dir.write(
+        "inside.geojson",
+        &feature_collection(&[
+            r#"{"type":"LineString","coordinates":[[500030,4000099.5],[500170,4000099.5]]}"#,
+        ]),
+    );
+    let o = mesh(
+        &dir,
+        "tin.ply",
+        &[
+            "--boundary",
+            "outline.geojson",
+            "--breaklines",
+            "inside.geojson",
+            "--report",
+            "r.json",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("points outside the boundary dropped"));
+    let r = report(&dir, "r.json");
+    let outside = r["points_outside"].as_u64().unwrap();
+    // About 1 - (160^2 - 40^2) / 200^2 = 40 % of the points are outside.
+    assert!((1000..1400).contains(&outside), "{outside}");
+    assert_eq!(r["points_read"], 3000);
+    let verify = |mesh: &str, extra: &[&str]| {
+        let mut args = vec!["verify", "pts.csv", mesh, "--max-error", "0.05"];
+        args.extend_from_slice(extra);
+        dir.run(&args)
+    };
+    let o = verify(
+        "tin.ply",
+        &[
+            "--boundary",
+            "outline.geojson",
+            "--breaklines",
+            "inside.geojson",
+        ],
+    );
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    let inside = 3000 - outside;
+    assert!(
+        stdout(&o).contains(&format!("{inside} points")),
+        "{}",
+        stdout(&o)
+    );
+    // Without --boundary the dropped points are outside the mesh: the check can fail.
+    let o = verify("tin.ply", &[]);
+    assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
+    assert!(
+        stdout(&o).contains(&format!("{outside} points outside the mesh")),
+        "{}",
+        stdout(&o)
+    );
+}
+
+#[test]
+fn a_longest_hull_edge_drops_the_points_beyond_a_concave_outline() {
+    let dir = Dir::new();
+    // An L: the points of the square's upper right quarter removed.
+    let all = step_points(3000);
+    let mut text = String::from("x,y,z\n");
+    let mut kept = 0;
+    for line in all.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|t| t.parse().unwrap()).collect();
+        if v[0] - 500_000.0 <= 100.0 || v[1] - 4_000_000.0 <= 100.0 {
+            text.push_str(line);
+            text.push('\n');
+            kept += 1;
+        }
+    }
+    dir.write("pts.csv", &text);
+    let o = mesh(&dir, "convex.ply", &["--report", "convex.json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = mesh(
+        &dir,
+        "concave.ply",
+        &["--hull-edge-length", "25", "--report", "concave.json"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (convex, concave) = (report(&dir, "convex.json"), report(&dir, "concave.json"));
+    assert_eq!(concave["hull_edge_length"], 25.0);
+    // The notch's long triangles go; the L's points stay (25 m is far above their
+    // spacing).
+    assert!(concave["delaunay_triangles"].as_u64() < convex["delaunay_triangles"].as_u64());
+    assert_eq!(concave["points_outside"], 0);
+    let o = dir.run(&["verify", "pts.csv", "concave.ply", "--max-error", "0.05"]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    assert!(
+        stdout(&o).contains(&format!("{kept} points")),
+        "{}",
+        stdout(&o)
+    );
+    // Too short for the points' spacing: triangles and points go, counted.
+    let o = mesh(
+        &dir,
+        "eaten.ply",
+        &["--hull-edge-length", "2", "--report", "eaten.json"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        report(&dir, "eaten.json")["points_outside"]
+            .as_u64()
+            .unwrap()
+            > 0
+    );
+}
+
+#[test]
+fn bad_boundaries_are_refused_naming_the_file() {
+    let dir = Dir::new();
+    dir.write("pts.csv", &step_points(500));
+    let refused = |args: &[&str], file: &str, problem: &str| {
+        let before = dir.files();
+        let mut all = args.to_vec();
+        all.extend(["--report", "r.json"]);
+        let o = mesh(&dir, "out.ply", &all);
+        assert!(!o.status.success(), "{args:?} was accepted");
+        let e = stderr(&o);
+        assert!(e.contains(file) && e.contains(problem), "{args:?}: {e}");
+        assert_eq!(dir.files(), before, "{args:?} left output");
+    };
+    dir.write("lines.geojson", &feature_collection(&CROSSING));
+    refused(
+        &["--boundary", "lines.geojson"],
+        "lines.geojson",
+        "not polygons",
+    );
+    refused(&["--boundary", "none.gpkg"], "none.gpkg", "no such file");
+    // Between points: a ring far smaller than their spacing holds none.
+    let tiny = format!(
+        r#"{{"type":"Polygon","coordinates":[{}]}}"#,
+        ring(50.0001, 50.0001, 50.0004, 50.0004)
+    );
+    dir.write("tiny.geojson", &feature_collection(&[&tiny]));
+    refused(
+        &["--boundary", "tiny.geojson"],
+        "tiny.geojson",
+        "none of the points is inside",
+    );
+    let outline = format!(
+        r#"{{"type":"Polygon","coordinates":[{}]}}"#,
+        ring(20.0, 20.0, 180.0, 180.0)
+    );
+    dir.write("outline.geojson", &feature_collection(&[&outline]));
+    // The crossing lines leave the outline.
+    refused(
+        &[
+            "--boundary",
+            "outline.geojson",
+            "--breaklines",
+            "lines.geojson",
+        ],
+        "outline.geojson",
+        "crosses boundary ring 1",
+    );
+    let wide = format!(
+        r#"{{"type":"Polygon","coordinates":[{}]}}"#,
+        ring(-20.0, 20.0, 180.0, 180.0)
+    );
+    dir.write("wide.geojson", &feature_collection(&[&wide]));
+    refused(
+        &["--boundary", "wide.geojson"],
+        "wide.geojson",
+        "outside the points' extent",
+    );
+}

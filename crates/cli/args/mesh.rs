@@ -143,6 +143,19 @@ pub struct MeshArgs {
     /// Points only: the CRS to write (EPSG:CODE, WKT, ...), instead of the file's.
     #[arg(long, value_name = "CRS", help_heading = "Point input")]
     pub crs: Option<String>,
+    /// Point files only: a concave hull instead of the convex one: outer triangles are
+    /// removed, repeatedly, while an outer edge (not a breakline or boundary edge) is
+    /// longer than L (in the points' x, y units); points left outside are dropped
+    /// (counted in the report).
+    #[arg(long, value_name = "L", help_heading = "Point input", value_parser = positive_length)]
+    pub hull_edge_length: Option<f64>,
+}
+
+fn positive_length(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("`{text}` is not a positive length")),
+    }
 }
 
 /// The flags of point input (LAS/LAZ, XYZ/CSV text), shared by `mesh` and `verify`.
@@ -170,6 +183,11 @@ pub struct PointArgs {
     /// crossing lines are split where they cross.
     #[arg(long, value_name = "FILE", help_heading = "Point input")]
     pub breaklines: Option<PathBuf>,
+    /// Point files only: the TIN's outline and holes, an OGR polygon layer in the points'
+    /// CRS, kept as edges; points outside are dropped (counted in the report), and
+    /// `verify` measures only the points inside.
+    #[arg(long, value_name = "FILE", help_heading = "Point input")]
+    pub boundary: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -198,6 +216,7 @@ impl PointArgs {
         };
         choices.crs = crs;
         choices.breaklines = self.breaklines.clone();
+        choices.boundary = self.boundary.clone();
         choices
     }
 }
@@ -270,6 +289,7 @@ impl MeshArgs {
             TileFormatArg::Obj => TileFormat::Obj,
         });
         job.points = self.points.choices(self.crs.clone());
+        job.points.hull_edge_length = self.hull_edge_length;
         Ok(job)
     }
 }

@@ -73,6 +73,11 @@ pub struct PointChoices {
     /// A line or polygon layer whose segments the TIN keeps as edges (constrained
     /// Delaunay triangulation; their vertices are never removed).
     pub breaklines: Option<std::path::PathBuf>,
+    /// A polygon layer: the TIN's outline and holes (constrained edges); points outside
+    /// are dropped.
+    pub boundary: Option<std::path::PathBuf>,
+    /// Remove outer triangles while an outer edge is longer than this (a concave hull).
+    pub hull_edge_length: Option<f64>,
 }
 
 /// The format of the files a per-tile run writes.

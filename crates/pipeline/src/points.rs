@@ -140,6 +140,13 @@ struct PointsMeshReport<'a> {
     input_triangles: Option<usize>,
     #[serde(skip_serializing_if = "Option::is_none")]
     breaklines: Option<BreaklinesSummary<'a>>,
+    /// The `--boundary` file.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    boundary: Option<&'a Path>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    hull_edge_length: Option<f64>,
+    /// Points outside the boundary or the `--hull-edge-length` hull: not in the TIN.
+    points_outside: usize,
     triangles: usize,
     vertices: usize,
     max_error_bound: f64,
@@ -232,25 +239,60 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
             "{}: --breaklines applies to point files (LAS, LAZ, XYZ, CSV), not to a TIN",
             input.display()
         ),
-        Some(path) => Some((
-            path.as_path(),
-            read_breaklines(path, input, crs.as_deref())?,
-        )),
+        Some(path) => Some((path.as_path(), read_layer(path, input, crs.as_deref())?)),
         None => None,
     };
+    let boundary = match &job.points.boundary {
+        Some(_) if tin_input => bail!(
+            "{}: --boundary applies to point files (LAS, LAZ, XYZ, CSV); a TIN keeps its own",
+            input.display()
+        ),
+        Some(path) => {
+            let layer = read_layer(path, input, crs.as_deref())?;
+            if !layer.polygons {
+                bail!(
+                    "{}: holds lines, not polygons: --boundary takes a polygon layer (the \
+                     TIN's outline and holes)",
+                    path.display()
+                );
+            }
+            Some((path.as_path(), layer))
+        }
+        None => None,
+    };
+    if tin_input && job.points.hull_edge_length.is_some() {
+        bail!(
+            "{}: --hull-edge-length applies to point files (LAS, LAZ, XYZ, CSV); a TIN keeps \
+             its own outline",
+            input.display()
+        );
+    }
+    let constrain =
+        breaklines.is_some() || boundary.is_some() || job.points.hull_edge_length.is_some();
     let mut cloud = cloud;
+    let points_read = cloud.xy.len();
 
     let t = Instant::now();
     let mut constrained = None;
-    let (points, triangles, constrained_edges) = match (tin, &breaklines) {
+    let (points, triangles, constrained_edges) = match tin {
         // The TIN's own triangles; its vertices exactly as the file has them.
-        (Some((world, triangles)), _) => (world, triangles, Vec::new()),
-        (None, None) => match tinsmith_points::delaunay(&cloud) {
+        Some((world, triangles)) => (world, triangles, Vec::new()),
+        None if !constrain => match tinsmith_points::delaunay(&cloud) {
             Ok(triangles) => (world_points(&cloud), triangles, Vec::new()),
             Err(e) => bail!("{}: cannot triangulate: {e}", input.display()),
         },
-        (None, Some((path, layer))) => {
-            match tinsmith_points::constrained_delaunay(&mut cloud, &layer.lines, layer.has_z) {
+        None => {
+            let mut constraints = tinsmith_points::Constraints::default();
+            if let Some((_, layer)) = &breaklines {
+                constraints.breaklines = &layer.lines;
+                constraints.breaklines_have_z = layer.has_z;
+            }
+            if let Some((_, layer)) = &boundary {
+                constraints.boundary = &layer.lines;
+                constraints.boundary_has_z = layer.has_z;
+            }
+            constraints.max_edge_length = job.points.hull_edge_length;
+            match tinsmith_points::constrained_delaunay(&mut cloud, &constraints) {
                 Ok(mut c) => {
                     let (triangles, edges) = (
                         std::mem::take(&mut c.triangles),
@@ -262,10 +304,33 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
                 Err(tinsmith_points::BreaklineError::Points(e)) => {
                     bail!("{}: cannot triangulate: {e}", input.display())
                 }
-                Err(e) => bail!("{}: {e}", path.display()),
+                Err(
+                    e @ (tinsmith_points::BreaklineError::BoundaryOutside { .. }
+                    | tinsmith_points::BreaklineError::BoundaryCrossed { .. }
+                    | tinsmith_points::BreaklineError::Empty),
+                ) => {
+                    let file = boundary.as_ref().map_or(input.as_path(), |b| b.0);
+                    bail!("{}: {e}", file.display())
+                }
+                Err(e) => {
+                    let file = breaklines.as_ref().map_or(input.as_path(), |b| b.0);
+                    bail!("{}: {e}", file.display())
+                }
             }
         }
     };
+    if let Some((c, _)) = constrained.as_ref().filter(|(c, _)| c.dropped > 0) {
+        feedback.note(&format!(
+            "{}: {} points outside the {} dropped: not in the TIN, not measured",
+            input.display(),
+            c.dropped,
+            if boundary.is_some() {
+                "boundary"
+            } else {
+                "--hull-edge-length hull"
+            }
+        ));
+    }
     // The points the file gave (after the duplicates rule): the breaklines' vertices
     // follow them and are kept, not measured.
     let measured = constrained.as_ref().map_or(points.len(), |(c, _)| c.points);
@@ -298,8 +363,7 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
         classes,
         ..
     } = cloud;
-    let points_read = measured;
-    let points_read_total = xy.len();
+    let points_total = xy.len();
     let scatter = Scatter::new(xy, z).with_context(|| format!("{}", input.display()))?;
     let (tin, report) =
         decimate_scatter_constrained(&scatter, triangles, &constrained_edges, &options)
@@ -369,7 +433,7 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
         "{}: {} points ({} {} triangles) -> {} triangles, {} vertices; largest error \
          {} (bound {max_error}), verified at every point",
         output.display(),
-        points_read,
+        measured,
         input_triangles,
         if tin_input {
             "input"
@@ -414,6 +478,9 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
             ClassChoice::Listed(list) => format!("{list:?}"),
         },
         lattice_spacing: spacing,
+        boundary: boundary.as_ref().map(|b| b.0),
+        hull_edge_length: job.points.hull_edge_length,
+        points_outside: constrained.as_ref().map_or(0, |(c, _)| c.dropped),
         breaklines: breaklines.as_ref().zip(constrained.as_ref()).map(
             |((path, layer), (c, edges))| BreaklinesSummary {
                 file: path,
@@ -423,7 +490,7 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
                 } else {
                     "interpolated from the points"
                 },
-                vertices_added: points_read_total - c.points,
+                vertices_added: points_total - c.points,
                 crossings: c.crossings,
                 constrained_edges: *edges,
                 locked_vertices: report.locked_vertices,
@@ -453,9 +520,9 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     Ok(())
 }
 
-/// The breaklines file at `path` as lines, refused when its CRS is not the points'
-/// (`points_crs`, from `input`): breaklines are not reprojected.
-fn read_breaklines(
+/// The breaklines or boundary file at `path` as lines, refused when its CRS is not the
+/// points' (`points_crs`, from `input`): such layers are not reprojected.
+fn read_layer(
     path: &Path,
     input: &Path,
     points_crs: Option<&str>,
@@ -466,7 +533,8 @@ fn read_breaklines(
             && tinsmith_raster::epsg_code(lines) != tinsmith_raster::epsg_code(points)
         {
             bail!(
-                "{}: its CRS is not the one of {}; reproject the breaklines to it first                  (ogr2ogr -t_srs)",
+                "{}: its CRS is not the one of {}; reproject the layer to it first \
+                 (ogr2ogr -t_srs)",
                 path.display(),
                 input.display()
             );
@@ -570,6 +638,19 @@ pub fn verify_points_file(
         Some(path) => Some(plan_lines(&tinsmith_raster::read_lines(path)?)),
         None => None,
     };
+    let outline = match &choices.boundary {
+        Some(path) => {
+            let layer = tinsmith_raster::read_lines(path)?;
+            if !layer.polygons {
+                bail!(
+                    "{}: holds lines, not polygons: --boundary takes a polygon layer",
+                    path.display()
+                );
+            }
+            Some(plan_lines(&layer))
+        }
+        None => None,
+    };
     let format = crate::mesh_file::mesh_format(mesh_path, format)?;
     if format == MeshFormat::GeoJson {
         bail!(
@@ -580,6 +661,23 @@ pub fn verify_points_file(
     }
     let mesh = tinsmith_formats::read_mesh_as(mesh_path, format)?;
     let tolerance = position_tolerance(format, &mesh.vertices);
+    let points: Vec<[f64; 3]> = match &outline {
+        // Points outside the boundary are not the TIN's (mesh dropped them).
+        Some(rings) => {
+            let inside = tinsmith_verify::inside_outline(
+                rings,
+                &points,
+                breakline_tolerance(spacing, tolerance),
+            );
+            points
+                .iter()
+                .zip(inside)
+                .filter(|(_, i)| *i)
+                .map(|(p, _)| *p)
+                .collect()
+        }
+        None => points,
+    };
     let mut report = verify_points(
         &points,
         &mesh.vertices,

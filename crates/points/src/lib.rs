@@ -32,7 +32,7 @@ mod tin;
 
 use std::path::Path;
 
-pub use breaklines::{constrained_delaunay, BreaklineError, ConstrainedTriangulation};
+pub use breaklines::{constrained_delaunay, BreaklineError, ConstrainedTriangulation, Constraints};
 pub use cloud::{ClassChoice, FileCrs, PointCloud, MAX_LATTICE};
 pub use dedupe::{dedupe, Duplicates};
 pub use delaunay::{delaunay, TriangulationError};

@@ -13,6 +13,7 @@ mod formats;
 mod mbtiles;
 mod mesh_and_verify;
 mod object_storage;
+mod ogr_points;
 mod points;
 mod preview;
 mod serve;

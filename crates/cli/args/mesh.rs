@@ -188,6 +188,10 @@ pub struct PointArgs {
     /// `verify` measures only the points inside.
     #[arg(long, value_name = "FILE", help_heading = "Point input")]
     pub boundary: Option<PathBuf>,
+    /// OGR point layers (GeoPackage, Shapefile, FlatGeobuf) only: the attribute holding
+    /// the heights [default: the points' Z].
+    #[arg(long, value_name = "NAME", help_heading = "Point input")]
+    pub z_field: Option<String>,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -217,6 +221,7 @@ impl PointArgs {
         choices.crs = crs;
         choices.breaklines = self.breaklines.clone();
         choices.boundary = self.boundary.clone();
+        choices.z_field = self.z_field.clone();
         choices
     }
 }

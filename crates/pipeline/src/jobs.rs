@@ -78,6 +78,8 @@ pub struct PointChoices {
     pub boundary: Option<std::path::PathBuf>,
     /// Remove outer triangles while an outer edge is longer than this (a concave hull).
     pub hull_edge_length: Option<f64>,
+    /// OGR point layers: the attribute holding heights, instead of the geometries' Z.
+    pub z_field: Option<String>,
 }
 
 /// The format of the files a per-tile run writes.

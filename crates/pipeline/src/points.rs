@@ -21,10 +21,21 @@ use crate::Feedback;
 use crate::Result;
 
 /// Whether `path` is read as points (by its extension: `.las`, `.laz`, `.xyz`, `.csv`,
-/// `.txt`) or as an existing TIN whose vertices are the points (`.ply`, `.obj`, `.xml`,
-/// `.fgb`) rather than as a raster.
+/// `.txt`; or an OGR point layer in `.gpkg`, `.shp`, `.fgb`) or as an existing TIN whose
+/// vertices are the points (`.ply`, `.obj`, `.xml`, `.fgb`) rather than as a raster.
 pub fn is_point_input(path: &Path) -> bool {
-    tinsmith_points::is_point_file(path) || is_tin_input(path)
+    tinsmith_points::is_point_file(path) || is_tin_input(path) || is_ogr_points(path)
+}
+
+/// Whether `path` is an OGR point layer read as points: a GeoPackage, Shapefile or
+/// FlatGeobuf (by extension) whose first layer holds points (a FlatGeobuf of triangles
+/// is a TIN).
+fn is_ogr_points(path: &Path) -> bool {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    matches!(ext.as_deref(), Some("gpkg" | "shp" | "fgb")) && tinsmith_raster::is_point_layer(path)
 }
 
 /// The points of `path` after the class filter and the duplicates rule, and how many
@@ -43,7 +54,20 @@ fn read(
             path.display()
         ));
     }
-    let mut cloud = tinsmith_points::read_points(path, &options)?;
+    if choices.z_field.is_some() && !is_ogr_points(path) {
+        feedback.note(&format!(
+            "{}: --z-field applies to OGR point layers only; ignored",
+            path.display()
+        ));
+    }
+    let mut cloud = if is_ogr_points(path) {
+        let layer = tinsmith_raster::read_point_layer(path, choices.z_field.as_deref())?;
+        let mut cloud = tinsmith_points::world_cloud(path, &layer.points)?;
+        cloud.crs.wkt = layer.crs_wkt;
+        cloud
+    } else {
+        tinsmith_points::read_points(path, &options)?
+    };
     match &cloud.classes {
         ClassChoice::DefaultGround => feedback.note(&format!(
             "{}: ground points only (class 2, the file has some; --classes to choose)",
@@ -212,7 +236,7 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     let reserved = crate::mesh::reserve_report(job, Some((output, format)))?;
 
     let t = Instant::now();
-    let tin_input = is_tin_input(input);
+    let tin_input = is_tin_input(input) && !is_ogr_points(input);
     let (cloud, merged, crs, tin) = if tin_input {
         if job.points.classes.is_some() || job.points.no_withheld {
             feedback.note(&format!(
@@ -622,7 +646,7 @@ pub fn verify_points_file(
     choices: &PointChoices,
     feedback: &dyn Feedback,
 ) -> Result<PointsReport> {
-    let (points, spacing) = if is_tin_input(points_path) {
+    let (points, spacing) = if is_tin_input(points_path) && !is_ogr_points(points_path) {
         if choices.breaklines.is_some() {
             bail!(
                 "{}: --breaklines applies to point files (LAS, LAZ, XYZ, CSV), not to a TIN",

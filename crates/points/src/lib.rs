@@ -29,6 +29,7 @@ mod error;
 mod las_file;
 mod text;
 mod tin;
+mod world;
 
 use std::path::Path;
 
@@ -38,6 +39,7 @@ pub use dedupe::{dedupe, Duplicates};
 pub use delaunay::{delaunay, TriangulationError};
 pub use error::{Error, Result};
 pub use tin::{tin_points, TinPoints};
+pub use world::world_cloud;
 
 /// Which points of a LAS file to read (text files have no classes).
 #[derive(Debug, Clone, Default, PartialEq)]

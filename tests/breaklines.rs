@@ -422,3 +422,71 @@ fn bad_boundaries_are_refused_naming_the_file() {
         "outside the points' extent",
     );
 }
+
+#[test]
+fn a_raster_with_breaklines_keeps_them_and_the_bound_at_every_sample() {
+    let dir = Dir::new();
+    // 40 x 30 samples, 2 m apart, a ridge along a diagonal; lower-left corner at (1000,
+    // 2000), so sample centres are at odd metres.
+    let mut asc = String::from(
+        "ncols 40\nnrows 30\nxllcorner 1000\nyllcorner 2000\ncellsize 2\nNODATA_value -9999\n",
+    );
+    for row in 0..30 {
+        let line: Vec<String> = (0..40)
+            .map(|col| {
+                let (x, y) = (f64::from(col), f64::from(29 - row));
+                format!(
+                    "{:.2}",
+                    10.0 + 3.0 * (-(x - y - 5.0).powi(2) / 20.0).exp() + 0.1 * x
+                )
+            })
+            .collect();
+        asc.push_str(&line.join(" "));
+        asc.push('\n');
+    }
+    dir.write("dem.asc", &asc);
+    // Two crossing lines whose crossing falls between samples.
+    dir.write(
+        "lines.geojson",
+        &feature_collection(&[
+            r#"{"type":"LineString","coordinates":[[1004,2010.2],[1070,2040.6]]}"#,
+            r#"{"type":"LineString","coordinates":[[1040.3,2004],[1036.1,2055]]}"#,
+        ]),
+    );
+    let o = dir.run(&[
+        "mesh",
+        "dem.asc",
+        "-o",
+        "tin.ply",
+        "--max-error",
+        "0.05",
+        "--breaklines",
+        "lines.geojson",
+        "--report",
+        "r.json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r = report(&dir, "r.json");
+    assert_eq!(r["points_read"], 1200);
+    assert_eq!(r["breaklines"]["crossings"], 1);
+    assert_eq!(r["breaklines"]["segments_verified"], 2);
+    let verify = |extra: &[&str]| {
+        let mut args = vec!["verify", "dem.asc", "tin.ply", "--max-error", "0.05"];
+        args.extend_from_slice(extra);
+        dir.run(&args)
+    };
+    let o = verify(&["--breaklines", "lines.geojson"]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    assert!(stdout(&o).contains("1200 points"), "{}", stdout(&o));
+    // At a tenth of the bound the same mesh fails: every sample is measured.
+    let o = dir.run(&[
+        "verify",
+        "dem.asc",
+        "tin.ply",
+        "--max-error",
+        "0.005",
+        "--breaklines",
+        "lines.geojson",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
+}

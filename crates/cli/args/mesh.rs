@@ -177,15 +177,16 @@ pub struct PointArgs {
     /// input", for how the default was chosen).
     #[arg(long, value_enum, default_value_t = DuplicatesArg::Lowest, help_heading = "Point input")]
     pub duplicates: DuplicatesArg,
-    /// Point files only: keep the segments of this OGR line or polygon layer (GeoPackage,
-    /// Shapefile, GeoJSON, FlatGeobuf...) as TIN edges, in the points' CRS. Lines with Z
-    /// keep their heights, 2D lines take the points'; vertices go on the points' lattice;
-    /// crossing lines are split where they cross.
+    /// Keep the segments of this OGR line or polygon layer (GeoPackage, Shapefile,
+    /// GeoJSON, FlatGeobuf...) as TIN edges, in the input's CRS. Lines with Z keep their
+    /// heights, 2D lines take the points'; vertices go on the points' lattice; crossing
+    /// lines are split where they cross. A raster's valid samples are then its points.
+    /// With verify: check every segment is a chain of mesh edges.
     #[arg(long, value_name = "FILE", help_heading = "Point input")]
     pub breaklines: Option<PathBuf>,
-    /// Point files only: the TIN's outline and holes, an OGR polygon layer in the points'
-    /// CRS, kept as edges; points outside are dropped (counted in the report), and
-    /// `verify` measures only the points inside.
+    /// The TIN's outline and holes, an OGR polygon layer in the input's CRS, kept as
+    /// edges; points (or a raster's samples) outside are dropped (counted in the report),
+    /// and `verify` measures only the points inside.
     #[arg(long, value_name = "FILE", help_heading = "Point input")]
     pub boundary: Option<PathBuf>,
     /// OGR point layers (GeoPackage, Shapefile, FlatGeobuf) only: the attribute holding

@@ -251,6 +251,15 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
         };
         let cloud = tin.cloud.clone();
         (cloud, tin.merged, crs, Some((tin.world, tin.triangles)))
+    } else if !is_point_input(input) {
+        // A raster with breaklines or a boundary: its valid samples are the points.
+        let mut cloud = raster_cloud(input, job.band)?;
+        tinsmith_points::dedupe(&mut cloud, job.points.duplicates);
+        let crs = match job.points.crs.as_deref() {
+            Some(text) => Some(tinsmith_raster::crs_wkt(text)?),
+            None => cloud.crs.wkt.clone(),
+        };
+        (cloud, 0, crs, None)
     } else {
         let (cloud, merged) = read(input, &job.points, feedback)?;
         let crs = resolve_crs(input, &cloud, job.points.crs.as_deref())?;
@@ -544,6 +553,46 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     Ok(())
 }
 
+/// The valid samples of band `band` of the raster at `path` as points on the sample
+/// lattice (x right, y up from the southernmost row), at the samples' centres, with the
+/// raster's CRS. Only north-up geotransforms (no rotation) are taken.
+fn raster_cloud(path: &Path, band: usize) -> Result<PointCloud> {
+    let raster = tinsmith_raster::read_samples(path, band)?;
+    let gt = raster
+        .info
+        .geo_transform
+        .unwrap_or([0.0, 1.0, 0.0, 0.0, 0.0, -1.0]);
+    if gt[2] != 0.0 || gt[4] != 0.0 || gt[1] <= 0.0 || gt[5] >= 0.0 {
+        bail!(
+            "{}: --breaklines and --boundary on a raster need a north-up geotransform (no \
+             rotation, rows from north to south); warp it first (gdalwarp)",
+            path.display()
+        );
+    }
+    let samples = &raster.samples;
+    let (w, h) = (samples.width(), samples.height());
+    let (mut xy, mut z) = (Vec::new(), Vec::new());
+    for row in 0..h {
+        for col in 0..w {
+            if let Some(v) = samples.get(col, row).filter(|v| v.is_finite()) {
+                xy.push([i64::from(col), i64::from(h - 1 - row)]);
+                z.push(v);
+            }
+        }
+    }
+    let mut crs = tinsmith_points::FileCrs::default();
+    crs.wkt = raster.info.crs_wkt.filter(|w| !w.trim().is_empty());
+    Ok(PointCloud {
+        points_in_file: xy.len() as u64,
+        xy,
+        z,
+        origin: [gt[0] + 0.5 * gt[1], gt[3] + (f64::from(h) - 0.5) * gt[5]],
+        spacing: [gt[1], -gt[5]],
+        crs,
+        classes: ClassChoice::All,
+    })
+}
+
 /// The breaklines or boundary file at `path` as lines, refused when its CRS is not the
 /// points' (`points_crs`, from `input`): such layers are not reprojected.
 fn read_layer(
@@ -634,8 +683,9 @@ fn describe(r: &PointsReport) -> String {
     parts.join("; ")
 }
 
-/// `tinsmith verify` on a point file: reads the points (with the same class filter and
-/// duplicates rule `mesh` used) and the mesh file, and measures every point against the
+/// `tinsmith verify` on a point file (or on band `band` of a raster meshed with breaklines
+/// or a boundary, its valid samples as points): reads the points (with the same class
+/// filter and duplicates rule `mesh` used) and the mesh file, and measures every point against the
 /// mesh with the independent verifier. A mesh outside the bound is not an error: see
 /// [`PointsReport::passed`].
 pub fn verify_points_file(
@@ -644,6 +694,7 @@ pub fn verify_points_file(
     format: Option<MeshFormat>,
     max_error: f64,
     choices: &PointChoices,
+    band: usize,
     feedback: &dyn Feedback,
 ) -> Result<PointsReport> {
     let (points, spacing) = if is_tin_input(points_path) && !is_ogr_points(points_path) {
@@ -654,6 +705,10 @@ pub fn verify_points_file(
             );
         }
         (read_tin(points_path, feedback)?.0.world, [0.0; 2])
+    } else if !is_point_input(points_path) {
+        // A raster meshed with breaklines or a boundary: its valid samples are the points.
+        let cloud = raster_cloud(points_path, band)?;
+        (world_points(&cloud), cloud.spacing)
     } else {
         let cloud = read(points_path, choices, feedback)?.0;
         (world_points(&cloud), cloud.spacing)

@@ -9,7 +9,10 @@
 //! at its vertices; a line with heights (a 3D layer) keeps its own. A breakline vertex at
 //! a point's position keeps the point's height (the points are what the TIN answers to).
 //! Where two breaklines cross, spade splits both at the crossing; the new vertex, rounded
-//! to the lattice, takes the height of the second line, linearly between its ends.
+//! to the lattice, takes the height of the second line, linearly between its ends. When
+//! a rounded crossing lands on another vertex or folds a triangle (on a raster's samples,
+//! every lattice position is one), the lattice is refined by up to 1024 (a power of two,
+//! the same positions) and the triangulation made again.
 //!
 //! A boundary's rings (outline and holes, even-odd) take heights the same way and must
 //! lie within the points' convex hull; no breakline may cross them (a crossing would move
@@ -157,6 +160,50 @@ const UNNUMBERED: u32 = u32::MAX;
 /// # Panics
 /// When two points share a position (call [`crate::dedupe`] first).
 pub fn constrained_delaunay(
+    cloud: &mut PointCloud,
+    constraints: &Constraints<'_>,
+) -> Result<ConstrainedTriangulation, BreaklineError> {
+    let mut work = cloud.clone();
+    let result = match triangulate(&mut work, constraints) {
+        Err(BreaklineError::Crossing { .. }) if refine(&mut work) => {
+            triangulate(&mut work, constraints)?
+        }
+        other => other?,
+    };
+    *cloud = work;
+    Ok(result)
+}
+
+/// The finest refinement of the lattice tried when a crossing falls on a vertex.
+const MAX_REFINEMENT: i64 = 1024;
+
+/// Refines the cloud's lattice by the largest power of two up to [`MAX_REFINEMENT`]
+/// that keeps every coordinate within `MAX_LATTICE` (the same positions on a finer
+/// lattice: every orientation keeps its sign); false when none does.
+fn refine(cloud: &mut PointCloud) -> bool {
+    let largest = cloud
+        .xy
+        .iter()
+        .map(|p| p[0].max(p[1]))
+        .max()
+        .unwrap_or(0)
+        .max(1);
+    let mut factor = MAX_REFINEMENT;
+    while factor > 1 && largest.saturating_mul(factor) > MAX_LATTICE {
+        factor /= 2;
+    }
+    if factor == 1 {
+        return false;
+    }
+    for p in &mut cloud.xy {
+        *p = p.map(|v| v * factor);
+    }
+    cloud.spacing = cloud.spacing.map(|s| s / factor as f64);
+    true
+}
+
+/// [`constrained_delaunay`] on the cloud's lattice as it is.
+fn triangulate(
     cloud: &mut PointCloud,
     constraints: &Constraints<'_>,
 ) -> Result<ConstrainedTriangulation, BreaklineError> {
@@ -610,6 +657,37 @@ mod tests {
         for t in &c.triangles {
             assert!(t.iter().all(|&i| (i as usize) < cloud.xy.len()));
         }
+    }
+
+    #[test]
+    fn a_crossing_on_a_point_refines_the_lattice() {
+        // Every lattice position 0..=10 is a point: the crossing at (4.5, 4.5) rounds onto
+        // one, so the lattice is refined (by 1024) and the crossing placed exactly.
+        let mut xy = Vec::new();
+        for y in 0..=10 {
+            for x in 0..=10 {
+                xy.push([x, y]);
+            }
+        }
+        let n = xy.len();
+        let mut cloud = PointCloud {
+            z: xy.iter().map(|p| (p[0] + p[1]) as f64).collect(),
+            xy,
+            origin: [0.0; 2],
+            spacing: [1.0; 2],
+            crs: FileCrs::default(),
+            classes: ClassChoice::All,
+            points_in_file: n as u64,
+        };
+        let a = vec![[0.0, 0.0, 0.0], [9.0, 9.0, 0.0]];
+        let b = vec![[0.0, 9.0, 0.0], [9.0, 0.0, 0.0]];
+        let c = constrained_delaunay(&mut cloud, &lines(&[a, b], false)).unwrap();
+        assert_eq!(cloud.spacing, [1.0 / 1024.0; 2]);
+        assert_eq!(c.crossings, 1);
+        assert_eq!(cloud.xy[0], [0, 0]);
+        assert!(cloud.xy.contains(&[4608, 4608]));
+        assert!(has_chain(&c, &cloud, [0, 0], [9216, 9216]));
+        assert!(has_chain(&c, &cloud, [0, 9216], [9216, 0]));
     }
 
     #[test]

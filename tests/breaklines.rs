@@ -202,6 +202,28 @@ fn bad_breaklines_are_refused_naming_the_file() {
         &feature_collection(&[r#"{"type":"Point","coordinates":[500010,4000010]}"#]),
     );
     refused("points.geojson", "not lines or polygons");
+    // A TIN keeps its own edges: breaklines are for points.
+    let o = mesh(&dir, "tin.ply", &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    dir.write("inside.geojson", &feature_collection(&[CROSSING[1]]));
+    let before = dir.files();
+    let o = dir.run(&[
+        "mesh",
+        "tin.ply",
+        "-o",
+        "smaller.ply",
+        "--max-error",
+        "0.1",
+        "--breaklines",
+        "inside.geojson",
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("tin.ply") && stderr(&o).contains("not to a TIN"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(dir.files(), before);
     refused("missing.gpkg", "no such file");
     dir.write("text.geojson", "these are not lines");
     refused("text.geojson", "not a vector file");

@@ -269,7 +269,7 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
 
     let breaklines = match &job.points.breaklines {
         Some(_) if tin_input => bail!(
-            "{}: --breaklines applies to point files (LAS, LAZ, XYZ, CSV), not to a TIN",
+            "{}: --breaklines applies to point files and rasters, not to a TIN (it keeps its own edges)",
             input.display()
         ),
         Some(path) => Some((path.as_path(), read_layer(path, input, crs.as_deref())?)),
@@ -277,7 +277,7 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     };
     let boundary = match &job.points.boundary {
         Some(_) if tin_input => bail!(
-            "{}: --boundary applies to point files (LAS, LAZ, XYZ, CSV); a TIN keeps its own",
+            "{}: --boundary applies to point files and rasters, not to a TIN (it keeps its own outline)",
             input.display()
         ),
         Some(path) => {
@@ -700,7 +700,7 @@ pub fn verify_points_file(
     let (points, spacing) = if is_tin_input(points_path) && !is_ogr_points(points_path) {
         if choices.breaklines.is_some() {
             bail!(
-                "{}: --breaklines applies to point files (LAS, LAZ, XYZ, CSV), not to a TIN",
+                "{}: --breaklines applies to point files and rasters, not to a TIN (it keeps its own edges)",
                 points_path.display()
             );
         }

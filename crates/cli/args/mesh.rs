@@ -143,10 +143,10 @@ pub struct MeshArgs {
     /// Points only: the CRS to write (EPSG:CODE, WKT, ...), instead of the file's.
     #[arg(long, value_name = "CRS", help_heading = "Point input")]
     pub crs: Option<String>,
-    /// Point files only: a concave hull instead of the convex one: outer triangles are
-    /// removed, repeatedly, while an outer edge (not a breakline or boundary edge) is
-    /// longer than L (in the points' x, y units); points left outside are dropped
-    /// (counted in the report).
+    /// A concave hull instead of the convex one: outer triangles are removed, repeatedly,
+    /// while an outer edge (not a breakline or boundary edge) is longer than L (in the
+    /// points' x, y units); points left outside are dropped (counted in the report). A
+    /// raster's valid samples are then its points.
     #[arg(long, value_name = "L", help_heading = "Point input", value_parser = positive_length)]
     pub hull_edge_length: Option<f64>,
 }

@@ -40,11 +40,12 @@ struct MeshReport<'a> {
 /// than `job.tile_size` or with `job.per_tile`); the mesh is written only if the
 /// independent verifier confirms the bound, with its heights as the file holds them.
 pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
-    // A raster with breaklines or a boundary goes the points' way: its valid samples are
-    // the points of a constrained triangulation.
+    // A raster with breaklines, a boundary or a hull edge length goes the points' way:
+    // its valid samples are the points of a constrained triangulation.
     if crate::points::is_point_input(&job.input)
         || job.points.breaklines.is_some()
         || job.points.boundary.is_some()
+        || job.points.hull_edge_length.is_some()
     {
         return crate::points::mesh_points(job, feedback);
     }

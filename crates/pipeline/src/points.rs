@@ -295,8 +295,8 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     };
     if tin_input && job.points.hull_edge_length.is_some() {
         bail!(
-            "{}: --hull-edge-length applies to point files (LAS, LAZ, XYZ, CSV); a TIN keeps \
-             its own outline",
+            "{}: --hull-edge-length applies to point files and rasters, not to a TIN (it \
+             keeps its own outline)",
             input.display()
         );
     }

@@ -209,9 +209,10 @@ bench-preview:
 ## Point input: points/s and bytes per point for read, triangulate and decimate on the
 ## LAS/LAZ files of ../shared/data/points and 1 M points sampled from a DEM, and triangles
 ## kept against the full Delaunay (docs/results.md, "Points"; about a minute).
-bench-points:
+bench-points: py-oracles
 	cargo build --release --quiet
-	python3 bench/points.py --shared ../shared
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check pydelatin==0.4.0 scipy rasterio
+	$(VENV)/bin/python bench/points.py --shared ../shared
 
 ## Sharded pyramids: ETOPO5 and a 16384 x 8192 resample in one process vs 4 shards on a
 ## Dask LocalCluster, and 1000 shards of a planet-size VRT (docs/results.md, "Sharded

@@ -5,7 +5,8 @@
 // Usage: node bench/cesium_shot.cjs PAGE_URL TERRAIN_URL OUT.png LON LAT HEIGHT_M
 //        HEADING_DEG PITCH_DEG EXAGGERATION [water]
 // With `water`, the provider asks for the pyramid's water masks and the globe draws
-// water (CesiumJS's animated specular water) where they say.
+// water (CesiumJS's animated specular water) where they say. A TERRAIN_URL ending in
+// tileset.json is 3D Tiles terrain, loaded through Cesium3DTilesTerrainProvider.
 'use strict';
 const fs = require('fs');
 const os = require('os');
@@ -27,7 +28,9 @@ const { chromium } = require(path.join(root, '.tools', 'node_modules', 'playwrig
     page.on('pageerror', (e) => console.error('pageerror: ' + e));
     await page.goto(pageUrl, { waitUntil: 'load', timeout: 60000 });
     await page.evaluate(async ({ terrainUrl, view, water }) => {
-      const terrainProvider = await Cesium.CesiumTerrainProvider.fromUrl(terrainUrl, {
+      const provider = terrainUrl.endsWith('tileset.json')
+        ? Cesium.Cesium3DTilesTerrainProvider : Cesium.CesiumTerrainProvider;
+      const terrainProvider = await provider.fromUrl(terrainUrl, {
         requestVertexNormals: true, requestWaterMask: water,
       });
       const viewer = new Cesium.Viewer('v', {

@@ -194,3 +194,98 @@ fn cesiumjs_receives_the_water_masks() {
         .collect();
     assert!(theirs == ours, "CesiumJS decoded another water mask");
 }
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn cesiumjs_samples_the_3dtiles_pyramid_as_the_quantized_mesh_one() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = Dir::new();
+    let input = fixture("tintn_valid_raster_3857.tif");
+    for (out, format) in [("site/qm", "quantized-mesh"), ("site/t3d", "3dtiles")] {
+        let o = dir.run(&[
+            "tiles",
+            &input,
+            "-o",
+            out,
+            "--normals",
+            "--format",
+            format,
+            "-q",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    cesium_page(&dir);
+    let layer: Value =
+        serde_json::from_slice(&std::fs::read(dir.path("site/qm/layer.json")).unwrap()).unwrap();
+    let z = layer["maxzoom"].as_u64().unwrap() as u32;
+    let rect = &layer["available"][z as usize][0];
+    let (x, y) = (
+        rect["startX"].as_u64().unwrap() as u32,
+        rect["startY"].as_u64().unwrap() as u32,
+    );
+    // Lattice points of the finest tile, away from its edges, with GDAL's samples there.
+    let samples = gdal_samples(&dir, &input, z, x, y);
+    let size = 180.0 / (1u64 << z) as f64;
+    let d = size / 217.0;
+    let (west, south) = (-180.0 + x as f64 * size, -90.0 + y as f64 * size);
+    let valid: Vec<(usize, usize)> = (3..215)
+        .flat_map(|j| (3..215).map(move |i| (i, j)))
+        .filter(|&(i, j)| samples[j][i].is_finite())
+        .collect();
+    let picks: Vec<(usize, usize)> = (0..8)
+        .filter_map(|k| valid.get(k * valid.len() / 8 + valid.len() / 16).copied())
+        .collect();
+    assert!(picks.len() >= 3, "too few sample points with data");
+    let points: Vec<[f64; 2]> = picks
+        .iter()
+        .map(|&(i, j)| [west + i as f64 * d, south + j as f64 * d])
+        .collect();
+    let points_file = dir.write("points.json", &serde_json::to_string(&points).unwrap());
+    let (_server, base) = serve(&dir, &["site"]);
+    let bound = 77_067.34 / (1u64 << z) as f64;
+    let mut heights = Vec::new();
+    for terrain in [format!("{base}qm/"), format!("{base}t3d/tileset.json")] {
+        let out = Command::new("node")
+            .arg(repo.join("tests/oracle/cesium_sample.cjs"))
+            .arg(format!("{base}index.html"))
+            .arg(&terrain)
+            .arg(&points_file)
+            .output()
+            .expect("node runs");
+        assert!(
+            out.status.success(),
+            "{terrain}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let result: Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
+        assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
+        let mut got = Vec::new();
+        for (k, &(i, j)) in picks.iter().enumerate() {
+            assert_eq!(result["levels"][k].as_u64(), Some(z as u64), "{result}");
+            let h = result["heights"][k]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{terrain}: point {k} has no height: {result}"));
+            let want = samples[j][i];
+            assert!(
+                (h - want).abs() <= bound + 1e-3,
+                "{terrain}: point {k}: CesiumJS {h}, DEM {want}, bound {bound}"
+            );
+            got.push(h);
+        }
+        heights.push(got);
+    }
+    // The same tiles: the same heights but for CesiumJS's own handling of each format
+    // (float32 positions turned back into longitude, latitude and height for 3D Tiles);
+    // about 1 cm apart at most here, where the bound is 2.35 m.
+    for (k, (a, b)) in heights[0].iter().zip(&heights[1]).enumerate() {
+        assert!(
+            (a - b).abs() < 1e-2 * bound,
+            "point {k}: quantized-mesh {a}, 3D Tiles {b}"
+        );
+    }
+    eprintln!(
+        "quantized-mesh {:?}\n3D Tiles       {:?}",
+        heights[0], heights[1]
+    );
+}

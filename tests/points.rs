@@ -527,3 +527,35 @@ fn bad_las_files_are_refused_naming_the_file() {
     std::fs::write(dir.path("junk.las"), b"not a LAS file at all").unwrap();
     refused(&dir, "junk.las", "junk.las");
 }
+
+#[test]
+fn raster_only_decimation_choices_are_refused_not_ignored() {
+    let dir = Dir::new();
+    dir.write("p.csv", &csv(&random_points(200, 5), ",", true));
+    for (flags, named) in [
+        (&["--order", "greedy"][..], "--order greedy"),
+        (&["--initial-mesh", "rtin"][..], "--initial-mesh"),
+        (&["--flip-rounds", "1"][..], "--flip-rounds"),
+        (&["--extend-rounds", "1"][..], "--extend-rounds"),
+    ] {
+        let mut args = vec!["mesh", "p.csv", "-o", "out.ply", "--max-error", "0.1"];
+        args.extend_from_slice(flags);
+        let o = dir.run(&args);
+        assert!(!o.status.success(), "{flags:?} was accepted");
+        let e = stderr(&o);
+        assert!(e.contains("p.csv") && e.contains(named), "{flags:?}: {e}");
+        assert!(!dir.path("out.ply").exists(), "{flags:?} left output");
+    }
+    // What points do take: the default start, or the whole triangulation named.
+    let o = dir.run(&[
+        "mesh",
+        "p.csv",
+        "-o",
+        "out.ply",
+        "--max-error",
+        "0.1",
+        "--initial-mesh",
+        "full",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

@@ -18,6 +18,7 @@ mod points;
 mod preview;
 mod serve;
 mod shards;
+mod threedtiles;
 mod tiled_mesh;
 mod tiled_variables;
 mod tiles;

@@ -302,9 +302,56 @@ fn tiled_bands_refuse_obj_tiles_and_heights_only_formats() {
     assert_fails_naming(&d.run(&args), &["multi.tif", "OBJ"]);
     assert!(!d.path("tiles").exists());
     let mut args = base.to_vec();
-    args.extend_from_slice(&["-o", "m.glb"]);
-    assert_fails_naming(&d.run(&args), &["multi.tif", "glTF"]);
-    assert!(!d.path("m.glb").exists());
+    args.extend_from_slice(&["-o", "m.stl"]);
+    assert_fails_naming(&d.run(&args), &["multi.tif", "STL"]);
+    assert!(!d.path("m.stl").exists());
+}
+
+#[test]
+fn tiled_bands_in_gltf_keep_each_bound_as_float32_holds_them() {
+    let d = Dir::new();
+    three_bands(&d);
+    let bounds = "1,0.5,0.25";
+    let r = mesh_ok(
+        &d,
+        &[
+            "-o",
+            "m.glb",
+            "--bands",
+            "1,2,3",
+            "--max-error",
+            bounds,
+            "--tile-size",
+            TILE,
+            "--pixel-coords",
+        ],
+    );
+    assert!(r["tiles"]["count"].as_u64().unwrap() > 1, "{r}");
+    assert_eq!(r["variables"].as_array().unwrap().len(), 2, "{r}");
+    // Read back from the file: each band against its float32 attribute.
+    let v = verify_bands(&d, "m.glb", "1,2,3", bounds);
+    assert_eq!(v["variables"].as_array().unwrap().len(), 2, "{v}");
+    // A bound float32's rounding alone would use up is refused, naming the band.
+    write_band(&d, "big.asc", |x, y| 1.0e9 + (x * 7 + y) as f64);
+    stack(&d, "big.tif", &["big.asc"]);
+    let o = d.run(&[
+        "mesh",
+        "multi.tif",
+        "-o",
+        "n.glb",
+        "--bands",
+        "1",
+        "--attributes",
+        "big.tif",
+        "--attribute-error",
+        "1",
+        "--max-error",
+        "1",
+        "--tile-size",
+        TILE,
+    ]);
+    assert_fails_naming(&o, &["multi.tif", "float32 rounds"]);
+    assert!(!d.path("n.glb").exists());
 }
 
 #[test]
@@ -344,11 +391,11 @@ fn tiled_attributes_from_another_raster_on_the_same_grid() {
         "0.5",
     ]);
     assert!(o.status.success(), "{} {}", stdout(&o), stderr(&o));
-    // On another grid: refused, naming the file, nothing written.
-    crate::variables::write_band_at(&d, "finer.asc", (1000.0, 2000.0, 5.0), field(1.0));
+    // Elsewhere: refused, naming the file, nothing written.
+    crate::variables::write_band_at(&d, "far.asc", (90_000.0, 2000.0, 10.0), field(1.0));
     let mut args = base.to_vec();
-    args.extend_from_slice(&["-o", "n.ply", "--attributes", "finer.asc"]);
-    assert_fails_naming(&d.run(&args), &["finer.asc", "gdalwarp"]);
+    args.extend_from_slice(&["-o", "n.ply", "--attributes", "far.asc"]);
+    assert_fails_naming(&d.run(&args), &["far.asc", "does not overlap"]);
     assert!(!d.path("n.ply").exists());
 }
 

@@ -14,15 +14,16 @@ const CELLS: i64 = 217;
 const U_STEP: i64 = 151;
 const E0: f64 = 77_067.34;
 
+#[derive(Clone)]
 pub(crate) struct Tile {
-    u: Vec<i64>,
-    v: Vec<i64>,
+    pub(crate) u: Vec<i64>,
+    pub(crate) v: Vec<i64>,
     /// Decoded heights.
-    h: Vec<f64>,
+    pub(crate) h: Vec<f64>,
     /// The header's minimum and maximum heights.
     header: (f64, f64),
-    triangles: Vec<[usize; 3]>,
-    edges: [Vec<usize>; 4],
+    pub(crate) triangles: Vec<[usize; 3]>,
+    pub(crate) edges: [Vec<usize>; 4],
     normals: Option<Vec<u64>>,
     /// The water mask extension's bytes, as decoded.
     pub(crate) water_mask: Option<Vec<u64>>,
@@ -229,7 +230,7 @@ fn check_shared_edges(tiles: &BTreeMap<(u32, u32, u32), Tile>) -> usize {
 /// The largest |decoded mesh - sample| over the tile's lattice (`samples[j][i]`, row 0
 /// the southernmost, NaN = nodata) and whether every valid sample of a valid cell is
 /// covered.
-fn max_error(t: &Tile, samples: &[Vec<f64>]) -> f64 {
+pub(crate) fn max_error(t: &Tile, samples: &[Vec<f64>]) -> f64 {
     let mut err: BTreeMap<(i64, i64), f64> = BTreeMap::new();
     for tri in &t.triangles {
         let p = tri.map(|k| (t.u[k], t.v[k], t.h[k]));
@@ -339,7 +340,7 @@ fn layer_json(root: &Path) -> (Value, Vec<f64>) {
     (layer, bounds)
 }
 
-fn all_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+pub(crate) fn all_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     let mut out = BTreeMap::new();
     let mut stack = vec![root.to_path_buf()];
     while let Some(p) = stack.pop() {

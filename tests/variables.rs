@@ -368,20 +368,50 @@ fn bad_band_lists_and_bounds_are_refused_with_nothing_written() {
         "greedy",
     ]);
     assert_fails_naming(&o, &["multi.tif", "--max-triangles"]);
-    let o = d.run(&[
-        "mesh",
-        "multi.tif",
-        "-o",
-        "m.ply",
-        "--bands",
-        "1,2",
-        "--max-error",
-        "1",
-        "--error-model",
-        "bounds",
-    ]);
-    assert_fails_naming(&o, &["multi.tif", "exact error model"]);
     assert_eq!(d.files(), ["multi.tif"]);
+}
+
+#[test]
+fn the_papers_bounds_model_keeps_every_band_within_its_bound() {
+    let d = Dir::new();
+    three_bands(&d);
+    for start in ["full", "auto"] {
+        let r = mesh_ok(
+            &d,
+            &[
+                "-o",
+                "m.ply",
+                "--bands",
+                "1,2,3",
+                "--max-error",
+                "8,8,2",
+                "--error-model",
+                "bounds",
+                "--initial-mesh",
+                start,
+            ],
+        );
+        assert_eq!(r["error_model"], "bounds", "{r}");
+        for v in r["variables"].as_array().unwrap() {
+            let measured = v["measured_max_error"].as_f64().unwrap();
+            assert!(
+                measured <= v["max_error"].as_f64().unwrap() && measured > 0.0,
+                "{v}"
+            );
+        }
+        // Decimated, and checked again from the file by the verifier.
+        assert!(r["decimation_percent"].as_f64().unwrap() > 10.0, "{r}");
+        let o = d.run(&[
+            "verify",
+            "multi.tif",
+            "m.ply",
+            "--bands",
+            "1,2,3",
+            "--max-error",
+            "8,8,2",
+        ]);
+        assert!(o.status.success(), "{} {}", stdout(&o), stderr(&o));
+    }
 }
 
 #[test]
@@ -473,6 +503,28 @@ fn gltf_carries_each_band_as_an_attribute_the_validator_accepts() {
     ]);
     assert!(o.status.success(), "{} {}", stdout(&o), stderr(&o));
     assert!(stdout(&o).contains("band 2 (band_2)"), "{}", stdout(&o));
+    // Tiled: the welded mesh's bands, as valid.
+    mesh_ok(
+        &d,
+        &[
+            "-o",
+            "t.glb",
+            "--bands",
+            "1,2,3",
+            "--max-error",
+            "1,0.5,0.25",
+            "--tile-size",
+            "16",
+        ],
+    );
+    let o = Command::new("node")
+        .arg(&script)
+        .arg(d.path("t.glb"))
+        .output()
+        .expect("node runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: Value = serde_json::from_slice(&o.stdout).expect("validator JSON");
+    assert_eq!(report["issues"]["numErrors"], 0, "{report:#}");
 }
 
 #[test]
@@ -580,25 +632,142 @@ fn attributes_from_another_raster_on_the_same_grid() {
     assert!(o.status.success(), "{} {}", stdout(&o), stderr(&o));
     assert!(stdout(&o).contains("(other_band_1)"), "{}", stdout(&o));
 
-    // Elsewhere, or on another grid: refused, naming the file, nothing written.
+    // Elsewhere: refused, naming the file, nothing written.
     write_band_at(&d, "far.asc", (90_000.0, 2000.0, 10.0), field(1.0));
-    write_band_at(&d, "finer.asc", (1000.0, 2000.0, 5.0), field(1.0));
-    for (file, problem) in [("far.asc", "does not overlap"), ("finer.asc", "gdalwarp")] {
+    let o = d.run(&[
+        "mesh",
+        "dem.asc",
+        "-o",
+        "n.ply",
+        "--max-error",
+        "1",
+        "--attributes",
+        "far.asc",
+        "--attribute-error",
+        "0.5",
+    ]);
+    assert_fails_naming(&o, &["far.asc", "does not overlap"]);
+    assert!(!d.path("n.ply").exists());
+}
+
+#[test]
+fn attributes_on_another_grid_are_resampled_as_gdalwarp_resamples_them() {
+    let d = Dir::new();
+    write_band(&d, "dem.asc", field(0.3));
+    // Half the cell size, shifted by a third of a cell: no sample on the DEM's grid.
+    write_band_at(&d, "finer.asc", (1003.0, 2000.0, 5.0), field(1.7));
+    let dem = tinsmith_raster::open_info(&d.path("dem.asc"), 1).unwrap();
+    let g = dem.geo_transform.unwrap();
+    let (x0, y1) = (g[0], g[3]);
+    let (x1, y0) = (
+        x0 + g[1] * f64::from(dem.width),
+        y1 + g[5] * f64::from(dem.height),
+    );
+    for method in ["bilinear", "nearest", "cubic", "average"] {
+        // The same values as the gdalwarp command line puts on the DEM's grid, in a file
+        // of the same name (the PLY property is named after it) in another directory.
+        std::fs::create_dir_all(d.path(method)).unwrap();
+        let warped = format!("{method}/finer.tif");
+        let gdal_method = if method == "nearest" { "near" } else { method };
+        run_in(
+            &d,
+            "gdalwarp",
+            &[
+                "-q",
+                "-te",
+                &x0.to_string(),
+                &y0.to_string(),
+                &x1.to_string(),
+                &y1.to_string(),
+                "-ts",
+                &dem.width.to_string(),
+                &dem.height.to_string(),
+                "-r",
+                gdal_method,
+                "-ot",
+                "Float64",
+                "-dstnodata",
+                "nan",
+                "finer.asc",
+                &warped,
+            ],
+        );
+        let mesh = |attributes: &str, out: &str| {
+            let o = d.run(&[
+                "mesh",
+                "dem.asc",
+                "-o",
+                out,
+                "--max-error",
+                "1",
+                "--attributes",
+                attributes,
+                "--attribute-error",
+                "0.5",
+                "--attribute-resampling",
+                method,
+                "--report",
+                "r.json",
+                "-q",
+            ]);
+            assert!(o.status.success(), "{method} {attributes}: {}", stderr(&o));
+            report(&d)
+        };
+        let r = mesh("finer.asc", "resampled.ply");
+        assert_eq!(r["variables"][0]["resampled"], method, "{r}");
+        assert!(
+            r["variables"][0]["measured_max_error"].as_f64().unwrap() <= 0.5,
+            "{r}"
+        );
+        let r = mesh(&warped, "warped.ply");
+        assert!(r["variables"][0].get("resampled").is_none(), "{r}");
+        assert_eq!(
+            std::fs::read(d.path("resampled.ply")).unwrap(),
+            std::fs::read(d.path("warped.ply")).unwrap(),
+            "{method}: the mesh differs from the one on gdalwarp's values"
+        );
+        // verify resamples the same way, and measures the band against those values.
         let o = d.run(&[
-            "mesh",
+            "verify",
             "dem.asc",
-            "-o",
-            "n.ply",
+            "resampled.ply",
             "--max-error",
             "1",
             "--attributes",
-            file,
+            "finer.asc",
             "--attribute-error",
             "0.5",
+            "--attribute-resampling",
+            method,
         ]);
-        assert_fails_naming(&o, &[file, problem]);
-        assert!(!d.path("n.ply").exists());
+        assert!(o.status.success(), "{} {}", stdout(&o), stderr(&o));
     }
+    // The resampled copy is written under TMPDIR, and gone when the run ends.
+    std::fs::create_dir_all(d.path("scratch")).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_tinsmith"))
+        .args([
+            "mesh",
+            "dem.asc",
+            "-o",
+            "t.ply",
+            "--max-error",
+            "1",
+            "--attributes",
+        ])
+        .args([
+            "finer.asc",
+            "--attribute-error",
+            "0.5",
+            "--tile-size",
+            "16",
+            "-q",
+        ])
+        .env("TMPDIR", d.path("scratch"))
+        .current_dir(d.path(""))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read_dir(d.path("scratch")).unwrap().count(), 0);
     let o = d.run(&[
         "mesh",
         "dem.asc",

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 use tinsmith_formats::MeshFormat;
 use tinsmith_pipeline::{PreviewJob, ServeOptions, VerifyJob};
-use tinsmith_terrain::TerrainOptions;
+use tinsmith_terrain::{TerrainOptions, TileFormat};
 
 pub use contour::ContourArgs;
 pub use mesh::MeshArgs;
@@ -175,6 +175,12 @@ pub struct TilesArgs {
     /// Content-Encoding: gzip).
     #[arg(long)]
     pub no_gzip: bool,
+    /// Tile format: quantized-mesh (CesiumTerrainProvider), or 3dtiles: 3D Tiles 1.1
+    /// terrain for Cesium3DTilesTerrainProvider (tileset.json, implicit subtrees, one
+    /// uncompressed GLB per tile with CESIUM_tile_edges), the same tiles, whole globe from
+    /// level 0, into a directory.
+    #[arg(long, value_name = "NAME", default_value = "quantized-mesh", value_parser = parse_tile_format)]
+    pub format: TileFormat,
     /// Worker threads, at most 1024 (default: all cores); no more are started than there
     /// are cores.
     #[arg(long, default_value_t = 0, value_parser = threads_or_all)]
@@ -185,6 +191,14 @@ pub struct TilesArgs {
     /// No per-level lines or summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// `--format` of `tiles`.
+fn parse_tile_format(name: &str) -> Result<TileFormat, String> {
+    [TileFormat::QuantizedMesh, TileFormat::ThreeDTiles]
+        .into_iter()
+        .find(|f| f.label() == name)
+        .ok_or_else(|| format!("unknown tile format {name:?}: quantized-mesh or 3dtiles"))
 }
 
 /// A step of a pyramid built in shards.
@@ -314,6 +328,7 @@ impl TilesArgs {
             vertical_datum: tinsmith_raster::VerticalDatum::Ellipsoid,
             water: None,
             whole_globe: !self.data_only,
+            format: self.format,
         }
     }
 }

@@ -54,7 +54,11 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
                 "band {} ({}):{}max error {}, allowed {}{}",
                 v.band,
                 v.name,
-                " ".repeat(9usize.saturating_sub(v.band.to_string().len() + v.name.len())),
+                " ".repeat(
+                    9usize
+                        .saturating_sub(v.band.to_string().len() + v.name.len())
+                        .max(1)
+                ),
                 readable(v.measured_max_error),
                 readable(v.max_error),
                 if r.passed() { "" } else { "  FAILED" }

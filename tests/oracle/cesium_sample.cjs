@@ -1,6 +1,8 @@
 // Loads a terrain pyramid in CesiumJS (npm `cesium`, in .tools) inside headless Debian
 // Chromium (driven by playwright-core), through CesiumTerrainProvider.fromUrl, and samples
-// it with sampleTerrainMostDetailed.
+// it with sampleTerrainMostDetailed; a TERRAIN_URL ending in tileset.json is 3D Tiles
+// terrain, loaded through Cesium3DTilesTerrainProvider.fromUrl (its levels are read after
+// sampling: its availability comes with the subtrees the sampling loads).
 // Usage: node cesium_sample.cjs PAGE_URL TERRAIN_URL POINTS_JSON_FILE [Z/X/Y]
 // Prints {heights, consoleErrors, failedRequests, levels}; with Z/X/Y, the provider asks
 // for water masks too and the result adds that tile's (TMS numbering) {hasWaterMask,
@@ -39,12 +41,16 @@ const { chromium } = require(path.join(root, '.tools', 'node_modules', 'playwrig
     page.on('response', (r) => { if (r.status() >= 400) failedRequests.push(r.url() + ' ' + r.status()); });
     await page.goto(pageUrl, { waitUntil: 'load', timeout: 60000 });
     const result = await page.evaluate(async ({ terrainUrl, points, waterTile }) => {
-      const provider = await Cesium.CesiumTerrainProvider.fromUrl(terrainUrl, {
-        requestVertexNormals: true, requestWaterMask: Boolean(waterTile),
-      });
+      const tiles3d = terrainUrl.endsWith('tileset.json');
+      const options = { requestVertexNormals: true, requestWaterMask: Boolean(waterTile) };
+      const provider = tiles3d
+        ? await Cesium.Cesium3DTilesTerrainProvider.fromUrl(terrainUrl, options)
+        : await Cesium.CesiumTerrainProvider.fromUrl(terrainUrl, options);
       const positions = points.map((p) => Cesium.Cartographic.fromDegrees(p[0], p[1], NaN));
-      const levels = positions.map((c) => provider.availability.computeMaximumLevelAtPosition(c));
+      const levelsOf = () => positions.map((c) => provider.availability.computeMaximumLevelAtPosition(c));
+      let levels = tiles3d ? null : levelsOf();
       await Cesium.sampleTerrainMostDetailed(provider, positions);
+      if (tiles3d) levels = levelsOf();
       const out = { heights: positions.map((c) => c.height), levels };
       if (waterTile) {
         const [z, x, y] = waterTile.split('/').map(Number);

@@ -326,11 +326,17 @@ pub struct VariableArgs {
     /// With --bands: the band that is the height (listed in --bands) [default: the first].
     #[arg(long, value_name = "N", requires = "bands")]
     pub height_band: Option<usize>,
-    /// Variables from another raster on the input's grid (same size and geotransform;
-    /// refused, naming it, when it does not overlap or would need resampling): FILE's
-    /// bands B,... (all without :B,...), each within --attribute-error, as --bands' are.
+    /// Variables from another raster: FILE's bands B,... (all without :B,...), each within
+    /// --attribute-error, as --bands' are. On another grid than the input's (size,
+    /// geotransform or CRS) it is resampled onto it by GDAL (--attribute-resampling);
+    /// refused, naming it, when it does not overlap the input.
     #[arg(long, value_name = "FILE[:B,B,...]", requires = "attribute_error")]
     pub attributes: Option<String>,
+    /// How --attributes is resampled onto the input's grid when it is on another one
+    /// (GDAL's warper; the report says when it was).
+    #[arg(long, value_name = "METHOD", default_value = "bilinear", requires = "attributes",
+          value_parser = parse_resampling)]
+    pub attribute_resampling: tinsmith_raster::Resampling,
     /// The bound of each --attributes band: one for all, or a comma-separated one per band.
     #[arg(long, value_name = "E", value_parser = parse_max_error, allow_hyphen_values = true,
           value_delimiter = ',', num_args = 1, requires = "attributes")]
@@ -353,9 +359,24 @@ impl VariableArgs {
             variables.extend(tinsmith_pipeline::attribute_variables(
                 spec,
                 &self.attribute_error,
+                self.attribute_resampling,
             )?);
         }
         let band = if bands.is_empty() { band } else { height };
         Ok((band, max_error, variables))
     }
+}
+
+/// `--attribute-resampling`: one of GDAL's methods tinsmith offers.
+fn parse_resampling(text: &str) -> Result<tinsmith_raster::Resampling, String> {
+    tinsmith_raster::Resampling::ALL
+        .into_iter()
+        .find(|m| m.name() == text)
+        .ok_or_else(|| {
+            let names: Vec<&str> = tinsmith_raster::Resampling::ALL
+                .iter()
+                .map(|m| m.name())
+                .collect();
+            format!("expected one of {}", names.join(", "))
+        })
 }

@@ -171,9 +171,6 @@ fn run(
     let limit = effective_limit(max_error, max_abs);
     let scaled;
     let grid = if grid.variable_count() > 0 {
-        if options.error_model != ErrorModel::Exact {
-            return Err(Error::VariablesUnsupported("needs the exact error model"));
-        }
         if count_target {
             return Err(Error::VariablesUnsupported(
                 "takes an error bound, not a triangle or vertex count",

@@ -34,6 +34,16 @@ struct SegmentError {
     introduced: f64,
 }
 
+/// One variable's values on the loaded hole, as points with the hole's positions: the
+/// ring's, the centre's, the star triangles' gradients and the factor into height units.
+#[derive(Debug, Clone, Default)]
+struct VariableLayer {
+    ring: Vec<Point>,
+    centre: Point,
+    gradients: Vec<[f64; 2]>,
+    scale: f64,
+}
+
 /// Reusable buffers for [`Retriangulator::retriangulate`]; one per thread.
 #[derive(Debug, Default)]
 pub(crate) struct Retriangulator {
@@ -48,6 +58,10 @@ pub(crate) struct Retriangulator {
     unit_hole: bool,
     max_star_above: f64,
     max_star_below: f64,
+    /// The variables' values on the hole (bounds model with several variables); the first
+    /// `variable_count` are loaded, the rest are buffers kept for reuse.
+    variable_layers: Vec<VariableLayer>,
+    variable_count: usize,
     // Current polygon during ear clipping.
     prev: Vec<u32>,
     next: Vec<u32>,
@@ -104,6 +118,7 @@ impl Retriangulator {
         debug_assert!(boundary || star_bounds.len() == ring.len());
         self.centre = Some(centre);
         self.boundary = boundary;
+        self.variable_count = 0;
         self.ring.clear();
         self.ring.extend_from_slice(ring);
         self.star_bounds.clear();

@@ -6,7 +6,7 @@
 
 /// A point of the grid: integer position and a height (a sample's value, or a vertex's
 /// height, see [`crate::VertexHeights`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(crate) struct Point {
     pub x: i64,
     pub y: i64,

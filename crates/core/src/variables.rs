@@ -90,6 +90,20 @@ impl Measured {
         }
     }
 
+    /// The factor that takes the variable's differences into height units when bounds are
+    /// propagated (the bounds model): the scale, or infinity when the height's limit is 0
+    /// (any change of the variable then refuses, which is stricter than its own limit but
+    /// never looser); `None` for a variable that never stops a removal.
+    pub(crate) fn propagation_scale(&self) -> Option<f64> {
+        if self.unconstrained() {
+            None
+        } else if self.scale > 0.0 {
+            Some(self.scale)
+        } else {
+            Some(f64::INFINITY)
+        }
+    }
+
     /// Whether the variable never stops a removal.
     fn unconstrained(&self) -> bool {
         self.limit == f64::INFINITY
@@ -240,5 +254,20 @@ pub(crate) fn centre_outside_ring(grid: &Grid, centre: &Point, ring: &[Point]) -
             });
         let z = value(centre);
         z - hi > v.limit || lo - z > v.limit
+    })
+}
+
+/// Whether some variable held at a limit of 0 (a bound below its rounding slack) changes
+/// between `centre` and its `ring`: under the bounds model only exactly flat stars of such
+/// a variable may go, as for the height (their propagated differences are all exactly 0).
+pub(crate) fn held_variable_not_flat(grid: &Grid, centre: &Point, ring: &[Point]) -> bool {
+    grid.variables().iter().any(|v| {
+        if v.unconstrained() || v.limit > 0.0 {
+            return false;
+        }
+        let width = v.grid.width() as i64;
+        let value = |p: &Point| v.grid.values()[(p.y * width + p.x) as usize];
+        let z = value(centre);
+        ring.iter().any(|p| value(p) != z)
     })
 }

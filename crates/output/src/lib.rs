@@ -7,6 +7,7 @@
 //!   (`.tinsmith-*.tmp`, a file or a directory) next to its target and renamed into place
 //!   only when complete ([`write_atomically`], [`write_bytes_atomically`], [`StagedDir`],
 //!   and [`StagedFile`] for a file another library writes, such as an SQLite database);
+//!   files a run only reads back itself go in a [`ScratchDir`];
 //!   a sidecar (a mesh's `.prj`) is staged with its file and renamed just before it
 //!   ([`write_atomically_with_sidecar`]). A run that fails leaves the previous output at
 //!   the target untouched (or none); a file it replaces keeps its permissions; an output
@@ -41,6 +42,7 @@ pub use local::atomic::{
 };
 pub use local::check::{check_distinct, check_not_inside, check_writable_target};
 pub use local::report::{ReservedReport, REPORT_RESERVE_BYTES};
+pub use local::scratch::ScratchDir;
 pub use local::staging::StagedDir;
 pub use local::stale::{take_removed_stale, RemovedTemp};
 pub use pending::{finished, interrupted, mark_finished, on_signal, Interrupt};

@@ -6,5 +6,6 @@
 pub(crate) mod atomic;
 pub(crate) mod check;
 pub(crate) mod report;
+pub(crate) mod scratch;
 pub(crate) mod staging;
 pub(crate) mod stale;

@@ -231,6 +231,7 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
             input.display()
         );
     }
+    refuse_raster_only_choices(input, &job.decimation)?;
     crate::output_paths::check_writable_target(output, input)?;
     let format = crate::format_plan::format(job)?;
     let reserved = crate::mesh::reserve_report(job, Some((output, format)))?;
@@ -790,4 +791,35 @@ pub fn points_summary(r: &PointsReport) -> String {
     } else {
         format!("{} points: FAILED: {}", r.points, describe(r))
     }
+}
+
+/// Refuses the decimation choices a triangulation of points does not take, rather than
+/// ignoring them: its start is the triangulation itself and its order the sweep.
+fn refuse_raster_only_choices(
+    input: &std::path::Path,
+    choices: &tinsmith_choices::DecimationChoices,
+) -> Result<()> {
+    use tinsmith_core::{InitialMesh, Order};
+    let mut refused = Vec::new();
+    if choices.order == Order::Greedy {
+        refused.push("--order greedy");
+    }
+    if !matches!(choices.initial_mesh, InitialMesh::Auto | InitialMesh::Full) {
+        refused.push("--initial-mesh (points start from their whole triangulation)");
+    }
+    if choices.flip_rounds > 0 {
+        refused.push("--flip-rounds");
+    }
+    if choices.extend_rounds > 0 {
+        refused.push("--extend-rounds");
+    }
+    if !refused.is_empty() {
+        bail!(
+            "{}: {} apply to rasters only; points are decimated in sweeps from their \
+             triangulation",
+            input.display(),
+            refused.join(", ")
+        );
+    }
+    Ok(())
 }

@@ -52,15 +52,15 @@ pub struct ServeOptions {
 
 /// Binds a server for `options.path` (a directory, or an MBTiles file of quantized-mesh
 /// tiles) on 127.0.0.1; fails, naming it, when it is missing, a file that is not such an
-/// MBTiles file, or the port is taken. Notes when there is no `layer.json` (CesiumJS would
-/// not load it as terrain).
+/// MBTiles file, or the port is taken. Notes when there is no `layer.json` or
+/// `tileset.json` (CesiumJS would not load it as terrain).
 pub fn serve(options: &ServeOptions, feedback: &dyn Feedback) -> Result<Server> {
     let path = &options.path;
     let source = Source::open(path)?;
     if !source.has_layer() {
         feedback.note(&format!(
-            "{}: note: no layer.json here, so CesiumJS will not load it as a terrain \
-             pyramid (serve the directory or MBTiles file `tinsmith tiles -o` made)",
+            "{}: note: no layer.json (or tileset.json) here, so CesiumJS will not load it \
+             as a terrain pyramid (serve the directory or MBTiles file `tinsmith tiles -o` made)",
             path.display()
         ));
     }

@@ -142,10 +142,12 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         crate::scan::scan_raster(&job.input, job.band, job.vertical_datum.as_ref(), feedback)?;
     crate::output_paths::note_gcps_unused(&info, job.pixel_coords, feedback);
     let source = RasterSource::new(&info)?;
-    let (source, variables) = if job.variables.is_empty() {
-        (source, Vec::new())
+    // `_resampled`: the --attributes files put on the input's grid, read until the end.
+    let (source, variables, largest, _resampled) = if job.variables.is_empty() {
+        (source, Vec::new(), Vec::new(), Vec::new())
     } else {
-        crate::variables::tiled_source(&job.input, (source, &info), &job.variables)?
+        let v = crate::variables::tiled_source(&job.input, (source, &info), &job.variables)?;
+        (v.source, v.named, v.largest, v.resampled)
     };
     let scan_seconds = t.elapsed().as_secs_f64();
     let plan = TilePlan::new(info.width, info.height, job.tile_size).naming_file(&job.input)?;
@@ -170,7 +172,12 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     let options = TileOptions::new(decimation)
         .with_tile_size(job.tile_size)
         .with_threads(job.threads.map_or(0, |n| n as usize))
-        .with_variable_errors(variables.iter().map(|(v, _)| v.max_error).collect());
+        .with_variable_errors(crate::variables::tiled_variable_errors(
+            &job.input,
+            &variables,
+            &largest,
+            welded_format.is_some_and(MeshFormat::is_float32),
+        )?);
     let placement = Placement::new(info.transform(), job.pixel_coords);
     let crs = if job.pixel_coords {
         None
@@ -277,12 +284,7 @@ pub fn run(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
     );
     json.variables = (variables.iter())
         .zip(&report.variables_measured_max_error)
-        .map(|((v, name), &measured)| crate::VariableReport {
-            band: v.band,
-            name: name.clone(),
-            max_error: v.max_error,
-            measured_max_error: measured,
-        })
+        .map(|((v, name), &measured)| crate::VariableReport::new(v, name, measured))
         .collect();
     json.summary.print(
         &format!(" in {} tiles of {}", json.tiles.count, json.tiles.size),

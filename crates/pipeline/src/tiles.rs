@@ -66,7 +66,7 @@ pub fn tiles(
         built.min_zoom,
         built.max_zoom,
         output.display(),
-        if options.gzip {
+        if options.gzip && options.format == tinsmith_terrain::TileFormat::QuantizedMesh {
             " (gzipped: serve with Content-Encoding: gzip, e.g. `tinsmith serve`)"
         } else {
             ""

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 use tinsmith_core::{Grid, Tin, Variable};
 use tinsmith_georef::Samples;
-use tinsmith_raster::RasterInfo;
+use tinsmith_raster::{RasterInfo, Resampling};
 use tinsmith_verify::{GridRef, MeshRef, Orientation, Report, VerifyOptions};
 
 use crate::error::{bail, Context};
@@ -22,14 +22,24 @@ pub struct BandVariable {
     pub band: usize,
     /// Its bound (`f64::INFINITY`: carried, never constraining).
     pub max_error: f64,
-    /// The raster it is read from when not the input (`--attributes`): it must be on the
-    /// input's grid (same size and geotransform).
+    /// The raster it is read from when not the input (`--attributes`): used as it is when
+    /// on the input's grid (same size, geotransform and CRS), else resampled onto it.
     pub file: Option<PathBuf>,
+    /// How `file` is resampled onto the input's grid when it is not on it.
+    pub resampling: Resampling,
+    /// Set when the band was read: the method that put `file` on the input's grid, or
+    /// `None` when it was on it already (or is the input's own band).
+    pub resampled: Option<Resampling>,
 }
 
 /// `--attributes FILE[:B,B,...]` with `--attribute-error E` (one bound, or one per band):
-/// those bands of another raster (all of them without `:bands`) as variables.
-pub fn attribute_variables(spec: &str, bounds: &[f64]) -> Result<Vec<BandVariable>> {
+/// those bands of another raster (all of them without `:bands`) as variables, resampled
+/// onto the input's grid by `resampling` when they are not on it.
+pub fn attribute_variables(
+    spec: &str,
+    bounds: &[f64],
+    resampling: Resampling,
+) -> Result<Vec<BandVariable>> {
     let (path, bands) = match spec.rsplit_once(':') {
         Some((path, list))
             if !path.is_empty() && list.split(',').all(|b| b.trim().parse::<usize>().is_ok()) =>
@@ -72,6 +82,8 @@ pub fn attribute_variables(spec: &str, bounds: &[f64]) -> Result<Vec<BandVariabl
                 bounds[i]
             },
             file: Some(path.clone()),
+            resampling,
+            resampled: None,
         })
         .collect())
 }
@@ -158,6 +170,8 @@ pub fn resolve_bands(
             band,
             max_error: bound(i),
             file: None,
+            resampling: Resampling::default(),
+            resampled: None,
         })
         .collect();
     Ok((height, Some(bound(at)), variables))
@@ -182,12 +196,19 @@ pub(crate) fn read(
     let mut bytes = 0;
     let mut read = Vec::with_capacity(variables.len());
     let mut names: Vec<String> = Vec::new();
-    for v in variables {
+    let mut variables = variables.to_vec();
+    for v in &mut variables {
         let raster = match &v.file {
             None => tinsmith_raster::read_samples(input, v.band)?,
             Some(file) => {
-                let raster = tinsmith_raster::read_samples(file, v.band)?;
-                check_same_grid(file, &raster.info, input, info)?;
+                let resampled = on_input_grid(file, v, input, info)?;
+                v.resampled = resampled.as_ref().map(|_| v.resampling);
+                let path = resampled
+                    .as_ref()
+                    .map_or(file.as_path(), ResampledFile::path);
+                let mut raster = tinsmith_raster::read_samples(path, v.band)
+                    .map_err(|e| no_overlap(e, file, input))?;
+                raster.info.path = file.clone();
                 raster
             }
         };
@@ -225,12 +246,11 @@ pub(crate) fn read(
     }
     let grid = Grid::with_variables(height, read).naming_file(input)?;
     let rgb = variables.len() == 3 && bytes == 3;
-    Ok((grid, variables.iter().cloned().zip(names).collect(), rgb))
+    Ok((grid, variables.into_iter().zip(names).collect(), rgb))
 }
 
 /// Refuses what a tiled run with variables does not do: OBJ tiles (`--per-tile
-/// --tile-format obj`), formats without per-vertex values, and float32 formats (their
-/// rounding of each band would need the whole band first).
+/// --tile-format obj`), formats without per-vertex values, and count targets.
 pub(crate) fn check_tiled(job: &crate::MeshJob) -> Result<()> {
     let input = job.input.display();
     if job.per_tile.is_some() {
@@ -246,32 +266,95 @@ pub(crate) fn check_tiled(job: &crate::MeshJob) -> Result<()> {
         bail!("{input}: --bands takes error bounds (--max-error), not --max-triangles or --max-vertices");
     }
     let format = crate::format_plan::format(job)?;
-    if !format.carries_attributes() || format.is_float32() {
+    if !format.carries_attributes() {
         bail!(
             "{input}: a raster larger than --tile-size {} is meshed tile by tile, and then \
-             --bands writes PLY (.ply), GeoJSON or FlatGeobuf (.geojson, .fgb); {format} is \
-             not among them (or raise --tile-size to mesh it in one piece)",
+             --bands writes PLY (.ply), glTF (.glb, .gltf), GeoJSON or FlatGeobuf (.geojson, \
+             .fgb); {format} is not among them (or raise --tile-size to mesh it in one piece)",
             job.tile_size
         );
     }
     Ok(())
 }
 
+/// The bound each variable is decimated within in a tiled run: its own, less what float32
+/// may round its values by when the file holds them as float32 (`float32`): at most half
+/// a unit in the last place of its largest |value| (the band's statistics), 2^-24 of it,
+/// since a tiled run never holds a whole band to measure the rounding exactly. Refuses,
+/// naming the band, a bound that rounding alone would use up.
+pub(crate) fn tiled_variable_errors(
+    input: &Path,
+    variables: &[Named],
+    largest: &[f64],
+    float32: bool,
+) -> Result<Vec<f64>> {
+    variables
+        .iter()
+        .zip(largest)
+        .map(|((v, name), &largest)| {
+            if !float32 {
+                return Ok(v.max_error);
+            }
+            let rounding = largest / f64::from(1u32 << 24);
+            if rounding >= v.max_error {
+                bail!(
+                    "{}: band {} ({name}): float32 rounds its values by up to {rounding} \
+                     (2^-24 of its largest |value| {largest}), not less than its bound {}; \
+                     write PLY (double) instead",
+                    input.display(),
+                    v.band,
+                    v.max_error
+                );
+            }
+            Ok(v.max_error - rounding)
+        })
+        .collect()
+}
+
+/// The variables of a tiled run: the engine's source reading every band, each variable's
+/// band, bound and name, each one's largest |value|, and the resampled files the source
+/// reads from, to keep until the run ends.
+pub(crate) struct TiledVariables {
+    pub(crate) source: tinsmith_tiling::RasterSource,
+    pub(crate) named: Vec<Named>,
+    pub(crate) largest: Vec<f64>,
+    pub(crate) resampled: Vec<ResampledFile>,
+}
+
 /// The tiled engine's source for `height` with every variable's band (each scanned once
-/// for its statistics, windows read per tile), and each variable's band, bound and name.
+/// for its statistics, windows read per tile).
 pub(crate) fn tiled_source(
     input: &Path,
     height: (tinsmith_tiling::RasterSource, &RasterInfo),
     variables: &[BandVariable],
-) -> Result<(tinsmith_tiling::RasterSource, Vec<Named>)> {
+) -> Result<TiledVariables> {
     let (mut source, info) = height;
     let mut names: Vec<String> = Vec::new();
-    for v in variables {
-        let file = v.file.as_deref().unwrap_or(input);
-        let band = tinsmith_raster::open_info(file, v.band)?;
-        if v.file.is_some() {
-            check_same_grid(file, &band, input, info)?;
-        } else if (band.width, band.height) != (info.width, info.height) {
+    let mut variables = variables.to_vec();
+    let mut kept = Vec::new();
+    let mut largest = Vec::new();
+    for v in &mut variables {
+        let file = v.file.clone().unwrap_or_else(|| input.to_path_buf());
+        let band = if v.file.is_some() {
+            let resampled = on_input_grid(&file, v, input, info)?;
+            v.resampled = resampled.as_ref().map(|_| v.resampling);
+            let path = resampled
+                .as_ref()
+                .map_or(file.clone(), |r| r.path().to_path_buf());
+            kept.extend(resampled);
+            let band = tinsmith_raster::open_info(&path, v.band)?;
+            if band.valid_samples == 0 {
+                return Err(no_overlap(
+                    tinsmith_raster::Error::AllNodata { path, band: v.band },
+                    &file,
+                    input,
+                ));
+            }
+            band
+        } else {
+            tinsmith_raster::open_info(&file, v.band)?
+        };
+        if v.file.is_none() && (band.width, band.height) != (info.width, info.height) {
             bail!(
                 "{}: band {} is not the height band's size",
                 input.display(),
@@ -292,9 +375,15 @@ pub(crate) fn tiled_source(
             &fallback,
             &names,
         ));
-        source = source.with_variable(&band).naming_file(file)?;
+        largest.push(band.max_abs_value().unwrap_or(0.0));
+        source = source.with_variable(&band).naming_file(&file)?;
     }
-    Ok((source, variables.iter().cloned().zip(names).collect()))
+    Ok(TiledVariables {
+        source,
+        named: variables.into_iter().zip(names).collect(),
+        largest,
+        resampled: kept,
+    })
 }
 
 /// The name a file gives a band's values: its description made a PLY property name
@@ -326,84 +415,93 @@ fn property_name(description: Option<&str>, fallback: &str, taken: &[String]) ->
     name
 }
 
-/// Refuses an attribute raster that is not on the input's grid: one that shares no area
-/// with it, or one on another grid (size or geotransform), which would need resampling.
-fn check_same_grid(file: &Path, other: &RasterInfo, input: &Path, info: &RasterInfo) -> Result<()> {
-    let extent = |i: &RasterInfo| {
-        i.geo_transform.map(|g| {
-            let xs = [
-                g[0],
-                g[0] + g[1] * f64::from(i.width) + g[2] * f64::from(i.height),
-            ];
-            let ys = [
-                g[3],
-                g[3] + g[4] * f64::from(i.width) + g[5] * f64::from(i.height),
-            ];
-            (
-                xs[0].min(xs[1]),
-                xs[0].max(xs[1]),
-                ys[0].min(ys[1]),
-                ys[0].max(ys[1]),
-            )
-        })
+/// An attribute raster resampled onto the input's grid: a temporary GeoTIFF, removed when
+/// this is dropped (and by the output layer on Ctrl-C before then).
+pub(crate) struct ResampledFile {
+    tif: PathBuf,
+    _dir: tinsmith_output::ScratchDir,
+}
+
+impl ResampledFile {
+    /// The GeoTIFF.
+    pub(crate) fn path(&self) -> &Path {
+        &self.tif
+    }
+}
+
+/// `None` when attribute raster `file` is on the input's grid (`info`) and its bands are
+/// read from it; else a copy of it resampled onto that grid by `v.resampling`, to read
+/// them from. Refuses, naming both, a file whose extent shares no area with the input's
+/// in the same CRS, or one that cannot be placed on its grid.
+fn on_input_grid(
+    file: &Path,
+    v: &BandVariable,
+    input: &Path,
+    info: &RasterInfo,
+) -> Result<Option<ResampledFile>> {
+    let other = tinsmith_raster::open_info(file, v.band)?;
+    if tinsmith_raster::on_same_grid(&other, info) {
+        return Ok(None);
+    }
+    let same_crs = match (&other.crs_wkt, &info.crs_wkt) {
+        (Some(a), Some(b)) => tinsmith_raster::same_crs(a, b),
+        (None, None) => true,
+        _ => false,
     };
-    let same_size = (other.width, other.height) == (info.width, info.height);
-    let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-9 * scale.max(1.0);
-    match (
-        extent(other),
-        extent(info),
-        other.geo_transform,
-        info.geo_transform,
-    ) {
-        (None, None, _, _) if same_size => Ok(()),
-        (Some(o), Some(i), Some(go), Some(gi)) => {
-            if o.1 <= i.0 || i.1 <= o.0 || o.3 <= i.2 || i.3 <= o.2 {
-                bail!(
-                    "{}: --attributes: does not overlap {} (extents x {}..{}, y {}..{} against \
-                     x {}..{}, y {}..{})",
-                    file.display(),
-                    input.display(),
-                    o.0,
-                    o.1,
-                    o.2,
-                    o.3,
-                    i.0,
-                    i.1,
-                    i.2,
-                    i.3
-                );
-            }
-            let pixel = gi[1].abs().max(gi[5].abs());
-            let same = same_size
-                && go
-                    .iter()
-                    .zip(&gi)
-                    .all(|(a, b)| close(*a, *b, pixel.max(a.abs() * 1e-6)));
-            if !same {
-                bail!(
-                    "{}: --attributes: on another grid than {} ({}x{} against {}x{}, or another \
-                     geotransform); resample it onto that grid first, e.g. gdalwarp -te {} {} {} {} \
-                     -ts {} {} {} OUT.tif",
-                    file.display(),
-                    input.display(),
-                    other.width,
-                    other.height,
-                    info.width,
-                    info.height,
-                    i.0, i.2, i.1, i.3,
-                    info.width,
-                    info.height,
-                    file.display()
-                );
-            }
-            Ok(())
+    if let (true, Some(o), Some(i)) = (same_crs, extent(&other), extent(info)) {
+        if o[1] <= i[0] || i[1] <= o[0] || o[3] <= i[2] || i[3] <= o[2] {
+            bail!(
+                "{}: --attributes: does not overlap {} (extents x {}..{}, y {}..{} against \
+                 x {}..{}, y {}..{})",
+                file.display(),
+                input.display(),
+                o[0],
+                o[1],
+                o[2],
+                o[3],
+                i[0],
+                i[1],
+                i[2],
+                i[3]
+            );
         }
-        _ => bail!(
-            "{}: --attributes: cannot be placed on {}'s grid (one has a geotransform, the \
-             other not, or their sizes differ)",
+    }
+    let dir = tinsmith_output::ScratchDir::new().with_context(|| {
+        format!(
+            "{}: cannot make a temporary directory to resample it in",
+            file.display()
+        )
+    })?;
+    let tif = dir.path().join("resampled.tif");
+    tinsmith_raster::resample_onto(file, info, v.resampling, &tif)?;
+    Ok(Some(ResampledFile { tif, _dir: dir }))
+}
+
+/// `[x_min, x_max, y_min, y_max]` of a raster's samples' cells, when it has a geotransform.
+fn extent(info: &RasterInfo) -> Option<[f64; 4]> {
+    let g = info.geo_transform?;
+    let (w, h) = (f64::from(info.width), f64::from(info.height));
+    let xs = [g[0], g[0] + g[1] * w + g[2] * h];
+    let ys = [g[3], g[3] + g[4] * w + g[5] * h];
+    Some([
+        xs[0].min(xs[1]),
+        xs[0].max(xs[1]),
+        ys[0].min(ys[1]),
+        ys[0].max(ys[1]),
+    ])
+}
+
+/// An attribute band with no valid sample on the input's grid (after resampling) reported
+/// as not overlapping the input; any other error as it is, naming `file`.
+fn no_overlap(error: tinsmith_raster::Error, file: &Path, input: &Path) -> crate::Error {
+    match error {
+        tinsmith_raster::Error::AllNodata { band, .. } => crate::Error::Refused(format!(
+            "{}: --attributes: band {band} has no valid sample on {}'s grid (it does not \
+             overlap it, or only with nodata)",
             file.display(),
             input.display()
-        ),
+        )),
+        other => other.into(),
     }
 }
 
@@ -418,6 +516,23 @@ pub struct VariableReport {
     pub max_error: f64,
     /// The independent verifier's largest |sample - TIN| over every domain sample.
     pub measured_max_error: f64,
+    /// GDAL's resampling method when the band came from another raster not on the
+    /// input's grid (`--attributes`), resampled onto it; absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub resampled: Option<&'static str>,
+}
+
+impl VariableReport {
+    /// The line of `variable`, named `name`, measured at `measured_max_error`.
+    pub(crate) fn new(variable: &BandVariable, name: &str, measured_max_error: f64) -> Self {
+        VariableReport {
+            band: variable.band,
+            name: name.to_owned(),
+            max_error: variable.max_error,
+            measured_max_error,
+            resampled: variable.resampled.map(Resampling::name),
+        }
+    }
 }
 
 /// Each variable's values at the TIN's vertices (in vertex order), rounded to float32 for
@@ -468,12 +583,7 @@ pub(crate) fn check(
                 report.problems.join("; ")
             );
         }
-        reports.push(VariableReport {
-            band: variable.band,
-            name: name.clone(),
-            max_error: variable.max_error,
-            measured_max_error: report.max_error,
-        });
+        reports.push(VariableReport::new(variable, name, report.max_error));
     }
     Ok(reports)
 }
@@ -545,12 +655,7 @@ pub(crate) fn verify_file(
         )
         .with_context(|| format!("{}: cannot verify", mesh_path.display()))?;
         out.push((
-            VariableReport {
-                band: variable.band,
-                name: name.clone(),
-                max_error: variable.max_error,
-                measured_max_error: report.max_error,
-            },
+            VariableReport::new(variable, name, report.max_error),
             report,
         ));
     }

@@ -204,6 +204,16 @@ pub enum Error {
         #[source]
         source: Box<gdal::errors::GdalError>,
     },
+    /// A raster could not be resampled onto another raster's grid.
+    #[error("{}: cannot be resampled onto the grid of {} ({reason})", path.display(), target.display())]
+    Resample {
+        /// The raster to resample.
+        path: PathBuf,
+        /// The raster whose grid it was to be put on.
+        target: PathBuf,
+        /// Why (GDAL's explanation, or what the grids lack).
+        reason: String,
+    },
     /// Reprojection: PROJ maps a point to no finite position (outside the area
     /// the projection is defined on).
     #[error("point {point} at {position:?} cannot be transformed")]

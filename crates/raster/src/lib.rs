@@ -70,6 +70,7 @@ mod polygons;
 mod quiet;
 mod read;
 mod reproject;
+mod resample;
 mod sample;
 mod window;
 
@@ -89,5 +90,6 @@ pub use reproject::{
     crs_wkt, epsg_code, from_wgs84, horizontal_crs, is_geographic, is_wgs84_lon_lat, same_crs,
     to_wgs84,
 };
+pub use resample::{on_same_grid, resample_onto, Resampling};
 pub use sample::sample_geographic;
 pub use window::{read_window, WindowReader};

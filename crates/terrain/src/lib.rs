@@ -3,11 +3,15 @@
 //! in the south), each decimated within `quality x e(level)` (Cesium's geometric error at
 //! the level) and checked by the independent verifier, with shared edges simplified once
 //! so that same-level neighbours keep identical edge vertices, and `layer.json` with the
-//! tiles' availability. The pyramid is staged and moved into place whole.
+//! tiles' availability. The pyramid is staged and moved into place whole. The same tiles
+//! can be written as 3D Tiles 1.1 terrain instead ([`TileFormat::ThreeDTiles`]: one GLB per
+//! tile, [`GlbTile`], implicit subtrees and `tileset.json`).
 
 mod blocks;
 mod budget;
 mod error;
+mod glb_tile;
+mod implicit;
 mod layer;
 mod plan;
 mod pyramid;
@@ -23,11 +27,13 @@ mod writer;
 
 pub use budget::LEVEL_ZERO_ERROR;
 pub use error::{TerrainError, TerrainResult};
+pub use glb_tile::{GlbTile, TileBounds, TILE_EDGES_EXTENSION};
+pub use implicit::MAX_SUBTREE_LEVELS;
 pub use layer::METADATA_AVAILABILITY;
 pub use plan::Shard;
 pub use pyramid::{
     build_terrain, build_terrain_in, streaming_bytes, LevelReport, Progress, TerrainOptions,
-    TerrainReport, MAX_LEVEL,
+    TerrainReport, TileFormat, MAX_LEVEL,
 };
 pub use quantized_mesh::{
     geodetic_to_ecef, gzip, oct_encode, surface_normal, EncodeError, GeoRectangle,

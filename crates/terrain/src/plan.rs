@@ -112,6 +112,8 @@ impl TileOptions {
             ),
             water: self.water.clone(),
             whole_globe: self.whole_globe,
+            // Shards are refused for 3D Tiles (see `build_shard`).
+            format: crate::TileFormat::QuantizedMesh,
         }
     }
 }

@@ -9,6 +9,7 @@ use tinsmith_raster::{geographic_bounds, GeoBounds};
 
 use crate::blocks::{block_level, block_window, blocks, domain, reach_margin, Cut, SplitSamples};
 use crate::budget::LevelBudget;
+use crate::implicit::{subtree_levels, subtrees, tileset_json};
 use crate::layer::{layer_json, Available};
 use crate::records::{
     block_name, gzip_samples, options_key, put_record, read_record, top_name, BlockRecord, Entries,
@@ -65,6 +66,32 @@ pub struct TerrainOptions {
     /// root tiles are written, so that a client shows a globe with the data on it.
     /// Without it, tiles have no triangles beyond the raster.
     pub whole_globe: bool,
+    /// How tiles are encoded and laid out. Part of every tile's identity.
+    pub format: TileFormat,
+}
+
+/// How a pyramid's tiles are encoded and laid out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TileFormat {
+    /// quantized-mesh-1.0 tiles `z/x/y.terrain` and `layer.json`, for CesiumJS's
+    /// `CesiumTerrainProvider`.
+    #[default]
+    QuantizedMesh,
+    /// 3D Tiles 1.1 terrain for CesiumJS's `Cesium3DTilesTerrainProvider`: one GLB per
+    /// tile with `CESIUM_tile_edges` under `tiles/`, implicit quadtree subtrees with each
+    /// tile's metadata under `subtrees/`, and `tileset.json`. Always the whole globe,
+    /// from level 0, into a directory; GLBs are not gzipped.
+    ThreeDTiles,
+}
+
+impl TileFormat {
+    /// The name the command line gives it: `quantized-mesh` or `3dtiles`.
+    pub fn label(self) -> &'static str {
+        match self {
+            TileFormat::QuantizedMesh => "quantized-mesh",
+            TileFormat::ThreeDTiles => "3dtiles",
+        }
+    }
 }
 
 impl TerrainOptions {
@@ -95,6 +122,7 @@ impl Default for TerrainOptions {
             vertical_datum: tinsmith_raster::VerticalDatum::Ellipsoid,
             water: None,
             whole_globe: false,
+            format: TileFormat::QuantizedMesh,
         }
     }
 }
@@ -307,6 +335,7 @@ pub fn build_terrain_in(
     options: &TerrainOptions,
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> TerrainResult<TerrainReport> {
+    directory_only(options, &store.location())?;
     let prepared = prepare(input, options)?;
     let known = if store.get_file(&top_name())?.is_some() {
         recorded_entries(store)?
@@ -432,6 +461,18 @@ pub enum Progress<'a> {
     },
 }
 
+/// Refuses a 3D Tiles pyramid anywhere but in a directory built whole (`destination`
+/// names where it was asked to go): its subtrees are made from every tile's metadata,
+/// which only a run that builds every tile holds.
+pub(super) fn directory_only(options: &TerrainOptions, destination: &str) -> TerrainResult<()> {
+    if options.format == TileFormat::ThreeDTiles {
+        return Err(TerrainError::Options(format!(
+            "{destination}: --format 3dtiles is written into a new directory, built whole              in one run (not into MBTiles or a bucket, not by shards, not with --update)"
+        )));
+    }
+    Ok(())
+}
+
 /// What every run of a pyramid works out from its input and options first.
 pub(super) struct Prepared {
     /// The input's extent in EPSG:4326.
@@ -478,6 +519,25 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
              the metadata of the level-0 tiles",
             options.min_zoom
         )));
+    }
+    if options.format == TileFormat::ThreeDTiles {
+        // CesiumJS requests both root tiles and reads every subtree from the root ones.
+        let clash = [
+            (options.min_zoom > 0, "--min-zoom above 0"),
+            (!options.whole_globe, "--data-only"),
+            (options.metadata, "--metadata (a quantized-mesh extension)"),
+            (
+                options.water.is_some(),
+                "--water (not written as 3D Tiles yet)",
+            ),
+            (options.update, "--update"),
+        ];
+        if let Some((_, what)) = clash.iter().find(|(on, _)| *on) {
+            return Err(TerrainError::Options(format!(
+                "--format 3dtiles cannot be combined with {what}: its pyramid covers the \
+                 whole globe from level 0, built whole"
+            )));
+        }
     }
     if options.max_zoom.is_none() && options.min_zoom > max_zoom {
         return Err(TerrainError::Options(format!(
@@ -825,11 +885,32 @@ pub(super) fn finish_pyramid(
     for level in reports.iter().rev() {
         progress(Progress::Level(level));
     }
+    if options.format == TileFormat::ThreeDTiles {
+        write_tileset(&written, store)?;
+        return Ok((reports, written.kept));
+    }
     let layer = layer_json(name, options, bounds, max_zoom, &written.available);
     if store.get_file("layer.json")?.as_deref() != Some(layer.as_bytes()) {
         store.put_file("layer.json", layer.as_bytes())?;
     }
     Ok((reports, written.kept))
+}
+
+/// Writes the subtrees of the 3D Tiles tiles in `written`, then `tileset.json`.
+fn write_tileset(written: &Written, store: &dyn TileStore) -> TerrainResult<()> {
+    let deepest = written.metadata.keys().map(|k| k.0).max().unwrap_or(0);
+    let files = subtrees(&written.metadata, subtree_levels(deepest)).map_err(|(z, x, y)| {
+        TerrainError::Options(format!(
+            "tile {z}/{x}/{y} was written without its parent tile, so no 3D Tiles client \
+             could reach it"
+        ))
+    })?;
+    for (name, bytes) in files {
+        store.put_file(&name, &bytes)?;
+    }
+    let tileset = tileset_json(&written.metadata, deepest);
+    store.put_file("tileset.json", tileset.as_bytes())?;
+    Ok(())
 }
 
 /// Every tile entry recorded in `store` (blocks and top), by address: what an update

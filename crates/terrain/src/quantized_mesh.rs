@@ -73,6 +73,17 @@ pub enum EncodeError {
     /// The rectangle is empty or not finite.
     #[error("tile rectangle {0:?} is empty or not finite")]
     Rectangle([f64; 4]),
+    /// The heights are not one per vertex (a GLB tile).
+    #[error("{got} heights for {expected} vertices")]
+    HeightCount {
+        /// Vertices.
+        expected: usize,
+        /// Heights.
+        got: usize,
+    },
+    /// No vertex lies on this edge of a GLB tile (`CESIUM_tile_edges` needs one).
+    #[error("no vertex on the tile's {0} edge")]
+    EmptyEdge(&'static str),
 }
 
 /// A tile's geodetic rectangle, in degrees.
@@ -355,7 +366,10 @@ fn zig_zag(d: i32) -> u16 {
 }
 
 /// The vertices in order of first use (old indices) and the triangles renumbered.
-fn first_use_order(vertex_count: usize, triangles: &[[u32; 3]]) -> (Vec<usize>, Vec<[u32; 3]>) {
+pub(super) fn first_use_order(
+    vertex_count: usize,
+    triangles: &[[u32; 3]],
+) -> (Vec<usize>, Vec<[u32; 3]>) {
     let mut new_index = vec![u32::MAX; vertex_count];
     let mut order = Vec::new();
     let renumbered = triangles
@@ -375,7 +389,7 @@ fn first_use_order(vertex_count: usize, triangles: &[[u32; 3]]) -> (Vec<usize>, 
 }
 
 /// The W, S, E, N edge lists, in CesiumJS's order.
-fn edge_lists(vertices: &[[u16; 3]]) -> [Vec<u32>; 4] {
+pub(super) fn edge_lists(vertices: &[[u16; 3]]) -> [Vec<u32>; 4] {
     let on = |k: usize, value: u16| -> Vec<u32> {
         (0..vertices.len() as u32)
             .filter(|&i| vertices[i as usize][k] == value)
@@ -394,7 +408,7 @@ fn edge_lists(vertices: &[[u16; 3]]) -> [Vec<u32>; 4] {
 
 /// Centre of the ECEF box of the points and the distance to the farthest one. An empty
 /// tile gets the rectangle's centre on the ellipsoid and radius 0.
-fn bounding_sphere(points: &[[f64; 3]], r: GeoRectangle) -> ([f64; 3], f64) {
+pub(super) fn bounding_sphere(points: &[[f64; 3]], r: GeoRectangle) -> ([f64; 3], f64) {
     if points.is_empty() {
         let c = geodetic_to_ecef((r.west + r.east) / 2.0, (r.south + r.north) / 2.0, 0.0);
         return (c, 0.0);
@@ -425,7 +439,7 @@ fn scaled(p: [f64; 3]) -> [f64; 3] {
 
 /// CesiumJS `EllipsoidalOccluder.computeHorizonCullingPointFromVertices`, with the
 /// direction towards `towards` (ECEF); in ellipsoid-scaled coordinates.
-fn horizon_occlusion_point(points: &[[f64; 3]], towards: [f64; 3]) -> [f64; 3] {
+pub(super) fn horizon_occlusion_point(points: &[[f64; 3]], towards: [f64; 3]) -> [f64; 3] {
     let s = scaled(towards);
     let len = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
     let d = if len > 0.0 {

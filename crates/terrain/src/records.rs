@@ -80,6 +80,9 @@ pub(super) fn options_key(options: &TerrainOptions) -> String {
     if options.whole_globe {
         text["whole_globe"] = true.into();
     }
+    if options.format != crate::TileFormat::QuantizedMesh {
+        text["tile_format"] = options.format.label().into();
+    }
     hex(&Sha256::digest(text.to_string().as_bytes()))
 }
 

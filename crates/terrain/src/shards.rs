@@ -74,6 +74,7 @@ pub fn build_shard(
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> TerrainResult<ShardReport> {
     let start = std::time::Instant::now();
+    crate::pyramid::directory_only(options, &dest.location())?;
     let Prepared {
         bounds,
         own_level,

@@ -1,5 +1,7 @@
-//! One tile: decimated with its edges locked, verified, and encoded as quantized-mesh.
+//! One tile: decimated with its edges locked, verified, and encoded as quantized-mesh or
+//! as a 3D Tiles GLB.
 
+use crate::glb_tile::{GlbTile, TileBounds};
 use crate::quantized_mesh::{gzip, QuantizedMeshTile, QUANTIZED_MAX};
 use tinsmith_core::{decimate_with_border, DecimationOptions, Grid, VertexHeights};
 use tinsmith_tiling::check_tin;
@@ -8,7 +10,7 @@ use crate::budget::{quanta_per_step, slack_scale, LevelBudget};
 use crate::layer::{metadata_json, Available};
 use crate::rows::LevelRows;
 use crate::tms::{step, tile_column, tile_rectangle, TILE_CELLS, U_PER_CELL};
-use crate::{TerrainError, TerrainOptions, TerrainResult};
+use crate::{TerrainError, TerrainOptions, TerrainResult, TileFormat};
 use tinsmith_tiling::{edge_limit, edge_span, EdgeProfile};
 
 /// One tile done on a worker.
@@ -21,6 +23,8 @@ pub(super) struct TileOut {
     pub(super) max_error: f64,
     /// The bound the tile was verified against (see [`LevelBudget::verify`]).
     pub(super) verified_bound: f64,
+    /// A 3D Tiles tile's metadata (for its subtree).
+    pub(super) bounds: Option<TileBounds>,
 }
 
 pub(super) fn build_tile(
@@ -175,37 +179,57 @@ pub(super) fn build_tile(
             })
             .collect()
     });
-    let metadata = metadata_available.map(|available| metadata_json(available, z, column, y));
-    let water = match &options.water {
-        Some(water) => Some(crate::water::mask(water, rect)?),
-        None => None,
-    };
     let triangles = in_space_order(&quantized, tin.triangles());
-    let mut tile = QuantizedMeshTile::new(
-        rect,
-        min_height as f32,
-        max_height as f32,
-        &quantized,
-        &triangles,
-    );
-    if let Some(normals) = &normals {
-        tile = tile.with_normals(normals);
-    }
-    if let Some(water) = &water {
-        tile = tile.with_water_mask(water.bytes());
-    }
-    if let Some(metadata) = &metadata {
-        tile = tile.with_metadata(metadata);
-    }
-    let mut bytes = tile.encode().map_err(|source| TerrainError::Encode {
+    let encode_error = |source| TerrainError::Encode {
         z,
         x: column,
         y,
         source,
-    })?;
-    if options.gzip {
-        bytes = gzip(&bytes);
-    }
+    };
+    let (bytes, bounds) = match options.format {
+        TileFormat::ThreeDTiles => {
+            // The decoded heights the check above measured, on the level's lattice.
+            let heights: Vec<f64> = quantized
+                .iter()
+                .map(|q| min_height + f64::from(q[2] / per_step as u16) * s)
+                .collect();
+            let mut tile = GlbTile::new(rect, &quantized, &heights, &triangles);
+            if let Some(normals) = &normals {
+                tile = tile.with_normals(normals);
+            }
+            let (bytes, bounds) = tile.encode().map_err(encode_error)?;
+            (bytes, Some(bounds))
+        }
+        TileFormat::QuantizedMesh => {
+            let metadata =
+                metadata_available.map(|available| metadata_json(available, z, column, y));
+            let water = match &options.water {
+                Some(water) => Some(crate::water::mask(water, rect)?),
+                None => None,
+            };
+            let mut tile = QuantizedMeshTile::new(
+                rect,
+                min_height as f32,
+                max_height as f32,
+                &quantized,
+                &triangles,
+            );
+            if let Some(normals) = &normals {
+                tile = tile.with_normals(normals);
+            }
+            if let Some(water) = &water {
+                tile = tile.with_water_mask(water.bytes());
+            }
+            if let Some(metadata) = &metadata {
+                tile = tile.with_metadata(metadata);
+            }
+            let mut bytes = tile.encode().map_err(encode_error)?;
+            if options.gzip {
+                bytes = gzip(&bytes);
+            }
+            (bytes, None)
+        }
+    };
     Ok(Some(TileOut {
         x: column,
         y,
@@ -214,6 +238,7 @@ pub(super) fn build_tile(
         triangles: tin.triangles().len(),
         max_error: check.max_error,
         verified_bound: budget.verify(scale),
+        bounds,
     }))
 }
 

@@ -10,13 +10,16 @@ use sha2::Digest;
 use tinsmith_store::{TileEncoding, TileStore};
 
 use crate::budget::LevelBudget;
+use crate::implicit::{tile_path, TileMetadata};
 use crate::layer::{metadata_json, Available};
 use crate::records::{count, options_key, tile_sum, Entries, TileEntry};
 use crate::rows::LevelRows;
 use crate::stream::LevelSink;
 use crate::tile::{build_tile, TileOut};
 use crate::tms::{tile_column, TileRect};
-use crate::{LevelReport, TerrainError, TerrainOptions, TerrainResult, METADATA_AVAILABILITY};
+use crate::{
+    LevelReport, TerrainError, TerrainOptions, TerrainResult, TileFormat, METADATA_AVAILABILITY,
+};
 
 /// Which tiles a writer writes.
 #[derive(Debug, Clone, Copy)]
@@ -67,6 +70,8 @@ pub(super) struct Written {
     /// Of them, tiles whose data had not changed since the run that recorded them: left
     /// as they were, not built again.
     pub(super) kept: u64,
+    /// 3D Tiles: each tile written's metadata, for the subtrees.
+    pub(super) metadata: TileMetadata,
 }
 
 impl Written {
@@ -89,6 +94,7 @@ impl Written {
         }
         self.entries.extend(other.entries);
         self.kept += other.kept;
+        self.metadata.extend(other.metadata);
     }
 }
 
@@ -140,6 +146,7 @@ impl<'a> TileWriter<'a> {
                 available,
                 entries: Vec::new(),
                 kept: 0,
+                metadata: TileMetadata::new(),
             },
             block_samples: None,
         }
@@ -212,6 +219,9 @@ impl<'a> TileWriter<'a> {
                         verified_bound: 0.0,
                     },
                 };
+                if let Some(bounds) = tile.as_ref().and_then(|t| t.bounds) {
+                    self.written.metadata.insert((z, x, y), bounds);
+                }
                 match tile {
                     Some(t) => self.write(z, &t)?,
                     None if self.known.get(&(z, x, y)).is_some_and(|e| e.written) => {
@@ -243,6 +253,11 @@ impl<'a> TileWriter<'a> {
                 path: self.store.location().into(),
                 source: std::io::Error::from(std::io::ErrorKind::Interrupted),
             });
+        }
+        if self.options.format == TileFormat::ThreeDTiles {
+            return Ok(self
+                .store
+                .put_file(&tile_path(z, tile.x, tile.y), &tile.bytes)?);
         }
         let encoding = if self.options.gzip {
             TileEncoding::Gzip

@@ -294,7 +294,13 @@ impl<'g> Remover<'g> {
             return None;
         }
         if self.rules.grid.variable_count() > 0
-            && crate::variables::centre_outside_ring(self.rules.grid, &centre, &self.points)
+            && (crate::variables::centre_outside_ring(self.rules.grid, &centre, &self.points)
+                || (self.rules.model == ErrorModel::Bounds
+                    && crate::variables::held_variable_not_flat(
+                        self.rules.grid,
+                        &centre,
+                        &self.points,
+                    )))
         {
             return None;
         }
@@ -302,6 +308,9 @@ impl<'g> Remover<'g> {
         self.bounds
             .extend(star.triangles.iter().map(|&t| mesh.bound(t)));
         self.hole.load(centre, &self.points, &self.bounds);
+        if self.rules.model == ErrorModel::Bounds && self.rules.grid.variable_count() > 0 {
+            self.hole.load_variables(self.rules.grid);
+        }
         let (triangles, worst) = self.hole.retriangulate(&self.rules)?;
         if let Some(levels) = self.rules.levels.filter(|_| self.segments_may_not_grow) {
             let m = self.points.len();

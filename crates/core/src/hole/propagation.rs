@@ -16,7 +16,7 @@
 //! bound a true bound; the paper's boundary rule (§3.3.2) is the special case of (a) and
 //! (b) on the new boundary edge, which passes through `c`.
 
-use super::{Retriangulator, SegmentError};
+use super::{Retriangulator, SegmentError, VariableLayer};
 use crate::predicates::{in_closed_triangle, orient, plane_gradient, Point};
 use crate::ErrorBound;
 
@@ -32,6 +32,46 @@ impl Retriangulator {
         for i in 0..self.star_bounds.len() {
             let g = plane_gradient(&centre, &self.ring[i], &self.ring[(i + 1) % m]);
             self.star_gradients.push(g);
+        }
+        let stars = self.star_bounds.len();
+        for layer in &mut self.variable_layers[..self.variable_count] {
+            layer.gradients.clear();
+            for i in 0..stars {
+                let g = plane_gradient(&layer.centre, &layer.ring[i], &layer.ring[(i + 1) % m]);
+                layer.gradients.push(g);
+            }
+        }
+    }
+
+    /// Loads the values of `grid`'s variables on the loaded hole (the ring's and the
+    /// centre's samples), for the bounds model with several variables: each new triangle's
+    /// bound then covers every variable's propagated error too, scaled into height units
+    /// (see [`crate::variables`]). [`Retriangulator::load`] forgets them.
+    pub(crate) fn load_variables(&mut self, grid: &crate::Grid) {
+        let centre = self.centre.expect("hole loaded");
+        let width = i64::from(grid.width());
+        self.variable_count = 0;
+        for v in grid.variables() {
+            let Some(scale) = v.propagation_scale() else {
+                continue;
+            };
+            if self.variable_layers.len() == self.variable_count {
+                self.variable_layers.push(VariableLayer::default());
+            }
+            let layer = &mut self.variable_layers[self.variable_count];
+            let values = v.grid.values();
+            let at = |p: &Point| Point {
+                z: values[(p.y * width + p.x) as usize],
+                ..*p
+            };
+            layer.ring.clear();
+            layer.ring.extend(self.ring.iter().map(at));
+            layer.centre = Point {
+                z: values[(centre.y * width + centre.x) as usize],
+                ..centre
+            };
+            layer.scale = scale;
+            self.variable_count += 1;
         }
     }
 
@@ -70,24 +110,31 @@ impl Retriangulator {
         let centre = self.centre.expect("hole loaded");
         let (pa, pb, pc) = (&self.ring[a], &self.ring[b], &self.ring[c]);
         if in_closed_triangle(pa, pb, pc, &centre) {
-            let g = plane_gradient(pa, pb, pc);
-            let new_at_centre =
-                pa.z + g[0] * (centre.x - pa.x) as f64 + g[1] * (centre.y - pa.y) as f64;
-            let delta = new_at_centre - centre.z;
-            bound.above = bound.above.max(self.max_star_above - delta);
-            bound.below = bound.below.max(self.max_star_below + delta);
+            let layers = std::iter::once((&self.ring[..], &centre, 1.0)).chain(
+                self.variable_layers[..self.variable_count]
+                    .iter()
+                    .map(|l| (&l.ring[..], &l.centre, l.scale)),
+            );
+            for (ring, centre, scale) in layers {
+                let (pa, pb, pc) = (&ring[a], &ring[b], &ring[c]);
+                let g = plane_gradient(pa, pb, pc);
+                let new_at_centre =
+                    pa.z + g[0] * (centre.x - pa.x) as f64 + g[1] * (centre.y - pa.y) as f64;
+                let delta = scaled(new_at_centre - centre.z, scale);
+                bound.above = bound.above.max(self.max_star_above - delta);
+                bound.below = bound.below.max(self.max_star_below + delta);
+            }
         }
         bound
     }
 
     /// Error of the segment from ring vertex `from` to ring vertex `to`: for each closed
     /// star triangle it meets, the signed introduced error at its entry and exit points
-    /// folded into that triangle's bound (paper §3.3.1).
+    /// folded into that triangle's bound (paper §3.3.1). With variables loaded (bounds
+    /// model), each variable's scaled introduced error is folded in too: a star triangle's
+    /// bound covers every variable's scaled error, so the largest of the folds covers them
+    /// on the new segment. The introduced error reported is the height's.
     fn segment_error(&self, from: usize, to: usize) -> SegmentError {
-        let centre = self.centre.expect("hole loaded");
-        let (p, q) = (self.ring[from], self.ring[to]);
-        let m = self.ring.len();
-        let stars = self.star_bounds.len();
         let mut out = SegmentError {
             bound: ErrorBound {
                 above: f64::NEG_INFINITY,
@@ -95,6 +142,54 @@ impl Retriangulator {
             },
             introduced: 0.0,
         };
+        let centre = self.centre.expect("hole loaded");
+        self.fold_segment(
+            Layer {
+                ring: &self.ring,
+                centre: &centre,
+                gradients: &self.star_gradients,
+                scale: 1.0,
+            },
+            from,
+            to,
+            &mut out,
+        );
+        let introduced = out.introduced;
+        for l in &self.variable_layers[..self.variable_count] {
+            let layer = Layer {
+                ring: &l.ring,
+                centre: &l.centre,
+                gradients: &l.gradients,
+                scale: l.scale,
+            };
+            self.fold_segment(layer, from, to, &mut out);
+        }
+        out.introduced = introduced;
+        // Finite unless a star triangle's own bound is not (a triangle a variable keeps
+        // beyond its limit, see `crate::variables::with_variables`), or a variable held at
+        // a bound of 0 changes along the segment.
+        debug_assert!(
+            out.bound.above.is_finite()
+                || self.variable_count > 0
+                || self.star_bounds.iter().any(|b| !b.above.is_finite()),
+            "a ring segment meets its star"
+        );
+        out
+    }
+
+    /// [`Retriangulator::segment_error`]'s folds for one layer of values (the heights, or
+    /// a variable's values scaled by `layer.scale`) into `out`.
+    fn fold_segment(&self, layer: Layer<'_>, from: usize, to: usize, out: &mut SegmentError) {
+        let Layer {
+            ring,
+            centre,
+            gradients,
+            scale,
+        } = layer;
+        let centre = *centre;
+        let (p, q) = (ring[from], ring[to]);
+        let m = ring.len();
+        let stars = self.star_bounds.len();
         // A diagonal of the (star-shaped) hole splits it in two; it crosses the spokes of
         // the chain on the far side from the centre and touches the two star triangles
         // beyond its ends at a shared corner. Walking it with the centre on its left, the
@@ -103,7 +198,7 @@ impl Retriangulator {
         let side = orient(&p, &q, &centre);
         if side != 0 {
             let (a, b) = if side > 0 { (from, to) } else { (to, from) };
-            let (p, q) = (self.ring[a], self.ring[b]);
+            let (p, q) = (ring[a], ring[b]);
             let side = side.abs() as f64;
             let span = (b + m - a) % m;
             let mut previous = 0.0f64; // introduced error at the last crossing (0 at p)
@@ -114,39 +209,32 @@ impl Retriangulator {
                     out.bound.below = out.bound.below.max(bound.below + hi);
                 }
             };
-            fold((a + m - 1) % m, 0.0, 0.0, &mut out);
+            fold((a + m - 1) % m, 0.0, 0.0, out);
             for step in 1..=span {
                 let k = (a + step) % m;
                 let current = if step == span {
                     0.0
                 } else {
-                    let r = &self.ring[k];
+                    let r = &ring[k];
                     let (fp, fq) = (orient(&centre, r, &p) as f64, orient(&centre, r, &q) as f64);
                     let t = fp / (fp - fq);
                     let u = side / (side - orient(&p, &q, r) as f64);
                     let new = p.z + t * (q.z - p.z);
                     let old = centre.z + u * (r.z - centre.z);
-                    new - old
+                    scaled(new - old, scale)
                 };
                 let i = (k + m - 1) % m;
-                fold(i, previous.min(current), previous.max(current), &mut out);
+                fold(i, previous.min(current), previous.max(current), out);
                 out.introduced = out.introduced.max(current.abs());
                 previous = current;
             }
-            fold(b, 0.0, 0.0, &mut out);
-            // Finite unless a star triangle's own bound is not (a triangle a variable
-            // keeps beyond its limit, see `crate::variables::with_variables`).
-            debug_assert!(
-                out.bound.above.is_finite()
-                    || self.star_bounds.iter().any(|b| !b.above.is_finite()),
-                "a ring segment meets its star"
-            );
-            return out;
+            fold(b, 0.0, 0.0, out);
+            return;
         }
         // The centre is on the segment: it touches every star triangle there.
         for i in 0..m.min(stars) {
-            let (star_bound, g) = (&self.star_bounds[i], &self.star_gradients[i]);
-            let tri = [centre, self.ring[i], self.ring[(i + 1) % m]];
+            let (star_bound, g) = (&self.star_bounds[i], &gradients[i]);
+            let tri = [centre, ring[i], ring[(i + 1) % m]];
             let Some((t_lo, t_hi)) = clip_segment(&p, &q, &tri) else {
                 continue;
             };
@@ -155,7 +243,7 @@ impl Retriangulator {
                 let sy = p.y as f64 + t * (q.y - p.y) as f64;
                 let new = p.z + t * (q.z - p.z);
                 let old = centre.z + g[0] * (sx - centre.x as f64) + g[1] * (sy - centre.y as f64);
-                new - old
+                scaled(new - old, scale)
             };
             let (d0, d1) = (delta(t_lo), delta(t_hi));
             let (lo, hi) = (d0.min(d1), d0.max(d1));
@@ -163,13 +251,6 @@ impl Retriangulator {
             out.bound.below = out.bound.below.max(star_bound.below + hi);
             out.introduced = out.introduced.max(lo.abs()).max(hi.abs());
         }
-        // Finite unless a star triangle's own bound is not (a triangle a variable
-        // keeps beyond its limit, see `crate::variables::with_variables`).
-        debug_assert!(
-            out.bound.above.is_finite() || self.star_bounds.iter().any(|b| !b.above.is_finite()),
-            "a ring segment meets its star"
-        );
-        out
     }
 
     /// Error of ring edge `i` (from ring vertex `i` to the next): the surface does not
@@ -234,4 +315,25 @@ pub(super) fn clip_segment(p: &Point, q: &Point, tri: &[Point; 3]) -> Option<(f6
         return None;
     }
     Some((lo_n as f64 / lo_d as f64, hi_n as f64 / hi_d as f64))
+}
+
+/// One layer of values on the hole's geometry for [`Retriangulator::fold_segment`]: the
+/// ring and centre with those values as `z`, the star triangles' gradients of them, and
+/// the factor that takes their differences into height units.
+#[derive(Clone, Copy)]
+struct Layer<'a> {
+    ring: &'a [Point],
+    centre: &'a Point,
+    gradients: &'a [[f64; 2]],
+    scale: f64,
+}
+
+/// `delta` in height units: times `scale`, with 0 kept 0 when the scale is infinite (a
+/// variable held at a bound of 0: any change is infinitely large, no change is none).
+fn scaled(delta: f64, scale: f64) -> f64 {
+    if scale == 1.0 || delta == 0.0 {
+        delta
+    } else {
+        delta * scale
+    }
 }

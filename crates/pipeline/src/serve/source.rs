@@ -53,12 +53,15 @@ impl Source {
         }
     }
 
-    /// Whether CesiumJS would find a terrain layer here: a `layer.json` at the top or, for
-    /// a directory, in a directory right below it.
+    /// Whether CesiumJS would find a terrain layer here: a `layer.json` (or a 3D Tiles
+    /// `tileset.json`) at the top or, for a directory, in a directory right below it.
     pub(super) fn has_layer(&self) -> bool {
         match self {
             Source::Directory(dir) => {
-                let has_layer = |dir: &Path| dir.join("layer.json").is_file();
+                // quantized-mesh's layer.json, or a 3D Tiles pyramid's tileset.json.
+                let has_layer = |dir: &Path| {
+                    dir.join("layer.json").is_file() || dir.join("tileset.json").is_file()
+                };
                 has_layer(dir)
                     || std::fs::read_dir(dir).is_ok_and(|entries| {
                         entries

@@ -3,6 +3,7 @@
 mod util;
 
 mod bad_input;
+mod breaklines;
 mod cesium;
 mod cli_reference;
 mod contour;
@@ -12,6 +13,7 @@ mod formats;
 mod mbtiles;
 mod mesh_and_verify;
 mod object_storage;
+mod ogr_points;
 mod points;
 mod preview;
 mod serve;

@@ -9,7 +9,10 @@ use crate::args::VerifyArgs;
 /// Runs the verifier and prints its report; `Ok(false)` when the mesh is invalid or
 /// exceeds `--max-error`.
 pub fn run(args: &VerifyArgs) -> Result<bool> {
-    if tinsmith_pipeline::is_point_input(&args.input) {
+    if tinsmith_pipeline::is_point_input(&args.input)
+        || args.points.breaklines.is_some()
+        || args.points.boundary.is_some()
+    {
         let [max_error] = args.max_error[..] else {
             anyhow::bail!(
                 "{}: verifying points needs one --max-error",
@@ -22,6 +25,7 @@ pub fn run(args: &VerifyArgs) -> Result<bool> {
             args.format,
             max_error,
             &args.points.choices(None),
+            args.band,
             &tinsmith_pipeline::Silent,
         )?;
         if args.json {

@@ -143,6 +143,19 @@ pub struct MeshArgs {
     /// Points only: the CRS to write (EPSG:CODE, WKT, ...), instead of the file's.
     #[arg(long, value_name = "CRS", help_heading = "Point input")]
     pub crs: Option<String>,
+    /// A concave hull instead of the convex one: outer triangles are removed, repeatedly,
+    /// while an outer edge (not a breakline or boundary edge) is longer than L (in the
+    /// points' x, y units); points left outside are dropped (counted in the report). A
+    /// raster's valid samples are then its points.
+    #[arg(long, value_name = "L", help_heading = "Point input", value_parser = positive_length)]
+    pub hull_edge_length: Option<f64>,
+}
+
+fn positive_length(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("`{text}` is not a positive length")),
+    }
 }
 
 /// The flags of point input (LAS/LAZ, XYZ/CSV text), shared by `mesh` and `verify`.
@@ -164,6 +177,22 @@ pub struct PointArgs {
     /// input", for how the default was chosen).
     #[arg(long, value_enum, default_value_t = DuplicatesArg::Lowest, help_heading = "Point input")]
     pub duplicates: DuplicatesArg,
+    /// Keep the segments of this OGR line or polygon layer (GeoPackage, Shapefile,
+    /// GeoJSON, FlatGeobuf...) as TIN edges, in the input's CRS. Lines with Z keep their
+    /// heights, 2D lines take the points'; vertices go on the points' lattice; crossing
+    /// lines are split where they cross. A raster's valid samples are then its points.
+    /// With verify: check every segment is a chain of mesh edges.
+    #[arg(long, value_name = "FILE", help_heading = "Point input")]
+    pub breaklines: Option<PathBuf>,
+    /// The TIN's outline and holes, an OGR polygon layer in the input's CRS, kept as
+    /// edges; points (or a raster's samples) outside are dropped (counted in the report),
+    /// and `verify` measures only the points inside.
+    #[arg(long, value_name = "FILE", help_heading = "Point input")]
+    pub boundary: Option<PathBuf>,
+    /// OGR point layers (GeoPackage, Shapefile, FlatGeobuf) only: the attribute holding
+    /// the heights [default: the points' Z].
+    #[arg(long, value_name = "NAME", help_heading = "Point input")]
+    pub z_field: Option<String>,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -191,6 +220,9 @@ impl PointArgs {
             DuplicatesArg::First => Duplicates::First,
         };
         choices.crs = crs;
+        choices.breaklines = self.breaklines.clone();
+        choices.boundary = self.boundary.clone();
+        choices.z_field = self.z_field.clone();
         choices
     }
 }
@@ -263,6 +295,7 @@ impl MeshArgs {
             TileFormatArg::Obj => TileFormat::Obj,
         });
         job.points = self.points.choices(self.crs.clone());
+        job.points.hull_edge_length = self.hull_edge_length;
         Ok(job)
     }
 }

@@ -60,6 +60,9 @@ pub use options::{
     DecimationOptions, EdgeSelection, ErrorModel, InitialMesh, Order, Retriangulation,
     VertexHeights,
 };
-pub use scatter::{decimate_scatter, Scatter, ScatterReport, ScatterTin, MAX_SCATTER_COORDINATE};
+pub use scatter::{
+    decimate_scatter, decimate_scatter_constrained, Scatter, ScatterReport, ScatterTin,
+    MAX_SCATTER_COORDINATE,
+};
 pub use tin::{Tin, TinVertex};
 pub use variables::Variable;

@@ -8,6 +8,13 @@
 //! charged to the hole, the removed vertex included, is within the bound of the new
 //! triangle containing it. Stars, classes, hole retriangulation (DP or ears) and both
 //! error models are the grid's: only where samples are differs.
+//!
+//! Constrained edges (breaklines, outlines) are kept exactly: both their end vertices are
+//! locked, never removed. A removal replaces only the triangles around the removed vertex
+//! and keeps every edge of its ring, so an edge whose ends both stay is never touched,
+//! and scattered decimation makes no edge flips. (The paper's boundary rule could remove
+//! a vertex between two collinear constrained edges; locking keeps the rule simple and the
+//! edges exactly where the input put them.)
 
 use crate::coverage::HolePoints;
 use crate::decimate::{effective_limit, MAX_ABS_HEIGHT};
@@ -165,6 +172,8 @@ pub struct ScatterReport {
     pub sweeps: usize,
     /// Removal attempts.
     pub attempts: usize,
+    /// Vertices locked by constrained edges (kept whatever the bound).
+    pub locked_vertices: usize,
 }
 
 /// Decimates the triangulation `triangles` of `scatter` (counter-clockwise corner
@@ -193,6 +202,25 @@ pub struct ScatterReport {
 pub fn decimate_scatter(
     scatter: &Scatter,
     triangles: Vec<[u32; 3]>,
+    options: &DecimationOptions,
+) -> Result<(ScatterTin, ScatterReport)> {
+    decimate_scatter_constrained(scatter, triangles, &[], options)
+}
+
+/// [`decimate_scatter`] keeping the `constrained` edges (pairs of point indices, each an
+/// edge of `triangles`, in either direction): every one of them is an edge of the result,
+/// because both its end points are kept (see the module documentation).
+///
+/// # Guarantee
+/// As [`decimate_scatter`], and every constrained edge is an edge of the TIN.
+///
+/// # Errors
+/// As [`decimate_scatter`], and [`Error::Scatter`] for a constrained edge that is not an
+/// edge of `triangles`.
+pub fn decimate_scatter_constrained(
+    scatter: &Scatter,
+    triangles: Vec<[u32; 3]>,
+    constrained: &[[u32; 2]],
     options: &DecimationOptions,
 ) -> Result<(ScatterTin, ScatterReport)> {
     let max_error = options.max_error;
@@ -228,6 +256,8 @@ pub fn decimate_scatter(
         )));
     }
     drop(used);
+    let locked = locked_vertices(n, &triangles, constrained)?;
+    let locked_count = locked.iter().filter(|&&l| l).count();
     let initial_triangles = triangles.len();
     let limit = effective_limit(max_error, scatter.max_abs_height());
     let mut mesh = Mesh::from_conforming(scatter, triangles);
@@ -243,7 +273,7 @@ pub fn decimate_scatter(
         max_edge_squared: i64::MAX,
         levels: None,
     };
-    let mut remover = ScatterRemover::new(&mesh, rules);
+    let mut remover = ScatterRemover::new(&mesh, rules, locked);
     let (sweeps, attempts) = remover.sweep(&mut mesh);
     #[cfg(any(test, debug_assertions))]
     mesh.check_invariants();
@@ -259,6 +289,7 @@ pub fn decimate_scatter(
         max_bound,
         sweeps,
         attempts,
+        locked_vertices: locked_count,
     };
     Ok((
         ScatterTin {
@@ -267,6 +298,35 @@ pub fn decimate_scatter(
         },
         report,
     ))
+}
+
+/// Per point, whether it ends a constrained edge; every constrained edge must be an edge
+/// of `triangles`.
+fn locked_vertices(
+    n: usize,
+    triangles: &[[u32; 3]],
+    constrained: &[[u32; 2]],
+) -> Result<Vec<bool>> {
+    let mut locked = vec![false; n];
+    if constrained.is_empty() {
+        return Ok(locked);
+    }
+    let key = |a: u32, b: u32| (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
+    let mut edges: Vec<u64> = triangles
+        .iter()
+        .flat_map(|c| [key(c[0], c[1]), key(c[1], c[2]), key(c[2], c[0])])
+        .collect();
+    edges.sort_unstable();
+    for &[a, b] in constrained {
+        if a == b || edges.binary_search(&key(a, b)).is_err() {
+            return Err(Error::Scatter(format!(
+                "constrained edge {a}-{b} is not an edge of the triangulation"
+            )));
+        }
+        locked[a as usize] = true;
+        locked[b as usize] = true;
+    }
+    Ok(locked)
 }
 
 /// Removes vertices and keeps each removed point charged to the triangle containing it:
@@ -289,10 +349,16 @@ struct ScatterRemover {
     method: crate::Retriangulation,
     dp_max_ring: usize,
     limit: f64,
+    /// Points that end a constrained edge: never removed.
+    locked: Vec<bool>,
 }
 
 impl ScatterRemover {
-    fn new(mesh: &Mesh<'_, Scatter>, rules: Rules<'_, HolePoints>) -> ScatterRemover {
+    fn new(
+        mesh: &Mesh<'_, Scatter>,
+        rules: Rules<'_, HolePoints>,
+        locked: Vec<bool>,
+    ) -> ScatterRemover {
         ScatterRemover {
             first: vec![NONE; mesh.triangle_slots()],
             next: vec![NONE; mesh.vertex_slots()],
@@ -309,6 +375,7 @@ impl ScatterRemover {
             method: rules.method,
             dp_max_ring: rules.dp_max_ring,
             limit: rules.limit,
+            locked,
         }
     }
 
@@ -350,6 +417,9 @@ impl ScatterRemover {
     /// Plans the removal of `v`: true when it is interior or boundary and its hole has a
     /// triangulation within the limit at every point charged to it.
     fn plan(&mut self, mesh: &Mesh<'_, Scatter>, v: u32) -> bool {
+        if self.locked[v as usize] {
+            return false;
+        }
         mesh.star(v, &mut self.star);
         if self.star.ring.len() > MAX_HOLE_RING
             || mesh.classify(v, &self.star) == VertexClass::Corner
@@ -524,7 +594,7 @@ mod tests {
         n: usize,
         seed: u64,
         side: i64,
-        f: impl Fn(f64, f64) -> f64,
+        f: &dyn Fn(f64, f64) -> f64,
     ) -> (Scatter, Vec<[u32; 3]>) {
         use spade::{DelaunayTriangulation, Point2, Triangulation};
         let mut s = seed;
@@ -571,7 +641,7 @@ mod tests {
     #[test]
     fn random_points_within_the_bound_for_every_model_method_and_seed() {
         for seed in [1, 2, 3] {
-            let (s, tris) = random_scatter(400, seed, 1000, |x, y| {
+            let (s, tris) = random_scatter(400, seed, 1000, &|x, y| {
                 (x / 90.0).sin() * 30.0 + (y / 140.0).cos() * 20.0 + ((x * y) % 7.0) * 0.1
             });
             for model in [ErrorModel::Exact, ErrorModel::Bounds] {
@@ -602,10 +672,140 @@ mod tests {
 
     #[test]
     fn a_plane_of_random_points_keeps_only_its_corners() {
-        let (s, tris) = random_scatter(300, 9, 500, |x, y| 3.0 + 0.5 * x - 0.25 * y);
+        let (s, tris) = random_scatter(300, 9, 500, &|x, y| 3.0 + 0.5 * x - 0.25 * y);
         let (tin, _) = decimate_scatter(&s, tris, &DecimationOptions::new(1e-6)).unwrap();
         assert_eq!(tin.vertices(), &[0, 1, 2, 3]);
         assert_eq!(tin.triangles().len(), 2);
+    }
+
+    /// `random_scatter`'s points re-triangulated by spade's constrained Delaunay with two
+    /// polylines through some of the points (a zigzag and a closed ring, not crossing), and
+    /// the constrained edges as point pairs.
+    fn constrained_scatter(
+        seed: u64,
+        f: impl Fn(f64, f64) -> f64,
+    ) -> (Scatter, Vec<[u32; 3]>, Vec<[u32; 2]>) {
+        use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+        let (s, _) = random_scatter(400, seed, 1000, &f);
+        let mut xy: Vec<[i64; 2]> = (0..s.len()).map(|i| s.position(i)).collect();
+        let mut z: Vec<f64> = (0..s.len()).map(|i| s.height(i)).collect();
+        let zigzag: Vec<[i64; 2]> = (0..=10)
+            .map(|k| [100 + 80 * k, 300 + 60 * (k % 2)])
+            .collect();
+        let ring = vec![[300, 600], [700, 620], [650, 900], [320, 880], [300, 600]];
+        let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
+            ConstrainedDelaunayTriangulation::bulk_load(
+                xy.iter()
+                    .map(|p| Point2::new(p[0] as f64, p[1] as f64))
+                    .collect(),
+            )
+            .unwrap();
+        for line in [&zigzag, &ring] {
+            let handles: Vec<_> = line
+                .iter()
+                .map(|p| cdt.insert(Point2::new(p[0] as f64, p[1] as f64)).unwrap())
+                .collect();
+            for w in handles.windows(2) {
+                assert!(cdt.add_constraint(w[0], w[1]));
+            }
+        }
+        let mut index: std::collections::BTreeMap<[i64; 2], u32> =
+            xy.iter().enumerate().map(|(i, p)| (*p, i as u32)).collect();
+        for v in cdt.vertices() {
+            let p = v.position();
+            let p = [p.x as i64, p.y as i64];
+            if let std::collections::btree_map::Entry::Vacant(e) = index.entry(p) {
+                e.insert(xy.len() as u32);
+                xy.push(p);
+                z.push(f(p[0] as f64, p[1] as f64));
+            }
+        }
+        let id = |v: spade::handles::VertexHandle<Point2<f64>, (), spade::CdtEdge<()>, ()>| {
+            let p = v.position();
+            index[&[p.x as i64, p.y as i64]]
+        };
+        let tris = cdt.inner_faces().map(|f| f.vertices().map(id)).collect();
+        let edges: Vec<[u32; 2]> = cdt
+            .undirected_edges()
+            .filter(|e| e.is_constraint_edge())
+            .map(|e| e.vertices().map(id))
+            .collect();
+        assert!(edges.len() >= 14);
+        (Scatter::new(xy, z).unwrap(), tris, edges)
+    }
+
+    fn has_edge(tin: &ScatterTin, [a, b]: [u32; 2]) -> bool {
+        let local = |p: u32| tin.vertices().binary_search(&p).ok().map(|i| i as u32);
+        let (Some(a), Some(b)) = (local(a), local(b)) else {
+            return false;
+        };
+        tin.triangles().iter().any(|t| {
+            (0..3).any(|e| (t[e] == a && t[(e + 1) % 3] == b) || (t[e] == b && t[(e + 1) % 3] == a))
+        })
+    }
+
+    #[test]
+    fn constrained_edges_are_kept_under_every_option() {
+        use crate::{EdgeSelection, VertexHeights};
+        for seed in [4, 5] {
+            let f = |x: f64, y: f64| (x / 90.0).sin() * 30.0 + (y / 140.0).cos() * 20.0;
+            let (s, tris, edges) = constrained_scatter(seed, f);
+            let mut all = Vec::new();
+            for model in [ErrorModel::Bounds, ErrorModel::Exact] {
+                for selection in [
+                    EdgeSelection::Hybrid,
+                    EdgeSelection::MinError,
+                    EdgeSelection::MinIntroduced,
+                ] {
+                    for method in [Retriangulation::Ears, Retriangulation::Dp] {
+                        let base = DecimationOptions::paper(2.0)
+                            .with_error_model(model)
+                            .with_selection(selection)
+                            .with_retriangulation(method);
+                        all.push(base.clone());
+                        all.push(base.clone().with_flip_rounds(2));
+                        all.push(base.clone().with_extend_rounds(2));
+                        all.push(base.with_vertex_heights(VertexHeights::Samples));
+                    }
+                }
+            }
+            for options in all {
+                let (tin, report) =
+                    decimate_scatter_constrained(&s, tris.clone(), &edges, &options).unwrap();
+                for &e in &edges {
+                    assert!(has_edge(&tin, e), "{seed} {options:?}: edge {e:?} lost");
+                }
+                assert!(worst_error(&s, &tin) <= 2.0, "{seed} {options:?}");
+                assert!(report.final_vertices < s.len() - 100, "{seed} {options:?}");
+                assert!(report.locked_vertices >= 15);
+            }
+            // Without the constraints the same run loses some of those edges: the check
+            // above can fail.
+            let (tin, _) = decimate_scatter(&s, tris, &DecimationOptions::paper(2.0)).unwrap();
+            assert!(edges.iter().any(|&e| !has_edge(&tin, e)));
+        }
+    }
+
+    #[test]
+    fn a_plane_keeps_its_corners_and_its_constrained_vertices_only() {
+        let (s, tris, edges) = constrained_scatter(6, |x, y| 3.0 + 0.5 * x - 0.25 * y);
+        let (tin, _) =
+            decimate_scatter_constrained(&s, tris, &edges, &DecimationOptions::new(1e-6)).unwrap();
+        let mut want: Vec<u32> = edges.iter().flatten().copied().chain(0..4).collect();
+        want.sort_unstable();
+        want.dedup();
+        assert_eq!(tin.vertices(), &want[..]);
+        for &e in &edges {
+            assert!(has_edge(&tin, e));
+        }
+    }
+
+    #[test]
+    fn a_constrained_edge_not_in_the_triangulation_is_refused() {
+        let (s, tris) = lattice_scatter(3, 3, |_, _| 0.0);
+        // Points 0 and 8 are opposite corners: never an edge of the lattice's triangles.
+        let e = decimate_scatter_constrained(&s, tris, &[[0, 8]], &DecimationOptions::new(1.0));
+        assert!(matches!(e, Err(Error::Scatter(m)) if m.contains("0-8")));
     }
 
     #[test]

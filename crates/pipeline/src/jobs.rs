@@ -70,6 +70,16 @@ pub struct PointChoices {
     pub duplicates: tinsmith_points::Duplicates,
     /// The CRS to write (anything GDAL's `SetFromUserInput` takes), instead of the file's.
     pub crs: Option<String>,
+    /// A line or polygon layer whose segments the TIN keeps as edges (constrained
+    /// Delaunay triangulation; their vertices are never removed).
+    pub breaklines: Option<std::path::PathBuf>,
+    /// A polygon layer: the TIN's outline and holes (constrained edges); points outside
+    /// are dropped.
+    pub boundary: Option<std::path::PathBuf>,
+    /// Remove outer triangles while an outer edge is longer than this (a concave hull).
+    pub hull_edge_length: Option<f64>,
+    /// OGR point layers: the attribute holding heights, instead of the geometries' Z.
+    pub z_field: Option<String>,
 }
 
 /// The format of the files a per-tile run writes.

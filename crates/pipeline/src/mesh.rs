@@ -40,7 +40,13 @@ struct MeshReport<'a> {
 /// than `job.tile_size` or with `job.per_tile`); the mesh is written only if the
 /// independent verifier confirms the bound, with its heights as the file holds them.
 pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
-    if crate::points::is_point_input(&job.input) {
+    // A raster with breaklines, a boundary or a hull edge length goes the points' way:
+    // its valid samples are the points of a constrained triangulation.
+    if crate::points::is_point_input(&job.input)
+        || job.points.breaklines.is_some()
+        || job.points.boundary.is_some()
+        || job.points.hull_edge_length.is_some()
+    {
         return crate::points::mesh_points(job, feedback);
     }
     if job.tile_format.is_some() && job.per_tile.is_none() {

@@ -1,16 +1,18 @@
 //! `tinsmith mesh` and `tinsmith verify` on point files (LAS/LAZ, XYZ/CSV text): read,
 //! merge duplicates, Delaunay-triangulate, decimate with every point within the bound,
 //! verify independently, write. Existing TINs (PLY, OBJ, LandXML, FlatGeobuf) go the
-//! same way with their own triangles instead of the Delaunay triangulation.
+//! same way with their own triangles instead of the Delaunay triangulation. Breaklines
+//! (`--breaklines`, an OGR line or polygon layer) make it a constrained Delaunay
+//! triangulation whose constrained edges the decimator keeps and the verifier checks.
 
 use std::path::Path;
 use std::time::Instant;
 
 use serde::Serialize;
-use tinsmith_core::{decimate_scatter, DecimationOptions, Scatter};
+use tinsmith_core::{decimate_scatter_constrained, DecimationOptions, Scatter};
 use tinsmith_formats::{LocalOrigin, MeshFormat, MeshRef, WriteOptions};
 use tinsmith_points::{ClassChoice, PointCloud, ReadOptions};
-use tinsmith_verify::{verify_points, PointsReport};
+use tinsmith_verify::{verify_breaklines, verify_points, PointsReport};
 
 use crate::error::{bail, Context};
 use crate::jobs::{MeshJob, PointChoices};
@@ -19,10 +21,21 @@ use crate::Feedback;
 use crate::Result;
 
 /// Whether `path` is read as points (by its extension: `.las`, `.laz`, `.xyz`, `.csv`,
-/// `.txt`) or as an existing TIN whose vertices are the points (`.ply`, `.obj`, `.xml`,
-/// `.fgb`) rather than as a raster.
+/// `.txt`; or an OGR point layer in `.gpkg`, `.shp`, `.fgb`) or as an existing TIN whose
+/// vertices are the points (`.ply`, `.obj`, `.xml`, `.fgb`) rather than as a raster.
 pub fn is_point_input(path: &Path) -> bool {
-    tinsmith_points::is_point_file(path) || is_tin_input(path)
+    tinsmith_points::is_point_file(path) || is_tin_input(path) || is_ogr_points(path)
+}
+
+/// Whether `path` is an OGR point layer read as points: a GeoPackage, Shapefile or
+/// FlatGeobuf (by extension) whose first layer holds points (a FlatGeobuf of triangles
+/// is a TIN).
+fn is_ogr_points(path: &Path) -> bool {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    matches!(ext.as_deref(), Some("gpkg" | "shp" | "fgb")) && tinsmith_raster::is_point_layer(path)
 }
 
 /// The points of `path` after the class filter and the duplicates rule, and how many
@@ -41,7 +54,20 @@ fn read(
             path.display()
         ));
     }
-    let mut cloud = tinsmith_points::read_points(path, &options)?;
+    if choices.z_field.is_some() && !is_ogr_points(path) {
+        feedback.note(&format!(
+            "{}: --z-field applies to OGR point layers only; ignored",
+            path.display()
+        ));
+    }
+    let mut cloud = if is_ogr_points(path) {
+        let layer = tinsmith_raster::read_point_layer(path, choices.z_field.as_deref())?;
+        let mut cloud = tinsmith_points::world_cloud(path, &layer.points)?;
+        cloud.crs.wkt = layer.crs_wkt;
+        cloud
+    } else {
+        tinsmith_points::read_points(path, &options)?
+    };
     match &cloud.classes {
         ClassChoice::DefaultGround => feedback.note(&format!(
             "{}: ground points only (class 2, the file has some; --classes to choose)",
@@ -136,6 +162,15 @@ struct PointsMeshReport<'a> {
     /// The input TIN's triangles (mesh files).
     #[serde(skip_serializing_if = "Option::is_none")]
     input_triangles: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    breaklines: Option<BreaklinesSummary<'a>>,
+    /// The `--boundary` file.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    boundary: Option<&'a Path>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    hull_edge_length: Option<f64>,
+    /// Points outside the boundary or the `--hull-edge-length` hull: not in the TIN.
+    points_outside: usize,
     triangles: usize,
     vertices: usize,
     max_error_bound: f64,
@@ -143,6 +178,23 @@ struct PointsMeshReport<'a> {
     sweeps: usize,
     removal_attempts: usize,
     seconds: PointsSeconds,
+}
+
+/// The breaklines of a point run, in its `--report`.
+#[derive(Debug, Serialize)]
+struct BreaklinesSummary<'a> {
+    file: &'a Path,
+    lines: usize,
+    /// "the file's" for a layer with Z, else "interpolated from the points".
+    heights: &'static str,
+    /// Vertices the lines added to the points (their own and crossings).
+    vertices_added: usize,
+    crossings: usize,
+    constrained_edges: usize,
+    /// Vertices that end a constrained edge: never removed.
+    locked_vertices: usize,
+    /// Segments checked present as chains of mesh edges.
+    segments_verified: usize,
 }
 
 #[derive(Debug, Serialize)]
@@ -185,7 +237,7 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     let reserved = crate::mesh::reserve_report(job, Some((output, format)))?;
 
     let t = Instant::now();
-    let tin_input = is_tin_input(input);
+    let tin_input = is_tin_input(input) && !is_ogr_points(input);
     let (cloud, merged, crs, tin) = if tin_input {
         if job.points.classes.is_some() || job.points.no_withheld {
             feedback.note(&format!(
@@ -200,6 +252,15 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
         };
         let cloud = tin.cloud.clone();
         (cloud, tin.merged, crs, Some((tin.world, tin.triangles)))
+    } else if !is_point_input(input) {
+        // A raster with breaklines or a boundary: its valid samples are the points.
+        let mut cloud = raster_cloud(input, job.band)?;
+        tinsmith_points::dedupe(&mut cloud, job.points.duplicates);
+        let crs = match job.points.crs.as_deref() {
+            Some(text) => Some(tinsmith_raster::crs_wkt(text)?),
+            None => cloud.crs.wkt.clone(),
+        };
+        (cloud, 0, crs, None)
     } else {
         let (cloud, merged) = read(input, &job.points, feedback)?;
         let crs = resolve_crs(input, &cloud, job.points.crs.as_deref())?;
@@ -207,15 +268,106 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     };
     let read_seconds = t.elapsed().as_secs_f64();
 
+    let breaklines = match &job.points.breaklines {
+        Some(_) if tin_input => bail!(
+            "{}: --breaklines applies to point files and rasters, not to a TIN (it keeps its own edges)",
+            input.display()
+        ),
+        Some(path) => Some((path.as_path(), read_layer(path, input, crs.as_deref())?)),
+        None => None,
+    };
+    let boundary = match &job.points.boundary {
+        Some(_) if tin_input => bail!(
+            "{}: --boundary applies to point files and rasters, not to a TIN (it keeps its own outline)",
+            input.display()
+        ),
+        Some(path) => {
+            let layer = read_layer(path, input, crs.as_deref())?;
+            if !layer.polygons {
+                bail!(
+                    "{}: holds lines, not polygons: --boundary takes a polygon layer (the \
+                     TIN's outline and holes)",
+                    path.display()
+                );
+            }
+            Some((path.as_path(), layer))
+        }
+        None => None,
+    };
+    if tin_input && job.points.hull_edge_length.is_some() {
+        bail!(
+            "{}: --hull-edge-length applies to point files and rasters, not to a TIN (it \
+             keeps its own outline)",
+            input.display()
+        );
+    }
+    let constrain =
+        breaklines.is_some() || boundary.is_some() || job.points.hull_edge_length.is_some();
+    let mut cloud = cloud;
+    let points_read = cloud.xy.len();
+
     let t = Instant::now();
-    let (points, triangles) = match tin {
+    let mut constrained = None;
+    let (points, triangles, constrained_edges) = match tin {
         // The TIN's own triangles; its vertices exactly as the file has them.
-        Some((world, triangles)) => (world, triangles),
-        None => match tinsmith_points::delaunay(&cloud) {
-            Ok(triangles) => (world_points(&cloud), triangles),
+        Some((world, triangles)) => (world, triangles, Vec::new()),
+        None if !constrain => match tinsmith_points::delaunay(&cloud) {
+            Ok(triangles) => (world_points(&cloud), triangles, Vec::new()),
             Err(e) => bail!("{}: cannot triangulate: {e}", input.display()),
         },
+        None => {
+            let mut constraints = tinsmith_points::Constraints::default();
+            if let Some((_, layer)) = &breaklines {
+                constraints.breaklines = &layer.lines;
+                constraints.breaklines_have_z = layer.has_z;
+            }
+            if let Some((_, layer)) = &boundary {
+                constraints.boundary = &layer.lines;
+                constraints.boundary_has_z = layer.has_z;
+            }
+            constraints.max_edge_length = job.points.hull_edge_length;
+            match tinsmith_points::constrained_delaunay(&mut cloud, &constraints) {
+                Ok(mut c) => {
+                    let (triangles, edges) = (
+                        std::mem::take(&mut c.triangles),
+                        std::mem::take(&mut c.edges),
+                    );
+                    constrained = Some((c, edges.len()));
+                    (world_points(&cloud), triangles, edges)
+                }
+                Err(tinsmith_points::BreaklineError::Points(e)) => {
+                    bail!("{}: cannot triangulate: {e}", input.display())
+                }
+                Err(
+                    e @ (tinsmith_points::BreaklineError::BoundaryOutside { .. }
+                    | tinsmith_points::BreaklineError::BoundaryCrossed { .. }
+                    | tinsmith_points::BreaklineError::Empty),
+                ) => {
+                    let file = boundary.as_ref().map_or(input.as_path(), |b| b.0);
+                    bail!("{}: {e}", file.display())
+                }
+                Err(e) => {
+                    let file = breaklines.as_ref().map_or(input.as_path(), |b| b.0);
+                    bail!("{}: {e}", file.display())
+                }
+            }
+        }
     };
+    if let Some((c, _)) = constrained.as_ref().filter(|(c, _)| c.dropped > 0) {
+        feedback.note(&format!(
+            "{}: {} points outside the {} dropped: not in the TIN, not measured",
+            input.display(),
+            c.dropped,
+            if boundary.is_some() {
+                "boundary"
+            } else {
+                "--hull-edge-length hull"
+            }
+        ));
+    }
+    // The points the file gave (after the duplicates rule): the breaklines' vertices
+    // follow them and are kept, not measured.
+    let measured = constrained.as_ref().map_or(points.len(), |(c, _)| c.points);
     let triangulate_seconds = t.elapsed().as_secs_f64();
     let input_triangles = triangles.len();
 
@@ -245,10 +397,11 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
         classes,
         ..
     } = cloud;
-    let points_read = xy.len();
+    let points_total = xy.len();
     let scatter = Scatter::new(xy, z).with_context(|| format!("{}", input.display()))?;
-    let (tin, report) = decimate_scatter(&scatter, triangles, &options)
-        .with_context(|| format!("{}", input.display()))?;
+    let (tin, report) =
+        decimate_scatter_constrained(&scatter, triangles, &constrained_edges, &options)
+            .with_context(|| format!("{}", input.display()))?;
     let decimate_seconds = t.elapsed().as_secs_f64();
 
     let mut vertices: Vec<[f64; 3]> = tin.vertices().iter().map(|&v| points[v as usize]).collect();
@@ -260,7 +413,21 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     }
     let t = Instant::now();
     let tolerance = position_tolerance(format, &vertices);
-    let check = verify_points(&points, &vertices, tin.triangles(), max_error, tolerance);
+    let mut check = verify_points(
+        &points[..measured],
+        &vertices,
+        tin.triangles(),
+        max_error,
+        tolerance,
+    );
+    if let Some((_, layer)) = &breaklines {
+        check.breaklines = Some(verify_breaklines(
+            &plan_lines(layer),
+            &vertices,
+            tin.triangles(),
+            breakline_tolerance(spacing, tolerance),
+        ));
+    }
     let verify_seconds = t.elapsed().as_secs_f64();
     if !check.passed() {
         bail!(
@@ -300,13 +467,33 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
         "{}: {} points ({} {} triangles) -> {} triangles, {} vertices; largest error \
          {} (bound {max_error}), verified at every point",
         output.display(),
-        points_read,
+        measured,
         input_triangles,
-        if tin_input { "input" } else { "Delaunay" },
+        if tin_input {
+            "input"
+        } else if constrained.is_some() {
+            "constrained Delaunay"
+        } else {
+            "Delaunay"
+        },
         report.final_triangles,
         report.final_vertices,
         crate::readable(check.max_error),
     ));
+    if let (Some((path, layer)), Some((c, edges))) = (&breaklines, &constrained) {
+        feedback.note(&format!(
+            "{}: {} lines ({} heights), {edges} constrained edges ({} crossings split), \
+             every segment a chain of mesh edges",
+            path.display(),
+            layer.lines.len(),
+            if layer.has_z {
+                "their own"
+            } else {
+                "the points'"
+            },
+            c.crossings
+        ));
+    }
     let summary = PointsMeshReport {
         input,
         output,
@@ -325,6 +512,25 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
             ClassChoice::Listed(list) => format!("{list:?}"),
         },
         lattice_spacing: spacing,
+        boundary: boundary.as_ref().map(|b| b.0),
+        hull_edge_length: job.points.hull_edge_length,
+        points_outside: constrained.as_ref().map_or(0, |(c, _)| c.dropped),
+        breaklines: breaklines.as_ref().zip(constrained.as_ref()).map(
+            |((path, layer), (c, edges))| BreaklinesSummary {
+                file: path,
+                lines: layer.lines.len(),
+                heights: if layer.has_z {
+                    "the file's"
+                } else {
+                    "interpolated from the points"
+                },
+                vertices_added: points_total - c.points,
+                crossings: c.crossings,
+                constrained_edges: *edges,
+                locked_vertices: report.locked_vertices,
+                segments_verified: check.breaklines.as_ref().map_or(0, |b| b.segments),
+            },
+        ),
         delaunay_triangles: (!tin_input).then_some(input_triangles),
         input_triangles: tin_input.then_some(input_triangles),
         triangles: report.final_triangles,
@@ -346,6 +552,85 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     }
     tinsmith_output::mark_finished();
     Ok(())
+}
+
+/// The valid samples of band `band` of the raster at `path` as points on the sample
+/// lattice (x right, y up from the southernmost row), at the samples' centres, with the
+/// raster's CRS. Only north-up geotransforms (no rotation) are taken.
+fn raster_cloud(path: &Path, band: usize) -> Result<PointCloud> {
+    let raster = tinsmith_raster::read_samples(path, band)?;
+    let gt = raster
+        .info
+        .geo_transform
+        .unwrap_or([0.0, 1.0, 0.0, 0.0, 0.0, -1.0]);
+    if gt[2] != 0.0 || gt[4] != 0.0 || gt[1] <= 0.0 || gt[5] >= 0.0 {
+        bail!(
+            "{}: --breaklines and --boundary on a raster need a north-up geotransform (no \
+             rotation, rows from north to south); warp it first (gdalwarp)",
+            path.display()
+        );
+    }
+    let samples = &raster.samples;
+    let (w, h) = (samples.width(), samples.height());
+    let (mut xy, mut z) = (Vec::new(), Vec::new());
+    for row in 0..h {
+        for col in 0..w {
+            if let Some(v) = samples.get(col, row).filter(|v| v.is_finite()) {
+                xy.push([i64::from(col), i64::from(h - 1 - row)]);
+                z.push(v);
+            }
+        }
+    }
+    let mut crs = tinsmith_points::FileCrs::default();
+    crs.wkt = raster.info.crs_wkt.filter(|w| !w.trim().is_empty());
+    Ok(PointCloud {
+        points_in_file: xy.len() as u64,
+        xy,
+        z,
+        origin: [gt[0] + 0.5 * gt[1], gt[3] + (f64::from(h) - 0.5) * gt[5]],
+        spacing: [gt[1], -gt[5]],
+        crs,
+        classes: ClassChoice::All,
+    })
+}
+
+/// The breaklines or boundary file at `path` as lines, refused when its CRS is not the
+/// points' (`points_crs`, from `input`): such layers are not reprojected.
+fn read_layer(
+    path: &Path,
+    input: &Path,
+    points_crs: Option<&str>,
+) -> Result<tinsmith_raster::LineLayer> {
+    let layer = tinsmith_raster::read_lines(path)?;
+    if let (Some(lines), Some(points)) = (layer.crs_wkt.as_deref(), points_crs) {
+        if !tinsmith_raster::same_crs(lines, points)
+            && tinsmith_raster::epsg_code(lines) != tinsmith_raster::epsg_code(points)
+        {
+            bail!(
+                "{}: its CRS is not the one of {}; reproject the layer to it first \
+                 (ogr2ogr -t_srs)",
+                path.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(layer)
+}
+
+/// The lines' x, y.
+fn plan_lines(layer: &tinsmith_raster::LineLayer) -> Vec<Vec<[f64; 2]>> {
+    layer
+        .lines
+        .iter()
+        .map(|l| l.iter().map(|p| [p[0], p[1]]).collect())
+        .collect()
+}
+
+/// How far a breakline's vertex may be from the mesh vertex that stands for it: half a
+/// lattice cell's diagonal (vertices are rounded to the points' lattice), plus the
+/// format's position rounding.
+fn breakline_tolerance(spacing: [f64; 2], position_tolerance: f64) -> f64 {
+    0.5 * spacing[0].hypot(spacing[1]) + position_tolerance
 }
 
 /// How far a float32 format may move a position (x, y): its rounding of the TIN's extent,
@@ -388,11 +673,20 @@ fn describe(r: &PointsReport) -> String {
             ));
         }
     }
+    if let Some(b) = r.breaklines.as_ref().filter(|b| !b.passed()) {
+        let [a, e] = b.first_missing.unwrap_or_default();
+        parts.push(format!(
+            "{} of {} breakline segments are not chains of mesh edges, the first from \
+             ({}, {}) to ({}, {})",
+            b.missing, b.segments, a[0], a[1], e[0], e[1]
+        ));
+    }
     parts.join("; ")
 }
 
-/// `tinsmith verify` on a point file: reads the points (with the same class filter and
-/// duplicates rule `mesh` used) and the mesh file, and measures every point against the
+/// `tinsmith verify` on a point file (or on band `band` of a raster meshed with breaklines
+/// or a boundary, its valid samples as points): reads the points (with the same class
+/// filter and duplicates rule `mesh` used) and the mesh file, and measures every point against the
 /// mesh with the independent verifier. A mesh outside the bound is not an error: see
 /// [`PointsReport::passed`].
 pub fn verify_points_file(
@@ -401,12 +695,41 @@ pub fn verify_points_file(
     format: Option<MeshFormat>,
     max_error: f64,
     choices: &PointChoices,
+    band: usize,
     feedback: &dyn Feedback,
 ) -> Result<PointsReport> {
-    let points = if is_tin_input(points_path) {
-        read_tin(points_path, feedback)?.0.world
+    let (points, spacing) = if is_tin_input(points_path) && !is_ogr_points(points_path) {
+        if choices.breaklines.is_some() {
+            bail!(
+                "{}: --breaklines applies to point files and rasters, not to a TIN (it keeps its own edges)",
+                points_path.display()
+            );
+        }
+        (read_tin(points_path, feedback)?.0.world, [0.0; 2])
+    } else if !is_point_input(points_path) {
+        // A raster meshed with breaklines or a boundary: its valid samples are the points.
+        let cloud = raster_cloud(points_path, band)?;
+        (world_points(&cloud), cloud.spacing)
     } else {
-        world_points(&read(points_path, choices, feedback)?.0)
+        let cloud = read(points_path, choices, feedback)?.0;
+        (world_points(&cloud), cloud.spacing)
+    };
+    let breaklines = match &choices.breaklines {
+        Some(path) => Some(plan_lines(&tinsmith_raster::read_lines(path)?)),
+        None => None,
+    };
+    let outline = match &choices.boundary {
+        Some(path) => {
+            let layer = tinsmith_raster::read_lines(path)?;
+            if !layer.polygons {
+                bail!(
+                    "{}: holds lines, not polygons: --boundary takes a polygon layer",
+                    path.display()
+                );
+            }
+            Some(plan_lines(&layer))
+        }
+        None => None,
     };
     let format = crate::mesh_file::mesh_format(mesh_path, format)?;
     if format == MeshFormat::GeoJson {
@@ -418,20 +741,49 @@ pub fn verify_points_file(
     }
     let mesh = tinsmith_formats::read_mesh_as(mesh_path, format)?;
     let tolerance = position_tolerance(format, &mesh.vertices);
-    Ok(verify_points(
+    let points: Vec<[f64; 3]> = match &outline {
+        // Points outside the boundary are not the TIN's (mesh dropped them).
+        Some(rings) => {
+            let inside = tinsmith_verify::inside_outline(
+                rings,
+                &points,
+                breakline_tolerance(spacing, tolerance),
+            );
+            points
+                .iter()
+                .zip(inside)
+                .filter(|(_, i)| *i)
+                .map(|(p, _)| *p)
+                .collect()
+        }
+        None => points,
+    };
+    let mut report = verify_points(
         &points,
         &mesh.vertices,
         &mesh.triangles,
         max_error,
         tolerance,
-    ))
+    );
+    if let Some(lines) = breaklines {
+        report.breaklines = Some(verify_breaklines(
+            &lines,
+            &mesh.vertices,
+            &mesh.triangles,
+            breakline_tolerance(spacing, tolerance),
+        ));
+    }
+    Ok(report)
 }
 
 /// Text for a points verification, as `tinsmith verify` prints it.
 pub fn points_summary(r: &PointsReport) -> String {
     if r.passed() {
+        let lines = r.breaklines.as_ref().map_or(String::new(), |b| {
+            format!(", {} breakline segments present", b.segments)
+        });
         format!(
-            "{} points, largest error {} <= {}: passed",
+            "{} points, largest error {} <= {}{lines}: passed",
             r.points,
             crate::readable(r.max_error),
             r.bound

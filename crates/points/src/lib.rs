@@ -1,6 +1,7 @@
 //! Point clouds in: LAS/LAZ (the `las` crate, LAZ through its `laz` feature) and XYZ/CSV
 //! text, streamed into compact lattice arrays (16 bytes of position and 8 of height per
-//! point), deduplicated by a rule, and Delaunay-triangulated with spade; or an existing
+//! point), deduplicated by a rule, and Delaunay-triangulated with spade (constrained by
+//! breaklines with [`constrained_delaunay`]); or an existing
 //! TIN's vertices put on a lattice with its own triangles checked ([`tin_points`]).
 //!
 //! Positions are kept as integers on a lattice: a LAS file's own integers (`X`, `Y`,
@@ -20,6 +21,7 @@
 //! # }
 //! ```
 
+mod breaklines;
 mod cloud;
 mod dedupe;
 mod delaunay;
@@ -27,14 +29,17 @@ mod error;
 mod las_file;
 mod text;
 mod tin;
+mod world;
 
 use std::path::Path;
 
+pub use breaklines::{constrained_delaunay, BreaklineError, ConstrainedTriangulation, Constraints};
 pub use cloud::{ClassChoice, FileCrs, PointCloud, MAX_LATTICE};
 pub use dedupe::{dedupe, Duplicates};
 pub use delaunay::{delaunay, TriangulationError};
 pub use error::{Error, Result};
 pub use tin::{tin_points, TinPoints};
+pub use world::world_cloud;
 
 /// Which points of a LAS file to read (text files have no classes).
 #[derive(Debug, Clone, Default, PartialEq)]

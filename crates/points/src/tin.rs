@@ -188,7 +188,7 @@ pub fn tin_points(path: &Path, vertices: &[[f64; 3]], triangles: &[[u32; 3]]) ->
 /// `1 / g` for the regular spacing `g` of the values (the smallest gap between distinct
 /// values, every value `lo + k g`), with the span at most [`MAX_LATTICE`] steps either
 /// way; why not otherwise.
-fn axis_scale(values: &[f64], lo: f64, hi: f64) -> std::result::Result<f64, String> {
+pub(crate) fn axis_scale(values: &[f64], lo: f64, hi: f64) -> std::result::Result<f64, String> {
     let fits = |per_unit: f64| ((hi - lo) * per_unit).round() <= MAX_LATTICE as f64;
     let decimals = (0..=MAX_DECIMALS).find(|&d| values.iter().all(|&v| on_lattice(v, d)));
     if let Some(d) = decimals {

@@ -185,6 +185,14 @@ pub enum Error {
         /// GDAL's or PROJ's explanation.
         reason: String,
     },
+    /// A line or polygon layer (breaklines, an outline) could not be read as lines.
+    #[error("{}: {reason}", path.display())]
+    Lines {
+        /// The vector file.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// GDAL failed to reproject the raster to EPSG:4326.
     #[error("{}: reprojecting to EPSG:4326 failed ({reason})", path.display())]
     Warp {

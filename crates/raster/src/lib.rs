@@ -64,6 +64,8 @@ mod error;
 mod files;
 mod geographic;
 mod info;
+mod lines;
+mod point_layer;
 mod polygons;
 mod quiet;
 mod read;
@@ -82,6 +84,8 @@ pub use geographic::{
     GeoLattice, Latitudes,
 };
 pub use info::{Raster, RasterInfo};
+pub use lines::{read_lines, LineLayer};
+pub use point_layer::{is_point_layer, read_point_layer, PointLayer};
 pub use polygons::{burn_polygons, is_vector};
 pub use quiet::{silence_gdal_errors, take_gdal_warnings};
 pub use read::{open_info, open_info_on, open_info_with_progress, read_samples, read_samples_on};

@@ -16,7 +16,7 @@ pub fn is_vector(path: &Path) -> bool {
     open_vector(path).is_ok_and(|ds| ds.layer_count() > 0)
 }
 
-fn open_vector(path: &Path) -> std::result::Result<Dataset, gdal::errors::GdalError> {
+pub(crate) fn open_vector(path: &Path) -> std::result::Result<Dataset, gdal::errors::GdalError> {
     Dataset::open_ex(
         path,
         DatasetOptions {

@@ -42,12 +42,14 @@
 //! # }
 //! ```
 
+mod breaklines;
 mod coverage;
 mod edges;
 mod error;
 mod grid;
 mod mesh;
 mod options;
+mod outline;
 mod points;
 mod predicates;
 mod problems;
@@ -57,10 +59,12 @@ mod surface;
 mod variables;
 mod verify;
 
+pub use breaklines::{verify_breaklines, BreaklinesReport};
 pub use error::{Result, VerifyError};
 pub use grid::GridRef;
 pub use mesh::MeshRef;
 pub use options::{Orientation, VerifyOptions};
+pub use outline::inside_outline;
 pub use points::{verify_points, PointsReport};
 pub use report::{ErrorLocation, Report};
 pub use surface::{surface, surface_at};

@@ -32,13 +32,20 @@ pub struct PointsReport {
     pub bad_triangles: usize,
     /// The bound asked for.
     pub bound: f64,
+    /// The breaklines' check, when breaklines were given (set by the caller from
+    /// [`crate::verify_breaklines`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub breaklines: Option<crate::BreaklinesReport>,
 }
 
 impl PointsReport {
     /// Whether every point is covered, every triangle counter-clockwise and non-degenerate,
-    /// and every point within the bound.
+    /// every point within the bound, and every breakline present.
     pub fn passed(&self) -> bool {
-        self.uncovered == 0 && self.bad_triangles == 0 && self.max_error <= self.bound
+        self.uncovered == 0
+            && self.bad_triangles == 0
+            && self.max_error <= self.bound
+            && self.breaklines.as_ref().is_none_or(|b| b.passed())
     }
 }
 
@@ -82,6 +89,7 @@ pub fn verify_points(
         first_uncovered: None,
         bad_triangles: 0,
         bound,
+        breaklines: None,
     };
     let mut good: Vec<u32> = Vec::with_capacity(triangles.len());
     for (t, c) in triangles.iter().enumerate() {

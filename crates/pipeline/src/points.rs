@@ -815,8 +815,9 @@ fn refuse_raster_only_choices(
     }
     if !refused.is_empty() {
         bail!(
-            "{}: {} apply to rasters only; points are decimated in sweeps from their \
-             triangulation",
+            "{}: {} apply to rasters meshed on their grid only; points, TINs and rasters \
+             with --breaklines, --boundary or --hull-edge-length are decimated in sweeps from \
+             their triangulation",
             input.display(),
             refused.join(", ")
         );

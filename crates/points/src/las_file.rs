@@ -37,7 +37,7 @@ pub(crate) fn read_las(path: &Path, options: &ReadOptions) -> Result<PointCloud>
             format_error(
                 path,
                 format!(
-                    "the point data is truncated or corrupt after {read} of the {declared}                      points the header declares ({e})"
+                    "the point data is truncated or corrupt after {read} of the {declared} points the header declares ({e})"
                 ),
             )
         })?;

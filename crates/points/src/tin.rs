@@ -215,11 +215,11 @@ pub(crate) fn axis_scale(values: &[f64], lo: f64, hi: f64) -> std::result::Resul
     }
     Err(match decimals {
         Some(d) => format!(
-            "the vertices span {} at a lattice step of 1e-{d} (the coarsest power of ten              holding their coordinates): more than {MAX_LATTICE} steps, beyond the exact              integer geometry, and they are on no coarser regular spacing",
+            "the vertices span {} at a lattice step of 1e-{d} (the coarsest power of ten holding their coordinates): more than {MAX_LATTICE} steps, beyond the exact integer geometry, and they are on no coarser regular spacing",
             hi - lo
         ),
         None => format!(
-            "the coordinates are on no power-of-ten step down to 1e-{MAX_DECIMALS} and on no              regular spacing within {MAX_LATTICE} steps, so the exact integer geometry cannot              hold them"
+            "the coordinates are on no power-of-ten step down to 1e-{MAX_DECIMALS} and on no regular spacing within {MAX_LATTICE} steps, so the exact integer geometry cannot hold them"
         ),
     })
 }

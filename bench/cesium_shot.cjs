@@ -56,11 +56,26 @@ const { chromium } = require(path.join(root, '.tools', 'node_modules', 'playwrig
       Cesium.Cartesian3.add(camera.directionWC, Cesium.Cartesian3.multiplyByScalar(camera.rightWC, 0.6, new Cesium.Cartesian3()), light);
       Cesium.Cartesian3.add(light, Cesium.Cartesian3.multiplyByScalar(camera.upWC, -0.6, new Cesium.Cartesian3()), light);
       viewer.scene.light = new Cesium.DirectionalLight({ direction: Cesium.Cartesian3.normalize(light, light) });
-      await new Promise((resolve) => {
-        const check = () => { if (viewer.scene.globe.tilesLoaded) { resolve(); } else { setTimeout(check, 200); } };
-        setTimeout(check, 1000);
+      // Loaded: `globe.tilesLoaded` on 30 frames running. One frame is not enough: it is
+      // also true for a frame or two between levels (the parents loaded, the children not
+      // yet asked for), and a picture shot then shows the coarse levels, which from 9 km up
+      // at pitch -30 deg fill the view with flat grey.
+      const frames = 30;
+      const timeoutMs = 240000;
+      await new Promise((resolve, reject) => {
+        let run = 0;
+        const start = performance.now();
+        const remove = viewer.scene.postRender.addEventListener(() => {
+          run = viewer.scene.globe.tilesLoaded ? run + 1 : 0;
+          if (run >= frames) {
+            remove();
+            resolve();
+          } else if (performance.now() - start > timeoutMs) {
+            remove();
+            reject(new Error(`the view's tiles were not all loaded after ${timeoutMs / 1000} s`));
+          }
+        });
       });
-      await new Promise((r) => setTimeout(r, 1000));
       window.__viewer = viewer;
     }, { terrainUrl, view: [lon, lat, height, heading, pitch, exaggeration].map(Number), water: water === 'water' });
     await page.screenshot({ path: out });

@@ -529,11 +529,10 @@ fn bad_las_files_are_refused_naming_the_file() {
 }
 
 #[test]
-fn raster_only_decimation_choices_are_refused_not_ignored() {
+fn raster_only_decimation_choices_are_refused_and_the_greedy_order_taken() {
     let dir = Dir::new();
     dir.write("p.csv", &csv(&random_points(200, 5), ",", true));
     for (flags, named) in [
-        (&["--order", "greedy"][..], "--order greedy"),
         (&["--initial-mesh", "rtin"][..], "--initial-mesh"),
         (&["--flip-rounds", "1"][..], "--flip-rounds"),
         (&["--extend-rounds", "1"][..], "--extend-rounds"),
@@ -546,7 +545,8 @@ fn raster_only_decimation_choices_are_refused_not_ignored() {
         assert!(e.contains("p.csv") && e.contains(named), "{flags:?}: {e}");
         assert!(!dir.path("out.ply").exists(), "{flags:?} left output");
     }
-    // What points do take: the default start, or the whole triangulation named.
+    // What points do take: the default start, or the whole triangulation named, and
+    // either order (the greedy one another mesh, as the verifier finds within the bound).
     let o = dir.run(&[
         "mesh",
         "p.csv",
@@ -558,4 +558,19 @@ fn raster_only_decimation_choices_are_refused_not_ignored() {
         "full",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+    let o = dir.run(&[
+        "mesh",
+        "p.csv",
+        "-o",
+        "g.ply",
+        "--max-error",
+        "0.1",
+        "--order",
+        "greedy",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let sweep = std::fs::read(dir.path("out.ply")).unwrap();
+    assert_ne!(sweep, std::fs::read(dir.path("g.ply")).unwrap());
+    let o = dir.run(&["verify", "p.csv", "g.ply", "--max-error", "0.1"]);
+    assert!(o.status.success(), "{} {}", stdout(&o), stderr(&o));
 }

@@ -1,7 +1,7 @@
 //! The decimation driver: builds the start, removes vertices in the chosen order (the
 //! paper's sweeps, §3.1, by default) and extracts the TIN.
 
-mod order;
+pub(crate) mod order;
 mod remover;
 mod rounding;
 mod start;

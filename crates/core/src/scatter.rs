@@ -274,7 +274,10 @@ pub fn decimate_scatter_constrained(
         levels: None,
     };
     let mut remover = ScatterRemover::new(&mesh, rules, locked);
-    let (sweeps, attempts) = remover.sweep(&mut mesh);
+    let (sweeps, attempts) = match options.order {
+        crate::Order::Sweep => remover.sweep(&mut mesh),
+        crate::Order::Greedy => remover.greedy(&mut mesh),
+    };
     #[cfg(any(test, debug_assertions))]
     mesh.check_invariants();
     let max_bound = mesh
@@ -396,7 +399,7 @@ impl ScatterRemover {
                     continue;
                 }
                 attempts += 1;
-                if self.plan(mesh, v) {
+                if self.plan(mesh, v).is_some() {
                     self.apply(mesh, v);
                     for &u in &self.star.ring {
                         if !queued[u as usize] {
@@ -414,17 +417,72 @@ impl ScatterRemover {
         (sweeps, attempts)
     }
 
-    /// Plans the removal of `v`: true when it is interior or boundary and its hole has a
-    /// triangulation within the limit at every point charged to it.
-    fn plan(&mut self, mesh: &Mesh<'_, Scatter>, v: u32) -> bool {
+    /// The greedy order: always removes the vertex whose best retriangulation has the
+    /// smallest largest bound (ties to the lower point index), re-planning a vertex's
+    /// neighbours after each removal; returns 1 (one pass) and the attempts. The result
+    /// depends on the points and options alone.
+    fn greedy(&mut self, mesh: &mut Mesh<'_, Scatter>) -> (usize, usize) {
+        use crate::decimate::order::Candidate;
+        let n = mesh.vertex_slots();
+        let mut version = vec![0u32; n];
+        let mut heap = std::collections::BinaryHeap::new();
+        let mut attempts = 0;
+        for v in 0..n as u32 {
+            if mesh.contains_vertex(v) {
+                attempts += 1;
+                if let Some(cost) = self.plan(mesh, v) {
+                    heap.push(Candidate {
+                        cost,
+                        vertex: v,
+                        version: 0,
+                    });
+                }
+            }
+        }
+        let mut ring = Vec::new();
+        while let Some(c) = heap.pop() {
+            let v = c.vertex;
+            if c.version != version[v as usize] || !mesh.contains_vertex(v) {
+                continue;
+            }
+            attempts += 1;
+            // The plan is redone: other plans since have used the remover's buffers.
+            let Some(cost) = self.plan(mesh, v) else {
+                continue;
+            };
+            debug_assert_eq!(cost.to_bits(), c.cost.to_bits(), "a current key is exact");
+            self.apply(mesh, v);
+            ring.clear();
+            ring.extend_from_slice(&self.star.ring);
+            for &u in &ring {
+                version[u as usize] = version[u as usize].wrapping_add(1);
+                if !mesh.contains_vertex(u) {
+                    continue;
+                }
+                attempts += 1;
+                if let Some(cost) = self.plan(mesh, u) {
+                    heap.push(Candidate {
+                        cost,
+                        vertex: u,
+                        version: version[u as usize],
+                    });
+                }
+            }
+        }
+        (1, attempts)
+    }
+
+    /// Plans the removal of `v`: `Some(largest new bound)` when it is interior or boundary
+    /// and its hole has a triangulation within the limit at every point charged to it.
+    fn plan(&mut self, mesh: &Mesh<'_, Scatter>, v: u32) -> Option<f64> {
         if self.locked[v as usize] {
-            return false;
+            return None;
         }
         mesh.star(v, &mut self.star);
         if self.star.ring.len() > MAX_HOLE_RING
             || mesh.classify(v, &self.star) == VertexClass::Corner
         {
-            return false;
+            return None;
         }
         self.ring.clear();
         self.ring
@@ -432,7 +490,7 @@ impl ScatterRemover {
         let centre = mesh.sample_point(v);
         if self.limit == 0.0 && self.ring.iter().any(|p| p.z != centre.z) {
             // Below the rounding slack only exactly flat stars go, as on grids.
-            return false;
+            return None;
         }
         let (lo, hi) = self
             .ring
@@ -441,7 +499,7 @@ impl ScatterRemover {
                 (lo.min(p.z), hi.max(p.z))
             });
         if centre.z - hi > self.limit || lo - centre.z > self.limit {
-            return false;
+            return None;
         }
         self.hole_points.points.clear();
         self.hole_ids.clear();
@@ -469,15 +527,15 @@ impl ScatterRemover {
             max_edge_squared: i64::MAX,
             levels: None,
         };
-        let Some((triangles, _)) = self.hole.retriangulate(&rules) else {
-            return false;
+        let Some((triangles, worst)) = self.hole.retriangulate(&rules) else {
+            return None;
         };
         self.new_triangles.clear();
         for (tri, &slot) in triangles.iter().zip(&self.star.triangles) {
             let corners = tri.corners.map(|i| self.star.ring[i as usize]);
             self.new_triangles.push((slot, corners, tri.bound));
         }
-        true
+        Some(worst)
     }
 
     /// Carries out the last successful plan (for `v`, mesh unchanged since) and charges
@@ -645,20 +703,24 @@ mod tests {
                 (x / 90.0).sin() * 30.0 + (y / 140.0).cos() * 20.0 + ((x * y) % 7.0) * 0.1
             });
             for model in [ErrorModel::Exact, ErrorModel::Bounds] {
-                for method in [Retriangulation::Dp, Retriangulation::Ears] {
+                for (method, order) in [
+                    (Retriangulation::Dp, crate::Order::Sweep),
+                    (Retriangulation::Ears, crate::Order::Sweep),
+                    (Retriangulation::Dp, crate::Order::Greedy),
+                ] {
                     for bound in [0.5, 4.0] {
-                        let mut options = DecimationOptions::new(bound);
+                        let mut options = DecimationOptions::new(bound).with_order(order);
                         options.error_model = model;
                         options.retriangulation = method;
                         let (tin, report) = decimate_scatter(&s, tris.clone(), &options).unwrap();
                         let worst = worst_error(&s, &tin);
                         assert!(
                             worst <= bound,
-                            "{seed} {model:?} {method:?} {bound}: {worst}"
+                            "{seed} {model:?} {method:?} {order:?} {bound}: {worst}"
                         );
                         assert!(
                             report.final_vertices < s.len(),
-                            "{seed} {model:?} {method:?}"
+                            "{seed} {model:?} {method:?} {order:?}"
                         );
                         // The hull's corners stay.
                         for corner in 0..4u32 {
@@ -826,9 +888,30 @@ mod tests {
     #[test]
     fn same_input_same_output() {
         let (s, tris) = lattice_scatter(15, 11, |x, y| (x * y).sqrt());
-        let o = DecimationOptions::new(0.3);
-        let a = decimate_scatter(&s, tris.clone(), &o).unwrap();
-        let b = decimate_scatter(&s, tris, &o).unwrap();
-        assert_eq!(a, b);
+        for o in [
+            DecimationOptions::new(0.3),
+            DecimationOptions::new(0.3).with_order(crate::Order::Greedy),
+        ] {
+            let a = decimate_scatter(&s, tris.clone(), &o).unwrap();
+            let b = decimate_scatter(&s, tris.clone(), &o).unwrap();
+            assert_eq!(a, b);
+        }
+    }
+
+    /// The greedy order removes the cheapest vertex first: on the same points it keeps a
+    /// different mesh than the sweep, within the same bound, and never a larger one by
+    /// more than a few vertices (measured: usually smaller).
+    #[test]
+    fn the_greedy_order_is_honoured() {
+        let (s, tris) = random_scatter(600, 4, 1000, &|x, y| {
+            (x / 70.0).sin() * 25.0 + (y / 110.0).cos() * 15.0
+        });
+        let sweep = DecimationOptions::new(1.0);
+        let greedy = DecimationOptions::new(1.0).with_order(crate::Order::Greedy);
+        let (a, _) = decimate_scatter(&s, tris.clone(), &sweep).unwrap();
+        let (b, report) = decimate_scatter(&s, tris, &greedy).unwrap();
+        assert_ne!(a, b, "the order made no difference");
+        assert_eq!(report.sweeps, 1);
+        assert!(worst_error(&s, &b) <= 1.0);
     }
 }

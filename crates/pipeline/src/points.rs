@@ -386,7 +386,8 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     let options = DecimationOptions::new(max_error - rounding)
         .with_selection(job.decimation.selection)
         .with_error_model(job.decimation.error_model)
-        .with_retriangulation(job.decimation.retriangulate);
+        .with_retriangulation(job.decimation.retriangulate)
+        .with_order(job.decimation.order);
     let mut options = options;
     options.dp_max_ring = job.decimation.dp_max_ring as usize;
     let PointCloud {
@@ -794,16 +795,13 @@ pub fn points_summary(r: &PointsReport) -> String {
 }
 
 /// Refuses the decimation choices a triangulation of points does not take, rather than
-/// ignoring them: its start is the triangulation itself and its order the sweep.
+/// ignoring them: its start is the triangulation itself, with no flips or extended holes.
 fn refuse_raster_only_choices(
     input: &std::path::Path,
     choices: &tinsmith_choices::DecimationChoices,
 ) -> Result<()> {
-    use tinsmith_core::{InitialMesh, Order};
+    use tinsmith_core::InitialMesh;
     let mut refused = Vec::new();
-    if choices.order == Order::Greedy {
-        refused.push("--order greedy");
-    }
     if !matches!(choices.initial_mesh, InitialMesh::Auto | InitialMesh::Full) {
         refused.push("--initial-mesh (points start from their whole triangulation)");
     }
@@ -816,8 +814,8 @@ fn refuse_raster_only_choices(
     if !refused.is_empty() {
         bail!(
             "{}: {} apply to rasters meshed on their grid only; points, TINs and rasters \
-             with --breaklines, --boundary or --hull-edge-length are decimated in sweeps from \
-             their triangulation",
+             with --breaklines, --boundary or --hull-edge-length are decimated from their \
+             triangulation",
             input.display(),
             refused.join(", ")
         );

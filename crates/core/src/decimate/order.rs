@@ -183,12 +183,15 @@ impl Target {
     }
 }
 
-/// A removal candidate: its cost, then the vertex, so ties go to the lower index.
+/// A removal candidate: its cost, then the vertex, so ties go to the lower index (the
+/// greedy order's heap entry, for grids and scattered points alike).
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Candidate {
-    cost: f64,
-    vertex: u32,
-    version: u32,
+pub(crate) struct Candidate {
+    /// The largest bound of the vertex's planned retriangulation.
+    pub(crate) cost: f64,
+    pub(crate) vertex: u32,
+    /// The vertex's version when planned: stale once a neighbour's removal bumps it.
+    pub(crate) version: u32,
 }
 
 impl Eq for Candidate {}

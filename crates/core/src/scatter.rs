@@ -527,9 +527,7 @@ impl ScatterRemover {
             max_edge_squared: i64::MAX,
             levels: None,
         };
-        let Some((triangles, worst)) = self.hole.retriangulate(&rules) else {
-            return None;
-        };
+        let (triangles, worst) = self.hole.retriangulate(&rules)?;
         self.new_triangles.clear();
         for (tri, &slot) in triangles.iter().zip(&self.star.triangles) {
             let corners = tri.corners.map(|i| self.star.ring[i as usize]);

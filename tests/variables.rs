@@ -884,3 +884,49 @@ fn three_8_bit_bands_are_vertex_colours_in_ply_obj_and_gltf() {
         assert!(o.status.success(), "{name}: {} {}", stdout(&o), stderr(&o));
     }
 }
+
+#[test]
+fn an_orthophoto_on_another_grid_stays_colours_when_resampled_by_nearest() {
+    let d = Dir::new();
+    write_band(&d, "dem.asc", field(0.3));
+    // Three 8-bit bands at two thirds of the DEM's cell size, shifted: another grid.
+    for (name, seed) in [("r.asc", 0.5), ("g.asc", 1.5), ("b.asc", 2.5)] {
+        write_band_at(&d, name, (1001.0, 2001.0, 10.0 * 2.0 / 3.0), |x, y| {
+            (field(seed)(x, y).abs() * 2.0).round().min(255.0)
+        });
+    }
+    stack(&d, "rgb_f.tif", &["r.asc", "g.asc", "b.asc"]);
+    run_in(
+        &d,
+        "gdal_translate",
+        &["-q", "-ot", "Byte", "rgb_f.tif", "rgb.tif"],
+    );
+    let header = |out: &str| {
+        let bytes = std::fs::read(d.path(out)).unwrap();
+        let end = bytes.windows(10).position(|w| w == b"end_header").unwrap();
+        String::from_utf8_lossy(&bytes[..end]).into_owned()
+    };
+    for (method, colours) in [("nearest", true), ("bilinear", false)] {
+        let out = format!("{method}.ply");
+        let o = d.run(&[
+            "mesh",
+            "dem.asc",
+            "-o",
+            &out,
+            "--max-error",
+            "1",
+            "--attributes",
+            "rgb.tif",
+            "--attribute-error",
+            "8",
+            "--attribute-resampling",
+            method,
+            "-q",
+        ]);
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+        let h = header(&out);
+        // Nearest keeps the bytes, so they are colours too; bilinear makes other numbers.
+        assert_eq!(h.contains("property uchar red"), colours, "{method}: {h}");
+        assert!(h.contains("property double rgb_band_3"), "{method}: {h}");
+    }
+}

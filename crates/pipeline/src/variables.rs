@@ -209,6 +209,14 @@ pub(crate) fn read(
                 let mut raster = tinsmith_raster::read_samples(path, v.band)
                     .map_err(|e| no_overlap(e, file, input))?;
                 raster.info.path = file.clone();
+                if let Some(r) = &resampled {
+                    // The band's own name, and its type where resampling kept its values
+                    // (nearest: three 8-bit bands stay colours).
+                    raster.info.description = r.source.description.clone();
+                    if v.resampling == Resampling::Nearest {
+                        raster.info.data_type = r.source.data_type.clone();
+                    }
+                }
                 raster
             }
         };
@@ -341,8 +349,12 @@ pub(crate) fn tiled_source(
             let path = resampled
                 .as_ref()
                 .map_or(file.clone(), |r| r.path().to_path_buf());
+            let description = resampled.as_ref().map(|r| r.source.description.clone());
             kept.extend(resampled);
-            let band = tinsmith_raster::open_info(&path, v.band)?;
+            let mut band = tinsmith_raster::open_info(&path, v.band)?;
+            if let Some(description) = description {
+                band.description = description;
+            }
             if band.valid_samples == 0 {
                 return Err(no_overlap(
                     tinsmith_raster::Error::AllNodata { path, band: v.band },
@@ -419,6 +431,8 @@ fn property_name(description: Option<&str>, fallback: &str, taken: &[String]) ->
 /// this is dropped (and by the output layer on Ctrl-C before then).
 pub(crate) struct ResampledFile {
     tif: PathBuf,
+    /// The band's own metadata, in the file resampled.
+    source: RasterInfo,
     _dir: tinsmith_output::ScratchDir,
 }
 
@@ -474,7 +488,11 @@ fn on_input_grid(
     })?;
     let tif = dir.path().join("resampled.tif");
     tinsmith_raster::resample_onto(file, info, v.resampling, &tif)?;
-    Ok(Some(ResampledFile { tif, _dir: dir }))
+    Ok(Some(ResampledFile {
+        tif,
+        source: other,
+        _dir: dir,
+    }))
 }
 
 /// `[x_min, x_max, y_min, y_max]` of a raster's samples' cells, when it has a geotransform.

@@ -73,6 +73,36 @@ fn vertex_normals(local: &[[f32; 3]], triangles: &[[u32; 3]]) -> Vec<[f32; 3]> {
         .collect()
 }
 
+/// Writes a GLB's 12-byte header and its JSON chunk (`json`, padded with spaces to a
+/// multiple of 4 bytes) and, with `bin_len`, the binary chunk's 8-byte header: the caller
+/// writes those `bin_len` bytes (a multiple of 4) next. The container every GLB tinsmith
+/// writes starts with (meshes here, terrain tiles in `tinsmith-terrain`).
+///
+/// # Errors
+/// The writer's, and `InvalidInput` for a file of 4 GiB or more.
+pub fn write_glb_start<W: Write>(w: &mut W, json: &[u8], bin_len: Option<u64>) -> io::Result<()> {
+    let padded = json.len().next_multiple_of(4);
+    let length = 12 + 8 + padded as u64 + bin_len.map_or(0, |n| 8 + n);
+    let (Ok(length), Ok(bin)) = (u32::try_from(length), u32::try_from(bin_len.unwrap_or(0))) else {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "larger than 4 GiB",
+        ));
+    };
+    w.write_all(&MAGIC.to_le_bytes())?;
+    w.write_all(&2u32.to_le_bytes())?;
+    w.write_all(&length.to_le_bytes())?;
+    w.write_all(&(padded as u32).to_le_bytes())?;
+    w.write_all(&CHUNK_JSON.to_le_bytes())?;
+    w.write_all(json)?;
+    w.write_all(&b"   "[..padded - json.len()])?;
+    if bin_len.is_some() {
+        w.write_all(&bin.to_le_bytes())?;
+        w.write_all(&CHUNK_BIN.to_le_bytes())?;
+    }
+    Ok(())
+}
+
 /// Writes `mesh` as GLB relative to `origin`, with normals if asked. The caller has
 /// checked the mesh.
 pub(crate) fn write<W: Write>(
@@ -199,27 +229,11 @@ pub(crate) fn write<W: Write>(
     }
     root["nodes"] = json!([node]);
 
-    let mut json_bytes = serde_json::to_vec(&root).map_err(io::Error::other)?;
-    while !json_bytes.len().is_multiple_of(4) {
-        json_bytes.push(b' ');
-    }
-    let mut length = 12 + 8 + json_bytes.len() as u64;
-    if has_mesh {
-        length += 8 + total_len;
-    }
-    let length = u32::try_from(length)
-        .map_err(|_| io::Error::new(io::ErrorKind::InvalidInput, "larger than 4 GiB"))?;
-    w.write_all(&MAGIC.to_le_bytes())?;
-    w.write_all(&2u32.to_le_bytes())?;
-    w.write_all(&length.to_le_bytes())?;
-    w.write_all(&(json_bytes.len() as u32).to_le_bytes())?;
-    w.write_all(&CHUNK_JSON.to_le_bytes())?;
-    w.write_all(&json_bytes)?;
+    let json_bytes = serde_json::to_vec(&root).map_err(io::Error::other)?;
+    write_glb_start(&mut w, &json_bytes, has_mesh.then_some(total_len))?;
     if !has_mesh {
         return Ok(());
     }
-    w.write_all(&(total_len as u32).to_le_bytes())?;
-    w.write_all(&CHUNK_BIN.to_le_bytes())?;
     let local: Vec<[f32; 3]> = if normals {
         mesh.vertices.iter().map(|&p| origin.to_local(p)).collect()
     } else {

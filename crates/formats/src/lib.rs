@@ -76,6 +76,7 @@ pub use antimeridian::cut_at_antimeridian;
 pub use error::{Error, Result};
 pub use file::{prj_path, read_mesh, read_mesh_as, read_mesh_bytes, write_mesh, write_mesh_with};
 pub use format::MeshFormat;
+pub use glb::write_glb_start;
 pub use lines::{write_lines, write_multilines, CrsRef, LineFormat, LinePoint};
 pub use mesh::{Mesh, MeshRef, VertexAttribute};
 pub use options::WriteOptions;

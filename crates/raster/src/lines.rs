@@ -6,7 +6,7 @@ use std::path::Path;
 use gdal::vector::{Geometry, LayerAccess};
 
 use crate::error::{Error, Result};
-use crate::polygons::open_vector;
+use crate::polygons::{open_vector_file, same_layer_crs};
 
 /// The lines of a vector file, in its own CRS.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -34,17 +34,11 @@ pub struct LineLayer {
 /// polygons), layers declare different CRSs, a coordinate is not finite, some geometries
 /// have heights and others not, or there is no line at all.
 pub fn read_lines(path: &Path) -> Result<LineLayer> {
-    if !path.exists() {
-        return Err(Error::NotFound {
-            path: path.to_path_buf(),
-        });
-    }
     let bad = |reason: String| Error::Lines {
         path: path.to_path_buf(),
         reason,
     };
-    let dataset =
-        open_vector(path).map_err(|e| bad(format!("not a vector file GDAL can read ({e})")))?;
+    let dataset = open_vector_file(path)?;
     let mut out = LineLayer {
         polygons: true,
         ..LineLayer::default()
@@ -52,17 +46,7 @@ pub fn read_lines(path: &Path) -> Result<LineLayer> {
     let mut crs: Option<Option<String>> = None;
     let mut heights: Option<bool> = None;
     for mut layer in dataset.layers() {
-        let wkt = layer.spatial_ref().and_then(|s| s.to_wkt().ok());
-        match &crs {
-            None => crs = Some(wkt),
-            Some(first) if *first != wkt => {
-                return Err(bad(format!(
-                    "layer {} has another CRS than the first layer",
-                    layer.name()
-                )))
-            }
-            Some(_) => {}
-        }
+        same_layer_crs(&mut crs, &layer, path)?;
         for feature in layer.features() {
             let Some(geometry) = feature.geometry() else {
                 continue;

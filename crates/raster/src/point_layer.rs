@@ -5,7 +5,7 @@ use std::path::Path;
 use gdal::vector::{Geometry, LayerAccess};
 
 use crate::error::{Error, Result};
-use crate::polygons::open_vector;
+use crate::polygons::{open_vector, open_vector_file, same_layer_crs};
 
 /// The points of a vector file, in its own CRS.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -52,31 +52,15 @@ pub fn is_point_layer(path: &Path) -> bool {
 /// no `z_field` is given, the field does not exist or is empty on a feature, layers
 /// declare different CRSs, or a value is not finite.
 pub fn read_point_layer(path: &Path, z_field: Option<&str>) -> Result<PointLayer> {
-    if !path.exists() {
-        return Err(Error::NotFound {
-            path: path.to_path_buf(),
-        });
-    }
     let bad = |reason: String| Error::Lines {
         path: path.to_path_buf(),
         reason,
     };
-    let dataset =
-        open_vector(path).map_err(|e| bad(format!("not a vector file GDAL can read ({e})")))?;
+    let dataset = open_vector_file(path)?;
     let mut out = PointLayer::default();
     let mut crs: Option<Option<String>> = None;
     for mut layer in dataset.layers() {
-        let wkt = layer.spatial_ref().and_then(|s| s.to_wkt().ok());
-        match &crs {
-            None => crs = Some(wkt),
-            Some(first) if *first != wkt => {
-                return Err(bad(format!(
-                    "layer {} has another CRS than the first layer",
-                    layer.name()
-                )))
-            }
-            Some(_) => {}
-        }
+        same_layer_crs(&mut crs, &layer, path)?;
         let field = match z_field {
             Some(name) => Some(layer.defn().field_index(name).map_err(|_| {
                 bad(format!(

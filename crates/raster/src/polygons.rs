@@ -113,3 +113,41 @@ pub fn burn_polygons(path: &Path, rect: [f64; 4], cells: u32) -> Result<Vec<u8>>
         .map_err(failed)?;
     Ok(buffer.data().to_vec())
 }
+
+/// Opens the vector file at `path` for a reader that reports its problems as
+/// [`Error::Lines`]: [`Error::NotFound`] when nothing is there, else GDAL's refusal.
+pub(crate) fn open_vector_file(path: &Path) -> Result<Dataset> {
+    if !path.exists() {
+        return Err(Error::NotFound {
+            path: path.to_path_buf(),
+        });
+    }
+    open_vector(path).map_err(|e| Error::Lines {
+        path: path.to_path_buf(),
+        reason: format!("not a vector file GDAL can read ({e})"),
+    })
+}
+
+/// The CRS (WKT) every layer of one file must share: the first layer's, as each layer
+/// comes (`seen` starts as `None`); refuses, naming the layer, one that declares another.
+pub(crate) fn same_layer_crs(
+    seen: &mut Option<Option<String>>,
+    layer: &gdal::vector::Layer<'_>,
+    path: &Path,
+) -> Result<()> {
+    let wkt = layer.spatial_ref().and_then(|s| s.to_wkt().ok());
+    match seen {
+        None => *seen = Some(wkt),
+        Some(first) if *first != wkt => {
+            return Err(Error::Lines {
+                path: path.to_path_buf(),
+                reason: format!(
+                    "layer {} has another CRS than the first layer",
+                    layer.name()
+                ),
+            })
+        }
+        Some(_) => {}
+    }
+    Ok(())
+}

@@ -14,16 +14,10 @@
 use serde_json::{json, Value};
 
 use crate::quantized_mesh::{
-    bounding_sphere, edge_lists, first_use_order, geodetic_to_ecef, horizon_occlusion_point,
-    EncodeError, GeoRectangle, QUANTIZED_MAX,
+    bounding_sphere, check_triangles_and_normals, edge_lists, first_use_order, geodetic_to_ecef,
+    horizon_occlusion_point, EncodeError, GeoRectangle, QUANTIZED_MAX,
 };
 
-/// `glTF` in ASCII, little-endian.
-const MAGIC: u32 = 0x4654_6C67;
-/// Chunk type of the JSON chunk (`JSON`).
-const CHUNK_JSON: u32 = 0x4E4F_534A;
-/// Chunk type of the binary chunk (`BIN\0`).
-const CHUNK_BIN: u32 = 0x004E_4942;
 const FLOAT: u32 = 5126;
 const UNSIGNED_SHORT: u32 = 5123;
 const UNSIGNED_INT: u32 = 5125;
@@ -258,23 +252,7 @@ impl<'a> GlbTile<'a> {
                 return Err(EncodeError::ValueOutOfRange { vertex, value });
             }
         }
-        for (triangle, t) in self.triangles.iter().enumerate() {
-            if let Some(&index) = t.iter().find(|&&i| i as usize >= vertex_count) {
-                return Err(EncodeError::IndexOutOfRange {
-                    triangle,
-                    index,
-                    vertex_count,
-                });
-            }
-        }
-        if let Some(normals) = self.normals {
-            if normals.len() != vertex_count {
-                return Err(EncodeError::NormalCount {
-                    expected: vertex_count,
-                    got: normals.len(),
-                });
-            }
-        }
+        check_triangles_and_normals(self.triangles, vertex_count, self.normals)?;
         Ok(())
     }
 }
@@ -313,18 +291,10 @@ impl Builder {
 
 /// The GLB container of `document` and its binary buffer `bin` (a multiple of 4 bytes).
 fn glb(document: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut text = serde_json::to_vec(document).expect("glTF JSON serializes");
-    text.resize(text.len().next_multiple_of(4), b' ');
-    let total = 12 + 8 + text.len() + 8 + bin.len();
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(&MAGIC.to_le_bytes());
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
-    out.extend_from_slice(&CHUNK_JSON.to_le_bytes());
-    out.extend_from_slice(&text);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
+    let text = serde_json::to_vec(document).expect("glTF JSON serializes");
+    let mut out = Vec::with_capacity(28 + text.len() + 3 + bin.len());
+    tinsmith_formats::write_glb_start(&mut out, &text, Some(bin.len() as u64))
+        .expect("a tile is far below 4 GiB, and a Vec takes every write");
     out.extend_from_slice(bin);
     out
 }

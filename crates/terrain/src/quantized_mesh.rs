@@ -259,23 +259,7 @@ impl<'a> QuantizedMeshTile<'a> {
             }
         }
         let vertex_count = self.vertices.len();
-        for (triangle, t) in self.triangles.iter().enumerate() {
-            if let Some(&index) = t.iter().find(|&&i| i as usize >= vertex_count) {
-                return Err(EncodeError::IndexOutOfRange {
-                    triangle,
-                    index,
-                    vertex_count,
-                });
-            }
-        }
-        if let Some(normals) = self.normals {
-            if normals.len() != vertex_count {
-                return Err(EncodeError::NormalCount {
-                    expected: vertex_count,
-                    got: normals.len(),
-                });
-            }
-        }
+        check_triangles_and_normals(self.triangles, vertex_count, self.normals)?;
         if let Some(mask) = self.water_mask {
             if mask.len() != 1 && mask.len() != 256 * 256 {
                 return Err(EncodeError::WaterMaskSize(mask.len()));
@@ -471,6 +455,33 @@ pub(super) fn horizon_occlusion_point(points: &[[f64; 3]], towards: [f64; 3]) ->
         max_magnitude = max_magnitude.max(magnitude);
     }
     d.map(|c| c * max_magnitude)
+}
+
+/// Refuses a triangle naming a vertex beyond `vertex_count`, or normals (when given) that
+/// are not one per vertex: what every tile encoder checks before writing.
+pub(crate) fn check_triangles_and_normals<N>(
+    triangles: &[[u32; 3]],
+    vertex_count: usize,
+    normals: Option<&[N]>,
+) -> Result<(), EncodeError> {
+    for (triangle, t) in triangles.iter().enumerate() {
+        if let Some(&index) = t.iter().find(|&&i| i as usize >= vertex_count) {
+            return Err(EncodeError::IndexOutOfRange {
+                triangle,
+                index,
+                vertex_count,
+            });
+        }
+    }
+    if let Some(normals) = normals {
+        if normals.len() != vertex_count {
+            return Err(EncodeError::NormalCount {
+                expected: vertex_count,
+                got: normals.len(),
+            });
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -453,7 +453,10 @@ fn on_input_grid(
     input: &Path,
     info: &RasterInfo,
 ) -> Result<Option<ResampledFile>> {
-    let other = tinsmith_raster::open_info(file, v.band)?;
+    // The band's metadata only: its samples are read once, afterwards.
+    let other = tinsmith_raster::WindowReader::open(file, v.band)?
+        .info()
+        .clone();
     if tinsmith_raster::on_same_grid(&other, info) {
         return Ok(None);
     }

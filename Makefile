@@ -14,11 +14,13 @@ TOOLS := .tools
 # previews back (tests/preview.rs); maturin builds the Python package (crates/python),
 # pytest runs its tests (make python-test), which hand it affine's transforms and ask it
 # for shapely's lines; rasterio and rioxarray run the README's Python examples;
-# laspy (with its lazrs LAZ backend) reads our point fixtures back (tests/points.rs).
+# laspy (with its lazrs LAZ backend) reads our point fixtures back and copclib writes
+# COPC files for them (tests/points.rs).
 PY_ORACLES := trimesh==4.12.2 numpy==2.2.6 moto[server]==5.2.5 boto3==1.44.5 \
   azure-storage-blob==12.27.1 dask[distributed]==2026.8.0 pyyaml==6.0.4 pillow==11.3.0 \
   maturin==1.16.0 pytest==9.2.0 affine==3.0.1 shapely==2.2.0 rasterio==1.4.4 \
-  rioxarray==0.19.0 xarray==2026.9.0 pandas==3.1.1 pyproj==3.7.2 laspy[lazrs]==2.7.0
+  rioxarray==0.19.0 xarray==2026.9.0 pandas==3.1.1 pyproj==3.7.2 laspy[lazrs]==2.7.0 \
+  copclib==2.6.3
 NPM_ORACLES := gltf-validator@2.0.0-dev.3.10
 
 .PHONY: deps gdal oracles demo pictures test python-test bench-python bench-ctb bench-results bench-contour bench-compare bench-tiles bench-shards bench-preview bench-points bench-variables

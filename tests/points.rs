@@ -458,6 +458,74 @@ fn laspy_reads_the_points_our_mesh_is_within_the_bound_of() {
     }
 }
 
+/// COPC (LAZ 1.4 in an octree of variable-size chunks) written by copclib, an independent
+/// writer, from the LAS file of the same points: the same points are read (laspy agrees
+/// on the count), so the same mesh, byte for byte, with the same CRS.
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn copc_from_another_writer_gives_the_las_mesh() {
+    let python = laspy();
+    let dir = Dir::new();
+    let points = classified_points();
+    let wkt = "PROJCS[\"WGS 84 / UTM zone 33N\",GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],PARAMETER[\"latitude_of_origin\",0],PARAMETER[\"central_meridian\",15],PARAMETER[\"scale_factor\",0.9996],PARAMETER[\"false_easting\",500000],PARAMETER[\"false_northing\",0],UNIT[\"metre\",1],AUTHORITY[\"EPSG\",\"32633\"]]";
+    write_las(&dir.path("p.las"), &points, Some(wkt));
+    let o = std::process::Command::new(&python)
+        .arg(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/oracles/copc_write.py"))
+        .args(["p.las", "p.copc.laz", "3"])
+        .current_dir(dir.path(""))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "copclib: {}", stderr(&o));
+    let nodes: usize = stdout(&o).trim().parse().unwrap();
+    assert!(nodes > 8, "an octree of several chunks, got {nodes} nodes");
+    let args = |input: &str, out: &str, report: &str| {
+        let o = dir.run(&[
+            "mesh",
+            input,
+            "-o",
+            out,
+            "--max-error",
+            "0.03",
+            "--no-withheld",
+            "--report",
+            report,
+        ]);
+        assert!(o.status.success(), "{input}: {}", stderr(&o));
+    };
+    args("p.las", "las.ply", "las.json");
+    args("p.copc.laz", "copc.ply", "copc.json");
+    let (las, copc) = (report(&dir, "las.json"), report(&dir, "copc.json"));
+    let kept = points.iter().filter(|p| p.1 == 2 && !p.2).count() as u64;
+    for r in [&las, &copc] {
+        assert_eq!(r["points_read"].as_u64(), Some(kept));
+        assert_eq!(r["points_in_file"].as_u64(), Some(points.len() as u64));
+    }
+    assert!(
+        std::fs::read(dir.path("las.ply")).unwrap() == std::fs::read(dir.path("copc.ply")).unwrap(),
+        "the COPC file's mesh differs from the LAS file's"
+    );
+    assert!(
+        String::from_utf8_lossy(&std::fs::read(dir.path("copc.ply")).unwrap())
+            .contains("UTM zone 33N"),
+        "the COPC file's CRS is carried to the mesh"
+    );
+    // laspy reads the COPC file on its own: our mesh is within the bound of its points.
+    let script = "import laspy, numpy as np\n\
+         las = laspy.read('p.copc.laz')\n\
+         keep = (np.asarray(las.classification) == 2) & ~np.asarray(las.withheld, dtype=bool)\n\
+         np.savetxt('copc.csv', np.column_stack([las.x[keep], las.y[keep], las.z[keep]]), fmt='%.3f', delimiter=',')\n\
+         print(int(keep.sum()))";
+    let o = std::process::Command::new(&python)
+        .args(["-c", script])
+        .current_dir(dir.path(""))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stdout(&o).trim(), kept.to_string());
+    let o = dir.run(&["verify", "copc.csv", "copc.ply", "--max-error", "0.03"]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+}
+
 /// Runs `mesh` on `input` and checks the failure: non-zero exit, the file and `problem`
 /// named, and no output left beside the input.
 fn refused(dir: &Dir, input: &str, problem: &str) {

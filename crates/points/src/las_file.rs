@@ -28,7 +28,7 @@ pub(crate) fn read_las(path: &Path, options: &ReadOptions) -> Result<PointCloud>
     let declared = header.number_of_points();
     let format = *header.point_format();
     let transforms = *header.transforms();
-    let crs = file_crs(&header);
+    let crs = file_crs(&crs_records(path, &header).unwrap_or_else(|_| header.clone()));
     let mut data = las::PointDataBuilder::new().for_header(&header).build();
     let (mut raw, mut z, mut class) = (Vec::new(), Vec::new(), Vec::new());
     let mut read = 0u64;
@@ -184,6 +184,27 @@ fn check_point_count(path: &Path) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// A header holding every CRS-bearing record of the file: its VLRs and all its EVLRs.
+/// The `las` crate keeps only the first EVLR, while COPC writers put the hierarchy there
+/// and the WKT after it (copclib does), so the others are read here. Unreadable records
+/// count as none, as everywhere in the CRS lookup.
+fn crs_records(path: &Path, header: &las::Header) -> las::Result<las::Header> {
+    use std::io::{BufReader, Seek, SeekFrom};
+    let mut file = BufReader::new(std::fs::File::open(path)?);
+    let raw = las::raw::Header::read_from(&mut file)?;
+    let Some(evlr) = raw.evlr.filter(|e| e.number_of_evlrs > 1) else {
+        return Ok(header.clone());
+    };
+    let _ = file.seek(SeekFrom::Start(evlr.start_of_first_evlr))?;
+    let mut builder = las::Builder::from((1, 4));
+    builder.vlrs = header.vlrs().clone();
+    for _ in 0..evlr.number_of_evlrs {
+        let record = las::raw::Vlr::read_from(&mut file, true)?;
+        builder.evlrs.push(las::Vlr::new(record));
+    }
+    builder.into_header()
 }
 
 /// The CRS the header's VLRs declare (unreadable CRS records count as none).

@@ -151,6 +151,13 @@ pub struct TilesArgs {
     /// (0), or a polygon layer of water.
     #[arg(long, value_name = "SOURCE")]
     pub water: Option<String>,
+    /// A raster under INPUT (several: a VRT of them), read where INPUT has no valid
+    /// sample: beyond it and at its nodata. It adds its extent to the pyramid down to its
+    /// own level (where the tile sample spacing reaches its resolution); finer levels
+    /// cover INPUT's extent only. Its heights are above --vertical-datum, else its own
+    /// vertical CRS.
+    #[arg(long, value_name = "RASTER")]
+    pub base: Option<PathBuf>,
     /// Only the raster's data: no triangles beyond it, no root tile it does not reach
     /// (a layer to draw over another pyramid). Without it, the globe beyond the raster is
     /// flat at height 0 (the ellipsoid) and every root tile is written, so that a client
@@ -334,6 +341,7 @@ impl TilesArgs {
             whole_globe: !self.data_only,
             format: self.format,
             tiling: self.tiling.into(),
+            base: None,
         }
     }
 }

@@ -8,6 +8,7 @@
 //! can be written as 3D Tiles 1.1 terrain instead ([`TileFormat::ThreeDTiles`]: one GLB per
 //! tile, [`GlbTile`], implicit subtrees and `tileset.json`).
 
+mod base;
 mod blocks;
 mod budget;
 mod error;
@@ -26,6 +27,7 @@ mod tms;
 mod water;
 mod writer;
 
+pub use base::BaseRaster;
 pub use budget::LEVEL_ZERO_ERROR;
 pub use error::{TerrainError, TerrainResult};
 pub use glb_tile::{GlbTile, TileBounds, TILE_EDGES_EXTENSION};

@@ -4,9 +4,11 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
+use std::process::Command;
+
 use crate::tiles::{
-    all_files, ascii_grid, check_shared_edges, check_tile, decode_pyramid, layer_json, max_error,
-    stacked_gdal_samples, Tile, Tiling,
+    all_files, ascii_grid, check_shared_edges, check_tile, decode_pyramid, egm96_undulations,
+    layer_json, max_error, stacked_gdal_samples, Tile, Tiling,
 };
 use crate::util::{assert_fails_naming, stderr, Dir};
 
@@ -169,21 +171,79 @@ fn a_base_fills_the_pyramid_around_the_input_within_the_bound_and_stitched() {
     for (&(z, x, y), t) in tiles.range((BASE_LEVEL, 0, 0)..) {
         let bound = 0.1 * Tiling::Geographic.level_error(z);
         let mut samples = stacked_gdal_samples(&dir, &[&low, &high], Tiling::Geographic, z, x, y);
-        let [west, south, east, north] = Tiling::Geographic.rectangle(z, x, y);
-        let n = samples.len() - 1;
-        for (j, row) in samples.iter_mut().enumerate() {
-            let lat = south + (north - south) * j as f64 / n as f64;
-            for (i, s) in row.iter_mut().enumerate() {
-                if near_the_rim(west + (east - west) * i as f64 / n as f64, lat) {
-                    *s = f64::NAN;
-                }
-            }
-        }
+        skip_the_rim(&mut samples, z, x, y);
         let e = max_error(t, &samples);
         assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
         checked += 1;
     }
     assert!(checked > 10, "{checked}");
+}
+
+/// Sets the samples of tile `z/x/y`'s lattice near the input's hole's rim to NaN (see
+/// [`near_the_rim`]).
+fn skip_the_rim(samples: &mut [Vec<f64>], z: u32, x: u32, y: u32) {
+    let [west, south, east, north] = Tiling::Geographic.rectangle(z, x, y);
+    let n = samples.len() - 1;
+    for (j, row) in samples.iter_mut().enumerate() {
+        let lat = south + (north - south) * j as f64 / n as f64;
+        for (i, s) in row.iter_mut().enumerate() {
+            if near_the_rim(west + (east - west) * i as f64 / n as f64, lat) {
+                *s = f64::NAN;
+            }
+        }
+    }
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn each_raster_is_shifted_by_its_own_vertical_datum() {
+    // The base declares EGM96 heights (about 47 m above the ellipsoid here), the input no
+    // vertical CRS: the base's samples are shifted, the input's are not.
+    let dir = Dir::new();
+    let (low, high) = inputs(&dir);
+    let declared = dir.path("low_egm96.tif").to_string_lossy().into_owned();
+    let status = Command::new("gdal_translate")
+        .args(["-q", "-a_srs", "EPSG:4326+5773", &low, &declared])
+        .status()
+        .expect("gdal_translate runs");
+    assert!(status.success());
+    let o = dir.run(&[
+        "tiles",
+        &high,
+        "--base",
+        &declared,
+        "-o",
+        "p",
+        "--quality",
+        "0.005",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("low_egm96.tif: heights above egm96"), "{err}");
+    assert!(err.contains("high.asc: no vertical CRS"), "{err}");
+    let tiles = decode_pyramid(&dir.path("p"));
+    let (mut base_samples, mut input_samples) = (0, 0);
+    for (&(z, x, y), t) in tiles.range((BASE_LEVEL, 0, 0)..) {
+        let bound = 0.005 * Tiling::Geographic.level_error(z);
+        let mut samples = stacked_gdal_samples(&dir, &[&low, &high], Tiling::Geographic, z, x, y);
+        let input = stacked_gdal_samples(&dir, &[&high], Tiling::Geographic, z, x, y);
+        let n = egm96_undulations(z, x, y);
+        for ((row, input_row), n_row) in samples.iter_mut().zip(&input).zip(&n) {
+            for ((s, i), n) in row.iter_mut().zip(input_row).zip(n_row) {
+                if i.is_nan() && s.is_finite() {
+                    assert!(*n > 2.0 * bound, "{z}/{x}/{y}: the geoid must matter");
+                    *s += n;
+                    base_samples += 1;
+                } else if i.is_finite() {
+                    input_samples += 1;
+                }
+            }
+        }
+        skip_the_rim(&mut samples, z, x, y);
+        let e = max_error(t, &samples);
+        assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
+    }
+    assert!(base_samples > 0 && input_samples > 0);
 }
 
 #[test]

@@ -1156,6 +1156,7 @@ mod tests {
     use super::*;
     use crate::layer::{metadata_json, rectangles};
     use crate::quantized_mesh::QUANTIZED_MAX;
+    use crate::stream::Warp;
     use crate::tms::{max_edge_length, EARTH_RADIUS, U_PER_CELL};
     use crate::LEVEL_ZERO_ERROR;
     use std::collections::BTreeSet;

@@ -140,10 +140,10 @@ pub struct TilesArgs {
     /// Band to read (1-based).
     #[arg(long, default_value_t = 1)]
     pub band: usize,
-    /// What INPUT's heights are above: egm96, egm2008 or a geoid grid file (heights are
-    /// turned into the ellipsoidal heights CesiumJS draws, through PROJ), or ellipsoid
-    /// (used as they are). Default: INPUT's own vertical CRS, else the ellipsoid, with a
-    /// note.
+    /// What INPUT's (and --base's) heights are above: egm96, egm2008 or a geoid grid file
+    /// (heights are turned into the ellipsoidal heights CesiumJS draws, through PROJ), or
+    /// ellipsoid (used as they are). Default: each raster's own vertical CRS, else the
+    /// ellipsoid, with a note.
     #[arg(long, value_name = "DATUM")]
     pub vertical_datum: Option<String>,
     /// Add the water mask extension (CesiumJS's requestWaterMask): `sea-level` (INPUT's
@@ -159,9 +159,10 @@ pub struct TilesArgs {
     #[arg(long, value_name = "RASTER")]
     pub base: Option<PathBuf>,
     /// Only the raster's data: no triangles beyond it, no root tile it does not reach
-    /// (a layer to draw over another pyramid). Without it, the globe beyond the raster is
-    /// flat at height 0 (the ellipsoid) and every root tile is written, so that a client
-    /// shows the whole globe with the data on it.
+    /// (a layer to draw over another pyramid). Without it, the globe beyond the raster
+    /// (and --base) is flat at height 0 on the ellipsoid, whatever --vertical-datum, and
+    /// every root tile is written, so that a client shows the whole globe with the data
+    /// on it.
     #[arg(long)]
     pub data_only: bool,
     /// How tiles divide the globe (layer.json's projection).

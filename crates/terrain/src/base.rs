@@ -28,13 +28,21 @@ pub struct BaseRaster {
 /// does ([`Warp`]).
 pub(super) struct Stacked<'a> {
     /// By priority, the input first.
-    pub(super) layers: Vec<Warp<'a>>,
+    layers: Vec<Warp<'a>>,
+    /// With a base: the input's extent widened by a margin (west, south, east, north),
+    /// beyond which it has no sample, so that it is not sampled there: a global base's
+    /// coarse levels would otherwise transform every point of the globe into the input's
+    /// CRS.
+    reach: Option<[f64; 4]>,
 }
 
 impl<'a> Stacked<'a> {
     /// `input` over `options.base` (when given); points beyond every layer get
     /// [`TerrainOptions::outside`].
-    pub(super) fn new(input: &'a Path, options: &'a TerrainOptions) -> Stacked<'a> {
+    ///
+    /// # Errors
+    /// As [`tinsmith_raster::geographic_bounds`] of `input`.
+    pub(super) fn new(input: &'a Path, options: &'a TerrainOptions) -> TerrainResult<Stacked<'a>> {
         let outside = options.outside();
         let mut layers = vec![Warp {
             path: input,
@@ -42,6 +50,7 @@ impl<'a> Stacked<'a> {
             datum: &options.vertical_datum,
             outside,
         }];
+        let mut reach = None;
         if let Some(base) = &options.base {
             layers[0].outside = f32::NAN;
             layers.push(Warp {
@@ -50,8 +59,55 @@ impl<'a> Stacked<'a> {
                 datum: &base.vertical_datum,
                 outside,
             });
+            // The extent's edges are densified, so a point within the input's pixel edges
+            // is within a small fraction of it: a hundredth of its span and ten samples
+            // is far more than curved edges between densified points depart from it.
+            let b = tinsmith_raster::geographic_bounds(input, options.band)?;
+            let margin = |span: f64| span / 100.0 + 10.0 * b.resolution;
+            let (dx, dy) = (margin(b.east - b.west), margin(b.north - b.south));
+            reach = Some([b.west - dx, b.south - dy, b.east + dx, b.north + dy]);
         }
-        Stacked { layers }
+        Ok(Stacked { layers, reach })
+    }
+
+    /// The input's samples at rows `rows`, columns `columns` of `level`: only within its
+    /// reach, NaN beyond.
+    fn input_rows(
+        &self,
+        level: &LevelRows,
+        rows: Range<usize>,
+        columns: Range<usize>,
+    ) -> TerrainResult<Vec<f32>> {
+        let Some([west, south, east, north]) = self.reach else {
+            return self.layers[0].rows(level, rows, columns);
+        };
+        let lattice = level.lattice(rows.clone(), columns.clone());
+        let (width, height) = (columns.len(), rows.len());
+        let span = east - west;
+        let within = |lon: f64| span >= 360.0 || (lon - west).rem_euclid(360.0) <= span;
+        let first_last = |hits: &mut dyn Iterator<Item = usize>| {
+            let first = hits.next()?;
+            Some(first..hits.last().unwrap_or(first) + 1)
+        };
+        let in_columns = first_last(&mut (0..width).filter(|&i| within(lattice.lon(i as u32))));
+        let in_rows = first_last(&mut (0..height).filter(|&j| {
+            let lat = lattice.lat(j as u32);
+            (south..=north).contains(&lat)
+        }));
+        let mut out = vec![f32::NAN; width * height];
+        let (Some(i), Some(j)) = (in_columns, in_rows) else {
+            return Ok(out);
+        };
+        let values = self.layers[0].rows(
+            level,
+            rows.start + j.start..rows.start + j.end,
+            columns.start + i.start..columns.start + i.end,
+        )?;
+        for (k, row) in values.chunks_exact(i.len()).enumerate() {
+            let start = (j.start + k) * width + i.start;
+            out[start..start + i.len()].copy_from_slice(row);
+        }
+        Ok(out)
     }
 }
 
@@ -63,7 +119,7 @@ impl RowSource for Stacked<'_> {
         columns: Range<usize>,
     ) -> TerrainResult<Vec<f32>> {
         let width = columns.len();
-        let mut out = self.layers[0].rows(level, rows.clone(), columns.clone())?;
+        let mut out = self.input_rows(level, rows.clone(), columns.clone())?;
         for layer in &self.layers[1..] {
             // Only the smallest window holding every sample still missing is sampled.
             let missing = out.iter().enumerate().filter(|(_, v)| v.is_nan());

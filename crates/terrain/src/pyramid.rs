@@ -63,9 +63,10 @@ pub struct TerrainOptions {
     pub vertical_datum: tinsmith_raster::VerticalDatum,
     /// Add the water mask extension (2) from this source.
     pub water: Option<crate::Water>,
-    /// Draw the whole globe: the globe beyond the raster is flat at height 0 (the
-    /// ellipsoid), every tile the raster reaches covers its whole rectangle, and both
-    /// root tiles are written, so that a client shows a globe with the data on it.
+    /// Draw the whole globe: the globe beyond the raster (and the base) is flat at height
+    /// 0 on the ellipsoid, whatever `vertical_datum` (not on the geoid, which is up to
+    /// about 100 m from it), every tile the raster reaches covers its whole rectangle, and
+    /// both root tiles are written, so that a client shows a globe with the data on it.
     /// Without it, tiles have no triangles beyond the raster.
     pub whole_globe: bool,
     /// How tiles are encoded and laid out. Part of every tile's identity.
@@ -374,7 +375,7 @@ fn build_into(
         max_zoom,
         fine,
     } = prepared;
-    let source = Stacked::new(input, options);
+    let source = Stacked::new(input, options)?;
     let cut = Cut::coarsest(options.tiling, own_level);
     let pool = worker_pool(
         &bounds,

@@ -171,7 +171,7 @@ fn a_base_fills_the_pyramid_around_the_input_within_the_bound_and_stitched() {
     for (&(z, x, y), t) in tiles.range((BASE_LEVEL, 0, 0)..) {
         let bound = 0.1 * Tiling::Geographic.level_error(z);
         let mut samples = stacked_gdal_samples(&dir, &[&low, &high], Tiling::Geographic, z, x, y);
-        skip_the_rim(&mut samples, z, x, y);
+        skip_the_rim(&mut samples, Tiling::Geographic, z, x, y);
         let e = max_error(t, &samples);
         assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
         checked += 1;
@@ -181,10 +181,11 @@ fn a_base_fills_the_pyramid_around_the_input_within_the_bound_and_stitched() {
 
 /// Sets the samples of tile `z/x/y`'s lattice near the input's hole's rim to NaN (see
 /// [`near_the_rim`]).
-fn skip_the_rim(samples: &mut [Vec<f64>], z: u32, x: u32, y: u32) {
-    let [west, south, east, north] = Tiling::Geographic.rectangle(z, x, y);
+fn skip_the_rim(samples: &mut [Vec<f64>], tiling: Tiling, z: u32, x: u32, y: u32) {
+    let [west, south, east, north] = tiling.rectangle(z, x, y);
     let n = samples.len() - 1;
     for (j, row) in samples.iter_mut().enumerate() {
+        // Web Mercator rows are even in latitude inside a tile, as the test lattice is.
         let lat = south + (north - south) * j as f64 / n as f64;
         for (i, s) in row.iter_mut().enumerate() {
             if near_the_rim(west + (east - west) * i as f64 / n as f64, lat) {
@@ -239,11 +240,57 @@ fn each_raster_is_shifted_by_its_own_vertical_datum() {
                 }
             }
         }
-        skip_the_rim(&mut samples, z, x, y);
+        skip_the_rim(&mut samples, Tiling::Geographic, z, x, y);
         let e = max_error(t, &samples);
         assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
     }
     assert!(base_samples > 0 && input_samples > 0);
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn a_base_works_in_web_mercator_and_as_3d_tiles() {
+    let dir = Dir::new();
+    let (low, high) = inputs(&dir);
+    let run = |out: &str, extra: &[&str]| {
+        let mut args = vec!["tiles", &high, "--base", &low, "-o", out, "-q"];
+        args.extend_from_slice(&["--vertical-datum", "ellipsoid"]);
+        args.extend_from_slice(extra);
+        let o = dir.run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    run("mercator", &["--tiling", "mercator", "--quality", "0.1"]);
+    let tiles = decode_pyramid(&dir.path("mercator"));
+    let (layer, _) = layer_json(&dir.path("mercator"));
+    assert_eq!(layer["projection"], "EPSG:3857");
+    let max_zoom = layer["maxzoom"].as_u64().unwrap() as u32;
+    for (&key, t) in &tiles {
+        check_tile(key, t);
+    }
+    assert!(check_shared_edges(&tiles) > 0);
+    let mut checked = 0;
+    for (&(z, x, y), t) in tiles.range((max_zoom, 0, 0)..) {
+        let bound = 0.1 * Tiling::Mercator.level_error(z);
+        let mut samples = stacked_gdal_samples(&dir, &[&low, &high], Tiling::Mercator, z, x, y);
+        skip_the_rim(&mut samples, Tiling::Mercator, z, x, y);
+        let e = max_error(t, &samples);
+        assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
+        checked += 1;
+    }
+    assert!(checked > 0);
+
+    // 3D Tiles: one GLB for each tile the quantized-mesh pyramid writes.
+    run("qm", &[]);
+    run("3d", &["--format", "3dtiles"]);
+    let count = |root: &str, extension: &str| {
+        all_files(&dir.path(root))
+            .keys()
+            .filter(|p| p.extension().is_some_and(|e| e == extension))
+            .count()
+    };
+    assert!(dir.path("3d").join("tileset.json").exists());
+    assert_eq!(count("3d", "glb"), count("qm", "terrain"));
+    assert!(count("qm", "terrain") > 20);
 }
 
 #[test]

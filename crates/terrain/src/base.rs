@@ -161,7 +161,10 @@ pub(super) fn union(a: &GeoBounds, b: &GeoBounds) -> GeoBounds {
     let (west, east) = if width >= 360.0 {
         (-180.0, 180.0)
     } else {
-        (a.west.min(b.west + k), a.east.max(b.east + k))
+        // West in -180..180, as `geographic_bounds` gives it (east then past 180).
+        let west = a.west.min(b.west + k);
+        let turns = ((west + 180.0) / 360.0).floor() * 360.0;
+        (west - turns, a.east.max(b.east + k) - turns)
     };
     GeoBounds {
         west,
@@ -214,6 +217,8 @@ mod tests {
         assert_eq!((u.west, u.east), (-5.0, 20.0));
         // Across the antimeridian: 170..190 and -175..-160 meet east of 180.
         let u = union(&bounds(170.0, 190.0), &bounds(-175.0, -160.0));
+        assert_eq!((u.west, u.east), (170.0, 200.0));
+        let u = union(&bounds(-175.0, -160.0), &bounds(170.0, 190.0));
         assert_eq!((u.west, u.east), (170.0, 200.0));
         let u = union(&bounds(-180.0, 180.0), &bounds(10.0, 20.0));
         assert_eq!((u.west, u.east), (-180.0, 180.0));

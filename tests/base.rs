@@ -294,6 +294,32 @@ fn a_base_works_in_web_mercator_and_as_3d_tiles() {
 }
 
 #[test]
+fn a_tile_over_a_base_does_not_depend_on_the_zoom_range_or_the_threads() {
+    let dir = Dir::new();
+    let (low, high) = inputs(&dir);
+    let run = |out: &str, extra: &[&str]| {
+        let mut args = vec!["tiles", &high, "--base", &low, "-o", out, "-q"];
+        args.extend_from_slice(&["--vertical-datum", "ellipsoid", "--normals"]);
+        args.extend_from_slice(extra);
+        let o = dir.run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        all_files(&dir.path(out))
+            .into_iter()
+            .filter(|(p, _)| p.extension().is_some_and(|e| e == "terrain"))
+            .collect::<BTreeMap<_, _>>()
+    };
+    let all = run("all", &["--threads", "2"]);
+    let some = run(
+        "some",
+        &["--min-zoom", "3", "--max-zoom", "6", "--threads", "1"],
+    );
+    assert!(some.len() > 5 && some.len() < all.len());
+    for (path, bytes) in &some {
+        assert!(all.get(path) == Some(bytes), "{path:?} differs");
+    }
+}
+
+#[test]
 fn a_base_that_is_missing_not_a_raster_or_not_placed_is_refused_naming_it() {
     let dir = Dir::new();
     let (_, high) = inputs(&dir);

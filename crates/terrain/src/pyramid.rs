@@ -287,6 +287,9 @@ pub struct TerrainReport {
 ///   each sample from its position alone), each coarser level is the finer one filtered
 ///   (binomial 5 x 5) and halved (Web Mercator: filtered from the finer rows resampled
 ///   in latitude, see [`Tiling::Mercator`]), and each finer level is sampled alone.
+///   With [`TerrainOptions::base`], each lattice point is the input's sample where valid,
+///   else the base's; the base's own level is the anchor, over both rasters' extent, and
+///   the finer levels cover the input's extent only.
 /// - **Bound.** At every valid sample of a tile's grid (its `(TILE_CELLS + 1)^2` lattice
 ///   points of its level), the decoded tile (float32 min/max, 16-bit heights) is within
 ///   `quality x e(level)` of the sample, or within half the level's height quantum and

@@ -28,7 +28,8 @@ PICTURES = [("bigtujunga", 30.0, 800), ("fuji", 20.0, 560)]
 # (name, DEM under ../shared/data, terrain directory, camera: lon, lat, height m, heading,
 # pitch, vertical exaggeration; variant: none, "below-0" for a water mask of the DEM's
 # samples below 0 m, "data-only" for `--data-only`, "mercator" for `--tiling mercator`, or
-# "3dtiles" for `--format 3dtiles`, loaded through Cesium3DTilesTerrainProvider)
+# "3dtiles" for `--format 3dtiles`, loaded through Cesium3DTilesTerrainProvider, or "base"
+# for `--base` ETOPO5)
 CESIUM = [
     ("cesium-global", "dem/etopo5_global_5arcmin.tif", "etopo5",
      (85, 25, 11_000_000, 0, -90, 20), None),
@@ -50,6 +51,10 @@ CESIUM = [
      (85, 25, 11_000_000, 0, -90, 20), "mercator"),
     ("cesium-mercator-close", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga-mercator",
      (-118.19, 34.16, 9_000, 20, -30, 1), "mercator"),
+    ("cesium-base-globe", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga-base",
+     (-118.19, 34.16, 15_000_000, 0, -90, 20), "base"),
+    ("cesium-base-60km", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga-base",
+     (-118.19, 34.16, 60_000, 20, -60, 1), "base"),
 ]
 PAGE = ("<!doctype html><html><head><link rel=\"icon\" href=\"data:,\">"
         "<script>window.CESIUM_BASE_URL = '/cesium/';</script>"
@@ -133,7 +138,8 @@ def cesium_pictures(args, data, out, tmp):
             continue
         built.add(terrain)
         extra = {"data-only": ["--data-only"], "mercator": ["--tiling", "mercator"],
-                 "3dtiles": ["--format", "3dtiles"]}.get(variant, [])
+                 "3dtiles": ["--format", "3dtiles"],
+                 "base": ["--base", data / "dem/etopo5_global_5arcmin.tif"]}.get(variant, [])
         if variant == "below-0":
             # 255 (water) where the DEM is below 0 m, 0 elsewhere: -scale maps 0 m to 0
             # and -1 m to 255, and Byte clips the rest.
@@ -205,6 +211,16 @@ def cesium_pictures(args, data, out, tmp):
         "|---|---|",
         "| ![ETOPO5 in Web Mercator tiles](images/cesium-mercator-global.png) "
         "| ![Big Tujunga in Web Mercator tiles](images/cesium-mercator-close.png) |",
+        "",
+        "Big Tujunga over ETOPO5 (`--base`): from 15,000 km (heights exaggerated 20 x) the "
+        "globe is ETOPO5's; 60 km up, at the camera of the quantized-mesh picture above, the "
+        "ground around the raster is ETOPO5's slopes instead of the flat globe at 0 m, with a "
+        "step at the raster's edge where ETOPO5's 9 km samples meet its 30 m ones.",
+        "",
+        "| Big Tujunga `--base` ETOPO5, the globe | the same, 60 km |",
+        "|---|---|",
+        "| ![the globe from the base](images/cesium-base-globe.png) "
+        "| ![the base around the raster](images/cesium-base-60km.png) |",
         "",
     ]
 

@@ -3,6 +3,7 @@
 mod util;
 
 mod bad_input;
+mod base;
 mod breaklines;
 mod cesium;
 mod cli_reference;

@@ -115,7 +115,7 @@ pub(crate) fn decode_pyramid(dir: &Path) -> BTreeMap<(u32, u32, u32), Tile> {
 
 /// Spec checks on one tile: ranges, counter-clockwise triangles, vertices on the tile's
 /// sample lattice, edge lists = border vertices.
-fn check_tile(key: (u32, u32, u32), t: &Tile) {
+pub(crate) fn check_tile(key: (u32, u32, u32), t: &Tile) {
     let n = t.u.len();
     assert!(n >= 3 && !t.triangles.is_empty(), "{key:?} is empty");
     for i in 0..n {
@@ -193,7 +193,7 @@ fn edge_segments(t: &Tile, side: usize) -> Vec<(i64, i64)> {
 /// heights agree; where their triangles both reach the edge, they end at the same
 /// vertices (no T-junction: no vertex of one inside a border segment of the other). A
 /// vertex only one side has lies where the other has no data.
-fn check_shared_edges(tiles: &BTreeMap<(u32, u32, u32), Tile>) -> usize {
+pub(crate) fn check_shared_edges(tiles: &BTreeMap<(u32, u32, u32), Tile>) -> usize {
     let mut shared = 0;
     for (&(z, x, y), t) in tiles {
         for (dx, dy, mine, theirs) in [(1, 0, 2, 0), (0, 1, 3, 1)] {
@@ -328,6 +328,37 @@ pub(crate) fn tiled_gdal_samples(
     x: u32,
     y: u32,
 ) -> Vec<Vec<f64>> {
+    warped_samples(dir, &[input], &[], tiling, z, x, y)
+}
+
+/// As [`tiled_gdal_samples`], of several `inputs` warped in turn into the one lattice:
+/// each input's valid samples over those of the inputs before it (the last wins). The
+/// bilinear kernel is not widened where the lattice is coarser than an input (`-wo
+/// XSCALE=1`): each point interpolated between the four pixel centres around it, as
+/// tinsmith samples the levels from the base's own down.
+pub(crate) fn stacked_gdal_samples(
+    dir: &Dir,
+    inputs: &[&str],
+    tiling: Tiling,
+    z: u32,
+    x: u32,
+    y: u32,
+) -> Vec<Vec<f64>> {
+    let point = ["-wo", "XSCALE=1", "-wo", "YSCALE=1"];
+    warped_samples(dir, inputs, &point, tiling, z, x, y)
+}
+
+/// `inputs` warped by gdalwarp (bilinear, with `extra` options) into the lattice of tile
+/// `z/x/y`, row 0 the southernmost.
+fn warped_samples(
+    dir: &Dir,
+    inputs: &[&str],
+    extra: &[&str],
+    tiling: Tiling,
+    z: u32,
+    x: u32,
+    y: u32,
+) -> Vec<Vec<f64>> {
     let [west, south, east, north] = tiling.rectangle(z, x, y);
     let (dx, dy) = ((east - west) / CELLS as f64, (north - south) / CELLS as f64);
     let out = dir.path(&format!("warp_{}_{z}_{x}_{y}.asc", tiling.arg()));
@@ -354,7 +385,9 @@ pub(crate) fn tiled_gdal_samples(
             ]
             .map(|v| format!("{v:.17}")),
         )
-        .args(["-ts", "218", "218", input])
+        .args(["-ts", "218", "218"])
+        .args(extra)
+        .args(inputs)
         .arg(&out)
         .status()
         .expect("gdalwarp runs");
@@ -392,7 +425,7 @@ fn pyramid(dir: &Dir, input: &str, out: &str, extra: &[&str]) {
 }
 
 /// `DIR/layer.json` of a pyramid, and its `bounds` as numbers.
-fn layer_json(root: &Path) -> (Value, Vec<f64>) {
+pub(crate) fn layer_json(root: &Path) -> (Value, Vec<f64>) {
     let layer: Value =
         serde_json::from_slice(&std::fs::read(root.join("layer.json")).unwrap()).unwrap();
     let bounds = layer["bounds"]

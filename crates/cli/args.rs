@@ -140,10 +140,10 @@ pub struct TilesArgs {
     /// Band to read (1-based).
     #[arg(long, default_value_t = 1)]
     pub band: usize,
-    /// What INPUT's heights are above: egm96, egm2008 or a geoid grid file (heights are
-    /// turned into the ellipsoidal heights CesiumJS draws, through PROJ), or ellipsoid
-    /// (used as they are). Default: INPUT's own vertical CRS, else the ellipsoid, with a
-    /// note.
+    /// What INPUT's (and --base's) heights are above: egm96, egm2008 or a geoid grid file
+    /// (heights are turned into the ellipsoidal heights CesiumJS draws, through PROJ), or
+    /// ellipsoid (used as they are). Default: each raster's own vertical CRS, else the
+    /// ellipsoid, with a note.
     #[arg(long, value_name = "DATUM")]
     pub vertical_datum: Option<String>,
     /// Add the water mask extension (CesiumJS's requestWaterMask): `sea-level` (INPUT's
@@ -151,10 +151,18 @@ pub struct TilesArgs {
     /// (0), or a polygon layer of water.
     #[arg(long, value_name = "SOURCE")]
     pub water: Option<String>,
+    /// A raster under INPUT (several: a VRT of them), read where INPUT has no valid
+    /// sample: beyond it and at its nodata. It adds its extent to the pyramid down to its
+    /// own level (where the tile sample spacing reaches its resolution); finer levels
+    /// cover INPUT's extent only. Its heights are above --vertical-datum, else its own
+    /// vertical CRS.
+    #[arg(long, value_name = "RASTER")]
+    pub base: Option<PathBuf>,
     /// Only the raster's data: no triangles beyond it, no root tile it does not reach
-    /// (a layer to draw over another pyramid). Without it, the globe beyond the raster is
-    /// flat at height 0 (the ellipsoid) and every root tile is written, so that a client
-    /// shows the whole globe with the data on it.
+    /// (a layer to draw over another pyramid). Without it, the globe beyond the raster
+    /// (and --base) is flat at height 0 on the ellipsoid, whatever --vertical-datum, and
+    /// every root tile is written, so that a client shows the whole globe with the data
+    /// on it.
     #[arg(long)]
     pub data_only: bool,
     /// How tiles divide the globe (layer.json's projection).
@@ -334,6 +342,7 @@ impl TilesArgs {
             whole_globe: !self.data_only,
             format: self.format,
             tiling: self.tiling.into(),
+            base: None,
         }
     }
 }

@@ -38,6 +38,10 @@ pub fn tiles(args: &TilesArgs) -> Result<bool> {
         &feedback,
     )?;
     options.water = tinsmith_pipeline::water_source(input, args.band, args.water.as_deref())?;
+    if let Some(base) = &args.base {
+        let datum = args.vertical_datum.as_deref();
+        options.base = Some(tinsmith_pipeline::base_raster(base, datum, &feedback)?);
+    }
     let report = args.report.as_deref();
     match args.shard {
         Some(shard) => {

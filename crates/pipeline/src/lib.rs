@@ -60,7 +60,7 @@ pub use points::{duplicates_name, is_point_input, points_summary, verify_points_
 pub use preview::{preview, preview_decimated, Previewed, WHOLE_READ_SAMPLES};
 pub use scan::scan_raster;
 pub use serve::{serve, ServeOptions};
-pub use tiles::{merge_tiles, tiles, tiles_shard, vertical_datum, water_source};
+pub use tiles::{base_raster, merge_tiles, tiles, tiles_shard, vertical_datum, water_source};
 pub use tin_input::is_tin_input;
 pub use tinsmith_choices::DecimationChoices;
 pub use tinsmith_georef::readable;

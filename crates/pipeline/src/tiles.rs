@@ -118,6 +118,27 @@ pub fn vertical_datum(
     Ok(datum)
 }
 
+/// The base raster `path` of a pyramid (`tiles --base`), its heights above `choice` or its
+/// own vertical CRS (as [`vertical_datum`] decides), checked to open as a georeferenced
+/// raster before any work.
+///
+/// # Errors
+/// Naming `path`: when it is missing, not a raster, or not georeferenced; as
+/// [`vertical_datum`].
+pub fn base_raster(
+    path: &Path,
+    choice: Option<&str>,
+    feedback: &dyn Feedback,
+) -> Result<tinsmith_terrain::BaseRaster> {
+    let checked = vertical_datum(path, 1, choice, feedback)
+        .and_then(|datum| Ok((datum, tinsmith_raster::geographic_bounds(path, 1)?)));
+    let (vertical_datum, _) = checked.naming_file(path).map_err(|e| e.context("--base"))?;
+    Ok(tinsmith_terrain::BaseRaster {
+        path: path.to_path_buf(),
+        vertical_datum,
+    })
+}
+
 /// Where the water mask of `input`'s pyramid comes from: `sea-level` (`input` itself,
 /// band `band`), a mask raster or a polygon layer, checked to open; `None` without
 /// `choice`.

@@ -6,8 +6,10 @@
 //! so that same-level neighbours keep identical edge vertices, and `layer.json` with the
 //! tiles' availability. The pyramid is staged and moved into place whole. The same tiles
 //! can be written as 3D Tiles 1.1 terrain instead ([`TileFormat::ThreeDTiles`]: one GLB per
-//! tile, [`GlbTile`], implicit subtrees and `tileset.json`).
+//! tile, [`GlbTile`], implicit subtrees and `tileset.json`). A [`BaseRaster`] under the
+//! input fills every lattice point where the input has no valid sample.
 
+mod base;
 mod blocks;
 mod budget;
 mod error;
@@ -26,6 +28,7 @@ mod tms;
 mod water;
 mod writer;
 
+pub use base::BaseRaster;
 pub use budget::LEVEL_ZERO_ERROR;
 pub use error::{TerrainError, TerrainResult};
 pub use glb_tile::{GlbTile, TileBounds, TILE_EDGES_EXTENSION};

@@ -124,6 +124,8 @@ impl TileOptions {
             // Shards are refused for 3D Tiles (see `build_shard`).
             format: crate::TileFormat::QuantizedMesh,
             tiling: self.tiling,
+            // Shards are refused with a base (see `build_shard`).
+            base: None,
         }
     }
 }

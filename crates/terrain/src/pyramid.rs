@@ -8,6 +8,7 @@ use std::path::Path;
 use tinsmith_output::StagedDir;
 use tinsmith_raster::{geographic_bounds, GeoBounds};
 
+use crate::base::Stacked;
 use crate::blocks::{block_level, block_window, blocks, domain, reach_margin, Cut, SplitSamples};
 use crate::budget::LevelBudget;
 use crate::implicit::{subtree_levels, subtrees, tileset_json};
@@ -17,7 +18,7 @@ use crate::records::{
     TopRecord, RECORDS_DIR,
 };
 use crate::rows::LevelRows;
-use crate::stream::{band_tile_rows, stream_levels, RowSource, Warp};
+use crate::stream::{band_tile_rows, stream_levels, RowSource};
 use crate::tms::{bounds_array, TileRect, Tiling, TILE_CELLS};
 use crate::writer::{Scope, TileWriter, Written};
 use crate::{TerrainError, TerrainResult};
@@ -62,9 +63,10 @@ pub struct TerrainOptions {
     pub vertical_datum: tinsmith_raster::VerticalDatum,
     /// Add the water mask extension (2) from this source.
     pub water: Option<crate::Water>,
-    /// Draw the whole globe: the globe beyond the raster is flat at height 0 (the
-    /// ellipsoid), every tile the raster reaches covers its whole rectangle, and both
-    /// root tiles are written, so that a client shows a globe with the data on it.
+    /// Draw the whole globe: the globe beyond the raster (and the base) is flat at height
+    /// 0 on the ellipsoid, whatever `vertical_datum` (not on the geoid, which is up to
+    /// about 100 m from it), every tile the raster reaches covers its whole rectangle, and
+    /// both root tiles are written, so that a client shows a globe with the data on it.
     /// Without it, tiles have no triangles beyond the raster.
     pub whole_globe: bool,
     /// How tiles are encoded and laid out. Part of every tile's identity.
@@ -72,6 +74,10 @@ pub struct TerrainOptions {
     /// How tiles divide the globe. A Web Mercator pyramid tiles the part of the raster
     /// within its latitudes (about ±85.0511°).
     pub tiling: Tiling,
+    /// A raster under the input: its heights wherever the input has no valid sample, and
+    /// its extent added to the pyramid's down to the base's own level; the levels finer
+    /// than that cover the input's extent only. Part of every tile's identity.
+    pub base: Option<crate::BaseRaster>,
 }
 
 /// How a pyramid's tiles are encoded and laid out.
@@ -128,6 +134,7 @@ impl Default for TerrainOptions {
             whole_globe: false,
             format: TileFormat::QuantizedMesh,
             tiling: Tiling::Geographic,
+            base: None,
         }
     }
 }
@@ -280,6 +287,9 @@ pub struct TerrainReport {
 ///   each sample from its position alone), each coarser level is the finer one filtered
 ///   (binomial 5 x 5) and halved (Web Mercator: filtered from the finer rows resampled
 ///   in latitude, see [`Tiling::Mercator`]), and each finer level is sampled alone.
+///   With [`TerrainOptions::base`], each lattice point is the input's sample where valid,
+///   else the base's; the base's own level is the anchor, over both rasters' extent, and
+///   the finer levels cover the input's extent only.
 /// - **Bound.** At every valid sample of a tile's grid (its `(TILE_CELLS + 1)^2` lattice
 ///   points of its level), the decoded tile (float32 min/max, 16-bit heights) is within
 ///   `quality x e(level)` of the sample, or within half the level's height quantum and
@@ -366,13 +376,9 @@ fn build_into(
         bounds,
         own_level,
         max_zoom,
+        fine,
     } = prepared;
-    let source = Warp {
-        path: input,
-        band: options.band,
-        datum: &options.vertical_datum,
-        outside: options.outside(),
-    };
+    let source = Stacked::new(input, options)?;
     let cut = Cut::coarsest(options.tiling, own_level);
     let pool = worker_pool(
         &bounds,
@@ -385,6 +391,7 @@ fn build_into(
     let (written, samples) = build_recorded_blocks(
         &source,
         &bounds,
+        &fine,
         cut,
         max_zoom,
         &all,
@@ -486,18 +493,21 @@ pub(super) fn directory_only(options: &TerrainOptions, destination: &str) -> Ter
 
 /// What every run of a pyramid works out from its input and options first.
 pub(super) struct Prepared {
-    /// The input's extent in EPSG:4326.
+    /// The pyramid's extent in EPSG:4326: the input's, with a base the base's too.
     pub(super) bounds: GeoBounds,
-    /// The raster's own level (the anchor).
+    /// The raster's own level (the anchor); with a base, the base's.
     pub(super) own_level: u8,
     /// The finest level written.
     pub(super) max_zoom: u8,
+    /// The extent of the levels finer than the anchor: the input's.
+    pub(super) fine: GeoBounds,
 }
 
 /// Checks `options` against `input` and works out its bounds and levels; refuses, saying
 /// why, options that make no sense and runs that could not finish (too many tiles, too
 /// much memory, heights beyond float32).
 pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<Prepared> {
+    crate::base::refuse_clashes(options)?;
     if !(options.quality > 0.0 && options.quality <= MAX_QUALITY) {
         return Err(TerrainError::Options(format!(
             "--quality must be a positive number up to {MAX_QUALITY:e}, got {:?}",
@@ -663,21 +673,90 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
             }
         }
     }
+    match &options.base {
+        None => Ok(Prepared {
+            bounds,
+            own_level,
+            max_zoom,
+            fine: bounds,
+        }),
+        Some(base) => prepare_base(base, bounds, max_zoom, threads, options),
+    }
+}
+
+/// The extent and anchor of a pyramid of an input over `fine` (its extent) with `base`
+/// under it: the base's own level is the anchor, over both extents; refuses a base that
+/// is not a raster with valid samples in reach of the tiling, or whose own level over
+/// both extents would need more memory than the run may use.
+fn prepare_base(
+    base: &crate::BaseRaster,
+    fine: GeoBounds,
+    max_zoom: u8,
+    threads: usize,
+    options: &TerrainOptions,
+) -> TerrainResult<Prepared> {
+    let path = &base.path;
+    let mut below = geographic_bounds(path, 1)?;
+    let [south, north] = options.tiling.latitude_range();
+    if below.south >= north || below.north <= south || below.south >= below.north {
+        return Err(TerrainError::Options(format!(
+            "--base {}: the raster lies within latitudes {:.4}..{:.4}, beyond the {:.4}..{:.4} \
+             that --tiling {} covers",
+            path.display(),
+            below.south,
+            below.north,
+            south,
+            north,
+            options.tiling.name(),
+        )));
+    }
+    below.south = below.south.max(south);
+    below.north = below.north.min(north);
+    if !tinsmith_raster::WindowReader::open(path, 1)?.has_valid_cell()? {
+        return Err(TerrainError::Options(format!(
+            "--base {}: band 1 has no 2x2 block of valid samples",
+            path.display(),
+        )));
+    }
+    if tinsmith_raster::heights_may_exceed_f32(path, 1)? {
+        return Err(TerrainError::Options(format!(
+            "--base {}: its heights may be beyond what quantized-mesh tiles can hold (their \
+             height range is stored in f32); give a Float32 or integer copy (gdal_translate \
+             -ot Float32)",
+            path.display()
+        )));
+    }
+    let anchor = own_level(&below, options.tiling);
+    let bounds = crate::base::union(&below, &fine);
+    let need = streaming_bytes(&bounds, options.tiling, anchor, threads);
+    if let Some(limit) = options.memory_limit.filter(|&limit| need > limit) {
+        return Err(TerrainError::Options(format!(
+            "--base {}: its own level {anchor}, which the levels up to it are filtered from, \
+             would need about {:.1} GB in memory over the pyramid's extent (its tile rows span \
+             {} tiles) and {:.1} GB is available; make a coarser copy of it (gdalwarp -tr)",
+            path.display(),
+            need as f64 / 1e9,
+            domain(&bounds, options.tiling, anchor).width,
+            limit as f64 / 1e9,
+        )));
+    }
     Ok(Prepared {
         bounds,
-        own_level,
+        own_level: anchor,
         max_zoom,
+        fine,
     })
 }
 
 /// Builds every tile of `block` (a tile of `cut.split`) and of the levels under it down
-/// to `max_zoom`, writing them under `out_dir`; returns what was written and the block's
-/// samples at the split level when it has any valid one (what the levels above are
-/// filtered from).
+/// to `max_zoom` (those finer than the anchor only within `fine`), writing them under
+/// `out_dir`; returns what was written and the block's samples at the split level when it
+/// has any valid one (what the levels above are filtered from).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn build_block(
     source: &dyn RowSource,
     bounds: &GeoBounds,
+    fine: &GeoBounds,
     cut: Cut,
     max_zoom: u8,
     block: TileRect,
@@ -692,27 +771,55 @@ pub(super) fn build_block(
         under: Some(block),
     };
     let mut writer = TileWriter::new(scope, max_zoom, Vec::new(), known, store, options, pool);
-    let band = |z: u8| band_rows.unwrap_or_else(|| band_tile_rows(block_window(bounds, block, z)));
+    let band = |over: &GeoBounds, z: u8| {
+        band_rows.unwrap_or_else(|| band_tile_rows(block_window(over, block, z)))
+    };
     // Levels finer than the anchor first, each sampled alone; then the anchor and the
     // levels filtered from it, down to the block's own.
     for z in (cut.anchor + 1..=max_zoom).rev() {
+        if !meets(block, domain(fine, cut.tiling, z)) {
+            continue;
+        }
         let level = |z: u8| {
-            block_level(bounds, block, z, reach_margin(cut.tiling, z, z))
+            block_level(fine, block, z, reach_margin(cut.tiling, z, z))
                 .filled_with(options.outside())
         };
-        stream_levels(source, &level, (z, z), band(z), pool, &mut writer)?;
+        stream_levels(source, &level, (z, z), band(fine, z), pool, &mut writer)?;
     }
     let level = |z: u8| {
         block_level(bounds, block, z, reach_margin(cut.tiling, cut.split, z))
             .filled_with(options.outside())
     };
     let zooms = (cut.split, cut.anchor);
-    stream_levels(source, &level, zooms, band(cut.anchor), pool, &mut writer)?;
+    stream_levels(
+        source,
+        &level,
+        zooms,
+        band(bounds, cut.anchor),
+        pool,
+        &mut writer,
+    )?;
     let samples = writer
         .block_samples
         .take()
         .filter(|values| values.iter().any(|v| v.is_finite()));
     Ok((writer.finish(), samples))
+}
+
+/// Whether any tile under `block` lies in `rect` (a finer level's), round the globe.
+fn meets(block: TileRect, rect: TileRect) -> bool {
+    let f = rect.level - block.level;
+    let turn = block.tiling.columns(rect.level) as i64;
+    let (x0, x1) = (
+        i64::from(block.x0) << f,
+        i64::from(block.x0 + block.width) << f,
+    );
+    let (y0, y1) = (block.y0 << f, (block.y0 + block.height) << f);
+    let (d0, d1) = (i64::from(rect.x0), i64::from(rect.x0 + rect.width));
+    let columns = [-1, 0, 1]
+        .iter()
+        .any(|k| x0 + k * turn < d1 && d0 < x1 + k * turn);
+    columns && y0 < rect.y0 + rect.height && rect.y0 < y1
 }
 
 /// The worker pool of a pyramid whose finest streamed level over `bounds` is `finest`.
@@ -827,6 +934,7 @@ pub(super) fn build_top(
 pub(super) fn build_recorded_blocks(
     source: &dyn RowSource,
     bounds: &GeoBounds,
+    fine: &GeoBounds,
     cut: Cut,
     max_zoom: u8,
     blocks: &[TileRect],
@@ -841,7 +949,7 @@ pub(super) fn build_recorded_blocks(
     let key = options_key(options);
     for (k, &block) in blocks.iter().enumerate() {
         let (built, values) = build_block(
-            source, bounds, cut, max_zoom, block, None, store, options, pool, known,
+            source, bounds, fine, cut, max_zoom, block, None, store, options, pool, known,
         )?;
         let id = [cut.tiling.tile_column(cut.split, block.x0), block.y0];
         let name = block_name(cut.split, id);
@@ -1052,6 +1160,7 @@ mod tests {
     use super::*;
     use crate::layer::{metadata_json, rectangles};
     use crate::quantized_mesh::QUANTIZED_MAX;
+    use crate::stream::Warp;
     use crate::tms::{max_edge_length, EARTH_RADIUS, U_PER_CELL};
     use crate::LEVEL_ZERO_ERROR;
     use std::collections::BTreeSet;
@@ -1266,6 +1375,7 @@ mod tests {
         for block in blocks(bounds, cut) {
             let (built, values) = build_block(
                 source,
+                bounds,
                 bounds,
                 cut,
                 max_zoom,

@@ -80,6 +80,10 @@ pub(super) fn options_key(options: &TerrainOptions) -> String {
     if options.whole_globe {
         text["whole_globe"] = true.into();
     }
+    if let Some(base) = &options.base {
+        text["base"] = base.path.to_string_lossy().into();
+        text["base_vertical_datum"] = base.vertical_datum.label().into();
+    }
     if options.format != crate::TileFormat::QuantizedMesh {
         text["tile_format"] = options.format.label().into();
     }

@@ -75,10 +75,18 @@ pub fn build_shard(
 ) -> TerrainResult<ShardReport> {
     let start = std::time::Instant::now();
     crate::pyramid::directory_only(options, &dest.location())?;
+    if options.base.is_some() {
+        return Err(TerrainError::Options(
+            "--shard cannot be combined with --base yet: a shard's plan weighs its blocks by \
+             the input's samples alone; build the pyramid in one run"
+                .into(),
+        ));
+    }
     let Prepared {
         bounds,
         own_level,
         max_zoom,
+        ..
     } = prepare(input, options)?;
     let plan = Plan::new(
         input,
@@ -121,6 +129,7 @@ pub fn build_shard(
     let total = blocks.len();
     let (written, _) = build_recorded_blocks(
         &source,
+        &bounds,
         &bounds,
         cut,
         max_zoom,

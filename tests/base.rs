@@ -1,0 +1,355 @@
+//! `tinsmith tiles INPUT --base RASTER`: a regional raster over a coarser one of a wider
+//! extent, decoded by the independent decoder and measured against GDAL's own warp of
+//! both rasters in priority order into each tile's lattice.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use std::process::Command;
+
+use crate::tiles::{
+    all_files, ascii_grid, check_shared_edges, check_tile, decode_pyramid, egm96_undulations,
+    layer_json, max_error, stacked_gdal_samples, Tile, Tiling,
+};
+use crate::util::{assert_fails_naming, stderr, Dir};
+
+/// The input's extent: west, south, east, north.
+const HIGH: [f64; 4] = [9.6, 44.3, 10.6, 45.1];
+
+/// The base's own level: the first whose sample spacing (180° / 2^z / 217 samples a tile)
+/// is at most its 0.05° (level 4: 0.052°, level 5: 0.026°).
+const BASE_LEVEL: u32 = 5;
+
+/// The input's hole of nodata: centre longitude, latitude and radius (degrees).
+const HOLE: [f64; 3] = [10.1, 44.7, 0.1];
+
+/// Whether a point lies within three of the input's 0.005° pixels of its hole's rim. There
+/// GDAL and tinsmith read the input differently, both fairly: GDAL drops a point whose own
+/// pixel is nodata (so the base shows through), tinsmith interpolates it from the valid
+/// pixels of the four around it (as it does for one input, where GDAL's nodata is not
+/// compared).
+fn near_the_rim(lon: f64, lat: f64) -> bool {
+    ((lon - HOLE[0]).hypot(lat - HOLE[1]) - HOLE[2]).abs() < 0.015
+}
+
+/// A 0.05° base over 5..15°E, 40..48°N and a 0.005° input over [`HIGH`] with a hole of
+/// nodata: their paths.
+fn inputs(dir: &Dir) -> (String, String) {
+    let low = ascii_grid(dir, "low.asc", (5.0, 40.0, 0.05), (200, 160), |lon, lat| {
+        300.0 + 200.0 * lon.sin() * (2.0 * lat).cos()
+    });
+    let high = ascii_grid(
+        dir,
+        "high.asc",
+        (9.6, 44.3, 0.005),
+        (200, 160),
+        |lon, lat| {
+            if (lon - HOLE[0]).hypot(lat - HOLE[1]) < HOLE[2] {
+                f64::NAN
+            } else {
+                800.0 + 150.0 * (20.0 * lon).sin() * (15.0 * lat).cos()
+            }
+        },
+    );
+    (low, high)
+}
+
+/// Whether the rectangle `[west, south, east, north]` overlaps [`HIGH`].
+fn meets_high(r: [f64; 4]) -> bool {
+    r[0] < HIGH[2] && HIGH[0] < r[2] && r[1] < HIGH[3] && HIGH[1] < r[3]
+}
+
+/// Whether the edge from `a` to `b` (a meridian or a parallel) runs partly inside the
+/// input's extent and partly outside it: its samples come from both rasters.
+fn crosses_the_seam(a: [f64; 2], b: [f64; 2]) -> bool {
+    let inside =
+        |p: [f64; 2]| (HIGH[0]..=HIGH[2]).contains(&p[0]) && (HIGH[1]..=HIGH[3]).contains(&p[1]);
+    let steps = 64;
+    let points: Vec<bool> = (0..=steps)
+        .map(|k| {
+            let t = k as f64 / steps as f64;
+            inside([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])])
+        })
+        .collect();
+    points.iter().any(|&p| p) && points.iter().any(|&p| !p)
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn a_base_fills_the_pyramid_around_the_input_within_the_bound_and_stitched() {
+    let dir = Dir::new();
+    let (low, high) = inputs(&dir);
+    let run = |out: &str, threads: &str| {
+        let o = dir.run(&[
+            "tiles",
+            &high,
+            "--base",
+            &low,
+            "-o",
+            out,
+            "--vertical-datum",
+            "ellipsoid",
+            "--normals",
+            "--quality",
+            "0.1",
+            "--threads",
+            threads,
+            "-q",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    run("one", "1");
+    run("two", "2");
+    let (one, two) = (all_files(&dir.path("one")), all_files(&dir.path("two")));
+    assert!(one == two, "1 and 2 threads wrote different bytes");
+
+    let tiles = decode_pyramid(&dir.path("one"));
+    let (layer, bounds) = layer_json(&dir.path("one"));
+    // The pyramid's extent is both rasters'.
+    assert_eq!(bounds, vec![5.0, 40.0, 15.0, 48.0]);
+    // `available` lists exactly the tiles written.
+    let mut listed = BTreeSet::new();
+    for (z, rects) in layer["available"].as_array().unwrap().iter().enumerate() {
+        for r in rects.as_array().unwrap() {
+            let c = |k: &str| r[k].as_u64().unwrap() as u32;
+            for x in c("startX")..=c("endX") {
+                for y in c("startY")..=c("endY") {
+                    assert!(listed.insert((z as u32, x, y)));
+                }
+            }
+        }
+    }
+    assert_eq!(listed, tiles.keys().copied().collect::<BTreeSet<_>>());
+
+    // Down to the base's own level, every tile either raster reaches; finer, only the
+    // input's.
+    let max_zoom = layer["maxzoom"].as_u64().unwrap() as u32;
+    assert!(max_zoom > BASE_LEVEL + 1, "{max_zoom}");
+    let rect = |&(z, x, y): &(u32, u32, u32)| Tiling::Geographic.rectangle(z, x, y);
+    for key in tiles.keys() {
+        assert!(key.0 <= BASE_LEVEL || meets_high(rect(key)), "{key:?}");
+    }
+    let base_only = |z: u32| {
+        tiles
+            .keys()
+            .filter(|k| k.0 == z && !meets_high(rect(k)))
+            .count()
+    };
+    assert!(base_only(BASE_LEVEL) > 0 && base_only(BASE_LEVEL + 1) == 0);
+
+    // Same-level neighbours agree on their edges, those across the seam included.
+    for (&key, t) in &tiles {
+        check_tile(key, t);
+    }
+    assert!(check_shared_edges(&tiles) > 0);
+    let mut seams = BTreeSet::new();
+    for (&(z, x, y), t) in &tiles {
+        let r = rect(&(z, x, y));
+        for (dx, dy, a, b) in [
+            (1, 0, [r[2], r[1]], [r[2], r[3]]),
+            (0, 1, [r[0], r[3]], [r[2], r[3]]),
+        ] {
+            let Some(other) = tiles.get(&(z, x + dx, y + dy)) else {
+                continue;
+            };
+            if crosses_the_seam(a, b) {
+                let pair: BTreeMap<(u32, u32, u32), Tile> =
+                    [((z, x, y), t.clone()), ((z, x + dx, y + dy), other.clone())].into();
+                assert!(check_shared_edges(&pair) > 2, "{z}/{x}/{y}");
+                seams.insert(z);
+            }
+        }
+    }
+    assert!(
+        seams.contains(&BASE_LEVEL) && seams.contains(&max_zoom),
+        "seams tested at levels {seams:?}"
+    );
+
+    // From the base's own level down, every sample is sampled from the rasters (coarser
+    // levels are filtered from it): within the bound of GDAL's warp of the base, then the
+    // input over it, at every lattice point.
+    let mut checked = 0;
+    for (&(z, x, y), t) in tiles.range((BASE_LEVEL, 0, 0)..) {
+        let bound = 0.1 * Tiling::Geographic.level_error(z);
+        let mut samples = stacked_gdal_samples(&dir, &[&low, &high], Tiling::Geographic, z, x, y);
+        skip_the_rim(&mut samples, Tiling::Geographic, z, x, y);
+        let e = max_error(t, &samples);
+        assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
+        checked += 1;
+    }
+    assert!(checked > 10, "{checked}");
+}
+
+/// Sets the samples of tile `z/x/y`'s lattice near the input's hole's rim to NaN (see
+/// [`near_the_rim`]).
+fn skip_the_rim(samples: &mut [Vec<f64>], tiling: Tiling, z: u32, x: u32, y: u32) {
+    let [west, south, east, north] = tiling.rectangle(z, x, y);
+    let n = samples.len() - 1;
+    for (j, row) in samples.iter_mut().enumerate() {
+        // Web Mercator rows are even in latitude inside a tile, as the test lattice is.
+        let lat = south + (north - south) * j as f64 / n as f64;
+        for (i, s) in row.iter_mut().enumerate() {
+            if near_the_rim(west + (east - west) * i as f64 / n as f64, lat) {
+                *s = f64::NAN;
+            }
+        }
+    }
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn each_raster_is_shifted_by_its_own_vertical_datum() {
+    // The base declares EGM96 heights (about 47 m above the ellipsoid here), the input no
+    // vertical CRS: the base's samples are shifted, the input's are not.
+    let dir = Dir::new();
+    let (low, high) = inputs(&dir);
+    let declared = dir.path("low_egm96.tif").to_string_lossy().into_owned();
+    let status = Command::new("gdal_translate")
+        .args(["-q", "-a_srs", "EPSG:4326+5773", &low, &declared])
+        .status()
+        .expect("gdal_translate runs");
+    assert!(status.success());
+    let o = dir.run(&[
+        "tiles",
+        &high,
+        "--base",
+        &declared,
+        "-o",
+        "p",
+        "--quality",
+        "0.005",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("low_egm96.tif: heights above egm96"), "{err}");
+    assert!(err.contains("high.asc: no vertical CRS"), "{err}");
+    let tiles = decode_pyramid(&dir.path("p"));
+    let (mut base_samples, mut input_samples) = (0, 0);
+    for (&(z, x, y), t) in tiles.range((BASE_LEVEL, 0, 0)..) {
+        let bound = 0.005 * Tiling::Geographic.level_error(z);
+        let mut samples = stacked_gdal_samples(&dir, &[&low, &high], Tiling::Geographic, z, x, y);
+        let input = stacked_gdal_samples(&dir, &[&high], Tiling::Geographic, z, x, y);
+        let n = egm96_undulations(z, x, y);
+        for ((row, input_row), n_row) in samples.iter_mut().zip(&input).zip(&n) {
+            for ((s, i), n) in row.iter_mut().zip(input_row).zip(n_row) {
+                if i.is_nan() && s.is_finite() {
+                    assert!(*n > 2.0 * bound, "{z}/{x}/{y}: the geoid must matter");
+                    *s += n;
+                    base_samples += 1;
+                } else if i.is_finite() {
+                    input_samples += 1;
+                }
+            }
+        }
+        skip_the_rim(&mut samples, Tiling::Geographic, z, x, y);
+        let e = max_error(t, &samples);
+        assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
+    }
+    assert!(base_samples > 0 && input_samples > 0);
+}
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn a_base_works_in_web_mercator_and_as_3d_tiles() {
+    let dir = Dir::new();
+    let (low, high) = inputs(&dir);
+    let run = |out: &str, extra: &[&str]| {
+        let mut args = vec!["tiles", &high, "--base", &low, "-o", out, "-q"];
+        args.extend_from_slice(&["--vertical-datum", "ellipsoid"]);
+        args.extend_from_slice(extra);
+        let o = dir.run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    run("mercator", &["--tiling", "mercator", "--quality", "0.1"]);
+    let tiles = decode_pyramid(&dir.path("mercator"));
+    let (layer, _) = layer_json(&dir.path("mercator"));
+    assert_eq!(layer["projection"], "EPSG:3857");
+    let max_zoom = layer["maxzoom"].as_u64().unwrap() as u32;
+    for (&key, t) in &tiles {
+        check_tile(key, t);
+    }
+    assert!(check_shared_edges(&tiles) > 0);
+    let mut checked = 0;
+    for (&(z, x, y), t) in tiles.range((max_zoom, 0, 0)..) {
+        let bound = 0.1 * Tiling::Mercator.level_error(z);
+        let mut samples = stacked_gdal_samples(&dir, &[&low, &high], Tiling::Mercator, z, x, y);
+        skip_the_rim(&mut samples, Tiling::Mercator, z, x, y);
+        let e = max_error(t, &samples);
+        assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
+        checked += 1;
+    }
+    assert!(checked > 0);
+
+    // 3D Tiles: one GLB for each tile the quantized-mesh pyramid writes.
+    run("qm", &[]);
+    run("3d", &["--format", "3dtiles"]);
+    let count = |root: &str, extension: &str| {
+        all_files(&dir.path(root))
+            .keys()
+            .filter(|p| p.extension().is_some_and(|e| e == extension))
+            .count()
+    };
+    assert!(dir.path("3d").join("tileset.json").exists());
+    assert_eq!(count("3d", "glb"), count("qm", "terrain"));
+    assert!(count("qm", "terrain") > 20);
+}
+
+#[test]
+fn a_tile_over_a_base_does_not_depend_on_the_zoom_range_or_the_threads() {
+    let dir = Dir::new();
+    let (low, high) = inputs(&dir);
+    let run = |out: &str, extra: &[&str]| {
+        let mut args = vec!["tiles", &high, "--base", &low, "-o", out, "-q"];
+        args.extend_from_slice(&["--vertical-datum", "ellipsoid", "--normals"]);
+        args.extend_from_slice(extra);
+        let o = dir.run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        all_files(&dir.path(out))
+            .into_iter()
+            .filter(|(p, _)| p.extension().is_some_and(|e| e == "terrain"))
+            .collect::<BTreeMap<_, _>>()
+    };
+    let all = run("all", &["--threads", "2"]);
+    let some = run(
+        "some",
+        &["--min-zoom", "3", "--max-zoom", "6", "--threads", "1"],
+    );
+    assert!(some.len() > 5 && some.len() < all.len());
+    for (path, bytes) in &some {
+        assert!(all.get(path) == Some(bytes), "{path:?} differs");
+    }
+}
+
+#[test]
+fn a_base_that_is_missing_not_a_raster_or_not_placed_is_refused_naming_it() {
+    let dir = Dir::new();
+    let (_, high) = inputs(&dir);
+    dir.write("notes.txt", "not a raster\n");
+    let plain = ascii_grid(&dir, "plain.asc", (5.0, 40.0, 0.05), (20, 20), |_, _| 1.0);
+    std::fs::remove_file(dir.path("plain.prj")).unwrap();
+    for (base, why) in [
+        ("missing.tif", "missing.tif"),
+        ("notes.txt", "notes.txt"),
+        (plain.as_str(), "CRS"),
+    ] {
+        let o = dir.run(&["tiles", &high, "--base", base, "-o", "out", "-q"]);
+        assert_fails_naming(&o, &["--base", base, why]);
+        assert!(!dir.path("out").exists(), "{base}");
+    }
+}
+
+#[test]
+fn options_a_base_does_not_work_with_are_refused_by_name() {
+    let dir = Dir::new();
+    let (low, high) = inputs(&dir);
+    for (extra, name) in [
+        (&["--water", "sea-level"][..], "--water sea-level"),
+        (&["--shard", "0/2"][..], "--shard"),
+        (&["--update"][..], "--update"),
+    ] {
+        let mut args = vec!["tiles", &high, "--base", &low, "-o", "out", "-q"];
+        args.extend_from_slice(extra);
+        let o = dir.run(&args);
+        assert_fails_naming(&o, &[name, "--base"]);
+        assert!(!dir.path("out").join("layer.json").exists(), "{name}");
+    }
+}

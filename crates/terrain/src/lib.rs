@@ -16,6 +16,7 @@ mod error;
 mod glb_tile;
 mod implicit;
 mod layer;
+mod order;
 mod plan;
 mod pyramid;
 mod quantized_mesh;

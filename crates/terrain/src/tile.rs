@@ -8,6 +8,7 @@ use tinsmith_tiling::check_tin;
 
 use crate::budget::{quanta_per_step, slack_scale, LevelBudget};
 use crate::layer::{metadata_json, Available};
+use crate::order::encoding_order;
 use crate::rows::LevelRows;
 use crate::tms::{Tiling, TILE_CELLS, U_PER_CELL};
 use crate::{TerrainError, TerrainOptions, TerrainResult, TileFormat};
@@ -184,7 +185,7 @@ pub(super) fn build_tile(
             })
             .collect()
     });
-    let triangles = in_space_order(&quantized, tin.triangles());
+    let triangles = encoding_order(&quantized, tin.triangles());
     let encode_error = |source| TerrainError::Encode {
         z,
         x: column,
@@ -245,42 +246,4 @@ pub(super) fn build_tile(
         verified_bound: budget.verify(scale),
         bounds,
     }))
-}
-
-/// The triangles along a Hilbert curve through their centroids, so that the
-/// encoder, which numbers vertices by first use, sees neighbours one after another: small
-/// index and position deltas, which gzip packs tightly. Decided by positions alone.
-fn in_space_order(vertices: &[[u16; 3]], triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
-    let key = |t: &[u32; 3]| {
-        let (x, y) = t.iter().fold((0u32, 0u32), |(x, y), &v| {
-            let p = vertices[v as usize];
-            (x + u32::from(p[0]), y + u32::from(p[1]))
-        });
-        hilbert(x / 3, y / 3)
-    };
-    let mut ordered: Vec<(u64, [u32; 3])> = triangles.iter().map(|t| (key(t), *t)).collect();
-    ordered.sort_unstable();
-    ordered.into_iter().map(|(_, t)| t).collect()
-}
-
-/// The position of (`x`, `y`) (16 bits each) along a Hilbert curve over the 2^16 square.
-fn hilbert(x: u32, y: u32) -> u64 {
-    let (mut x, mut y) = (x & 0xffff, y & 0xffff);
-    let mut d = 0u64;
-    let mut s = 1u32 << 15;
-    while s > 0 {
-        let rx = u32::from(x & s > 0);
-        let ry = u32::from(y & s > 0);
-        d += u64::from(s) * u64::from(s) * u64::from((3 * rx) ^ ry);
-        // Rotate the quadrant so the curve continues.
-        if ry == 0 {
-            if rx == 1 {
-                x = 0xffff - x;
-                y = 0xffff - y;
-            }
-            std::mem::swap(&mut x, &mut y);
-        }
-        s >>= 1;
-    }
-    d
 }

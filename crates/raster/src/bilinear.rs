@@ -15,15 +15,6 @@ pub(crate) struct PixelGrid {
 }
 
 impl PixelGrid {
-    /// The raster column of column `x` (any integer where the columns wrap), or `None`
-    /// outside the raster.
-    pub(crate) fn column(&self, x: i64) -> Option<i64> {
-        match self.turn {
-            Some(turn) => Some(x.rem_euclid(turn)),
-            None => (0..self.width).contains(&x).then_some(x),
-        }
-    }
-
     /// Whether the point at pixel coordinates `col`, `row` (from the raster's top-left
     /// corner, in pixels) lies within the raster's pixel edges, borders included. Where the
     /// columns wrap, any column does.
@@ -54,7 +45,7 @@ impl Footprint {
     /// `(x, y)`'s centre is at `x + 0.5`, `y + 0.5`).
     pub(crate) fn at(col: f64, row: f64) -> Footprint {
         let (fx, fy) = (col - 0.5, row - 0.5);
-        let (x0, y0) = (fx.floor(), fy.floor());
+        let (x0, y0) = (floor(fx), floor(fy));
         Footprint {
             x0: x0 as i64,
             y0: y0 as i64,
@@ -92,6 +83,21 @@ impl Footprint {
     }
 }
 
+/// `v.floor()` for a finite `v`, without the library call the target's instruction set
+/// needs for it (the same value: truncation is exact, then one step down for negative
+/// non-integers; beyond 2^52 every `f64` is an integer).
+fn floor(v: f64) -> f64 {
+    if v.abs() >= 4_503_599_627_370_496.0 {
+        return v;
+    }
+    let t = v as i64 as f64;
+    if t > v {
+        t - 1.0
+    } else {
+        t
+    }
+}
+
 /// A rectangle of decoded pixels: columns `x0 .. x0 + width` (before any wrapping, so a
 /// window can reach across the seam of a raster whose columns wrap), rows `y0 .. y0 +
 /// height`, row-major, NaN for nodata.
@@ -110,7 +116,8 @@ impl Window {
     /// # Panics
     /// When the pixel is in the raster but not in the window.
     pub(crate) fn pixel(&self, grid: &PixelGrid, x: i64, y: i64) -> f64 {
-        if y < 0 || y >= grid.height || grid.column(x).is_none() {
+        // Where the columns wrap, every column is in the raster.
+        if y < 0 || y >= grid.height || (grid.turn.is_none() && !(0..grid.width).contains(&x)) {
             return f64::NAN;
         }
         let (i, j) = (x - self.x0, y - self.y0);
@@ -139,6 +146,37 @@ mod tests {
             width: 3,
             height: 2,
             values: values.to_vec(),
+        }
+    }
+
+    #[test]
+    fn floor_is_the_library_floor() {
+        let values = [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.75,
+            -2.75,
+            1e-300,
+            -1e-300,
+            4503599627370495.5,
+            -4503599627370495.5,
+            9e15,
+            -9e15,
+            1e300,
+            -1e300,
+            f64::MAX,
+            f64::MIN,
+        ];
+        for v in values {
+            assert_eq!(floor(v), v.floor(), "{v}");
+        }
+        for k in -2000..2000 {
+            let v = f64::from(k) * 0.37;
+            assert_eq!(floor(v), v.floor(), "{v}");
         }
     }
 
@@ -177,8 +215,6 @@ mod tests {
             height: 1,
             turn: Some(3),
         };
-        assert_eq!(grid.column(-1), Some(2));
-        assert_eq!(grid.column(3), Some(0));
         assert!(grid.contains(7.0, 0.5) && !grid.contains(1.0, 1.5));
         assert!(!GRID.contains(3.01, 1.0) && GRID.contains(3.0, 2.0));
         // Columns -1 and 0 (the raster's 2 and 0), read as one window.

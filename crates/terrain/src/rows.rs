@@ -299,7 +299,18 @@ impl LevelRows {
         for j in j0 - 1..=j0 + CELLS as i64 + 1 {
             bytes.clear();
             let row = self.row(j);
-            for i in i0 - 1..=i0 + CELLS as i64 + 1 {
+            let (first, last) = (i0 - 1, i0 + CELLS as i64 + 1);
+            if let Some(r) = row.filter(|_| first >= 0 && last + 1 < self.width as i64) {
+                // Every column inside the level, at its own index (also round a level that
+                // wraps: its last column, which repeats the first, is not reached).
+                for &v in &r[first as usize..=last as usize] {
+                    let bits = if v.is_nan() { f32::NAN } else { v }.to_bits();
+                    bytes.extend_from_slice(&bits.to_le_bytes());
+                }
+                hash.update(&bytes);
+                continue;
+            }
+            for i in first..=last {
                 let bits = match (row, self.column(i)) {
                     (Some(r), Some(c)) if r[c].is_nan() => f32::NAN.to_bits(),
                     (Some(r), Some(c)) => r[c].to_bits(),
@@ -553,12 +564,38 @@ impl LevelRows {
             }
             let gy = 2 * (cy0 + (rows.start + k) as i64);
             let fine_rows = TAPS.map(|(dy, _)| self.row(gy + dy - fy0));
+            // Every tap row inside the level: the taps of a column with all five columns
+            // inside are read directly, summed in the same order as below.
+            let inner_rows: Option<[&[f32]; 5]> = if fine_rows.iter().all(Option::is_some) {
+                Some(fine_rows.map(|r| r.expect("checked")))
+            } else {
+                None
+            };
             for ((slot, taps), _) in row
                 .iter_mut()
                 .zip(&columns)
                 .zip(reach_columns)
                 .filter(|(_, &in_reach)| in_reach)
             {
+                if let (Some(lines), [Some(c0), Some(c1), Some(c2), Some(c3), Some(c4)]) =
+                    (&inner_rows, *taps)
+                {
+                    let cs = [c0, c1, c2, c3, c4];
+                    let (mut sum, mut weight) = (0.0f64, 0.0f64);
+                    for (r, (_, wy)) in lines.iter().zip(TAPS) {
+                        for (&c, (_, wx)) in cs.iter().zip(TAPS) {
+                            let v = r[c];
+                            if v.is_finite() {
+                                sum += wx * wy * f64::from(v);
+                                weight += wx * wy;
+                            }
+                        }
+                    }
+                    if weight > 0.0 {
+                        *slot = (sum / weight) as f32;
+                    }
+                    continue;
+                }
                 let (mut sum, mut weight) = (0.0f64, 0.0f64);
                 for (r, (_, wy)) in fine_rows.iter().zip(TAPS) {
                     for (column, (_, wx)) in taps.iter().zip(TAPS) {

@@ -167,7 +167,11 @@ impl Samples {
 
     /// Whether every sample is valid (finite).
     pub fn all_valid(&self) -> bool {
-        self.values().iter().all(|v| v.is_finite())
+        // Chunks without an early exit inside vectorise: the callers ask once per tile of
+        // tens of thousands of samples, and most tiles have no nodata.
+        self.values()
+            .chunks(256)
+            .all(|chunk| chunk.iter().fold(true, |all, v| all & v.is_finite()))
     }
 
     /// Whether the cell with top-left sample `(x, y)` has four valid corners. Panics when

@@ -88,14 +88,28 @@ pub fn sample_geographic(
             );
             cols.clear();
             rows.clear();
-            for j in j0..j1 {
-                let lat = lattice.lat(j);
-                for i in i0..i1 {
-                    cols.push(lattice.lon(i));
-                    rows.push(lat);
+            if locator.separable() {
+                // Each column's pixel column and each row's pixel row located once.
+                let xs: Vec<f64> = (i0..i1)
+                    .map(|i| locator.column_of(lattice.lon(i)))
+                    .collect();
+                for j in j0..j1 {
+                    let y = locator.row_of(lattice.lat(j));
+                    for &x in &xs {
+                        let inside = locator.grid.contains(x, y);
+                        cols.push(if inside { x } else { f64::NAN });
+                        rows.push(if inside { y } else { f64::NAN });
+                    }
                 }
+            } else {
+                let lons: Vec<f64> = (i0..i1).map(|i| lattice.lon(i)).collect();
+                for j in j0..j1 {
+                    let lat = lattice.lat(j);
+                    cols.extend_from_slice(&lons);
+                    rows.extend((i0..i1).map(|_| lat));
+                }
+                locator.locate(&mut cols, &mut rows);
             }
-            locator.locate(&mut cols, &mut rows);
             let footprints: Vec<Option<Footprint>> = cols
                 .iter()
                 .zip(&rows)
@@ -309,28 +323,57 @@ impl Locator {
             let _ = transform.transform_coords(xs, ys, &mut []);
         }
         let gt = &self.geo_transform;
-        let rotated = gt[2] != 0.0 || gt[4] != 0.0;
+        let rotated = self.rotated();
         let det = gt[1] * gt[5] - gt[2] * gt[4];
         for (x, y) in xs.iter_mut().zip(ys.iter_mut()) {
             let mut position = None;
             if x.is_finite() && y.is_finite() {
-                let lon = match self.wrap {
-                    Some((west, turn)) => west + (*x - west).rem_euclid(turn),
-                    None => *x,
-                };
-                let (dx, dy) = (lon - gt[0], *y - gt[3]);
                 let (col, row) = if rotated {
+                    let (dx, dy) = (self.wrapped(*x) - gt[0], *y - gt[3]);
                     (
                         (gt[5] * dx - gt[2] * dy) / det,
                         (gt[1] * dy - gt[4] * dx) / det,
                     )
                 } else {
-                    (dx / gt[1], dy / gt[5])
+                    (self.column_of(*x), self.row_of(*y))
                 };
                 position = Some((col, row)).filter(|&(c, r)| self.grid.contains(c, r));
             }
             (*x, *y) = position.unwrap_or((f64::NAN, f64::NAN));
         }
+    }
+}
+
+impl Locator {
+    /// Whether the geotransform is rotated or sheared.
+    fn rotated(&self) -> bool {
+        let gt = &self.geo_transform;
+        gt[2] != 0.0 || gt[4] != 0.0
+    }
+
+    /// Whether a point's column depends on its longitude alone and its row on its latitude
+    /// alone (no PROJ transformation, a north-up raster): [`Locator::locate`] is then
+    /// [`Locator::column_of`] and [`Locator::row_of`], kept where `grid.contains` them.
+    fn separable(&self) -> bool {
+        self.transform.is_none() && !self.rotated()
+    }
+
+    /// `x` moved by whole turns to at or east of the raster's west edge (geographic CRS).
+    fn wrapped(&self, x: f64) -> f64 {
+        match self.wrap {
+            Some((west, turn)) => west + (x - west).rem_euclid(turn),
+            None => x,
+        }
+    }
+
+    /// The pixel column of `x` (the raster's CRS) on a north-up raster.
+    fn column_of(&self, x: f64) -> f64 {
+        (self.wrapped(x) - self.geo_transform[0]) / self.geo_transform[1]
+    }
+
+    /// The pixel row of `y` (the raster's CRS) on a north-up raster.
+    fn row_of(&self, y: f64) -> f64 {
+        (y - self.geo_transform[3]) / self.geo_transform[5]
     }
 }
 

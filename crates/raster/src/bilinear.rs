@@ -62,8 +62,8 @@ impl Footprint {
     pub(crate) fn interpolate(&self, pixel: impl Fn(i64, i64) -> f64) -> f64 {
         let (wx, wy) = ([1.0 - self.tx, self.tx], [1.0 - self.ty, self.ty]);
         let (mut sum, mut weight) = (0.0, 0.0);
-        for (dy, wy) in wy.into_iter().enumerate() {
-            for (dx, wx) in wx.into_iter().enumerate() {
+        for (dy, &wy) in wy.iter().enumerate() {
+            for (dx, &wx) in wx.iter().enumerate() {
                 let w = wx * wy;
                 if w == 0.0 {
                     continue;
@@ -80,6 +80,32 @@ impl Footprint {
         } else {
             f64::NAN
         }
+    }
+}
+
+impl Footprint {
+    /// [`Footprint::interpolate`] of the pixels of `grid` in `window` (which holds every
+    /// pixel of nonzero weight inside the raster): the same value, the four pixels read
+    /// directly from the window when they all lie in it and in the raster.
+    pub(crate) fn interpolate_in(&self, window: &Window, grid: &PixelGrid) -> f64 {
+        let in_raster = self.y0 >= 0
+            && self.y0 + 1 < grid.height
+            && (grid.turn.is_some() || (self.x0 >= 0 && self.x0 + 1 < grid.width));
+        let (i, j) = (self.x0 - window.x0, self.y0 - window.y0);
+        if in_raster
+            && i >= 0
+            && j >= 0
+            && i + 1 < window.width as i64
+            && j + 1 < window.height as i64
+        {
+            let at = j as usize * window.width + i as usize;
+            let rows = [
+                &window.values[at..at + 2],
+                &window.values[at + window.width..at + window.width + 2],
+            ];
+            return self.interpolate(|x, y| rows[(y - self.y0) as usize][(x - self.x0) as usize]);
+        }
+        self.interpolate(|x, y| window.pixel(grid, x, y))
     }
 }
 

@@ -213,7 +213,7 @@ fn sample_points(
     let window = read_window(opened, rb, grid, [x0, y0], (w, h))?;
     for (f, v) in footprints.iter().zip(values.iter_mut()) {
         if let Some(f) = f {
-            *v = f.interpolate(|x, y| window.pixel(grid, x, y));
+            *v = f.interpolate_in(&window, grid);
         }
     }
     Ok(())

@@ -60,19 +60,29 @@ impl Footprint {
     /// summed in one fixed order, so the result depends on the four pixels and the
     /// weights only.
     pub(crate) fn interpolate(&self, pixel: impl Fn(i64, i64) -> f64) -> f64 {
+        let mut values = [f64::NAN; 4];
+        for (k, (w, v)) in self.weights().into_iter().zip(&mut values).enumerate() {
+            if w != 0.0 {
+                *v = pixel(self.x0 + (k & 1) as i64, self.y0 + (k >> 1) as i64);
+            }
+        }
+        self.mean(values)
+    }
+
+    /// The weights of pixels (x0, y0), (x0 + 1, y0), (x0, y0 + 1), (x0 + 1, y0 + 1).
+    fn weights(&self) -> [f64; 4] {
         let (wx, wy) = ([1.0 - self.tx, self.tx], [1.0 - self.ty, self.ty]);
+        [wx[0] * wy[0], wx[1] * wy[0], wx[0] * wy[1], wx[1] * wy[1]]
+    }
+
+    /// The weighted mean of `values` (in [`Footprint::weights`]' order) over those of
+    /// nonzero weight that are valid, summed in that order; NaN when there are none.
+    fn mean(&self, values: [f64; 4]) -> f64 {
         let (mut sum, mut weight) = (0.0, 0.0);
-        for (dy, &wy) in wy.iter().enumerate() {
-            for (dx, &wx) in wx.iter().enumerate() {
-                let w = wx * wy;
-                if w == 0.0 {
-                    continue;
-                }
-                let v = pixel(self.x0 + dx as i64, self.y0 + dy as i64);
-                if v.is_finite() {
-                    sum += w * v;
-                    weight += w;
-                }
+        for (w, v) in self.weights().into_iter().zip(values) {
+            if w != 0.0 && v.is_finite() {
+                sum += w * v;
+                weight += w;
             }
         }
         if weight > 0.0 {
@@ -99,11 +109,8 @@ impl Footprint {
             && j + 1 < window.height as i64
         {
             let at = j as usize * window.width + i as usize;
-            let rows = [
-                &window.values[at..at + 2],
-                &window.values[at + window.width..at + window.width + 2],
-            ];
-            return self.interpolate(|x, y| rows[(y - self.y0) as usize][(x - self.x0) as usize]);
+            let (below, above) = window.values[at..].split_at(window.width);
+            return self.mean([below[0], below[1], above[0], above[1]]);
         }
         self.interpolate(|x, y| window.pixel(grid, x, y))
     }

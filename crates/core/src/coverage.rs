@@ -1,8 +1,8 @@
 //! The samples a triangle covers, as the exact error model measures them: a grid's lattice
 //! samples in the triangle, or the scattered points charged to the hole being filled.
 
-use crate::exact::{corner_samples, error_at, triangle_error};
-use crate::predicates::{in_closed_triangle, Point};
+use crate::exact::{corner_samples, triangle_error};
+use crate::predicates::{in_closed_triangle, plane_gradient, Point};
 use crate::{ErrorBound, Grid};
 
 /// The original samples a new triangle of a hole must come within the bound of.
@@ -86,11 +86,31 @@ pub(crate) struct HolePoints {
 
 impl Coverage for HolePoints {
     fn triangle_error(&self, a: &Point, b: &Point, c: &Point, limit: f64) -> Option<ErrorBound> {
-        let inside = self
-            .points
-            .iter()
-            .filter(|p| in_closed_triangle(a, b, c, p));
-        error_at(a, b, c, inside, limit)
+        // `error_at`'s arithmetic, fused with the point-in-triangle test: a bounding-box
+        // test first (most of a large hole's points lie outside a candidate), and a stop
+        // as soon as either side exceeds the limit.
+        let (x_lo, x_hi) = (a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
+        let (y_lo, y_hi) = (a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
+        let g = plane_gradient(a, b, c);
+        let (mut above, mut below) = (0.0f64, 0.0f64);
+        for p in &self.points {
+            if p.x < x_lo
+                || p.x > x_hi
+                || p.y < y_lo
+                || p.y > y_hi
+                || !in_closed_triangle(a, b, c, p)
+            {
+                continue;
+            }
+            let plane = (a.z + g[1] * (p.y - a.y) as f64) + g[0] * (p.x - a.x) as f64;
+            let d = p.z - plane;
+            above = above.max(d);
+            below = below.max(-d);
+            if above > limit || below > limit {
+                return None;
+            }
+        }
+        Some(ErrorBound { above, below })
     }
 
     fn integral_heights(&self) -> bool {

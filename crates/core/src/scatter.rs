@@ -345,8 +345,9 @@ struct ScatterRemover {
     ring: Vec<Point>,
     bounds: Vec<ErrorBound>,
     new_triangles: Vec<(u32, [u32; 3], ErrorBound)>,
-    /// The new triangles' slots and corner points, while charging points to them.
-    corner_points: Vec<(u32, [Point; 3])>,
+    /// The new triangles' slots, corner points and bounding boxes (`[x_lo, x_hi, y_lo,
+    /// y_hi]`), while charging points to them.
+    corner_points: Vec<(u32, [Point; 3], [i64; 4])>,
     model: crate::ErrorModel,
     selection: crate::EdgeSelection,
     method: crate::Retriangulation,
@@ -545,16 +546,22 @@ impl ScatterRemover {
             self.first[t as usize] = NONE;
         }
         self.corner_points.clear();
-        self.corner_points.extend(
-            self.new_triangles
-                .iter()
-                .map(|(slot, c, _)| (*slot, c.map(|u| mesh.point(u)))),
-        );
+        self.corner_points
+            .extend(self.new_triangles.iter().map(|(slot, c, _)| {
+                let [a, b, c] = c.map(|u| mesh.point(u));
+                let x = (a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
+                let y = (a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
+                (*slot, [a, b, c], [x.0, x.1, y.0, y.1])
+            }));
         for (&p, point) in self.hole_ids.iter().zip(&self.hole_points.points) {
             let home = self
                 .corner_points
                 .iter()
-                .find(|(_, [a, b, c])| in_closed_triangle(a, b, c, point));
+                .find(|(_, [a, b, c], [x0, x1, y0, y1])| {
+                    (*x0..=*x1).contains(&point.x)
+                        && (*y0..=*y1).contains(&point.y)
+                        && in_closed_triangle(a, b, c, point)
+                });
             // Some new triangle holds every point of the hole: they tile it.
             let slot = home.map_or(self.new_triangles[0].0, |h| h.0);
             debug_assert!(home.is_some(), "point {p} outside its hole");

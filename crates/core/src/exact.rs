@@ -147,7 +147,25 @@ pub(crate) fn triangle_worst(
             }
         };
         match grid.equal_runs() {
-            None => (lo..=hi).for_each(&mut measure),
+            None => {
+                // The row's largest |d| first, without a branch per sample; the worst
+                // sample is looked for only on a row that can beat it (the same first
+                // worst sample, and bit for bit the same bound, as one pass).
+                let (up, down) =
+                    row_extremes(&row[lo as usize..=hi as usize], base, g[0], lo - a.x);
+                above = if up > above { up } else { above };
+                below = if down > below { down } else { below };
+                let e = if up > down { up } else { down };
+                if e > worst.0 {
+                    for x in lo..=hi {
+                        let plane = base + g[0] * (x - a.x) as f64;
+                        let e = (row[x as usize] - plane).abs();
+                        if e > worst.0 && !is_vertex[start + x as usize] {
+                            worst = (e, Some((start + x as usize, e)));
+                        }
+                    }
+                }
+            }
             Some(runs) => {
                 // Along a run of equal samples |d| is largest at one of its ends (see
                 // `triangle_error`); a vertex at an end hands that end to its neighbour.
@@ -174,6 +192,43 @@ pub(crate) fn triangle_worst(
         }
     }
     (ErrorBound { above, below }, worst.1)
+}
+
+/// The largest `d` and `-d` (each at least `-inf`) over `row`, where `d` is a sample less
+/// the plane `base + gx * dx`, `dx` counted from `dx0` at the row's first sample: the
+/// arithmetic of [`triangle_error`] per sample, in four independent lanes (a maximum does
+/// not depend on the order it is taken in).
+#[inline]
+fn row_extremes(row: &[f64], base: f64, gx: f64, dx0: i64) -> (f64, f64) {
+    let mut up = [f64::NEG_INFINITY; 4];
+    let mut down = [f64::NEG_INFINITY; 4];
+    let mut chunks = row.chunks_exact(4);
+    let mut dx = dx0;
+    for chunk in &mut chunks {
+        for l in 0..4 {
+            let d = chunk[l] - (base + gx * (dx + l as i64) as f64);
+            up[l] = if d > up[l] { d } else { up[l] };
+            down[l] = if -d > down[l] { -d } else { down[l] };
+        }
+        dx += 4;
+    }
+    for (l, &z) in chunks.remainder().iter().enumerate() {
+        let d = z - (base + gx * (dx + l as i64) as f64);
+        up[l] = if d > up[l] { d } else { up[l] };
+        down[l] = if -d > down[l] { -d } else { down[l] };
+    }
+    let max = |v: [f64; 4]| {
+        let (p, q) = (
+            if v[0] > v[1] { v[0] } else { v[1] },
+            if v[2] > v[3] { v[2] } else { v[3] },
+        );
+        if p > q {
+            p
+        } else {
+            q
+        }
+    };
+    (max(up), max(down))
 }
 
 /// The samples at the given vertices' positions, as points (their heights may differ, see
@@ -233,6 +288,25 @@ struct RowSpans {
     x_hi: i64,
     y0: i64,
     y1: i64,
+    /// For a narrow triangle (see [`NARROW_SPAN`]), per edge its edge function at
+    /// (`x_lo`, the current row) and its steps per column and per row, in place of
+    /// `bounds` (which then stay unset): the span is found by testing the bounding box's
+    /// columns, without the six divisions that set up `bounds`.
+    narrow: Option<[EdgeFunction; 3]>,
+}
+
+/// Triangles at most this many columns wide find their rows' spans by testing each column
+/// of their bounding box against the edge functions instead of stepping floor quotients,
+/// whose set-up costs six 64-bit divisions; the same spans. Late in a greedy insertion
+/// and in most removal holes at small bounds, triangles cover a handful of samples.
+const NARROW_SPAN: i64 = 8;
+
+/// `value + per_column * dx + per_row * dy >= 0` inside (or on) an edge.
+#[derive(Clone, Copy)]
+struct EdgeFunction {
+    value: i64,
+    per_column: i64,
+    per_row: i64,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -276,9 +350,34 @@ impl FloorQuotient {
 
 impl RowSpans {
     fn new(a: &Point, b: &Point, c: &Point) -> RowSpans {
+        RowSpans::with_narrow_span(a, b, c, NARROW_SPAN)
+    }
+
+    /// [`RowSpans::new`], with triangles at most `narrow_span` columns wide taking the
+    /// edge-function path.
+    fn with_narrow_span(a: &Point, b: &Point, c: &Point, narrow_span: i64) -> RowSpans {
         let y0 = a.y.min(b.y).min(c.y);
+        let (x_lo, x_hi) = (a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
         let mut bounds = [FloorQuotient::default(); 3];
         let mut kind = [EdgeKind::Horizontal; 3];
+        if x_hi - x_lo <= narrow_span {
+            // E(x, y) = (q.x - p.x)(y - p.y) - (q.y - p.y)(x - p.x) >= 0: left of (or on)
+            // the counter-clockwise edge pq.
+            let edge = |p: &Point, q: &Point| EdgeFunction {
+                value: (q.x - p.x) * (y0 - p.y) - (q.y - p.y) * (x_lo - p.x),
+                per_column: p.y - q.y,
+                per_row: q.x - p.x,
+            };
+            return RowSpans {
+                bounds,
+                kind,
+                x_lo,
+                x_hi,
+                y0,
+                y1: a.y.max(b.y).max(c.y),
+                narrow: Some([edge(a, b), edge(b, c), edge(c, a)]),
+            };
+        }
         for (k, (p, q)) in [(a, b), (b, c), (c, a)].into_iter().enumerate() {
             // The edge function E(x) = e0 + s * x must be >= 0, with e0 growing by q.x - p.x
             // per row. A horizontal edge (s = 0) holds on every row of the triangle: its
@@ -298,10 +397,11 @@ impl RowSpans {
         RowSpans {
             bounds,
             kind,
-            x_lo: a.x.min(b.x).min(c.x),
-            x_hi: a.x.max(b.x).max(c.x),
+            x_lo,
+            x_hi,
             y0,
             y1: a.y.max(b.y).max(c.y),
+            narrow: None,
         }
     }
 
@@ -313,6 +413,19 @@ impl RowSpans {
     /// The columns `lo..=hi` of the next row inside the triangle (`lo > hi` when none).
     #[inline]
     fn next_span(&mut self) -> (i64, i64) {
+        if let Some(edges) = &mut self.narrow {
+            let inside = |dx: i64| edges.iter().all(|e| e.value + e.per_column * dx >= 0);
+            let width = self.x_hi - self.x_lo;
+            // A row of a convex triangle: its columns inside are one run.
+            let span = (0..=width).find(|&dx| inside(dx)).map(|lo| {
+                let hi = (lo..=width).rev().find(|&dx| inside(dx)).unwrap_or(lo);
+                (self.x_lo + lo, self.x_lo + hi)
+            });
+            for e in edges.iter_mut() {
+                e.value += e.per_row;
+            }
+            return span.unwrap_or((self.x_hi + 1, self.x_hi));
+        }
         let (mut lo, mut hi) = (self.x_lo, self.x_hi);
         for k in 0..3 {
             let q = self.bounds[k].quotient;
@@ -518,19 +631,21 @@ mod tests {
                         o if o < 0 => (c, b),
                         _ => continue,
                     };
-                    let mut spans = RowSpans::new(&a, &b, &c);
-                    for y in spans.rows() {
-                        let (lo, hi) = spans.next_span();
-                        for x in -5..6 {
-                            let q = Point { x, y, z: 0.0 };
-                            let inside = orient(&a, &b, &q) >= 0
-                                && orient(&b, &c, &q) >= 0
-                                && orient(&c, &a, &q) >= 0;
-                            assert_eq!(
-                                inside,
-                                (lo..=hi).contains(&x),
-                                "{a:?} {b:?} {c:?} at {x},{y}"
-                            );
+                    for narrow_span in [0, i64::MAX] {
+                        let mut spans = RowSpans::with_narrow_span(&a, &b, &c, narrow_span);
+                        for y in spans.rows() {
+                            let (lo, hi) = spans.next_span();
+                            for x in -5..6 {
+                                let q = Point { x, y, z: 0.0 };
+                                let inside = orient(&a, &b, &q) >= 0
+                                    && orient(&b, &c, &q) >= 0
+                                    && orient(&c, &a, &q) >= 0;
+                                assert_eq!(
+                                    inside,
+                                    (lo..=hi).contains(&x),
+                                    "{a:?} {b:?} {c:?} at {x},{y}, narrow span {narrow_span}"
+                                );
+                            }
                         }
                     }
                     checked += 1;

@@ -163,6 +163,7 @@ impl Grid {
     }
 
     /// [`Grid::vertex_height`] of sample `i`, which is at column `x`, row `y`.
+    #[inline]
     pub(crate) fn vertex_height_at(&self, i: usize, x: usize, y: usize) -> f64 {
         let (width, height) = (self.width() as usize, self.height() as usize);
         let inner = x > 0 && y > 0 && x + 1 < width && y + 1 < height;

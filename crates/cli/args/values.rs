@@ -72,7 +72,7 @@ pub enum InitialMeshArg {
     /// auto's start).
     Insert,
     /// Insert where the grid has no nodata and the strips would keep at most 1 sample in
-    /// 12 (estimated from every 8th line where that is clear); else strips, or the RTIN where it is cheap to build and has fewer triangles; the
+    /// 12 (on a whole raster estimated from every 8th line where that is clear, on a tile counted); else strips, or the RTIN where it is cheap to build and has fewer triangles; the
     /// RTIN with contour levels.
     Auto,
 }

@@ -284,6 +284,31 @@ pub(crate) fn estimated_kept(grid: &Grid, limit: f64, full_border: bool, step: u
         .expect("two directions")
 }
 
+/// Loads positions `span` of `line` into the front of `z` (the samples) and `heights` (the
+/// vertex heights there); returns how many.
+fn load_segment(
+    grid: &Grid,
+    lines: &Lines,
+    line: usize,
+    span: std::ops::RangeInclusive<usize>,
+    z: &mut [f64],
+    heights: &mut [f64],
+) -> usize {
+    let values = grid.values();
+    let n = span.end() - span.start() + 1;
+    for (p, (zp, hp)) in span.zip(z.iter_mut().zip(heights.iter_mut())) {
+        let i = lines.sample(line, p);
+        let (x, y) = if lines.along_rows {
+            (p, line)
+        } else {
+            (line, p)
+        };
+        *zp = values[i];
+        *hp = grid.vertex_height_at(i, x, y);
+    }
+    n
+}
+
 /// [`estimated_kept`] along one direction.
 fn estimated_kept_along(
     grid: &Grid,
@@ -294,7 +319,6 @@ fn estimated_kept_along(
 ) -> usize {
     let (count, len) = (lines.count(), lines.len());
     let step = step.max(1);
-    let values = grid.values();
     let mut z = vec![0.0; len];
     let mut heights = vec![0.0; len];
     let reciprocals: Vec<f64> = (0..len).map(|k| 1.0 / k as f64).collect();
@@ -319,17 +343,7 @@ fn estimated_kept_along(
             if next == pos + 1 {
                 continue;
             }
-            for (p, (zp, hp)) in (pos..=next).zip(z.iter_mut().zip(heights.iter_mut())) {
-                let i = lines.sample(line, p);
-                let (x, y) = if lines.along_rows {
-                    (p, line)
-                } else {
-                    (line, p)
-                };
-                *zp = values[i];
-                *hp = grid.vertex_height_at(i, x, y);
-            }
-            let n = next - pos + 1;
+            let n = load_segment(grid, &lines, line, pos..=next, &mut z, &mut heights);
             simplify(&z[..n], &heights[..n], limit, &reciprocals, |_| kept += 1);
         }
     }
@@ -342,7 +356,6 @@ fn estimated_kept_along(
 /// of them that borders a valid cell is simplified within `limit`.
 fn kept_samples(grid: &Grid, lines: Lines, limit: f64, full_border: bool, tick: &dyn Fn()) -> Kept {
     let (count, len) = (lines.count(), lines.len());
-    let values = grid.values();
     let mut kept = Kept {
         positions: Vec::new(),
         starts: Vec::with_capacity(count + 1),
@@ -398,17 +411,7 @@ fn kept_samples(grid: &Grid, lines: Lines, limit: f64, full_border: bool, tick: 
             if next == pos + 1 || !(before[pos] || after[pos]) {
                 continue;
             }
-            for (p, (zp, hp)) in (pos..=next).zip(z.iter_mut().zip(heights.iter_mut())) {
-                let i = lines.sample(line, p);
-                let (x, y) = if lines.along_rows {
-                    (p, line)
-                } else {
-                    (line, p)
-                };
-                *zp = values[i];
-                *hp = grid.vertex_height_at(i, x, y);
-            }
-            let n = next - pos + 1;
+            let n = load_segment(grid, &lines, line, pos..=next, &mut z, &mut heights);
             simplify(&z[..n], &heights[..n], limit, &reciprocals, |p| {
                 kept.positions.push((pos + p) as u32)
             });

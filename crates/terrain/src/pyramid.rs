@@ -524,21 +524,14 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
     }
     // Web Mercator tiles end short of the poles: the part of the raster beyond is left
     // out, and a raster wholly beyond is refused.
-    let [south, north] = options.tiling.latitude_range();
-    if bounds.south >= north || bounds.north <= south {
-        return Err(TerrainError::Options(format!(
-            "{}: the raster lies within latitudes {:.4}..{:.4}, wholly beyond the {:.4}..{:.4} \
-             that --tiling {} covers; use --tiling geographic",
+    clip_to_tiling(&mut bounds, options.tiling, |beyond| {
+        format!(
+            "{}: the raster lies within latitudes {beyond} that --tiling {} covers; use \
+             --tiling geographic",
             input.display(),
-            bounds.south,
-            bounds.north,
-            south,
-            north,
             options.tiling.name(),
-        )));
-    }
-    bounds.south = bounds.south.max(south);
-    bounds.north = bounds.north.min(north);
+        )
+    })?;
     // Refused as `mesh` and `contour` refuse it: a warp to a lattice finer than the raster
     // would fill a block from a single sample, and every coarser level is made from it.
     if !tinsmith_raster::WindowReader::open(input, options.band)?.has_valid_cell()? {
@@ -684,6 +677,25 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
     }
 }
 
+/// Clips `bounds` to the latitudes `tiling` covers; a raster wholly beyond them (or with
+/// no extent left) is refused with `message` given "S..N, wholly beyond the S'..N'".
+fn clip_to_tiling(
+    bounds: &mut GeoBounds,
+    tiling: Tiling,
+    message: impl FnOnce(String) -> String,
+) -> TerrainResult<()> {
+    let [south, north] = tiling.latitude_range();
+    if bounds.south >= north || bounds.north <= south || bounds.south >= bounds.north {
+        return Err(TerrainError::Options(message(format!(
+            "{:.4}..{:.4}, wholly beyond the {south:.4}..{north:.4}",
+            bounds.south, bounds.north
+        ))));
+    }
+    bounds.south = bounds.south.max(south);
+    bounds.north = bounds.north.min(north);
+    Ok(())
+}
+
 /// The extent and anchor of a pyramid of an input over `fine` (its extent) with `base`
 /// under it: the base's own level is the anchor, over both extents; refuses a base that
 /// is not a raster with valid samples in reach of the tiling, or whose own level over
@@ -697,21 +709,13 @@ fn prepare_base(
 ) -> TerrainResult<Prepared> {
     let path = &base.path;
     let mut below = geographic_bounds(path, 1)?;
-    let [south, north] = options.tiling.latitude_range();
-    if below.south >= north || below.north <= south || below.south >= below.north {
-        return Err(TerrainError::Options(format!(
-            "--base {}: the raster lies within latitudes {:.4}..{:.4}, beyond the {:.4}..{:.4} \
-             that --tiling {} covers",
+    clip_to_tiling(&mut below, options.tiling, |beyond| {
+        format!(
+            "--base {}: the raster lies within latitudes {beyond} that --tiling {} covers",
             path.display(),
-            below.south,
-            below.north,
-            south,
-            north,
             options.tiling.name(),
-        )));
-    }
-    below.south = below.south.max(south);
-    below.north = below.north.min(north);
+        )
+    })?;
     if !tinsmith_raster::WindowReader::open(path, 1)?.has_valid_cell()? {
         return Err(TerrainError::Options(format!(
             "--base {}: band 1 has no 2x2 block of valid samples",

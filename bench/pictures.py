@@ -37,6 +37,10 @@ CESIUM = [
      (-118.19, 34.16, 9_000, 20, -30, 1), None),
     ("cesium-water", "dem/etopo5_global_5arcmin.tif", "etopo5-water",
      (15, 38, 4_000_000, 0, -90, 20), "below-0"),
+    ("cesium-water-close", "dem/etopo5_global_5arcmin.tif", "etopo5-water",
+     (24.5, 35.0, 700_000, 0, -45, 20), "below-0"),
+    ("cesium-global-3dtiles", "dem/etopo5_global_5arcmin.tif", "etopo5-3dtiles",
+     (85, 25, 11_000_000, 0, -90, 20), "3dtiles"),
     ("cesium-regional-globe", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga",
      (-118.19, 34.16, 15_000_000, 0, -90, 1), None),
     ("cesium-regional-data-only", "dem/topotoolbox_bigtujunga_30m.tif", "bigtujunga-data-only",
@@ -84,6 +88,9 @@ def main():
     ap.add_argument("--shared", default="../shared")
     ap.add_argument("--bin", default=str(ROOT / "target/release/tinsmith"))
     ap.add_argument("--out", default=str(ROOT / "docs/images"))
+    ap.add_argument("--only", default="",
+                    help="comma-separated CesiumJS pictures to redraw alone (e.g. "
+                         "cesium-water-close); the TIN pictures are then skipped")
     args = ap.parse_args()
     compare = compare_module()
     data = pathlib.Path(args.shared) / "data"
@@ -92,7 +99,7 @@ def main():
     lines = []
     with tempfile.TemporaryDirectory() as tmp:
         tmp = pathlib.Path(tmp)
-        for name, eps, size in PICTURES:
+        for name, eps, size in ([] if args.only else PICTURES):
             rel, decode = compare.CASES[name]
             grid = compare.load(data / rel, decode)
             raster = tmp / f"{name}.tif"
@@ -132,8 +139,13 @@ def cesium_pictures(args, data, out, tmp):
     site.mkdir()
     (site / "index.html").write_text(PAGE)
     os.symlink(ROOT / ".tools/node_modules/cesium/Build/Cesium", site / "cesium")
+    only = set(filter(None, args.only.split(",")))
+    unknown = only - {c[0] for c in CESIUM}
+    if unknown:
+        sys.exit(f"--only: no CesiumJS picture named {', '.join(sorted(unknown))}")
+    shots = [c for c in CESIUM if not only or c[0] in only]
     built = set()
-    for _, dem, terrain, _, variant in CESIUM:
+    for _, dem, terrain, _, variant in shots:
         if terrain in built:
             continue
         built.add(terrain)
@@ -153,7 +165,7 @@ def cesium_pictures(args, data, out, tmp):
                               text=True)
     try:
         base = server.stdout.readline().strip().rsplit(" ", 1)[-1]
-        for name, _, terrain, view, variant in CESIUM:
+        for name, _, terrain, view, variant in shots:
             url = f"{base}{terrain}/" + ("tileset.json" if variant == "3dtiles" else "")
             run(["node", ROOT / "bench/cesium_shot.cjs", f"{base}index.html",
                  url, out / f"{name}.png", *view,
@@ -176,7 +188,13 @@ def cesium_pictures(args, data, out, tmp):
         "the Mediterranean, the Black Sea and the Red Sea (each tile's mask is 256 x 256 "
         "cells, about 5 km at level 4, which shows as the coasts' steps).",
         "",
-        "![ETOPO5 with water masks in CesiumJS](images/cesium-water.png)",
+        "Closer, 700 km over Crete looking north to the Aegean: the sea lit as water, "
+        "the islands as land, each at the 5 km of its tile's mask.",
+        "",
+        "| ETOPO5 with water, the Mediterranean | closer, the Aegean |",
+        "|---|---|",
+        "| ![ETOPO5 with water masks in CesiumJS](images/cesium-water.png) "
+        "| ![the Aegean's water masks in CesiumJS](images/cesium-water-close.png) |",
         "",
         "A regional pyramid (Big Tujunga, 30 m, about 36 x 19 km) seen from 15,000 km: as "
         "built (the globe beyond the raster flat at 0 m, both root tiles written) CesiumJS "
@@ -203,6 +221,10 @@ def cesium_pictures(args, data, out, tmp):
         "| ![quantized-mesh](images/cesium-60km.png) "
         "| ![3D Tiles](images/cesium-60km-3dtiles.png) "
         "| ![3D Tiles, close](images/cesium-close-3dtiles.png) |",
+        "",
+        "ETOPO5 as 3D Tiles at the camera of the global quantized-mesh picture above:",
+        "",
+        "![ETOPO5 as 3D Tiles in CesiumJS](images/cesium-global-3dtiles.png)",
         "",
         "The first two pyramids with `--tiling mercator` (Web Mercator tiles, EPSG:3857; "
         "ETOPO5 to level 5, its own), at the same cameras:",

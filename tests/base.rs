@@ -6,6 +6,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use std::process::Command;
 
+use crate::shards::{check_shards, identities, pyramid_files, run_ok};
 use crate::tiles::{
     all_files, ascii_grid, check_shared_edges, check_tile, decode_pyramid, egm96_undulations,
     layer_json, max_error, stacked_gdal_samples, Tile, Tiling,
@@ -338,18 +339,125 @@ fn a_base_that_is_missing_not_a_raster_or_not_placed_is_refused_naming_it() {
 }
 
 #[test]
-fn options_a_base_does_not_work_with_are_refused_by_name() {
+fn an_option_a_base_does_not_work_with_is_refused_by_name() {
     let dir = Dir::new();
     let (low, high) = inputs(&dir);
-    for (extra, name) in [
-        (&["--water", "sea-level"][..], "--water sea-level"),
-        (&["--shard", "0/2"][..], "--shard"),
-        (&["--update"][..], "--update"),
-    ] {
+    for (extra, name) in [(&["--water", "sea-level"][..], "--water sea-level")] {
         let mut args = vec!["tiles", &high, "--base", &low, "-o", "out", "-q"];
         args.extend_from_slice(extra);
         let o = dir.run(&args);
         assert_fails_naming(&o, &[name, "--base"]);
         assert!(!dir.path("out").join("layer.json").exists(), "{name}");
+    }
+}
+
+/// The level of a tile file `z/x/y.terrain`.
+fn level_of(path: &std::path::Path) -> u32 {
+    let first = path.iter().next().and_then(|c| c.to_str()).unwrap();
+    first.parse().unwrap()
+}
+
+#[test]
+fn shards_over_a_base_are_the_one_process_pyramid() {
+    let dir = Dir::new();
+    let (low, high) = inputs(&dir);
+    let extra = ["--base", low.as_str(), "--vertical-datum", "ellipsoid"];
+    check_shards(&dir, &high, &extra, &[2, 5]);
+}
+
+#[test]
+fn an_update_over_a_base_rebuilds_what_either_raster_changed() {
+    let dir = Dir::new();
+    let (low, high) = inputs(&dir);
+    let args = |out: &'static str, update: bool| {
+        let mut a = vec![
+            "tiles",
+            high.as_str(),
+            "--base",
+            low.as_str(),
+            "-o",
+            out,
+            "-q",
+        ];
+        a.extend_from_slice(&["--vertical-datum", "ellipsoid"]);
+        if update {
+            a.push("--update");
+        }
+        a
+    };
+    run_ok(&dir, &args("p", false));
+    // The base raised by 50 m west of 6.5°E, far from the input; then the input raised
+    // by 30 m in its north-east corner, as rasters are re-surveyed in place.
+    let rewrites: [(&str, Box<dyn Fn() -> String>); 2] = [
+        (
+            "base",
+            Box::new(|| {
+                ascii_grid(
+                    &dir,
+                    "low.asc",
+                    (5.0, 40.0, 0.05),
+                    (200, 160),
+                    |lon, lat| {
+                        let rise = if lon < 6.5 { 50.0 } else { 0.0 };
+                        300.0 + rise + 200.0 * lon.sin() * (2.0 * lat).cos()
+                    },
+                )
+            }),
+        ),
+        (
+            "input",
+            Box::new(|| {
+                ascii_grid(
+                    &dir,
+                    "high.asc",
+                    (9.6, 44.3, 0.005),
+                    (200, 160),
+                    |lon, lat| {
+                        if (lon - HOLE[0]).hypot(lat - HOLE[1]) < HOLE[2] {
+                            f64::NAN
+                        } else {
+                            let rise = if lon > 10.5 && lat > 45.0 { 30.0 } else { 0.0 };
+                            800.0 + rise + 150.0 * (20.0 * lon).sin() * (15.0 * lat).cos()
+                        }
+                    },
+                )
+            }),
+        ),
+    ];
+    for (what, rewrite) in rewrites {
+        let old = identities(&dir.path("p"));
+        rewrite();
+        run_ok(&dir, &args("p", true));
+        let _ = std::fs::remove_dir_all(dir.path("fresh"));
+        run_ok(&dir, &args("fresh", false));
+        let (updated, fresh) = (
+            pyramid_files(&dir.path("p")),
+            pyramid_files(&dir.path("fresh")),
+        );
+        let differ: Vec<_> = fresh
+            .keys()
+            .chain(updated.keys())
+            .filter(|k| fresh.get(*k) != updated.get(*k))
+            .collect();
+        assert!(
+            differ.is_empty(),
+            "{what}: the update differs in {differ:?}"
+        );
+        let new = identities(&dir.path("p"));
+        let rewritten: Vec<u32> = new
+            .iter()
+            .filter(|(p, id)| old.get(*p) != Some(id))
+            .map(|(p, _)| level_of(p))
+            .collect();
+        assert!(!rewritten.is_empty(), "{what}: the change rewrote no tile");
+        assert!(rewritten.len() < new.len(), "{what}: every tile rewritten");
+        if what == "base" {
+            // Far from the input: the levels finer than the base's own read the input and
+            // the base only near it.
+            assert!(
+                rewritten.iter().all(|&z| z <= BASE_LEVEL),
+                "{what}: rewrote tiles at levels {rewritten:?}"
+            );
+        }
     }
 }

@@ -28,7 +28,7 @@ pub(crate) fn pyramid_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     out
 }
 
-fn run_ok(dir: &Dir, args: &[&str]) -> String {
+pub(crate) fn run_ok(dir: &Dir, args: &[&str]) -> String {
     let o = dir.run(args);
     assert!(o.status.success(), "{args:?}: {}", stderr(&o));
     stderr(&o)
@@ -36,7 +36,7 @@ fn run_ok(dir: &Dir, args: &[&str]) -> String {
 
 /// Builds `input`'s pyramid in one process (`one`) and in `n` shards then a merge
 /// (`sharded-n`), with `extra` options, and asserts they are the same files.
-fn check_shards(dir: &Dir, input: &str, extra: &[&str], counts: &[u32]) {
+pub(crate) fn check_shards(dir: &Dir, input: &str, extra: &[&str], counts: &[u32]) {
     let mut args = vec!["tiles", input, "-o", "one", "-q"];
     args.extend_from_slice(extra);
     run_ok(dir, &args);
@@ -274,7 +274,7 @@ fn patched(dir: &Dir, input: &str, name: &str, window: [u32; 3], rise: f64) -> S
 }
 
 /// Each tile file's identity on disk (inode and modification time), by path.
-fn identities(root: &Path) -> BTreeMap<PathBuf, (u64, std::time::SystemTime)> {
+pub(crate) fn identities(root: &Path) -> BTreeMap<PathBuf, (u64, std::time::SystemTime)> {
     use std::os::unix::fs::MetadataExt;
     pyramid_files(root)
         .into_keys()

@@ -180,13 +180,6 @@ pub(super) fn refuse_clashes(options: &TerrainOptions) -> TerrainResult<()> {
     if options.base.is_none() {
         return Ok(());
     }
-    if options.update {
-        return Err(TerrainError::Options(
-            "--update cannot be combined with --base yet: the records of a pyramid say \
-             which tiles the input's data made, not the base's; build the pyramid again"
-                .into(),
-        ));
-    }
     if let Some(crate::Water::SeaLevel { .. }) = options.water {
         return Err(TerrainError::Options(
             "--water sea-level cannot be combined with --base: it reads the sea from the \

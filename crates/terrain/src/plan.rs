@@ -76,6 +76,17 @@ pub(super) struct TileOptions {
     /// [`TerrainOptions::tiling`]; absent when geographic.
     #[serde(default, skip_serializing_if = "is_geographic")]
     pub(super) tiling: Tiling,
+    /// [`TerrainOptions::base`]; absent without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) base: Option<BaseOptions>,
+}
+
+/// A base raster as a plan records it: its path as given and its vertical datum as
+/// [`tinsmith_raster::VerticalDatum::parse`] reads it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(super) struct BaseOptions {
+    pub(super) path: String,
+    pub(super) vertical_datum: String,
 }
 
 /// Whether `tiling` is the geographic one (which plans leave unsaid).
@@ -99,6 +110,10 @@ impl TileOptions {
             water: options.water.clone(),
             whole_globe: options.whole_globe,
             tiling: options.tiling,
+            base: options.base.as_ref().map(|base| BaseOptions {
+                path: base.path.to_string_lossy().into_owned(),
+                vertical_datum: base.vertical_datum.spec(),
+            }),
         }
     }
 
@@ -124,8 +139,10 @@ impl TileOptions {
             // Shards are refused for 3D Tiles (see `build_shard`).
             format: crate::TileFormat::QuantizedMesh,
             tiling: self.tiling,
-            // Shards are refused with a base (see `build_shard`).
-            base: None,
+            base: self.base.as_ref().map(|base| crate::BaseRaster {
+                path: base.path.clone().into(),
+                vertical_datum: tinsmith_raster::VerticalDatum::parse(&base.vertical_datum),
+            }),
         }
     }
 }
@@ -138,7 +155,7 @@ pub(super) struct Plan {
     pub(super) input: String,
     pub(super) name: String,
     /// SHA-256 of the input's size, georeferencing, band type and nodata, and of a
-    /// coarse read of its samples.
+    /// coarse read of its samples; then the same of the base, with one.
     pub(super) fingerprint: String,
     /// `[west, south, east, north, resolution]`, as [`GeoBounds`].
     pub(super) bounds: [f64; 5],
@@ -146,8 +163,8 @@ pub(super) struct Plan {
     pub(super) anchor: u8,
     pub(super) split: u8,
     pub(super) shards: u32,
-    /// Each block's weight (valid samples of the coarse read it holds, plus one), in block
-    /// order.
+    /// Each block's weight (valid samples of the coarse reads, the input's and the
+    /// base's, it holds, plus one), in block order.
     pub(super) weights: Vec<u64>,
 }
 
@@ -161,29 +178,39 @@ impl Plan {
         options: TileOptions,
         shards: u32,
     ) -> TerrainResult<Plan> {
-        let coverage = tinsmith_raster::coverage(input, options.band, COVERAGE_SIDE)?;
-        let info = tinsmith_raster::WindowReader::open(input, options.band)?
-            .info()
-            .clone();
+        // The input, then the base under it: both fingerprinted, both weigh the blocks.
+        let mut rasters = vec![(input.to_path_buf(), options.band)];
+        if let Some(base) = &options.base {
+            rasters.push((base.path.clone().into(), 1));
+        }
         let mut hash = Sha256::new();
-        let described = serde_json::json!({
-            "width": info.width, "height": info.height, "band": info.band,
-            "type": info.data_type, "nodata": info.nodata, "scale": info.scale,
-            "offset": info.offset, "crs": info.crs_wkt, "transform": info.geo_transform,
-        });
-        hash.update(described.to_string().as_bytes());
-        for v in &coverage.values {
-            hash.update(v.to_bits().to_le_bytes());
+        let mut centres: Vec<[f64; 2]> = Vec::new();
+        let mut cells = 0u64;
+        for (path, band) in &rasters {
+            let coverage = tinsmith_raster::coverage(path, *band, COVERAGE_SIDE)?;
+            let info = tinsmith_raster::WindowReader::open(path, *band)?
+                .info()
+                .clone();
+            let described = serde_json::json!({
+                "width": info.width, "height": info.height, "band": info.band,
+                "type": info.data_type, "nodata": info.nodata, "scale": info.scale,
+                "offset": info.offset, "crs": info.crs_wkt, "transform": info.geo_transform,
+            });
+            hash.update(described.to_string().as_bytes());
+            for v in &coverage.values {
+                hash.update(v.to_bits().to_le_bytes());
+            }
+            centres.extend(
+                coverage
+                    .centres
+                    .iter()
+                    .zip(&coverage.values)
+                    .filter(|(c, v)| v.is_finite() && c[0].is_finite() && c[1].is_finite())
+                    .map(|(&c, _)| c),
+            );
+            cells += (coverage.width * coverage.height) as u64;
         }
         let fingerprint = hex(&hash.finalize());
-        let centres: Vec<[f64; 2]> = coverage
-            .centres
-            .iter()
-            .zip(&coverage.values)
-            .filter(|(c, v)| v.is_finite() && c[0].is_finite() && c[1].is_finite())
-            .map(|(&c, _)| c)
-            .collect();
-        let cells = (coverage.width * coverage.height) as u64;
         let tiling = options.tiling;
         let (split, weights) = split_and_weights(bounds, tiling, anchor, shards, &centres, cells);
         Ok(Plan {

@@ -10,6 +10,7 @@ use tinsmith_store::TileStore;
 
 use serde::Serialize;
 
+use crate::base::Stacked;
 use crate::blocks::SplitSamples;
 use crate::plan::{Plan, Shard, TileOptions};
 use crate::pyramid::{
@@ -19,7 +20,6 @@ use crate::records::{
     block_name, options_key, read_record, read_samples, shard_name, BlockRecord, Entries,
     ShardRecord, RECORDS_DIR,
 };
-use crate::stream::Warp;
 use crate::tms::bounds_array;
 use crate::writer::Written;
 use crate::{LevelReport, TerrainError, TerrainOptions, TerrainReport, TerrainResult};
@@ -75,18 +75,11 @@ pub fn build_shard(
 ) -> TerrainResult<ShardReport> {
     let start = std::time::Instant::now();
     crate::pyramid::directory_only(options, &dest.location())?;
-    if options.base.is_some() {
-        return Err(TerrainError::Options(
-            "--shard cannot be combined with --base yet: a shard's plan weighs its blocks by \
-             the input's samples alone; build the pyramid in one run"
-                .into(),
-        ));
-    }
     let Prepared {
         bounds,
         own_level,
         max_zoom,
-        ..
+        fine,
     } = prepare(input, options)?;
     let plan = Plan::new(
         input,
@@ -114,12 +107,7 @@ pub fn build_shard(
         max_zoom.max(cut.anchor),
         options.threads,
     )?;
-    let source = Warp {
-        path: input,
-        band: options.band,
-        datum: &options.vertical_datum,
-        outside: options.outside(),
-    };
+    let source = Stacked::new(input, options)?;
     let key = options_key(options);
     let mut known = Entries::new();
     for block in &blocks {
@@ -130,7 +118,7 @@ pub fn build_shard(
     let (written, _) = build_recorded_blocks(
         &source,
         &bounds,
-        &bounds,
+        &fine,
         cut,
         max_zoom,
         &blocks,

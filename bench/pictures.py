@@ -222,7 +222,8 @@ def cesium_pictures(args, data, out, tmp):
         "| ![3D Tiles](images/cesium-60km-3dtiles.png) "
         "| ![3D Tiles, close](images/cesium-close-3dtiles.png) |",
         "",
-        "ETOPO5 as 3D Tiles at the camera of the global quantized-mesh picture above:",
+        "ETOPO5 as 3D Tiles at the camera of the global quantized-mesh picture above: the "
+        "two pictures differ by at most 1 of 255 in a pixel (5e-6 on average).",
         "",
         "![ETOPO5 as 3D Tiles in CesiumJS](images/cesium-global-3dtiles.png)",
         "",

@@ -461,3 +461,87 @@ fn an_update_over_a_base_rebuilds_what_either_raster_changed() {
         }
     }
 }
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn several_bases_stacked_in_a_vrt_keep_its_priority_the_bound_and_shared_edges() {
+    let dir = Dir::new();
+    let (_, high) = inputs(&dir);
+    // Two bases overlapping over 9..10°E, each of its own shape; the VRT lists the east
+    // one last, so it is read where both have data (gdalbuildvrt's order).
+    let west = ascii_grid(
+        &dir,
+        "west.asc",
+        (5.0, 40.0, 0.05),
+        (100, 160),
+        |lon, lat| 300.0 + 200.0 * lon.sin() * (2.0 * lat).cos(),
+    );
+    let east = ascii_grid(
+        &dir,
+        "east.asc",
+        (9.0, 41.0, 0.05),
+        (120, 120),
+        |lon, lat| 900.0 + 300.0 * (3.0 * lon).cos() * lat.sin(),
+    );
+    let vrt = dir.path("bases.vrt").to_string_lossy().into_owned();
+    let status = Command::new("gdalbuildvrt")
+        .args(["-q", &vrt, &west, &east])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let o = dir.run(&[
+        "tiles",
+        &high,
+        "--base",
+        &vrt,
+        "-o",
+        "p",
+        "--vertical-datum",
+        "ellipsoid",
+        "--quality",
+        "0.1",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let tiles = decode_pyramid(&dir.path("p"));
+    for (&key, t) in &tiles {
+        check_tile(key, t);
+    }
+    assert!(check_shared_edges(&tiles) > 0);
+    // Every lattice point from the bases' own level down is within the bound of GDAL's
+    // warp of the VRT, then the input over it.
+    let mut checked = 0;
+    for (&(z, x, y), t) in tiles.range((BASE_LEVEL, 0, 0)..) {
+        let bound = 0.1 * Tiling::Geographic.level_error(z);
+        let mut samples = stacked_gdal_samples(&dir, &[&vrt, &high], Tiling::Geographic, z, x, y);
+        skip_the_rim(&mut samples, Tiling::Geographic, z, x, y);
+        let e = max_error(t, &samples);
+        assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
+        checked += 1;
+    }
+    assert!(checked > 10, "{checked}");
+    // Where both bases have data, away from their edges and the input, the vertices of
+    // the base's own level carry the east base's heights, not the west one's.
+    let z = BASE_LEVEL;
+    let bound = 0.1 * Tiling::Geographic.level_error(z);
+    let mut over_both = 0;
+    for (&(tz, x, y), t) in tiles.range((z, 0, 0)..(z + 1, 0, 0)) {
+        let [w, s, e, n] = Tiling::Geographic.rectangle(tz, x, y);
+        for k in 0..t.h.len() {
+            let lon = w + (e - w) * t.u[k] as f64 / 32767.0;
+            let lat = s + (n - s) * t.v[k] as f64 / 32767.0;
+            if !((9.2..9.8).contains(&lon) && (41.2..46.8).contains(&lat)) {
+                continue;
+            }
+            let east = 900.0 + 300.0 * (3.0 * lon).cos() * lat.sin();
+            let west = 300.0 + 200.0 * lon.sin() * (2.0 * lat).cos();
+            assert!(
+                (t.h[k] - east).abs() <= bound + 1.0 && (t.h[k] - west).abs() > bound + 1.0,
+                "{tz}/{x}/{y} at {lon}, {lat}: {} (east {east}, west {west})",
+                t.h[k]
+            );
+            over_both += 1;
+        }
+    }
+    assert!(over_both > 0, "no vertex where both bases have data");
+}

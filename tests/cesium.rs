@@ -138,7 +138,7 @@ fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
 
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
-fn cesiumjs_receives_the_water_masks() {
+fn cesiumjs_receives_the_water_masks_as_quantized_mesh_and_as_3d_tiles() {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = Dir::new();
     // Land west of 10.6°E, nodata sea east of it.
@@ -155,47 +155,63 @@ fn cesiumjs_receives_the_water_masks() {
             }
         },
     );
-    let o = dir.run(&[
-        "tiles",
-        &dem,
-        "-o",
-        "site/terrain",
-        "--water",
-        "sea-level",
-        "-q",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    for (out, format) in [("site/terrain", "quantized-mesh"), ("site/glb", "3dtiles")] {
+        let o = dir.run(&[
+            "tiles",
+            &dem,
+            "-o",
+            out,
+            "--water",
+            "sea-level",
+            "--format",
+            format,
+            "-q",
+        ]);
+        assert!(o.status.success(), "{format}: {}", stderr(&o));
+    }
     cesium_page(&dir);
     let tiles = decode_pyramid(&dir.path("site/terrain"));
     let (&(z, x, y), finest) = tiles.iter().next_back().expect("tiles");
     let ours = finest.water_mask.clone().expect("a water mask");
     assert_eq!(ours.len(), 65536, "a tile with land and water");
+    assert!(ours.contains(&0) && ours.contains(&255));
+    // A level-0 tile away from the DEM: beyond the DEM is its nodata sea, so all water,
+    // a mask of one byte (in 3D Tiles, a 1 x 1 image).
+    let root = tiles[&(0, 0, 0)].water_mask.clone().expect("a water mask");
+    assert_eq!(root, vec![255]);
     let points_file = dir.write("points.json", "[[10.3, 45.5]]");
     let (_server, base) = serve(&dir, &["site"]);
-    let out = Command::new("node")
-        .arg(repo.join("tests/oracle/cesium_sample.cjs"))
-        .arg(format!("{base}index.html"))
-        .arg(format!("{base}terrain/"))
-        .arg(&points_file)
-        .arg(format!("{z}/{x}/{y}"))
-        .output()
-        .expect("node runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let result: Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
-    assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
-    assert_eq!(result["hasWaterMask"], true);
-    let theirs: Vec<u64> = result["waterMask"]
-        .as_array()
-        .expect("CesiumJS has the tile's water mask")
-        .iter()
-        .map(|v| v.as_u64().unwrap())
-        .collect();
-    assert!(theirs == ours, "CesiumJS decoded another water mask");
+    for (terrain, tile, want) in [
+        ("terrain/", (z, x, y), Some(&ours)),
+        ("glb/tileset.json", (z, x, y), Some(&ours)),
+        ("terrain/", (0, 0, 0), Some(&root)),
+        ("glb/tileset.json", (0, 0, 0), Some(&root)),
+    ] {
+        let out = Command::new("node")
+            .arg(repo.join("tests/oracle/cesium_sample.cjs"))
+            .arg(format!("{base}index.html"))
+            .arg(format!("{base}{terrain}"))
+            .arg(&points_file)
+            .arg(format!("{}/{}/{}", tile.0, tile.1, tile.2))
+            .output()
+            .expect("node runs");
+        assert!(
+            out.status.success(),
+            "{terrain}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let result: Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
+        assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
+        assert_eq!(result["hasWaterMask"], true);
+        let theirs: Option<Vec<u64>> = result["waterMask"]
+            .as_array()
+            .map(|a| a.iter().map(|v| v.as_u64().unwrap()).collect());
+        assert!(
+            theirs.as_ref() == want,
+            "{terrain} {tile:?}: CesiumJS decoded another water mask"
+        );
+    }
 }
 
 #[test]

@@ -458,3 +458,68 @@ fn a_3dtiles_pyramid_anywhere_but_a_whole_new_directory_is_refused() {
         }
     }
 }
+
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn a_3dtiles_pyramid_with_water_masks_validates_and_keeps_its_meshes() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = Dir::new();
+    let input = fixture("etopo5_2deg_i16.tif");
+    // Water (255) where the DEM is below 0 m, land (0) elsewhere.
+    let mask = dir.path("below0.tif");
+    let status = Command::new("gdal_translate")
+        .args(["-q", "-ot", "Byte", "-scale", "0", "-1", "0", "255", &input])
+        .arg(&mask)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let mask = mask.to_string_lossy().into_owned();
+    for (out, water) in [("plain", None), ("water", Some(mask.as_str()))] {
+        let mut args = vec![
+            "tiles",
+            input.as_str(),
+            "-o",
+            out,
+            "--format",
+            "3dtiles",
+            "-q",
+        ];
+        if let Some(mask) = water {
+            args.extend_from_slice(&["--water", mask]);
+        }
+        let o = dir.run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let (plain, water) = (glb_files(&dir.path("plain")), glb_files(&dir.path("water")));
+    assert_eq!(
+        plain.keys().collect::<Vec<_>>(),
+        water.keys().collect::<Vec<_>>()
+    );
+    let mut with_mask = 0;
+    for (key, path) in &water {
+        let (a, b) = (
+            read_glb(&std::fs::read(&plain[key]).unwrap()),
+            read_glb(&std::fs::read(path).unwrap()),
+        );
+        // The same mesh; the mask is added beside it.
+        assert_eq!(a.ecef, b.ecef, "{key:?}");
+        assert_eq!(a.triangles, b.triangles, "{key:?}");
+        let bytes = std::fs::read(path).unwrap();
+        with_mask += usize::from(bytes.windows(b"WATERMASK".len()).any(|w| w == b"WATERMASK"));
+    }
+    assert!(with_mask > 0, "no tile with water");
+    let out = Command::new("node")
+        .arg(repo.join("tests/oracles/gltf_validate.js"))
+        .args(water.values())
+        .output()
+        .expect("node runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for line in String::from_utf8(out.stdout).unwrap().lines() {
+        let report: Value = serde_json::from_str(line).unwrap();
+        assert_eq!(report["issues"]["numErrors"], 0, "{report:#}");
+    }
+}

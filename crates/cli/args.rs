@@ -189,8 +189,8 @@ pub struct TilesArgs {
     pub no_gzip: bool,
     /// Tile format: quantized-mesh (CesiumTerrainProvider), or 3dtiles: 3D Tiles 1.1
     /// terrain for Cesium3DTilesTerrainProvider (tileset.json, implicit subtrees, one
-    /// uncompressed GLB per tile with CESIUM_tile_edges), the same tiles, whole globe from
-    /// level 0, into a directory.
+    /// uncompressed GLB per tile with CESIUM_tile_edges, water masks as PNG property
+    /// textures), the same tiles, whole globe from level 0, into a directory.
     #[arg(long, value_name = "NAME", default_value = "quantized-mesh", value_parser = parse_tile_format)]
     pub format: TileFormat,
     /// Worker threads, at most 1024 (default: all cores); no more are started than there

@@ -7,7 +7,7 @@
 // Prints {heights, consoleErrors, failedRequests, levels, tiles, tiling} (each point's
 // tile at its level, and the provider's tiling scheme); with Z/X/Y, the provider asks
 // for water masks too and the result adds that tile's (TMS numbering) {hasWaterMask,
-// waterMask} as CesiumJS decoded it. Exit code 3: Chromium cannot
+// waterMask} as CesiumJS decoded it (a 3D Tiles tile's image: its red channel, row by row). Exit code 3: Chromium cannot
 // start (the caller may skip); any other non-zero code is a failure.
 'use strict';
 const fs = require('fs');
@@ -70,7 +70,16 @@ const { chromium } = require(path.join(root, '.tools', 'node_modules', 'playwrig
         // from the north.
         const data = await provider.requestTileGeometry(x, (1 << z) - 1 - y, z);
         out.hasWaterMask = provider.hasWaterMask;
-        out.waterMask = data.waterMask ? Array.from(data.waterMask) : null;
+        let mask = data.waterMask;
+        if (mask instanceof ImageBitmap) {
+          // 3D Tiles: the property texture's image; CesiumJS samples its red channel.
+          const canvas = new OffscreenCanvas(mask.width, mask.height);
+          const context2d = canvas.getContext('2d');
+          context2d.drawImage(mask, 0, 0);
+          const rgba = context2d.getImageData(0, 0, mask.width, mask.height).data;
+          mask = rgba.filter((_, i) => i % 4 === 0);
+        }
+        out.waterMask = mask ? Array.from(mask) : null;
       }
       return out;
     }, { terrainUrl, points, waterTile });

@@ -5,6 +5,9 @@
 //! tile's west, south, east and north edges as the `CESIUM_tile_edges` extension's
 //! `left`, `bottom`, `right` and `top` accessors. The tile's height range, bounding sphere
 //! and horizon occlusion point go to the subtree's metadata ([`TileBounds`]), not the GLB.
+//! A water mask, when given, is a greyscale PNG property texture of `EXT_structural_metadata`
+//! whose property has the `WATERMASK` semantic, as the provider's `requestWaterMask` reads
+//! it.
 //!
 //! Follows CesiumJS 1.140's `Cesium3DTilesTerrainGeometryProcessor.js`: it reads
 //! `nodes[0].matrix`, maps it from Y-up to Z-up (`Axis.Y_UP_TO_Z_UP`, glTF `(x, y, z)` is
@@ -26,6 +29,9 @@ const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 
 /// The glTF extension naming the tile's edge vertices.
 pub const TILE_EDGES_EXTENSION: &str = "CESIUM_tile_edges";
+
+/// The glTF extension a water mask is written in (a property texture).
+pub const STRUCTURAL_METADATA_EXTENSION: &str = "EXT_structural_metadata";
 
 /// What the subtree's tile metadata says of a tile (the semantics CesiumJS reads).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -53,6 +59,7 @@ pub struct GlbTile<'a> {
     heights: &'a [f64],
     triangles: &'a [[u32; 3]],
     normals: Option<&'a [[f64; 3]]>,
+    water_mask: Option<&'a [u8]>,
 }
 
 impl<'a> GlbTile<'a> {
@@ -69,7 +76,16 @@ impl<'a> GlbTile<'a> {
             heights,
             triangles,
             normals: None,
+            water_mask: None,
         }
+    }
+
+    /// Adds a water mask as the quantized-mesh extension has it: 1 byte (0 all land, 255
+    /// all water) or 256 x 256, rows north to south. An all-land mask writes nothing
+    /// (CesiumJS takes a tile without one as land).
+    pub fn with_water_mask(mut self, mask: &'a [u8]) -> Self {
+        self.water_mask = Some(mask);
+        self
     }
 
     /// Adds `NORMAL`s: one ECEF unit normal per vertex, in the input order.
@@ -197,7 +213,7 @@ impl<'a> GlbTile<'a> {
             1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, centre[0], centre[2],
             -centre[1], 1.0,
         ];
-        let document = json!({
+        let mut document = json!({
             "asset": {"version": "2.0", "generator": "tinsmith"},
             "extensionsUsed": [TILE_EDGES_EXTENSION],
             "scene": 0,
@@ -211,10 +227,13 @@ impl<'a> GlbTile<'a> {
                     "left": west, "bottom": south, "right": east, "top": north,
                 }},
             }]}],
-            "accessors": bin.accessors,
-            "bufferViews": bin.views,
-            "buffers": [{"byteLength": bin.bytes.len()}],
         });
+        if let Some(mask) = self.water_mask.filter(|m| *m != [0]) {
+            bin.water_mask(mask, &mut document)?;
+        }
+        document["accessors"] = std::mem::take(&mut bin.accessors).into();
+        document["bufferViews"] = std::mem::take(&mut bin.views).into();
+        document["buffers"] = json!([{"byteLength": bin.bytes.len()}]);
         // Rounding an offset of at most `radius` to float32 moves a vertex by at most
         // `radius x 2^-24`: the bounds are widened by twice that, so that they hold the
         // vertices the client decodes, not only the exact ones.
@@ -253,6 +272,11 @@ impl<'a> GlbTile<'a> {
             }
         }
         check_triangles_and_normals(self.triangles, vertex_count, self.normals)?;
+        if let Some(mask) = self.water_mask {
+            if mask.len() != 1 && mask.len() != 65_536 {
+                return Err(EncodeError::WaterMaskSize(mask.len()));
+            }
+        }
         Ok(())
     }
 }
@@ -286,6 +310,50 @@ impl Builder {
         accessor["bufferView"] = (self.views.len() - 1).into();
         self.accessors.push(accessor);
         self.accessors.len() - 1
+    }
+}
+
+impl Builder {
+    /// Adds `mask` (1 or 256 x 256 bytes, rows north to south) to `document` as a
+    /// greyscale PNG in a buffer view of its own, the texture of an
+    /// `EXT_structural_metadata` property texture whose one property is `WATERMASK`
+    /// (normalized UINT8 in the red channel, which CesiumJS samples).
+    fn water_mask(&mut self, mask: &[u8], document: &mut Value) -> Result<(), EncodeError> {
+        let side = if mask.len() == 1 { 1 } else { 256 };
+        let mut png_bytes = Vec::new();
+        let mut encoder = png::Encoder::new(&mut png_bytes, side, side);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_compression(png::Compression::High);
+        let written = encoder
+            .write_header()
+            .and_then(|mut w| w.write_image_data(mask));
+        written.map_err(|e| EncodeError::WaterMaskImage(e.to_string()))?;
+        let offset = self.bytes.len();
+        self.bytes.extend_from_slice(&png_bytes);
+        self.bytes.resize(self.bytes.len().next_multiple_of(4), 0);
+        self.views
+            .push(json!({"buffer": 0, "byteOffset": offset, "byteLength": png_bytes.len()}));
+        let view = self.views.len() - 1;
+        document["extensionsUsed"]
+            .as_array_mut()
+            .expect("extensionsUsed is a list")
+            .push(STRUCTURAL_METADATA_EXTENSION.into());
+        document["images"] = json!([{"bufferView": view, "mimeType": "image/png"}]);
+        // LINEAR, CLAMP_TO_EDGE: as CesiumJS samples a quantized-mesh tile's mask.
+        document["samplers"] =
+            json!([{"magFilter": 9729, "minFilter": 9729, "wrapS": 33071, "wrapT": 33071}]);
+        document["textures"] = json!([{"source": 0, "sampler": 0}]);
+        document["extensions"] = json!({STRUCTURAL_METADATA_EXTENSION: {
+            "schema": {"id": "terrain", "classes": {"water": {"properties": {"mask": {
+                "type": "SCALAR", "componentType": "UINT8", "normalized": true,
+                "semantic": "WATERMASK",
+            }}}}},
+            "propertyTextures": [{"class": "water", "properties": {"mask": {
+                "index": 0, "texCoord": 0, "channels": [0],
+            }}}],
+        }});
+        Ok(())
     }
 }
 
@@ -381,6 +449,47 @@ mod tests {
             .unwrap() as usize;
         assert_eq!(doc["accessors"][left]["componentType"], UNSIGNED_INT);
         assert_eq!(doc["accessors"][left]["count"], n);
+    }
+
+    #[test]
+    fn a_water_mask_is_a_png_property_texture_and_all_land_writes_none() {
+        let m = QUANTIZED_MAX;
+        let vertices = [[0, 0, 0], [m, 0, 0], [m, m, 0], [0, m, 0]];
+        let heights = [0.0; 4];
+        let triangles = [[0, 1, 2], [0, 2, 3]];
+        let tile = || GlbTile::new(rect(), &vertices, &heights, &triangles);
+        let cells: Vec<u8> = (0..65_536)
+            .map(|k| if k % 256 < 100 { 255 } else { 0 })
+            .collect();
+        for (mask, side) in [(&[255u8][..], 1), (&cells[..], 256)] {
+            let (bytes, _) = tile().with_water_mask(mask).encode().unwrap();
+            let doc = document(&bytes);
+            assert!(doc["extensionsUsed"]
+                .as_array()
+                .unwrap()
+                .contains(&STRUCTURAL_METADATA_EXTENSION.into()));
+            let class = &doc["extensions"][STRUCTURAL_METADATA_EXTENSION]["schema"]["classes"]
+                ["water"]["properties"]["mask"];
+            assert_eq!(class["semantic"], "WATERMASK");
+            let view =
+                &doc["bufferViews"][doc["images"][0]["bufferView"].as_u64().unwrap() as usize];
+            let json_length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+            let bin = &bytes[20 + json_length + 8..];
+            let at = view["byteOffset"].as_u64().unwrap() as usize;
+            let png = &bin[at..at + view["byteLength"].as_u64().unwrap() as usize];
+            let mut reader = png::Decoder::new(std::io::Cursor::new(png))
+                .read_info()
+                .unwrap();
+            let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+            let info = reader.next_frame(&mut pixels).unwrap();
+            assert_eq!((info.width, info.height), (side, side));
+            assert_eq!(&pixels[..info.buffer_size()], mask);
+        }
+        let (land, _) = tile().with_water_mask(&[0]).encode().unwrap();
+        let (none, _) = tile().encode().unwrap();
+        assert_eq!(land, none);
+        let wrong = tile().with_water_mask(&[0, 255]).encode();
+        assert_eq!(wrong.unwrap_err(), EncodeError::WaterMaskSize(2));
     }
 
     #[test]

@@ -557,10 +557,6 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
             (options.min_zoom > 0, "--min-zoom above 0"),
             (!options.whole_globe, "--data-only"),
             (options.metadata, "--metadata (a quantized-mesh extension)"),
-            (
-                options.water.is_some(),
-                "--water (not written as 3D Tiles yet)",
-            ),
             (options.update, "--update"),
             (
                 options.tiling != Tiling::Geographic,

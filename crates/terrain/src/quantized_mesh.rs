@@ -62,6 +62,9 @@ pub enum EncodeError {
     /// A water mask is neither 1 byte nor 256 x 256.
     #[error("a water mask of {0} bytes: it is 1 or 65536")]
     WaterMaskSize(usize),
+    /// A water mask could not be encoded as PNG (3D Tiles).
+    #[error("the water mask's PNG: {0}")]
+    WaterMaskImage(String),
     /// The normals are not one per vertex.
     #[error("{got} normals for {expected} vertices")]
     NormalCount {

@@ -192,6 +192,10 @@ pub(super) fn build_tile(
         y,
         source,
     };
+    let water = match &options.water {
+        Some(water) => Some(crate::water::mask(water, rect)?),
+        None => None,
+    };
     let (bytes, bounds) = match options.format {
         TileFormat::ThreeDTiles => {
             // The decoded heights the check above measured, on the level's lattice.
@@ -203,16 +207,15 @@ pub(super) fn build_tile(
             if let Some(normals) = &normals {
                 tile = tile.with_normals(normals);
             }
+            if let Some(water) = &water {
+                tile = tile.with_water_mask(water.bytes());
+            }
             let (bytes, bounds) = tile.encode().map_err(encode_error)?;
             (bytes, Some(bounds))
         }
         TileFormat::QuantizedMesh => {
             let metadata =
                 metadata_available.map(|available| metadata_json(available, z, column, y));
-            let water = match &options.water {
-                Some(water) => Some(crate::water::mask(water, rect)?),
-                None => None,
-            };
             let mut tile = QuantizedMeshTile::new(
                 rect,
                 min_height as f32,

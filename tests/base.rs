@@ -342,13 +342,19 @@ fn a_base_that_is_missing_not_a_raster_or_not_placed_is_refused_naming_it() {
 fn an_option_a_base_does_not_work_with_is_refused_by_name() {
     let dir = Dir::new();
     let (low, high) = inputs(&dir);
-    for (extra, name) in [(&["--water", "sea-level"][..], "--water sea-level")] {
-        let mut args = vec!["tiles", &high, "--base", &low, "-o", "out", "-q"];
-        args.extend_from_slice(extra);
-        let o = dir.run(&args);
-        assert_fails_naming(&o, &[name, "--base"]);
-        assert!(!dir.path("out").join("layer.json").exists(), "{name}");
-    }
+    let o = dir.run(&[
+        "tiles",
+        &high,
+        "--base",
+        &low,
+        "-o",
+        "out",
+        "-q",
+        "--water",
+        "sea-level",
+    ]);
+    assert_fails_naming(&o, &["--water sea-level", "--base"]);
+    assert!(!dir.path("out").join("layer.json").exists());
 }
 
 /// The level of a tile file `z/x/y.terrain`.
@@ -388,7 +394,8 @@ fn an_update_over_a_base_rebuilds_what_either_raster_changed() {
     run_ok(&dir, &args("p", false));
     // The base raised by 50 m west of 6.5°E, far from the input; then the input raised
     // by 30 m in its north-east corner, as rasters are re-surveyed in place.
-    let rewrites: [(&str, Box<dyn Fn() -> String>); 2] = [
+    type Rewrite<'a> = Box<dyn Fn() -> String + 'a>;
+    let rewrites: [(&str, Rewrite); 2] = [
         (
             "base",
             Box::new(|| {

@@ -470,64 +470,62 @@ fn a_pyramid_goes_to_a_bucket_whole_and_in_shards_as_it_goes_to_disk() {
         let o = run_with(&dir, &env, args);
         assert!(o.status.success(), "{args:?}: {}", stderr(&o));
     };
-    run(&["tiles", &input, "-o", "local", "--normals", "-q"]);
-    run(&[
-        "tiles",
-        &input,
-        "-o",
-        "s3://terrain/whole",
-        "--normals",
-        "-q",
-    ]);
-    for i in 0..3 {
-        let shard = format!("{i}/3");
-        run(&[
-            "tiles",
-            &input,
-            "-o",
-            "s3://terrain/sharded",
-            "--normals",
-            "--shard",
-            &shard,
-            "-q",
-        ]);
-    }
-    let before_merge = moto.boto3("terrain", &["keys", "sharded/layer.json"]);
-    assert!(
-        before_merge.trim().is_empty(),
-        "layer.json before the merge"
-    );
-    run(&["tiles", "merge", "s3://terrain/sharded", "-q"]);
-
-    let local: BTreeMap<String, String> = tree(&dir.path("local"))
-        .into_iter()
-        .filter(|(p, _)| !p.starts_with("tinsmith"))
-        .map(|(p, bytes)| (p.to_string_lossy().into_owned(), hex(&bytes)))
-        .collect();
-    assert!(local.len() > 20);
-    for prefix in ["whole", "sharded"] {
-        let remote = bucket_tree(&moto, "terrain", prefix);
-        let pyramid: BTreeMap<&String, &String> = remote
-            .iter()
-            .filter(|(k, _)| !k.starts_with("tinsmith/"))
-            .map(|(k, v)| (k, &v.2))
-            .collect();
-        assert_eq!(
-            pyramid.keys().map(|k| k.as_str()).collect::<Vec<_>>(),
-            local.keys().map(|k| k.as_str()).collect::<Vec<_>>(),
-            "{prefix}"
+    for format in ["quantized-mesh", "3dtiles"] {
+        let (whole, sharded) = (
+            format!("s3://terrain/{format}/whole"),
+            format!("s3://terrain/{format}/sharded"),
         );
-        for (key, body) in &local {
-            assert!(
-                *pyramid[key] == *body,
-                "{prefix}/{key} differs from the local file"
+        let options = ["--normals", "--format", format, "-q"];
+        run(&[&["tiles", &input, "-o", format][..], &options].concat());
+        run(&[&["tiles", &input, "-o", &whole][..], &options].concat());
+        for i in 0..3 {
+            let shard = format!("{i}/3");
+            let args = ["tiles", &input, "-o", &sharded, "--shard", &shard];
+            run(&[&args[..], &options].concat());
+        }
+        for last in ["layer.json", "tileset.json"] {
+            let before_merge =
+                moto.boto3("terrain", &["keys", &format!("{format}/sharded/{last}")]);
+            assert!(before_merge.trim().is_empty(), "{last} before the merge");
+        }
+        run(&["tiles", "merge", &sharded, "-q"]);
+
+        let local: BTreeMap<String, String> = tree(&dir.path(format))
+            .into_iter()
+            .filter(|(p, _)| !p.starts_with("tinsmith"))
+            .map(|(p, bytes)| (p.to_string_lossy().into_owned(), hex(&bytes)))
+            .collect();
+        assert!(local.len() > 20);
+        for prefix in ["whole", "sharded"] {
+            let remote = bucket_tree(&moto, "terrain", &format!("{format}/{prefix}"));
+            let pyramid: BTreeMap<&String, &String> = remote
+                .iter()
+                .filter(|(k, _)| !k.starts_with("tinsmith/"))
+                .map(|(k, v)| (k, &v.2))
+                .collect();
+            assert_eq!(
+                pyramid.keys().map(|k| k.as_str()).collect::<Vec<_>>(),
+                local.keys().map(|k| k.as_str()).collect::<Vec<_>>(),
+                "{format}/{prefix}"
             );
-            let (content_type, encoding, _) = &remote[key];
-            if key.ends_with(".terrain") {
-                assert_eq!(content_type, "application/vnd.quantized-mesh", "{key}");
-                assert_eq!(encoding, "gzip", "{key}");
-            } else {
-                assert_eq!(content_type, "application/json", "{key}");
+            for (key, body) in &local {
+                assert!(
+                    *pyramid[key] == *body,
+                    "{format}/{prefix}/{key} differs from the local file"
+                );
+                let (content_type, encoding, _) = &remote[key];
+                let (want_type, want_encoding) = match key.rsplit_once('.').unwrap().1 {
+                    "terrain" => ("application/vnd.quantized-mesh", "gzip"),
+                    "glb" => ("model/gltf-binary", ""),
+                    "subtree" => ("application/octet-stream", ""),
+                    _ => ("application/json", ""),
+                };
+                assert_eq!(content_type, want_type, "{key}");
+                if !want_encoding.is_empty() {
+                    assert_eq!(encoding, want_encoding, "{key}");
+                } else {
+                    assert!(encoding.is_null() || encoding == "", "{key}: {encoding}");
+                }
             }
         }
     }

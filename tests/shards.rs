@@ -41,7 +41,12 @@ pub(crate) fn check_shards(dir: &Dir, input: &str, extra: &[&str], counts: &[u32
     args.extend_from_slice(extra);
     run_ok(dir, &args);
     let one = pyramid_files(&dir.path("one"));
-    assert!(one.contains_key(Path::new("layer.json")) && one.len() > 5);
+    let last = if extra.contains(&"3dtiles") {
+        "tileset.json"
+    } else {
+        "layer.json"
+    };
+    assert!(one.contains_key(Path::new(last)) && one.len() > 5);
     for &n in counts {
         let out = format!("sharded-{n}");
         // Shards in an order that is not their index order.
@@ -52,8 +57,8 @@ pub(crate) fn check_shards(dir: &Dir, input: &str, extra: &[&str], counts: &[u32
             run_ok(dir, &args);
         }
         assert!(
-            !dir.path(&out).join("layer.json").exists(),
-            "no layer.json before the merge"
+            !dir.path(&out).join(last).exists(),
+            "no {last} before the merge"
         );
         run_ok(dir, &["tiles", "merge", &out, "-q"]);
         let sharded = pyramid_files(&dir.path(&out));
@@ -153,7 +158,7 @@ fn a_globe_on_0_360_is_whole_and_the_same_in_shards() {
         let one = pyramid_files(&dir.path("one"));
         let count = one
             .keys()
-            .filter(|p| p.extension().is_some_and(|e| e == "terrain"))
+            .filter(|p| p.extension().is_some_and(|e| e == "terrain" || e == "glb"))
             .count();
         assert_eq!(count, tiles, "every tile of levels 0 to {max_zoom}");
         std::fs::remove_dir_all(dir.path("one")).unwrap();
@@ -244,7 +249,7 @@ fn a_shard_run_again_keeps_the_tiles_it_finished() {
 
 /// `input` with heights raised by `rise` m in the `size` x `size` window at `x0`, `y0`
 /// (a VRT over it).
-fn patched(dir: &Dir, input: &str, name: &str, window: [u32; 3], rise: f64) -> String {
+pub(crate) fn patched(dir: &Dir, input: &str, name: &str, window: [u32; 3], rise: f64) -> String {
     let [x0, y0, size] = window;
     let info = std::process::Command::new("gdalinfo")
         .args(["-json", input])
@@ -273,12 +278,13 @@ fn patched(dir: &Dir, input: &str, name: &str, window: [u32; 3], rise: f64) -> S
     vrt.to_string_lossy().into_owned()
 }
 
-/// Each tile file's identity on disk (inode and modification time), by path.
+/// Each tile file's (`.terrain` or `.glb`) identity on disk (inode and modification
+/// time), by path.
 pub(crate) fn identities(root: &Path) -> BTreeMap<PathBuf, (u64, std::time::SystemTime)> {
     use std::os::unix::fs::MetadataExt;
     pyramid_files(root)
         .into_keys()
-        .filter(|p| p.extension().is_some_and(|e| e == "terrain"))
+        .filter(|p| p.extension().is_some_and(|e| e == "terrain" || e == "glb"))
         .map(|p| {
             let meta = std::fs::metadata(root.join(&p)).unwrap();
             (p, (meta.ino(), meta.modified().unwrap()))

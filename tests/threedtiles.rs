@@ -11,6 +11,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
+use crate::shards::{check_shards, identities, patched, pyramid_files, run_ok};
 use crate::tiles::{all_files, decode_pyramid, gdal_samples, max_error, Tile};
 use crate::util::{assert_fails_naming, fixture, stderr, Dir};
 
@@ -423,7 +424,7 @@ fn a_3dtiles_pyramid_is_the_quantized_mesh_pyramid_in_glb_and_validates() {
 }
 
 #[test]
-fn a_3dtiles_pyramid_anywhere_but_a_whole_new_directory_is_refused() {
+fn a_3dtiles_pyramid_in_mbtiles_or_without_the_whole_globe_is_refused() {
     let dir = Dir::new();
     let input = fixture("etopo5_2deg_i16.tif");
     for (extra, names) in [
@@ -439,10 +440,6 @@ fn a_3dtiles_pyramid_anywhere_but_a_whole_new_directory_is_refused() {
         (
             &["-o", "c", "--metadata"][..],
             &["--metadata", "3dtiles"][..],
-        ),
-        (
-            &["-o", "d", "--shard", "0/2"][..],
-            &["shards", "3dtiles"][..],
         ),
         (
             &["-o", "e", "--tiling", "mercator"][..],
@@ -522,4 +519,58 @@ fn a_3dtiles_pyramid_with_water_masks_validates_and_keeps_its_meshes() {
         let report: Value = serde_json::from_str(line).unwrap();
         assert_eq!(report["issues"]["numErrors"], 0, "{report:#}");
     }
+}
+
+#[test]
+fn a_3dtiles_pyramid_in_shards_is_the_one_process_pyramid() {
+    let dir = Dir::new();
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    check_shards(&dir, &input, &["--format", "3dtiles", "--normals"], &[2, 7]);
+}
+
+#[test]
+fn a_3dtiles_update_rebuilds_only_the_tiles_a_change_reaches_and_its_subtrees() {
+    let dir = Dir::new();
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    let args = |input: &str, out: &str, update: bool| {
+        let mut a = vec![
+            "tiles".to_owned(),
+            input.to_owned(),
+            "-o".into(),
+            out.into(),
+        ];
+        a.extend(["--format", "3dtiles", "-q"].map(String::from));
+        if update {
+            a.push("--update".into());
+        }
+        a
+    };
+    let run = |a: Vec<String>| run_ok(&dir, &a.iter().map(String::as_str).collect::<Vec<_>>());
+    let before = patched(&dir, &input, "dem.vrt", [300, 350, 60], 0.0);
+    run(args(&before, "p", false));
+    let old = identities(&dir.path("p"));
+    let after = patched(&dir, &input, "dem.vrt", [300, 350, 60], 40.0);
+    run(args(&after, "p", true));
+    run(args(&after, "fresh", false));
+    let (updated, fresh) = (
+        pyramid_files(&dir.path("p")),
+        pyramid_files(&dir.path("fresh")),
+    );
+    let differ: Vec<_> = fresh
+        .keys()
+        .chain(updated.keys())
+        .filter(|k| fresh.get(*k) != updated.get(*k))
+        .collect();
+    assert!(
+        differ.is_empty(),
+        "the update differs from a fresh build in {differ:?}"
+    );
+    assert!(fresh.keys().any(|k| k.starts_with("subtrees")));
+    let new = identities(&dir.path("p"));
+    let rewritten = new.iter().filter(|(p, id)| old.get(*p) != Some(id)).count();
+    assert!(
+        rewritten > 0 && rewritten * 2 < new.len(),
+        "{rewritten} of {}",
+        new.len()
+    );
 }

@@ -34,6 +34,13 @@ pub fn tiles(
             build_terrain_in(input, &store, options, &mut progress).naming_file(input)?
         }
         Destination::Mbtiles => {
+            if options.format == tinsmith_terrain::TileFormat::ThreeDTiles {
+                bail!(
+                    "{}: --format 3dtiles is written into a directory or a bucket (tileset.json, \
+                     subtrees and GLBs), not into MBTiles, which holds quantized-mesh tiles",
+                    output.display()
+                );
+            }
             if options.update {
                 bail!(
                     "{}: --update works on a directory or a bucket; build the MBTiles file \

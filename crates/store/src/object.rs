@@ -114,7 +114,8 @@ pub fn is_object_url(destination: &str) -> bool {
 /// Tiles and named files as objects under `prefix` in a bucket. Tiles are stored with
 /// `Content-Type: application/vnd.quantized-mesh`, and `Content-Encoding: gzip` when
 /// gzipped, so that the bucket can serve them to CesiumJS as they are; `.json` files with
-/// `Content-Type: application/json`. Every error names the object's URL.
+/// `Content-Type: application/json`, 3D Tiles' `.glb` with `model/gltf-binary` and
+/// `.subtree` with `application/octet-stream`. Every error names the object's URL.
 #[derive(Debug)]
 pub struct BucketStore {
     /// `s3://bucket` or `s3://bucket/prefix` (or `gs://`, `az://`), without a trailing `/`.
@@ -406,8 +407,14 @@ impl TileStore for BucketStore {
     fn put_file(&self, name: &str, bytes: &[u8]) -> StoreResult<()> {
         check_file_name(name)?;
         let mut attributes = Attributes::new();
-        if name.ends_with(".json") {
-            attributes.insert(Attribute::ContentType, "application/json".into());
+        let content_type = match name.rsplit_once('.').map(|(_, e)| e) {
+            Some("json") => Some("application/json"),
+            Some("glb") => Some("model/gltf-binary"),
+            Some("subtree") => Some("application/octet-stream"),
+            _ => None,
+        };
+        if let Some(content_type) = content_type {
+            attributes.insert(Attribute::ContentType, content_type.into());
         }
         self.put(name, bytes, attributes)
     }

@@ -34,7 +34,7 @@ pub const TILE_EDGES_EXTENSION: &str = "CESIUM_tile_edges";
 pub const STRUCTURAL_METADATA_EXTENSION: &str = "EXT_structural_metadata";
 
 /// What the subtree's tile metadata says of a tile (the semantics CesiumJS reads).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TileBounds {
     /// `TILE_MINIMUM_HEIGHT`: at or below the lowest vertex height (m above the
     /// ellipsoid), float32 rounding of the positions included.

@@ -76,6 +76,9 @@ pub(super) struct TileOptions {
     /// [`TerrainOptions::tiling`]; absent when geographic.
     #[serde(default, skip_serializing_if = "is_geographic")]
     pub(super) tiling: Tiling,
+    /// [`TerrainOptions::format`]; absent for quantized-mesh.
+    #[serde(default, skip_serializing_if = "is_quantized_mesh")]
+    pub(super) format: crate::TileFormat,
     /// [`TerrainOptions::base`]; absent without one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(super) base: Option<BaseOptions>,
@@ -87,6 +90,11 @@ pub(super) struct TileOptions {
 pub(super) struct BaseOptions {
     pub(super) path: String,
     pub(super) vertical_datum: String,
+}
+
+/// Whether `format` is quantized-mesh (which plans leave unsaid).
+fn is_quantized_mesh(format: &crate::TileFormat) -> bool {
+    *format == crate::TileFormat::QuantizedMesh
 }
 
 /// Whether `tiling` is the geographic one (which plans leave unsaid).
@@ -110,6 +118,7 @@ impl TileOptions {
             water: options.water.clone(),
             whole_globe: options.whole_globe,
             tiling: options.tiling,
+            format: options.format,
             base: options.base.as_ref().map(|base| BaseOptions {
                 path: base.path.to_string_lossy().into_owned(),
                 vertical_datum: base.vertical_datum.spec(),
@@ -136,8 +145,7 @@ impl TileOptions {
             ),
             water: self.water.clone(),
             whole_globe: self.whole_globe,
-            // Shards are refused for 3D Tiles (see `build_shard`).
-            format: crate::TileFormat::QuantizedMesh,
+            format: self.format,
             tiling: self.tiling,
             base: self.base.as_ref().map(|base| crate::BaseRaster {
                 path: base.path.clone().into(),

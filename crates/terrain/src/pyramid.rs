@@ -20,7 +20,7 @@ use crate::records::{
 use crate::rows::LevelRows;
 use crate::stream::{band_tile_rows, stream_levels, RowSource};
 use crate::tms::{bounds_array, TileRect, Tiling, TILE_CELLS};
-use crate::writer::{Scope, TileWriter, Written};
+use crate::writer::{remove_tile, Scope, TileWriter, Written};
 use crate::{TerrainError, TerrainResult};
 use tinsmith_store::{DirectoryStore, TileStore};
 
@@ -81,16 +81,18 @@ pub struct TerrainOptions {
 }
 
 /// How a pyramid's tiles are encoded and laid out.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum TileFormat {
     /// quantized-mesh-1.0 tiles `z/x/y.terrain` and `layer.json`, for CesiumJS's
     /// `CesiumTerrainProvider`.
     #[default]
+    #[serde(rename = "quantized-mesh")]
     QuantizedMesh,
     /// 3D Tiles 1.1 terrain for CesiumJS's `Cesium3DTilesTerrainProvider`: one GLB per
     /// tile with `CESIUM_tile_edges` under `tiles/`, implicit quadtree subtrees with each
     /// tile's metadata under `subtrees/`, and `tileset.json`. Always the whole globe,
-    /// from level 0, into a directory; GLBs are not gzipped.
+    /// from level 0, into a directory or a bucket; GLBs are not gzipped.
+    #[serde(rename = "3dtiles")]
     ThreeDTiles,
 }
 
@@ -351,7 +353,6 @@ pub fn build_terrain_in(
     options: &TerrainOptions,
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> TerrainResult<TerrainReport> {
-    directory_only(options, &store.location())?;
     let prepared = prepare(input, options)?;
     let known = if store.get_file(&top_name())?.is_some() {
         recorded_entries(store)?
@@ -479,18 +480,6 @@ pub enum Progress<'a> {
     },
 }
 
-/// Refuses a 3D Tiles pyramid anywhere but in a directory built whole (`destination`
-/// names where it was asked to go): its subtrees are made from every tile's metadata,
-/// which only a run that builds every tile holds.
-pub(super) fn directory_only(options: &TerrainOptions, destination: &str) -> TerrainResult<()> {
-    if options.format == TileFormat::ThreeDTiles {
-        return Err(TerrainError::Options(format!(
-            "{destination}: --format 3dtiles is written into a new directory, built whole              in one run (not into MBTiles or a bucket, not by shards, not with --update)"
-        )));
-    }
-    Ok(())
-}
-
 /// What every run of a pyramid works out from its input and options first.
 pub(super) struct Prepared {
     /// The pyramid's extent in EPSG:4326: the input's, with a base the base's too.
@@ -557,7 +546,6 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
             (options.min_zoom > 0, "--min-zoom above 0"),
             (!options.whole_globe, "--data-only"),
             (options.metadata, "--metadata (a quantized-mesh extension)"),
-            (options.update, "--update"),
             (
                 options.tiling != Tiling::Geographic,
                 "--tiling mercator (Cesium3DTilesTerrainProvider tiles the globe geographically)",
@@ -566,7 +554,7 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
         if let Some((_, what)) = clash.iter().find(|(on, _)| *on) {
             return Err(TerrainError::Options(format!(
                 "--format 3dtiles cannot be combined with {what}: its pyramid covers the \
-                 whole globe from level 0, built whole"
+                 whole globe from level 0"
             )));
         }
     }
@@ -1023,7 +1011,7 @@ pub(super) fn finish_pyramid(
         written.entries.iter().map(|e| (e.z, e.x, e.y)).collect();
     for entry in known.values() {
         if entry.written && !now.contains(&(entry.z, entry.x, entry.y)) {
-            store.delete_tile(entry.z, entry.x, entry.y)?;
+            remove_tile(store, options.format, (entry.z, entry.x, entry.y))?;
         }
     }
     for level in reports.iter().rev() {
@@ -1049,8 +1037,17 @@ fn write_tileset(written: &Written, store: &dyn TileStore) -> TerrainResult<()> 
              could reach it"
         ))
     })?;
+    let names: std::collections::HashSet<String> = files.iter().map(|(n, _)| n.clone()).collect();
     for (name, bytes) in files {
-        store.put_file(&name, &bytes)?;
+        if store.get_file(&name)?.as_deref() != Some(&bytes[..]) {
+            store.put_file(&name, &bytes)?;
+        }
+    }
+    // Subtrees of an earlier run (an update) that this one no longer has.
+    for name in store.list_files("subtrees/")? {
+        if !names.contains(&name) {
+            store.delete_file(&name)?;
+        }
     }
     let tileset = tileset_json(&written.metadata, deepest);
     store.put_file("tileset.json", tileset.as_bytes())?;

@@ -40,6 +40,10 @@ pub(super) struct TileEntry {
     pub(super) triangles: u64,
     pub(super) max_error: f64,
     pub(super) verified_bound: f64,
+    /// 3D Tiles: the metadata its subtree gives it (absent for quantized-mesh), so that a
+    /// run that keeps the tile (an update, a shard's merge) writes the same subtrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) bounds: Option<crate::TileBounds>,
 }
 
 /// Tiles by (level, column, TMS row).

@@ -74,7 +74,6 @@ pub fn build_shard(
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> TerrainResult<ShardReport> {
     let start = std::time::Instant::now();
-    crate::pyramid::directory_only(options, &dest.location())?;
     let Prepared {
         bounds,
         own_level,
@@ -319,6 +318,9 @@ pub fn merge_shards(
             for tile in &done.tiles {
                 if tile.written {
                     one.available[usize::from(tile.z)].insert((tile.x, tile.y));
+                    if let Some(bounds) = tile.bounds {
+                        one.metadata.insert((tile.z, tile.x, tile.y), bounds);
+                    }
                 }
                 let (tiling, quality) = (options.tiling, options.quality);
                 let report = one.reports[usize::from(tile.z)]

@@ -192,6 +192,11 @@ impl<'a> TileWriter<'a> {
         let entry = match outcome {
             Outcome::Kept(entry) => {
                 self.written.kept += 1;
+                if let (true, Some(bounds)) = (entry.written, entry.bounds) {
+                    self.written
+                        .metadata
+                        .insert((entry.z, entry.x, entry.y), bounds);
+                }
                 entry
             }
             Outcome::Built(z, x, y, sum, tile) => {
@@ -207,6 +212,7 @@ impl<'a> TileWriter<'a> {
                         triangles: t.triangles as u64,
                         max_error: t.max_error,
                         verified_bound: t.verified_bound,
+                        bounds: t.bounds,
                     },
                     None => TileEntry {
                         z,
@@ -219,6 +225,7 @@ impl<'a> TileWriter<'a> {
                         triangles: 0,
                         max_error: 0.0,
                         verified_bound: 0.0,
+                        bounds: None,
                     },
                 };
                 if let Some(bounds) = tile.as_ref().and_then(|t| t.bounds) {
@@ -244,7 +251,7 @@ impl<'a> TileWriter<'a> {
 
     /// Removes tile `z/x/y` (no longer any data there).
     fn remove(&self, z: u8, x: u32, y: u32) -> TerrainResult<()> {
-        Ok(self.store.delete_tile(z, x, y)?)
+        remove_tile(self.store, self.options.format, (z, x, y))
     }
 
     /// Stores a tile of level `z`.
@@ -269,6 +276,18 @@ impl<'a> TileWriter<'a> {
         Ok(self
             .store
             .put_tile(z, tile.x, tile.y, &tile.bytes, encoding)?)
+    }
+}
+
+/// Removes tile `z/x/y` of a pyramid of `format` from `store`.
+pub(super) fn remove_tile(
+    store: &dyn TileStore,
+    format: TileFormat,
+    (z, x, y): (u8, u32, u32),
+) -> TerrainResult<()> {
+    match format {
+        TileFormat::QuantizedMesh => Ok(store.delete_tile(z, x, y)?),
+        TileFormat::ThreeDTiles => Ok(store.delete_file(&tile_path(z, x, y))?),
     }
 }
 

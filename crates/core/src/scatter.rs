@@ -9,12 +9,15 @@
 //! triangle containing it. Stars, classes, hole retriangulation (DP or ears) and both
 //! error models are the grid's: only where samples are differs.
 //!
-//! Constrained edges (breaklines, outlines) are kept exactly: both their end vertices are
-//! locked, never removed. A removal replaces only the triangles around the removed vertex
-//! and keeps every edge of its ring, so an edge whose ends both stay is never touched,
-//! and scattered decimation makes no edge flips. (The paper's boundary rule could remove
-//! a vertex between two collinear constrained edges; locking keeps the rule simple and the
-//! edges exactly where the input put them.)
+//! Constrained edges (breaklines, outlines) stay in the TIN as chains of edges along them.
+//! A vertex that ends a constrained edge, joins three or more, or bends a line is locked,
+//! never removed. A vertex between exactly two constrained edges on one straight line is
+//! a boundary vertex of the line (the paper's rule, §3.2): its star is split along the
+//! line into two half stars, each retriangulated as a boundary vertex's hole with the
+//! straight edge joining the two line neighbours as its side, and that edge takes the
+//! two constrained edges' place. A removal replaces only the triangles around the
+//! removed vertex and keeps every edge of its ring, and scattered decimation makes no
+//! edge flips, so no other constrained edge is ever touched.
 
 use crate::coverage::HolePoints;
 use crate::decimate::{effective_limit, MAX_ABS_HEIGHT};
@@ -172,7 +175,8 @@ pub struct ScatterReport {
     pub sweeps: usize,
     /// Removal attempts.
     pub attempts: usize,
-    /// Vertices locked by constrained edges (kept whatever the bound).
+    /// Vertices locked by constrained edges (ends, junctions and bends of the lines:
+    /// kept whatever the bound).
     pub locked_vertices: usize,
 }
 
@@ -208,11 +212,14 @@ pub fn decimate_scatter(
 }
 
 /// [`decimate_scatter`] keeping the `constrained` edges (pairs of point indices, each an
-/// edge of `triangles`, in either direction): every one of them is an edge of the result,
-/// because both its end points are kept (see the module documentation).
+/// edge of `triangles`, in either direction): each one is covered by a chain of the
+/// result's edges along it (see the module documentation).
 ///
 /// # Guarantee
-/// As [`decimate_scatter`], and every constrained edge is an edge of the TIN.
+/// As [`decimate_scatter`], and every constrained edge lies on edges of the TIN: either
+/// it is one, or the vertices between its ends were removed as boundary vertices of a
+/// straight line and one straight TIN edge along the line covers it. The ends, junctions
+/// and bends of the lines are vertices of the TIN.
 ///
 /// # Errors
 /// As [`decimate_scatter`], and [`Error::Scatter`] for a constrained edge that is not an
@@ -256,8 +263,8 @@ pub fn decimate_scatter_constrained(
         )));
     }
     drop(used);
-    let locked = locked_vertices(n, &triangles, constrained)?;
-    let locked_count = locked.iter().filter(|&&l| l).count();
+    let lines = line_roles(scatter, n, &triangles, constrained)?;
+    let locked_count = lines.iter().filter(|&&l| l == Line::Locked).count();
     let initial_triangles = triangles.len();
     let limit = effective_limit(max_error, scatter.max_abs_height());
     let mut mesh = Mesh::from_conforming(scatter, triangles);
@@ -273,7 +280,7 @@ pub fn decimate_scatter_constrained(
         max_edge_squared: i64::MAX,
         levels: None,
     };
-    let mut remover = ScatterRemover::new(&mesh, rules, locked);
+    let mut remover = ScatterRemover::new(&mesh, rules, lines);
     let (sweeps, attempts) = match options.order {
         crate::Order::Sweep => remover.sweep(&mut mesh),
         crate::Order::Greedy => remover.greedy(&mut mesh),
@@ -303,16 +310,28 @@ pub fn decimate_scatter_constrained(
     ))
 }
 
-/// Per point, whether it ends a constrained edge; every constrained edge must be an edge
-/// of `triangles`.
-fn locked_vertices(
+/// What the constrained edges make of a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Line {
+    /// On no constrained edge.
+    Free,
+    /// Between exactly two constrained edges, to these two points, on the straight
+    /// segment joining them: removable as a boundary vertex of the line.
+    Through(u32, u32),
+    /// Ends a constrained edge, joins three or more, or bends a line: kept.
+    Locked,
+}
+
+/// Each point's [`Line`] role; every constrained edge must be an edge of `triangles`.
+fn line_roles(
+    scatter: &Scatter,
     n: usize,
     triangles: &[[u32; 3]],
     constrained: &[[u32; 2]],
-) -> Result<Vec<bool>> {
-    let mut locked = vec![false; n];
+) -> Result<Vec<Line>> {
+    let mut roles = vec![Line::Free; n];
     if constrained.is_empty() {
-        return Ok(locked);
+        return Ok(roles);
     }
     let key = |a: u32, b: u32| (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
     let mut edges: Vec<u64> = triangles
@@ -320,16 +339,41 @@ fn locked_vertices(
         .flat_map(|c| [key(c[0], c[1]), key(c[1], c[2]), key(c[2], c[0])])
         .collect();
     edges.sort_unstable();
+    let mut wanted: Vec<u64> = Vec::with_capacity(constrained.len());
     for &[a, b] in constrained {
         if a == b || edges.binary_search(&key(a, b)).is_err() {
             return Err(Error::Scatter(format!(
                 "constrained edge {a}-{b} is not an edge of the triangulation"
             )));
         }
-        locked[a as usize] = true;
-        locked[b as usize] = true;
+        wanted.push(key(a, b));
     }
-    Ok(locked)
+    wanted.sort_unstable();
+    wanted.dedup();
+    // Each point's constrained neighbours, up to three (three means a junction).
+    let mut ends: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for k in wanted {
+        let (a, b) = ((k >> 32) as u32, k as u32);
+        for (p, q) in [(a, b), (b, a)] {
+            if ends[p as usize].len() < 3 {
+                ends[p as usize].push(q);
+            }
+        }
+    }
+    for (v, near) in ends.iter().enumerate() {
+        roles[v] = match near[..] {
+            [] => Line::Free,
+            [a, b] if straight_between(scatter, a, v as u32, b) => Line::Through(a, b),
+            _ => Line::Locked,
+        };
+    }
+    Ok(roles)
+}
+
+/// Whether `v` lies strictly between `a` and `b` on the segment joining them (exact).
+fn straight_between(scatter: &Scatter, a: u32, v: u32, b: u32) -> bool {
+    let (a, c, b) = (scatter.point(a), scatter.point(v), scatter.point(b));
+    orient(&a, &c, &b) == 0 && (a.x - c.x) * (b.x - c.x) + (a.y - c.y) * (b.y - c.y) < 0
 }
 
 /// Removes vertices and keeps each removed point charged to the triangle containing it:
@@ -342,6 +386,13 @@ struct ScatterRemover {
     hole_points: HolePoints,
     /// Point ids of `hole_points.points`, in the same order.
     hole_ids: Vec<u32>,
+    /// The points of every hole of the last plan (two for a split star) and their ids:
+    /// what [`ScatterRemover::apply`] charges to the new triangles.
+    charged_points: Vec<Point>,
+    charged_ids: Vec<u32>,
+    /// A half star's ring and triangles (a split star's).
+    half_ring: Vec<u32>,
+    half_triangles: Vec<u32>,
     ring: Vec<Point>,
     bounds: Vec<ErrorBound>,
     new_triangles: Vec<(u32, [u32; 3], ErrorBound)>,
@@ -353,15 +404,15 @@ struct ScatterRemover {
     method: crate::Retriangulation,
     dp_max_ring: usize,
     limit: f64,
-    /// Points that end a constrained edge: never removed.
-    locked: Vec<bool>,
+    /// Each point's role on the constrained edges, kept current as line vertices go.
+    lines: Vec<Line>,
 }
 
 impl ScatterRemover {
     fn new(
         mesh: &Mesh<'_, Scatter>,
         rules: Rules<'_, HolePoints>,
-        locked: Vec<bool>,
+        lines: Vec<Line>,
     ) -> ScatterRemover {
         ScatterRemover {
             first: vec![NONE; mesh.triangle_slots()],
@@ -370,6 +421,10 @@ impl ScatterRemover {
             hole: Retriangulator::default(),
             hole_points: HolePoints::default(),
             hole_ids: Vec::new(),
+            charged_points: Vec::new(),
+            charged_ids: Vec::new(),
+            half_ring: Vec::new(),
+            half_triangles: Vec::new(),
             ring: Vec::new(),
             bounds: Vec::new(),
             new_triangles: Vec::new(),
@@ -379,7 +434,7 @@ impl ScatterRemover {
             method: rules.method,
             dp_max_ring: rules.dp_max_ring,
             limit: rules.limit,
-            locked,
+            lines,
         }
     }
 
@@ -474,20 +529,93 @@ impl ScatterRemover {
     }
 
     /// Plans the removal of `v`: `Some(largest new bound)` when it is interior or boundary
-    /// and its hole has a triangulation within the limit at every point charged to it.
+    /// (of the domain, or of a straight constrained line) and its hole (each half of its
+    /// star, for a line vertex) has a triangulation within the limit at every point
+    /// charged to it.
     fn plan(&mut self, mesh: &Mesh<'_, Scatter>, v: u32) -> Option<f64> {
-        if self.locked[v as usize] {
+        let line = self.lines[v as usize];
+        if line == Line::Locked {
             return None;
         }
         mesh.star(v, &mut self.star);
-        if self.star.ring.len() > MAX_HOLE_RING
-            || mesh.classify(v, &self.star) == VertexClass::Corner
-        {
+        if self.star.ring.len() > MAX_HOLE_RING {
             return None;
         }
+        self.new_triangles.clear();
+        self.charged_points.clear();
+        self.charged_ids.clear();
+        let star = std::mem::take(&mut self.star);
+        let planned = match line {
+            Line::Through(a, b) if !star.open => {
+                // Split along the line: from `a` round to `b`, then from `b` round to `a`.
+                let m = star.ring.len();
+                let at = |u: u32| star.ring.iter().position(|&r| r == u);
+                let (Some(ia), Some(ib)) = (at(a), at(b)) else {
+                    debug_assert!(false, "a line neighbour is in the star");
+                    self.star = star;
+                    return None;
+                };
+                let mut worst = 0.0f64;
+                let mut ok = true;
+                for (from, to) in [(ia, ib), (ib, ia)] {
+                    let k = (to + m - from) % m;
+                    self.half_ring.clear();
+                    self.half_triangles.clear();
+                    self.half_ring
+                        .extend((0..=k).map(|i| star.ring[(from + i) % m]));
+                    self.half_triangles
+                        .extend((0..k).map(|i| star.triangles[(from + i) % m]));
+                    let (ring, triangles) = (
+                        std::mem::take(&mut self.half_ring),
+                        std::mem::take(&mut self.half_triangles),
+                    );
+                    let half = self.plan_hole(mesh, v, &ring, &triangles);
+                    (self.half_ring, self.half_triangles) = (ring, triangles);
+                    match half {
+                        Some(w) => worst = worst.max(w),
+                        None => {
+                            ok = false;
+                            break;
+                        }
+                    }
+                }
+                ok.then_some(worst)
+            }
+            Line::Through(a, b) => {
+                // On the domain's boundary: only where the line is the boundary there.
+                let ends = (
+                    star.ring[0],
+                    *star.ring.last().expect("a star has neighbours"),
+                );
+                if (ends == (a, b) || ends == (b, a))
+                    && mesh.classify(v, &star) == VertexClass::Boundary
+                {
+                    self.plan_hole(mesh, v, &star.ring, &star.triangles)
+                } else {
+                    None
+                }
+            }
+            _ if mesh.classify(v, &star) == VertexClass::Corner => None,
+            _ => self.plan_hole(mesh, v, &star.ring, &star.triangles),
+        };
+        self.star = star;
+        planned
+    }
+
+    /// Plans one hole of the removal of `v`: the fan of its star `triangles` between the
+    /// neighbours `ring` (counter-clockwise; a closed fan has as many triangles as ring
+    /// vertices, an open one one fewer). Adds the new triangles (in the old triangles'
+    /// slots) to `new_triangles` and the hole's points to the charged ones; returns the
+    /// largest new bound, or `None` when no triangulation is within the limit.
+    fn plan_hole(
+        &mut self,
+        mesh: &Mesh<'_, Scatter>,
+        v: u32,
+        ring: &[u32],
+        triangles: &[u32],
+    ) -> Option<f64> {
         self.ring.clear();
-        self.ring
-            .extend(self.star.ring.iter().map(|&u| mesh.point(u)));
+        self.ring.extend(ring.iter().map(|&u| mesh.point(u)));
         let centre = mesh.sample_point(v);
         if self.limit == 0.0 && self.ring.iter().any(|p| p.z != centre.z) {
             // Below the rounding slack only exactly flat stars go, as on grids.
@@ -506,7 +634,7 @@ impl ScatterRemover {
         self.hole_ids.clear();
         self.hole_points.points.push(centre);
         self.hole_ids.push(v);
-        for &t in &self.star.triangles {
+        for &t in triangles {
             let mut p = self.first[t as usize];
             while p != NONE {
                 self.hole_points.points.push(mesh.sample_point(p));
@@ -515,8 +643,7 @@ impl ScatterRemover {
             }
         }
         self.bounds.clear();
-        self.bounds
-            .extend(self.star.triangles.iter().map(|&t| mesh.bound(t)));
+        self.bounds.extend(triangles.iter().map(|&t| mesh.bound(t)));
         self.hole.load(centre, &self.ring, &self.bounds);
         let rules = Rules {
             grid: &self.hole_points,
@@ -528,12 +655,16 @@ impl ScatterRemover {
             max_edge_squared: i64::MAX,
             levels: None,
         };
-        let (triangles, worst) = self.hole.retriangulate(&rules)?;
-        self.new_triangles.clear();
-        for (tri, &slot) in triangles.iter().zip(&self.star.triangles) {
-            let corners = tri.corners.map(|i| self.star.ring[i as usize]);
+        let (new, worst) = self.hole.retriangulate(&rules)?;
+        for (tri, &slot) in new.iter().zip(triangles) {
+            let corners = tri.corners.map(|i| ring[i as usize]);
             self.new_triangles.push((slot, corners, tri.bound));
         }
+        // The removed vertex is in both halves of a split star: charged once.
+        let skip = usize::from(!self.charged_ids.is_empty());
+        self.charged_points
+            .extend_from_slice(&self.hole_points.points[skip..]);
+        self.charged_ids.extend_from_slice(&self.hole_ids[skip..]);
         Some(worst)
     }
 
@@ -553,7 +684,7 @@ impl ScatterRemover {
                 let y = (a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
                 (*slot, [a, b, c], [x.0, x.1, y.0, y.1])
             }));
-        for (&p, point) in self.hole_ids.iter().zip(&self.hole_points.points) {
+        for (&p, point) in self.charged_ids.iter().zip(&self.charged_points) {
             let home = self
                 .corner_points
                 .iter()
@@ -567,6 +698,17 @@ impl ScatterRemover {
             debug_assert!(home.is_some(), "point {p} outside its hole");
             self.next[p as usize] = self.first[slot as usize];
             self.first[slot as usize] = p;
+        }
+        // The straight edge between a line vertex's neighbours takes the place of its two
+        // constrained edges.
+        if let Line::Through(a, b) = self.lines[v as usize] {
+            for (end, other) in [(a, b), (b, a)] {
+                if let Line::Through(x, y) = self.lines[end as usize] {
+                    let swap = |u: u32| if u == v { other } else { u };
+                    self.lines[end as usize] = Line::Through(swap(x), swap(y));
+                }
+            }
+            self.lines[v as usize] = Line::Free;
         }
         #[cfg(test)]
         mesh.check_invariants();
@@ -850,6 +992,48 @@ mod tests {
             // above can fail.
             let (tin, _) = decimate_scatter(&s, tris, &DecimationOptions::paper(2.0)).unwrap();
             assert!(edges.iter().any(|&e| !has_edge(&tin, e)));
+        }
+    }
+
+    #[test]
+    fn a_straight_line_loses_its_inner_vertices_and_keeps_its_ends_and_bends() {
+        use crate::EdgeSelection;
+        // A crease along the lattice column x = 10 (straight: positions (3x, 2y + x % 2)),
+        // constrained from y = 2 to 18; and a bent line up column 4 then across to 5.
+        let (s, tris) = lattice_scatter(21, 21, |x, _| 2.0 * (x - 10.0).abs());
+        let id = |x: u32, y: u32| y * 21 + x;
+        let mut edges: Vec<[u32; 2]> = (2..18).map(|y| [id(10, y), id(10, y + 1)]).collect();
+        edges.extend([
+            [id(4, 3), id(4, 4)],
+            [id(4, 4), id(4, 5)],
+            [id(4, 5), id(5, 5)],
+        ]);
+        for model in [ErrorModel::Bounds, ErrorModel::Exact] {
+            for method in [Retriangulation::Ears, Retriangulation::Dp] {
+                for order in [crate::Order::Sweep, crate::Order::Greedy] {
+                    let options = DecimationOptions::new(0.01)
+                        .with_error_model(model)
+                        .with_retriangulation(method)
+                        .with_selection(EdgeSelection::Hybrid)
+                        .with_order(order);
+                    let (tin, report) =
+                        decimate_scatter_constrained(&s, tris.clone(), &edges, &options).unwrap();
+                    let what = format!("{model:?} {method:?} {order:?}");
+                    assert!(worst_error(&s, &tin) <= 0.01, "{what}");
+                    let kept = |p: u32| tin.vertices().binary_search(&p).is_ok();
+                    // Ends and the bend are locked; every vertex between the ends went, and
+                    // one straight edge along the line covers the constrained ones.
+                    for p in [id(10, 2), id(10, 18), id(4, 3), id(4, 5), id(5, 5)] {
+                        assert!(kept(p), "{what}: line vertex {p} removed");
+                    }
+                    assert_eq!(report.locked_vertices, 5, "{what}");
+                    assert!((3..18).all(|y| !kept(id(10, y))), "{what}");
+                    assert!(!kept(id(4, 4)), "{what}");
+                    assert!(has_edge(&tin, [id(10, 2), id(10, 18)]), "{what}");
+                    assert!(has_edge(&tin, [id(4, 3), id(4, 5)]), "{what}");
+                    assert!(has_edge(&tin, [id(4, 5), id(5, 5)]), "{what}");
+                }
+            }
         }
     }
 

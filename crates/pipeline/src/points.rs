@@ -193,7 +193,7 @@ struct BreaklinesSummary<'a> {
     constrained_edges: usize,
     /// Vertices that end a constrained edge: never removed.
     locked_vertices: usize,
-    /// Segments checked present as chains of mesh edges.
+    /// Segments checked present on chains of mesh edges.
     segments_verified: usize,
 }
 
@@ -484,7 +484,7 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     if let (Some((path, layer)), Some((c, edges))) = (&breaklines, &constrained) {
         feedback.note(&format!(
             "{}: {} lines ({} heights), {edges} constrained edges ({} crossings split), \
-             every segment a chain of mesh edges",
+             every segment on a chain of mesh edges",
             path.display(),
             layer.lines.len(),
             if layer.has_z {
@@ -677,7 +677,7 @@ fn describe(r: &PointsReport) -> String {
     if let Some(b) = r.breaklines.as_ref().filter(|b| !b.passed()) {
         let [a, e] = b.first_missing.unwrap_or_default();
         parts.push(format!(
-            "{} of {} breakline segments are not chains of mesh edges, the first from \
+            "{} of {} breakline segments are not on chains of mesh edges, the first from \
              ({}, {}) to ({}, {})",
             b.missing, b.segments, a[0], a[1], e[0], e[1]
         ));

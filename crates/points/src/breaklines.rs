@@ -25,7 +25,7 @@ use spade::{
 };
 
 use crate::cloud::{PointCloud, MAX_LATTICE};
-use crate::delaunay::TriangulationError;
+use crate::delaunay::{insert_in_order, TriangulationError};
 
 /// Why points and breaklines have no constrained triangulation.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -213,16 +213,13 @@ fn triangulate(
     if n < 3 {
         return Err(TriangulationError::TooFewPoints(n).into());
     }
-    let sites: Vec<Site> = (0..n)
-        .map(|i| Site {
-            position: Point2::new(cloud.xy[i][0] as f64, cloud.xy[i][1] as f64),
-            index: i as u32,
-            z: cloud.z[i],
-        })
-        .collect();
-    let mut cdt: ConstrainedDelaunayTriangulation<Site> =
-        ConstrainedDelaunayTriangulation::bulk_load(sites)
-            .expect("lattice coordinates are in spade's range");
+    let sites = (0..n).map(|i| Site {
+        position: Point2::new(cloud.xy[i][0] as f64, cloud.xy[i][1] as f64),
+        index: i as u32,
+        z: cloud.z[i],
+    });
+    // In the cloud's Z-order, as the Delaunay triangulation without lines.
+    let mut cdt: ConstrainedDelaunayTriangulation<Site> = insert_in_order(n, sites);
     assert_eq!(
         cdt.num_vertices(),
         n,

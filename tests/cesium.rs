@@ -17,6 +17,33 @@ use crate::tiles::{
 };
 use crate::util::{fixture, serve, stderr, Dir};
 
+/// CesiumJS's samples of the pyramid at `terrain` (a URL; `tileset.json` for 3D Tiles) at
+/// the points of `points_file`, by `tests/oracle/cesium_sample.cjs` on the page at `base`
+/// (with `water_tile` Z/X/Y, that tile's water mask too): its JSON result, asserting it
+/// ran with no console error and no failed request.
+fn cesium_sample(base: &str, terrain: &str, points_file: &Path, water_tile: Option<&str>) -> Value {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut command = Command::new("node");
+    command
+        .arg(repo.join("tests/oracle/cesium_sample.cjs"))
+        .arg(format!("{base}index.html"))
+        .arg(terrain)
+        .arg(points_file);
+    if let Some(tile) = water_tile {
+        command.arg(tile);
+    }
+    let out = command.output().expect("node runs");
+    assert!(
+        out.status.success(),
+        "{terrain}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let result: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
+    assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
+    result
+}
+
 /// `DIR/site/`: CesiumJS (linked from `.tools`) and a page that loads it, beside the
 /// pyramids a test writes there. Fails when CesiumJS or Chromium is missing.
 fn cesium_page(dir: &Dir) {
@@ -37,7 +64,6 @@ fn cesium_page(dir: &Dir) {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
-    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = Dir::new();
     let input = fixture("tintn_valid_raster_3857.tif");
     let o = dir.run(&["tiles", &input, "-o", "site/terrain", "--normals"]);
@@ -104,21 +130,7 @@ fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
         (mbtiles_base, &expected),
         (format!("{base}geoid/"), &above_geoid),
     ] {
-        let out = Command::new("node")
-            .arg(repo.join("tests/oracle/cesium_sample.cjs"))
-            .arg(format!("{base}index.html"))
-            .arg(&terrain)
-            .arg(&points_file)
-            .output()
-            .expect("node runs");
-        assert!(
-            out.status.success(),
-            "{terrain}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let result: Value = serde_json::from_slice(&out.stdout).unwrap();
-        assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
-        assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
+        let result = cesium_sample(&base, &terrain, &points_file, None);
         for (k, want) in expected.iter().enumerate() {
             assert_eq!(result["levels"][k].as_u64(), Some(z as u64), "{result}");
             let got = result["heights"][k]
@@ -139,7 +151,6 @@ fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn cesiumjs_receives_the_water_masks_as_quantized_mesh_and_as_3d_tiles() {
-    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = Dir::new();
     // Land west of 10.6°E, nodata sea east of it.
     let dem = ascii_grid(
@@ -187,22 +198,13 @@ fn cesiumjs_receives_the_water_masks_as_quantized_mesh_and_as_3d_tiles() {
         ("terrain/", (0, 0, 0), Some(&root)),
         ("glb/tileset.json", (0, 0, 0), Some(&root)),
     ] {
-        let out = Command::new("node")
-            .arg(repo.join("tests/oracle/cesium_sample.cjs"))
-            .arg(format!("{base}index.html"))
-            .arg(format!("{base}{terrain}"))
-            .arg(&points_file)
-            .arg(format!("{}/{}/{}", tile.0, tile.1, tile.2))
-            .output()
-            .expect("node runs");
-        assert!(
-            out.status.success(),
-            "{terrain}: {}",
-            String::from_utf8_lossy(&out.stderr)
+        let water = format!("{}/{}/{}", tile.0, tile.1, tile.2);
+        let result = cesium_sample(
+            &base,
+            &format!("{base}{terrain}"),
+            &points_file,
+            Some(&water),
         );
-        let result: Value = serde_json::from_slice(&out.stdout).unwrap();
-        assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
-        assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
         assert_eq!(result["hasWaterMask"], true);
         let theirs: Option<Vec<u64>> = result["waterMask"]
             .as_array()
@@ -217,7 +219,6 @@ fn cesiumjs_receives_the_water_masks_as_quantized_mesh_and_as_3d_tiles() {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn cesiumjs_samples_the_3dtiles_pyramid_as_the_quantized_mesh_one() {
-    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = Dir::new();
     let input = fixture("tintn_valid_raster_3857.tif");
     for (out, format) in [("site/qm", "quantized-mesh"), ("site/t3d", "3dtiles")] {
@@ -264,21 +265,7 @@ fn cesiumjs_samples_the_3dtiles_pyramid_as_the_quantized_mesh_one() {
     let bound = 77_067.34 / (1u64 << z) as f64;
     let mut heights = Vec::new();
     for terrain in [format!("{base}qm/"), format!("{base}t3d/tileset.json")] {
-        let out = Command::new("node")
-            .arg(repo.join("tests/oracle/cesium_sample.cjs"))
-            .arg(format!("{base}index.html"))
-            .arg(&terrain)
-            .arg(&points_file)
-            .output()
-            .expect("node runs");
-        assert!(
-            out.status.success(),
-            "{terrain}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let result: Value = serde_json::from_slice(&out.stdout).unwrap();
-        assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
-        assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
+        let result = cesium_sample(&base, &terrain, &points_file, None);
         let mut got = Vec::new();
         for (k, &(i, j)) in picks.iter().enumerate() {
             assert_eq!(result["levels"][k].as_u64(), Some(z as u64), "{result}");
@@ -312,7 +299,6 @@ fn cesiumjs_samples_the_3dtiles_pyramid_as_the_quantized_mesh_one() {
 #[test]
 #[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
 fn cesiumjs_samples_a_web_mercator_pyramid_within_the_bound() {
-    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = Dir::new();
     // At 49°N, where a Web Mercator tile's rows (even in latitude) are far from even in
     // Web Mercator y at coarse levels.
@@ -367,21 +353,7 @@ fn cesiumjs_samples_a_web_mercator_pyramid_within_the_bound() {
     assert!(points.len() >= 6, "too few sample points with data");
     let points_file = dir.write("points.json", &serde_json::to_string(&points).unwrap());
     let (_server, base) = serve(&dir, &["site"]);
-    let out = Command::new("node")
-        .arg(repo.join("tests/oracle/cesium_sample.cjs"))
-        .arg(format!("{base}index.html"))
-        .arg(format!("{base}terrain/"))
-        .arg(&points_file)
-        .output()
-        .expect("node runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let result: Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(result["consoleErrors"], serde_json::json!([]), "{result}");
-    assert_eq!(result["failedRequests"], serde_json::json!([]), "{result}");
+    let result = cesium_sample(&base, &format!("{base}terrain/"), &points_file, None);
     assert_eq!(result["tiling"], "mercator", "{result}");
     let bound = Tiling::Mercator.level_error(z);
     for (k, want) in expected.iter().enumerate() {

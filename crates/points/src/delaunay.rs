@@ -5,13 +5,11 @@
 //! the Z-order curve's, each located from the vertex inserted before it: a walk of a
 //! step or two, over parts of the triangulation that are still in cache. spade's bulk
 //! load (a circle sweep, points sorted by their distance from the centre) touches the
-//! whole sweep front at every ring: on 20 M random lattice points it built the
-//! triangulation in 54 s against 34 s for this order, and on 2 M in 2.2 s against 1.75 s
-//! (`docs/results.md`, "Points").
+//! whole sweep front at every ring: on 20 M points it ran at 0.56 M points/s where this
+//! order runs at 1.20 M (medians of 3; `examples/triangulation_rate.rs`, numbers in
+//! `docs/results.md`, "Points").
 
-use spade::{
-    DelaunayTriangulation, HasPosition, LastUsedVertexHintGenerator, Point2, Triangulation,
-};
+use spade::{DelaunayTriangulation, LastUsedVertexHintGenerator, Point2, Triangulation};
 
 use crate::cloud::PointCloud;
 
@@ -25,18 +23,6 @@ pub enum TriangulationError {
     /// Every point on one line: no triangle has area.
     #[error("all {0} points are collinear")]
     Collinear(usize),
-}
-
-struct Site {
-    position: Point2<f64>,
-    index: u32,
-}
-
-impl HasPosition for Site {
-    type Scalar = f64;
-    fn position(&self) -> Point2<f64> {
-        self.position
-    }
 }
 
 /// The Delaunay triangles of the cloud's (distinct) lattice positions, as point indices,
@@ -54,11 +40,12 @@ pub fn delaunay(cloud: &PointCloud) -> Result<Vec<[u32; 3]>, TriangulationError>
     if n < 3 {
         return Err(TriangulationError::TooFewPoints(n));
     }
-    let sites = cloud.xy.iter().enumerate().map(|(i, p)| Site {
-        position: Point2::new(p[0] as f64, p[1] as f64),
-        index: i as u32,
-    });
-    let triangulation: DelaunayTriangulation<Site, (), (), (), LastUsedVertexHintGenerator> =
+    // spade numbers vertices in insertion order: vertex `i` is point `i` (no duplicates).
+    let sites = cloud
+        .xy
+        .iter()
+        .map(|p| Point2::new(p[0] as f64, p[1] as f64));
+    let triangulation: DelaunayTriangulation<Point2<f64>, (), (), (), LastUsedVertexHintGenerator> =
         insert_in_order(n, sites);
     assert_eq!(
         triangulation.num_vertices(),
@@ -67,7 +54,7 @@ pub fn delaunay(cloud: &PointCloud) -> Result<Vec<[u32; 3]>, TriangulationError>
     );
     let triangles: Vec<[u32; 3]> = triangulation
         .inner_faces()
-        .map(|f| f.vertices().map(|v| v.data().index))
+        .map(|f| f.vertices().map(|v| v.fix().index() as u32))
         .collect();
     if triangles.is_empty() {
         return Err(TriangulationError::Collinear(n));

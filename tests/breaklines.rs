@@ -512,3 +512,69 @@ fn a_raster_with_breaklines_keeps_them_and_the_bound_at_every_sample() {
     ]);
     assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
 }
+
+#[test]
+fn lines_that_continue_one_another_and_rings_keep_their_vertices_and_lose_points_on_them() {
+    let dir = Dir::new();
+    // The step's points, and points lying exactly on the lines below (every metre).
+    let mut points = step_points(3000);
+    for k in 10..=190 {
+        points.push_str(&format!(
+            "{},4000050.000,{:.3}\n",
+            500_000 + k,
+            50.0 + 0.02 * k as f64
+        ));
+    }
+    for k in 41..80 {
+        let z = 54.0 + 0.02 * k as f64;
+        points.push_str(&format!("{},4000140.000,{z:.3}\n", 500_000 + k));
+        points.push_str(&format!("{},4000170.000,{z:.3}\n", 500_000 + k));
+    }
+    dir.write("pts.csv", &points);
+    // Two lines, the second going straight on from the first's end; a closed ring whose
+    // first vertex is in the middle of a straight side.
+    dir.write(
+        "lines.geojson",
+        &feature_collection(&[
+            r#"{"type":"LineString","coordinates":[[500010,4000050],[500100,4000050]]}"#,
+            r#"{"type":"LineString","coordinates":[[500100,4000050],[500190,4000050]]}"#,
+            r#"{"type":"LineString","coordinates":[[500060,4000140],[500080,4000140],[500080,4000170],[500040,4000170],[500040,4000140],[500060,4000140]]}"#,
+        ]),
+    );
+    let o = mesh(&dir, "tin.obj", &["--breaklines", "lines.geojson"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = dir.run(&[
+        "verify",
+        "pts.csv",
+        "tin.obj",
+        "--max-error",
+        "0.05",
+        "--breaklines",
+        "lines.geojson",
+    ]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    // On the plane, the points lying on the lines go; the lines' own vertices stay.
+    let obj = std::fs::read_to_string(dir.path("tin.obj")).unwrap();
+    let on_row: Vec<f64> = obj
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            l.split_whitespace()
+                .map(|c| c.parse::<f64>().unwrap())
+                .collect::<Vec<_>>()
+        })
+        .filter(|v| (v[1] - 4_000_050.0).abs() < 1e-3)
+        .map(|v| v[0])
+        .collect();
+    for x in [500_010.0, 500_100.0, 500_190.0] {
+        assert!(
+            on_row.iter().any(|&v| (v - x).abs() < 1e-3),
+            "{x} missing: {on_row:?}"
+        );
+    }
+    assert!(
+        on_row.len() < 20,
+        "{} of 181 points on the line kept",
+        on_row.len()
+    );
+}

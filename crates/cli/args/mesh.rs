@@ -181,7 +181,7 @@ pub struct PointArgs {
     /// GeoJSON, FlatGeobuf...) as TIN edges, in the input's CRS. Lines with Z keep their
     /// heights, 2D lines take the points'; vertices go on the points' lattice; crossing
     /// lines are split where they cross. A raster's valid samples are then its points.
-    /// With verify: check every segment lies on a chain of mesh edges.
+    /// With verify: check every segment is a chain of mesh edges.
     #[arg(long, value_name = "FILE", help_heading = "Point input")]
     pub breaklines: Option<PathBuf>,
     /// The TIN's outline and holes, an OGR polygon layer in the input's CRS, kept as

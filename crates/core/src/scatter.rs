@@ -11,8 +11,10 @@
 //!
 //! Constrained edges (breaklines, outlines) stay in the TIN as chains of edges along them.
 //! A vertex that ends a constrained edge, joins three or more, or bends a line is locked,
-//! never removed. A vertex between exactly two constrained edges on one straight line is
-//! a boundary vertex of the line (the paper's rule, §3.2): its star is split along the
+//! never removed, as is any vertex the caller locks (a line's own vertices, so that each
+//! segment the caller was given stays a chain between its two ends). Any other vertex
+//! between exactly two constrained edges on one straight line (a point lying on a
+//! segment) is a boundary vertex of the line (the paper's rule, §3.2): its star is split along the
 //! line into two half stars, each retriangulated as a boundary vertex's hole with the
 //! straight edge joining the two line neighbours as its side, and that edge takes the
 //! two constrained edges' place. A removal replaces only the triangles around the
@@ -175,8 +177,8 @@ pub struct ScatterReport {
     pub sweeps: usize,
     /// Removal attempts.
     pub attempts: usize,
-    /// Vertices locked by constrained edges (ends, junctions and bends of the lines:
-    /// kept whatever the bound).
+    /// Vertices locked by constrained edges (ends, junctions and bends of the lines) or
+    /// by the caller: kept whatever the bound.
     pub locked_vertices: usize,
 }
 
@@ -208,18 +210,19 @@ pub fn decimate_scatter(
     triangles: Vec<[u32; 3]>,
     options: &DecimationOptions,
 ) -> Result<(ScatterTin, ScatterReport)> {
-    decimate_scatter_constrained(scatter, triangles, &[], options)
+    decimate_scatter_constrained(scatter, triangles, &[], &[], options)
 }
 
 /// [`decimate_scatter`] keeping the `constrained` edges (pairs of point indices, each an
 /// edge of `triangles`, in either direction): each one is covered by a chain of the
-/// result's edges along it (see the module documentation).
+/// result's edges along it (see the module documentation). The `locked` points are kept
+/// whatever the bound.
 ///
 /// # Guarantee
 /// As [`decimate_scatter`], and every constrained edge lies on edges of the TIN: either
 /// it is one, or the vertices between its ends were removed as boundary vertices of a
 /// straight line and one straight TIN edge along the line covers it. The ends, junctions
-/// and bends of the lines are vertices of the TIN.
+/// and bends of the lines, and the `locked` points, are vertices of the TIN.
 ///
 /// # Errors
 /// As [`decimate_scatter`], and [`Error::Scatter`] for a constrained edge that is not an
@@ -228,6 +231,7 @@ pub fn decimate_scatter_constrained(
     scatter: &Scatter,
     triangles: Vec<[u32; 3]>,
     constrained: &[[u32; 2]],
+    locked: &[u32],
     options: &DecimationOptions,
 ) -> Result<(ScatterTin, ScatterReport)> {
     let max_error = options.max_error;
@@ -263,7 +267,13 @@ pub fn decimate_scatter_constrained(
         )));
     }
     drop(used);
-    let lines = line_roles(scatter, n, &triangles, constrained)?;
+    let mut lines = line_roles(scatter, n, &triangles, constrained)?;
+    for &v in locked {
+        let role = lines.get_mut(v as usize).ok_or_else(|| {
+            Error::Scatter(format!("locked point {v} is not a point of the scatter"))
+        })?;
+        *role = Line::Locked;
+    }
     let locked_count = lines.iter().filter(|&&l| l == Line::Locked).count();
     let initial_triangles = triangles.len();
     let limit = effective_limit(max_error, scatter.max_abs_height());
@@ -980,7 +990,7 @@ mod tests {
             }
             for options in all {
                 let (tin, report) =
-                    decimate_scatter_constrained(&s, tris.clone(), &edges, &options).unwrap();
+                    decimate_scatter_constrained(&s, tris.clone(), &edges, &[], &options).unwrap();
                 for &e in &edges {
                     assert!(has_edge(&tin, e), "{seed} {options:?}: edge {e:?} lost");
                 }
@@ -1017,7 +1027,8 @@ mod tests {
                         .with_selection(EdgeSelection::Hybrid)
                         .with_order(order);
                     let (tin, report) =
-                        decimate_scatter_constrained(&s, tris.clone(), &edges, &options).unwrap();
+                        decimate_scatter_constrained(&s, tris.clone(), &edges, &[], &options)
+                            .unwrap();
                     let what = format!("{model:?} {method:?} {order:?}");
                     assert!(worst_error(&s, &tin) <= 0.01, "{what}");
                     let kept = |p: u32| tin.vertices().binary_search(&p).is_ok();
@@ -1035,13 +1046,22 @@ mod tests {
                 }
             }
         }
+        // A vertex the caller locks (a line's own vertex) stays, and splits the edge.
+        let options = DecimationOptions::new(0.01);
+        let (tin, report) =
+            decimate_scatter_constrained(&s, tris.clone(), &edges, &[id(10, 9)], &options).unwrap();
+        assert_eq!(report.locked_vertices, 6);
+        assert!(has_edge(&tin, [id(10, 2), id(10, 9)]) && has_edge(&tin, [id(10, 9), id(10, 18)]));
+        let outside = decimate_scatter_constrained(&s, tris, &edges, &[21 * 21], &options);
+        assert!(outside.is_err());
     }
 
     #[test]
     fn a_plane_keeps_its_corners_and_its_constrained_vertices_only() {
         let (s, tris, edges) = constrained_scatter(6, |x, y| 3.0 + 0.5 * x - 0.25 * y);
         let (tin, _) =
-            decimate_scatter_constrained(&s, tris, &edges, &DecimationOptions::new(1e-6)).unwrap();
+            decimate_scatter_constrained(&s, tris, &edges, &[], &DecimationOptions::new(1e-6))
+                .unwrap();
         let mut want: Vec<u32> = edges.iter().flatten().copied().chain(0..4).collect();
         want.sort_unstable();
         want.dedup();
@@ -1055,7 +1075,8 @@ mod tests {
     fn a_constrained_edge_not_in_the_triangulation_is_refused() {
         let (s, tris) = lattice_scatter(3, 3, |_, _| 0.0);
         // Points 0 and 8 are opposite corners: never an edge of the lattice's triangles.
-        let e = decimate_scatter_constrained(&s, tris, &[[0, 8]], &DecimationOptions::new(1.0));
+        let e =
+            decimate_scatter_constrained(&s, tris, &[[0, 8]], &[], &DecimationOptions::new(1.0));
         assert!(matches!(e, Err(Error::Scatter(m)) if m.contains("0-8")));
     }
 

@@ -191,9 +191,10 @@ struct BreaklinesSummary<'a> {
     vertices_added: usize,
     crossings: usize,
     constrained_edges: usize,
-    /// Vertices that end a constrained edge: never removed.
+    /// Vertices the lines lock: their own vertices, crossings, and any end, junction or
+    /// bend of the constrained edges (never removed).
     locked_vertices: usize,
-    /// Segments checked present on chains of mesh edges.
+    /// Segments checked present as chains of mesh edges.
     segments_verified: usize,
 }
 
@@ -308,11 +309,11 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
 
     let t = Instant::now();
     let mut constrained = None;
-    let (points, triangles, constrained_edges) = match tin {
+    let (points, triangles, constrained_edges, line_vertices) = match tin {
         // The TIN's own triangles; its vertices exactly as the file has them.
-        Some((world, triangles)) => (world, triangles, Vec::new()),
+        Some((world, triangles)) => (world, triangles, Vec::new(), Vec::new()),
         None if !constrain => match tinsmith_points::delaunay(&cloud) {
-            Ok(triangles) => (world_points(&cloud), triangles, Vec::new()),
+            Ok(triangles) => (world_points(&cloud), triangles, Vec::new(), Vec::new()),
             Err(e) => bail!("{}: cannot triangulate: {e}", input.display()),
         },
         None => {
@@ -328,12 +329,13 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
             constraints.max_edge_length = job.points.hull_edge_length;
             match tinsmith_points::constrained_delaunay(&mut cloud, &constraints) {
                 Ok(mut c) => {
-                    let (triangles, edges) = (
+                    let (triangles, edges, line_vertices) = (
                         std::mem::take(&mut c.triangles),
                         std::mem::take(&mut c.edges),
+                        std::mem::take(&mut c.line_vertices),
                     );
                     constrained = Some((c, edges.len()));
-                    (world_points(&cloud), triangles, edges)
+                    (world_points(&cloud), triangles, edges, line_vertices)
                 }
                 Err(tinsmith_points::BreaklineError::Points(e)) => {
                     bail!("{}: cannot triangulate: {e}", input.display())
@@ -400,9 +402,14 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     } = cloud;
     let points_total = xy.len();
     let scatter = Scatter::new(xy, z).with_context(|| format!("{}", input.display()))?;
-    let (tin, report) =
-        decimate_scatter_constrained(&scatter, triangles, &constrained_edges, &options)
-            .with_context(|| format!("{}", input.display()))?;
+    let (tin, report) = decimate_scatter_constrained(
+        &scatter,
+        triangles,
+        &constrained_edges,
+        &line_vertices,
+        &options,
+    )
+    .with_context(|| format!("{}", input.display()))?;
     let decimate_seconds = t.elapsed().as_secs_f64();
 
     let mut vertices: Vec<[f64; 3]> = tin.vertices().iter().map(|&v| points[v as usize]).collect();
@@ -484,7 +491,7 @@ pub(crate) fn mesh_points(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> 
     if let (Some((path, layer)), Some((c, edges))) = (&breaklines, &constrained) {
         feedback.note(&format!(
             "{}: {} lines ({} heights), {edges} constrained edges ({} crossings split), \
-             every segment on a chain of mesh edges",
+             every segment a chain of mesh edges",
             path.display(),
             layer.lines.len(),
             if layer.has_z {
@@ -677,7 +684,7 @@ fn describe(r: &PointsReport) -> String {
     if let Some(b) = r.breaklines.as_ref().filter(|b| !b.passed()) {
         let [a, e] = b.first_missing.unwrap_or_default();
         parts.push(format!(
-            "{} of {} breakline segments are not on chains of mesh edges, the first from \
+            "{} of {} breakline segments are not chains of mesh edges, the first from \
              ({}, {}) to ({}, {})",
             b.missing, b.segments, a[0], a[1], e[0], e[1]
         ));

@@ -99,6 +99,10 @@ pub struct ConstrainedTriangulation {
     /// The cloud's points kept (the first ones of the cloud, in their order), before the
     /// breaklines' and boundary's vertices that follow them.
     pub points: usize,
+    /// The vertices the lines and rings were given with (as point indices, sorted): the
+    /// decimation keeps them, so every segment of the file stays a chain of edges between
+    /// its own two ends.
+    pub line_vertices: Vec<u32>,
     /// The cloud's points removed: outside the boundary, or only in triangles the edge
     /// length limit removed.
     pub dropped: usize,
@@ -350,6 +354,11 @@ fn triangulate(
         .filter(|e| e.is_constraint_edge())
         .map(|e| e.vertices().map(|v| v.data().index))
         .collect();
+    let line_vertices: Vec<u32> = chains
+        .iter()
+        .flatten()
+        .map(|&h| cdt.vertex(h).data().index)
+        .collect();
     let mut z = cloud.z.clone();
     z.extend(added.iter().chain(&crossings).map(|a| a.1));
 
@@ -409,6 +418,13 @@ fn triangulate(
         .iter()
         .map(|t| t.map(|v| renumber[v as usize]))
         .collect();
+    let mut line_vertices: Vec<u32> = line_vertices
+        .into_iter()
+        .filter(|&v| used[v as usize])
+        .map(|v| renumber[v as usize])
+        .collect();
+    line_vertices.sort_unstable();
+    line_vertices.dedup();
     let points = used[..n].iter().filter(|&&u| u).count();
     if points == 0 {
         return Err(BreaklineError::Empty);
@@ -429,6 +445,7 @@ fn triangulate(
         triangles,
         edges,
         points,
+        line_vertices,
         dropped: n - points,
         crossings: crossings.len(),
     })

@@ -6,8 +6,9 @@
 //! `left`, `bottom`, `right` and `top` accessors. The tile's height range, bounding sphere
 //! and horizon occlusion point go to the subtree's metadata ([`TileBounds`]), not the GLB.
 //! A water mask, when given, is a greyscale PNG property texture of `EXT_structural_metadata`
-//! whose property has the `WATERMASK` semantic, as the provider's `requestWaterMask` reads
-//! it.
+//! whose property has the `WATERMASK` semantic, declared at the document level, where the
+//! provider's `requestWaterMask` reads it; no primitive references it and the primitive
+//! has no `TEXCOORD_0` (the mask spans the tile's rectangle, which the provider knows).
 //!
 //! Follows CesiumJS 1.140's `Cesium3DTilesTerrainGeometryProcessor.js`: it reads
 //! `nodes[0].matrix`, maps it from Y-up to Z-up (`Axis.Y_UP_TO_Z_UP`, glTF `(x, y, z)` is
@@ -228,7 +229,7 @@ impl<'a> GlbTile<'a> {
                 }},
             }]}],
         });
-        if let Some(mask) = self.water_mask.filter(|m| *m != [0]) {
+        if let Some(mask) = self.water_mask.filter(|m| m.iter().any(|&cell| cell != 0)) {
             bin.water_mask(mask, &mut document)?;
         }
         document["accessors"] = std::mem::take(&mut bin.accessors).into();

@@ -174,7 +174,9 @@ impl<'a> TileWriter<'a> {
             h.update(b"flat")
         });
         let outcome = match self.known.get(&(0, x, 0)) {
-            Some(entry) if entry.sum == sum => Outcome::Kept(entry.clone()),
+            Some(entry) if entry.sum == sum && keepable(entry, self.options.format) => {
+                Outcome::Kept(entry.clone())
+            }
             _ => {
                 let flat = LevelRows::flat_tile(self.options.tiling, 0, x, 0);
                 let tile = build_tile(&flat, x, 0, &self.budgets[0], self.options, available)?;
@@ -279,6 +281,13 @@ impl<'a> TileWriter<'a> {
     }
 }
 
+/// Whether a recorded tile with the fingerprint of this run's may be kept as it is: a 3D
+/// Tiles tile needs its subtree metadata recorded too (records written before it was are
+/// rebuilt, so that the subtrees are whole).
+fn keepable(entry: &TileEntry, format: TileFormat) -> bool {
+    format != TileFormat::ThreeDTiles || !entry.written || entry.bounds.is_some()
+}
+
 /// Removes tile `z/x/y` of a pyramid of `format` from `store`.
 pub(super) fn remove_tile(
     store: &dyn TileStore,
@@ -339,7 +348,9 @@ impl LevelSink for TileWriter<'_> {
                         level.hash_tile_window(x, y, h)
                     });
                     match known.get(&(z, column, y)) {
-                        Some(entry) if entry.sum == sum => Ok(Outcome::Kept(entry.clone())),
+                        Some(entry) if entry.sum == sum && keepable(entry, options.format) => {
+                            Ok(Outcome::Kept(entry.clone()))
+                        }
                         _ => {
                             let tile =
                                 build_tile(level, x, y, budget, options, metadata_available)?;

@@ -6,7 +6,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use std::process::Command;
 
-use crate::shards::{check_shards, identities, pyramid_files, run_ok};
+use crate::shards::{check_shards, differences, identities, pyramid_files, run_ok};
 use crate::tiles::{
     all_files, ascii_grid, check_shared_edges, check_tile, decode_pyramid, egm96_undulations,
     layer_json, max_error, stacked_gdal_samples, Tile, Tiling,
@@ -168,16 +168,30 @@ fn a_base_fills_the_pyramid_around_the_input_within_the_bound_and_stitched() {
     // From the base's own level down, every sample is sampled from the rasters (coarser
     // levels are filtered from it): within the bound of GDAL's warp of the base, then the
     // input over it, at every lattice point.
+    let checked = check_against_gdal(&dir, &tiles, &[&low, &high], Tiling::Geographic, BASE_LEVEL);
+    assert!(checked > 10, "{checked}");
+}
+
+/// Asserts every tile of `tiles` from level `from` down is within `0.1 x` its level's
+/// error of GDAL's warp of `rasters` (in priority order, the last on top) at every
+/// lattice point away from the input's hole's rim; returns how many tiles it checked.
+fn check_against_gdal(
+    dir: &Dir,
+    tiles: &BTreeMap<(u32, u32, u32), Tile>,
+    rasters: &[&str],
+    tiling: Tiling,
+    from: u32,
+) -> usize {
     let mut checked = 0;
-    for (&(z, x, y), t) in tiles.range((BASE_LEVEL, 0, 0)..) {
-        let bound = 0.1 * Tiling::Geographic.level_error(z);
-        let mut samples = stacked_gdal_samples(&dir, &[&low, &high], Tiling::Geographic, z, x, y);
-        skip_the_rim(&mut samples, Tiling::Geographic, z, x, y);
+    for (&(z, x, y), t) in tiles.range((from, 0, 0)..) {
+        let bound = 0.1 * tiling.level_error(z);
+        let mut samples = stacked_gdal_samples(dir, rasters, tiling, z, x, y);
+        skip_the_rim(&mut samples, tiling, z, x, y);
         let e = max_error(t, &samples);
         assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
         checked += 1;
     }
-    assert!(checked > 10, "{checked}");
+    checked
 }
 
 /// Sets the samples of tile `z/x/y`'s lattice near the input's hole's rim to NaN (see
@@ -269,15 +283,7 @@ fn a_base_works_in_web_mercator_and_as_3d_tiles() {
         check_tile(key, t);
     }
     assert!(check_shared_edges(&tiles) > 0);
-    let mut checked = 0;
-    for (&(z, x, y), t) in tiles.range((max_zoom, 0, 0)..) {
-        let bound = 0.1 * Tiling::Mercator.level_error(z);
-        let mut samples = stacked_gdal_samples(&dir, &[&low, &high], Tiling::Mercator, z, x, y);
-        skip_the_rim(&mut samples, Tiling::Mercator, z, x, y);
-        let e = max_error(t, &samples);
-        assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
-        checked += 1;
-    }
+    let checked = check_against_gdal(&dir, &tiles, &[&low, &high], Tiling::Mercator, max_zoom);
     assert!(checked > 0);
 
     // 3D Tiles: one GLB for each tile the quantized-mesh pyramid writes.
@@ -441,11 +447,7 @@ fn an_update_over_a_base_rebuilds_what_either_raster_changed() {
             pyramid_files(&dir.path("p")),
             pyramid_files(&dir.path("fresh")),
         );
-        let differ: Vec<_> = fresh
-            .keys()
-            .chain(updated.keys())
-            .filter(|k| fresh.get(*k) != updated.get(*k))
-            .collect();
+        let differ = differences(&fresh, &updated);
         assert!(
             differ.is_empty(),
             "{what}: the update differs in {differ:?}"
@@ -517,15 +519,7 @@ fn several_bases_stacked_in_a_vrt_keep_its_priority_the_bound_and_shared_edges()
     assert!(check_shared_edges(&tiles) > 0);
     // Every lattice point from the bases' own level down is within the bound of GDAL's
     // warp of the VRT, then the input over it.
-    let mut checked = 0;
-    for (&(z, x, y), t) in tiles.range((BASE_LEVEL, 0, 0)..) {
-        let bound = 0.1 * Tiling::Geographic.level_error(z);
-        let mut samples = stacked_gdal_samples(&dir, &[&vrt, &high], Tiling::Geographic, z, x, y);
-        skip_the_rim(&mut samples, Tiling::Geographic, z, x, y);
-        let e = max_error(t, &samples);
-        assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
-        checked += 1;
-    }
+    let checked = check_against_gdal(&dir, &tiles, &[&vrt, &high], Tiling::Geographic, BASE_LEVEL);
     assert!(checked > 10, "{checked}");
     // Where both bases have data, away from their edges and the input, the vertices of
     // the base's own level carry the east base's heights, not the west one's.

@@ -28,6 +28,23 @@ pub(crate) fn pyramid_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     out
 }
 
+/// The relative paths where two pyramids' files (as [`pyramid_files`] gives them)
+/// differ: in one only, or with other bytes.
+pub(crate) fn differences(
+    a: &BTreeMap<PathBuf, Vec<u8>>,
+    b: &BTreeMap<PathBuf, Vec<u8>>,
+) -> Vec<PathBuf> {
+    let mut out: Vec<PathBuf> = a
+        .keys()
+        .chain(b.keys())
+        .filter(|k| a.get(*k) != b.get(*k))
+        .cloned()
+        .collect();
+    out.sort();
+    out.dedup();
+    out
+}
+
 pub(crate) fn run_ok(dir: &Dir, args: &[&str]) -> String {
     let o = dir.run(args);
     assert!(o.status.success(), "{args:?}: {}", stderr(&o));
@@ -62,11 +79,7 @@ pub(crate) fn check_shards(dir: &Dir, input: &str, extra: &[&str], counts: &[u32
         );
         run_ok(dir, &["tiles", "merge", &out, "-q"]);
         let sharded = pyramid_files(&dir.path(&out));
-        let differ: Vec<_> = one
-            .keys()
-            .chain(sharded.keys())
-            .filter(|k| one.get(*k) != sharded.get(*k))
-            .collect();
+        let differ = differences(&one, &sharded);
         assert!(differ.is_empty(), "{n} shards differ in {differ:?}");
     }
 }
@@ -317,11 +330,7 @@ fn an_update_rebuilds_only_the_tiles_a_changed_patch_reaches() {
         pyramid_files(&dir.path("p")),
         pyramid_files(&dir.path("fresh")),
     );
-    let differ: Vec<_> = fresh
-        .keys()
-        .chain(updated.keys())
-        .filter(|k| fresh.get(*k) != updated.get(*k))
-        .collect();
+    let differ = differences(&fresh, &updated);
     assert!(
         differ.is_empty(),
         "the update differs from a fresh build in {differ:?}"

@@ -11,7 +11,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
-use crate::shards::{check_shards, identities, patched, pyramid_files, run_ok};
+use crate::shards::{check_shards, differences, identities, patched, pyramid_files, run_ok};
 use crate::tiles::{all_files, decode_pyramid, gdal_samples, max_error, Tile};
 use crate::util::{assert_fails_naming, fixture, stderr, Dir};
 
@@ -556,11 +556,7 @@ fn a_3dtiles_update_rebuilds_only_the_tiles_a_change_reaches_and_its_subtrees() 
         pyramid_files(&dir.path("p")),
         pyramid_files(&dir.path("fresh")),
     );
-    let differ: Vec<_> = fresh
-        .keys()
-        .chain(updated.keys())
-        .filter(|k| fresh.get(*k) != updated.get(*k))
-        .collect();
+    let differ = differences(&fresh, &updated);
     assert!(
         differ.is_empty(),
         "the update differs from a fresh build in {differ:?}"
@@ -577,10 +573,10 @@ fn a_3dtiles_update_rebuilds_only_the_tiles_a_change_reaches_and_its_subtrees() 
     // it): an update rebuilds those tiles rather than write subtrees without them.
     let records = dir.path("p").join("tinsmith");
     let mut stripped = 0;
-    for entry in walk(&records) {
-        if entry.extension().is_some_and(|e| e == "json") {
-            let mut record: Value =
-                serde_json::from_slice(&std::fs::read(&entry).unwrap()).unwrap();
+    for (name, bytes) in all_files(&records) {
+        if name.extension().is_some_and(|e| e == "json") {
+            let entry = records.join(name);
+            let mut record: Value = serde_json::from_slice(&bytes).unwrap();
             if let Some(tiles) = record.get_mut("tiles").and_then(Value::as_array_mut) {
                 for tile in tiles {
                     let fields = tile.as_object_mut().unwrap();
@@ -596,21 +592,4 @@ fn a_3dtiles_update_rebuilds_only_the_tiles_a_change_reaches_and_its_subtrees() 
         pyramid_files(&dir.path("p")) == fresh,
         "the update differs from a fresh build"
     );
-}
-
-/// Every file under `root`.
-fn walk(root: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![root.to_path_buf()];
-    while let Some(dir) = stack.pop() {
-        for entry in std::fs::read_dir(&dir).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                stack.push(path);
-            } else {
-                out.push(path);
-            }
-        }
-    }
-    out
 }

@@ -299,6 +299,14 @@ impl Builder {
         target: Option<u32>,
         mut accessor: Value,
     ) -> usize {
+        accessor["bufferView"] = self.view(data, target).into();
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
+    /// Appends `data` (at a multiple of 4 bytes) as a buffer view of its own; returns the
+    /// view's index.
+    fn view(&mut self, data: impl IntoIterator<Item = u8>, target: Option<u32>) -> usize {
         let offset = self.bytes.len();
         self.bytes.extend(data);
         let length = self.bytes.len() - offset;
@@ -308,9 +316,7 @@ impl Builder {
             view["target"] = target.into();
         }
         self.views.push(view);
-        accessor["bufferView"] = (self.views.len() - 1).into();
-        self.accessors.push(accessor);
-        self.accessors.len() - 1
+        self.views.len() - 1
     }
 }
 
@@ -330,12 +336,7 @@ impl Builder {
             .write_header()
             .and_then(|mut w| w.write_image_data(mask));
         written.map_err(|e| EncodeError::WaterMaskImage(e.to_string()))?;
-        let offset = self.bytes.len();
-        self.bytes.extend_from_slice(&png_bytes);
-        self.bytes.resize(self.bytes.len().next_multiple_of(4), 0);
-        self.views
-            .push(json!({"buffer": 0, "byteOffset": offset, "byteLength": png_bytes.len()}));
-        let view = self.views.len() - 1;
+        let view = self.view(png_bytes, None);
         document["extensionsUsed"]
             .as_array_mut()
             .expect("extensionsUsed is a list")

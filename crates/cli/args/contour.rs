@@ -6,7 +6,7 @@ use clap::{ArgGroup, Args};
 use tinsmith_formats::MeshFormat;
 use tinsmith_pipeline::ContourJob;
 
-use super::{parse_finite, parse_interval, parse_max_error};
+use super::numbers::{parse_finite, parse_interval, parse_max_error};
 
 #[derive(Debug, Args)]
 #[command(group(ArgGroup::new("which_levels").required(true).args(["interval", "levels"])))]

@@ -4,12 +4,13 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use tinsmith_formats::MeshFormat;
-use tinsmith_pipeline::{Duplicates, ExportChoices, MeshJob, PointChoices, TileFormat};
+use tinsmith_pipeline::{ExportChoices, MeshJob, TileFormat};
 
+use super::numbers::{parse_finite, parse_interval, parse_max_error};
 use super::values::{
     ErrorModelArg, InitialMeshArg, OrderArg, RetriangulateArg, SelectionArg, VertexHeightsArg,
 };
-use super::{parse_finite, parse_interval, parse_max_error};
+use super::{PointArgs, VariableArgs};
 
 #[derive(Debug, Args)]
 pub struct MeshArgs {
@@ -158,75 +159,6 @@ fn positive_length(text: &str) -> Result<f64, String> {
     }
 }
 
-/// The flags of point input (LAS/LAZ, XYZ/CSV text), shared by `mesh` and `verify`.
-#[derive(Debug, Args)]
-pub struct PointArgs {
-    /// LAS classes to keep, comma-separated [default: 2 (ground) when the file has any
-    /// ground point, else every class].
-    #[arg(
-        long,
-        value_name = "C,..",
-        value_delimiter = ',',
-        help_heading = "Point input"
-    )]
-    pub classes: Vec<u8>,
-    /// Drop LAS points flagged withheld.
-    #[arg(long, help_heading = "Point input")]
-    pub no_withheld: bool,
-    /// Which height a position with several points keeps (see docs/cli.md, "Point
-    /// input", for how the default was chosen).
-    #[arg(long, value_enum, default_value_t = DuplicatesArg::Lowest, help_heading = "Point input")]
-    pub duplicates: DuplicatesArg,
-    /// Keep the segments of this OGR line or polygon layer (GeoPackage, Shapefile,
-    /// GeoJSON, FlatGeobuf...) as TIN edges, in the input's CRS. Lines with Z keep their
-    /// heights, 2D lines take the points'; vertices go on the points' lattice; crossing
-    /// lines are split where they cross. A raster's valid samples are then its points.
-    /// With verify: check every segment is a chain of mesh edges.
-    #[arg(long, value_name = "FILE", help_heading = "Point input")]
-    pub breaklines: Option<PathBuf>,
-    /// The TIN's outline and holes, an OGR polygon layer in the input's CRS, kept as
-    /// edges; points (or a raster's samples) outside are dropped (counted in the report),
-    /// and `verify` measures only the points inside.
-    #[arg(long, value_name = "FILE", help_heading = "Point input")]
-    pub boundary: Option<PathBuf>,
-    /// OGR point layers (GeoPackage, Shapefile, FlatGeobuf) only: the attribute holding
-    /// the heights [default: the points' Z].
-    #[arg(long, value_name = "NAME", help_heading = "Point input")]
-    pub z_field: Option<String>,
-}
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum DuplicatesArg {
-    /// The lowest height.
-    Lowest,
-    /// The highest height.
-    Highest,
-    /// The mean of the heights.
-    Mean,
-    /// The first in file order.
-    First,
-}
-
-impl PointArgs {
-    /// The point choices these flags ask for (`crs` from `mesh --crs`).
-    pub fn choices(&self, crs: Option<String>) -> PointChoices {
-        let mut choices = PointChoices::default();
-        choices.classes = (!self.classes.is_empty()).then(|| self.classes.clone());
-        choices.no_withheld = self.no_withheld;
-        choices.duplicates = match self.duplicates {
-            DuplicatesArg::Lowest => Duplicates::Lowest,
-            DuplicatesArg::Highest => Duplicates::Highest,
-            DuplicatesArg::Mean => Duplicates::Mean,
-            DuplicatesArg::First => Duplicates::First,
-        };
-        choices.crs = crs;
-        choices.breaklines = self.breaklines.clone();
-        choices.boundary = self.boundary.clone();
-        choices.z_field = self.z_field.clone();
-        choices
-    }
-}
-
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum TileFormatArg {
     /// Binary PLY.
@@ -317,66 +249,4 @@ pub fn parse_datum(text: &str) -> Result<tinsmith_raster::VerticalDatum, String>
         "" => Err("give egm96, egm2008, ellipsoid or a geoid grid file".into()),
         text => Ok(tinsmith_raster::VerticalDatum::parse(text)),
     }
-}
-
-/// `--height-band`, `--attributes` and `--attribute-error`: what `mesh` and `verify` take
-/// besides `--bands` to make or check several variables over one mesh.
-#[derive(Debug, Args)]
-pub struct VariableArgs {
-    /// With --bands: the band that is the height (listed in --bands) [default: the first].
-    #[arg(long, value_name = "N", requires = "bands")]
-    pub height_band: Option<usize>,
-    /// Variables from another raster: FILE's bands B,... (all without :B,...), each within
-    /// --attribute-error, as --bands' are. On another grid than the input's (size,
-    /// geotransform or CRS) it is resampled onto it by GDAL (--attribute-resampling);
-    /// refused, naming it, when it does not overlap the input.
-    #[arg(long, value_name = "FILE[:B,B,...]", requires = "attribute_error")]
-    pub attributes: Option<String>,
-    /// How --attributes is resampled onto the input's grid when it is on another one
-    /// (GDAL's warper; the report says when it was).
-    #[arg(long, value_name = "METHOD", default_value = "bilinear", requires = "attributes",
-          value_parser = parse_resampling)]
-    pub attribute_resampling: tinsmith_raster::Resampling,
-    /// The bound of each --attributes band: one for all, or a comma-separated one per band.
-    #[arg(long, value_name = "E", value_parser = parse_max_error, allow_hyphen_values = true,
-          value_delimiter = ',', num_args = 1, requires = "attributes")]
-    pub attribute_error: Vec<f64>,
-}
-
-impl VariableArgs {
-    /// The height's band (`band` without `bands`), its bound and the variables that
-    /// `bands`, `max_error` (one bound, or one per band) and these flags ask for.
-    pub fn resolve(
-        &self,
-        input: &std::path::Path,
-        band: usize,
-        bands: &[usize],
-        max_error: &[f64],
-    ) -> tinsmith_pipeline::Result<(usize, Option<f64>, Vec<tinsmith_pipeline::BandVariable>)> {
-        let (height, max_error, mut variables) =
-            tinsmith_pipeline::resolve_bands(input, bands, max_error, self.height_band)?;
-        if let Some(spec) = &self.attributes {
-            variables.extend(tinsmith_pipeline::attribute_variables(
-                spec,
-                &self.attribute_error,
-                self.attribute_resampling,
-            )?);
-        }
-        let band = if bands.is_empty() { band } else { height };
-        Ok((band, max_error, variables))
-    }
-}
-
-/// `--attribute-resampling`: one of GDAL's methods tinsmith offers.
-fn parse_resampling(text: &str) -> Result<tinsmith_raster::Resampling, String> {
-    tinsmith_raster::Resampling::ALL
-        .into_iter()
-        .find(|m| m.name() == text)
-        .ok_or_else(|| {
-            let names: Vec<&str> = tinsmith_raster::Resampling::ALL
-                .iter()
-                .map(|m| m.name())
-                .collect();
-            format!("expected one of {}", names.join(", "))
-        })
 }

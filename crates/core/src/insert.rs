@@ -14,6 +14,10 @@
 //! all the way down from there. Insertion stops near the result instead, and the removal
 //! sweeps that follow take away what it over-placed.
 //!
+//! On a grid with variables, each triangle's bound and worst sample are the largest of
+//! the height's and every variable's scaled ones (`crate::variables`), so a variable
+//! beyond its own limit splits its triangle as the height does.
+//!
 //! # Scope
 //! Grids without nodata only (the domain is the grid's rectangle, so the triangulation
 //! of its convex hull is the domain's). For a tile whose border is decided
@@ -326,7 +330,19 @@ impl<'g> Triangulation<'g> {
     fn measure(&mut self, slot: u32) -> Option<()> {
         let s = slot as usize;
         let [a, b, c] = self.corners[s].map(|v| self.point(v));
-        let (bound, worst) = triangle_worst(self.grid, &a, &b, &c, &self.is_vertex);
+        let mut measured = triangle_worst(self.grid, &a, &b, &c, &self.is_vertex);
+        if self.grid.variable_count() > 0 {
+            measured = crate::variables::worst_with_variables(
+                self.grid,
+                &a,
+                &b,
+                &c,
+                &self.is_vertex,
+                self.limit,
+                measured,
+            );
+        }
+        let (bound, worst) = measured;
         self.bounds[s] = bound;
         let error = bound.above.max(bound.below);
         let (key, candidate) = if error > self.limit {

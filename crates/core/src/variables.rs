@@ -104,8 +104,13 @@ impl Measured {
         }
     }
 
+    /// `L_k`, the limit the variable's own errors are held to.
+    pub(crate) fn own_limit(&self) -> f64 {
+        self.limit
+    }
+
     /// Whether the variable never stops a removal.
-    fn unconstrained(&self) -> bool {
+    pub(crate) fn unconstrained(&self) -> bool {
         self.limit == f64::INFINITY
     }
 }
@@ -206,6 +211,64 @@ pub(crate) fn with_variables(
         bound.below = bound.below.max(scaled(e.below));
     }
     (bound.above <= limit && bound.below <= limit).then_some(bound)
+}
+
+/// [`crate::exact::triangle_worst`] with every variable of `grid` measured too, for
+/// greedy insertion: `height` is the height's bound and worst sample over counter-clockwise
+/// triangle `abc`; each constrained variable's are measured on its own samples and scaled
+/// into height units, and the triangle's bound and worst sample become the largest of all.
+/// A variable beyond its own limit gets a scaled bound and worst error above `limit`
+/// whatever the scale's rounding, so insertion splits the triangle; a variable within it
+/// gets [`with_variables`]'s clamp, so a triangle insertion keeps has the bound the exact
+/// model would store.
+pub(crate) fn worst_with_variables(
+    grid: &Grid,
+    a: &Point,
+    b: &Point,
+    c: &Point,
+    is_vertex: &[bool],
+    limit: f64,
+    height: (ErrorBound, Option<(usize, f64)>),
+) -> (ErrorBound, Option<(usize, f64)>) {
+    let (mut bound, mut worst) = height;
+    let beyond = |x: f64| x.max(limit.next_up());
+    for v in grid.variables() {
+        if v.unconstrained() {
+            continue;
+        }
+        let [va, vb, vc] = corner_samples(&v.grid, [a, b, c]);
+        let (e, w) = crate::exact::triangle_worst(&v.grid, &va, &vb, &vc, is_vertex);
+        let exceeds = e.above > v.limit || e.below > v.limit;
+        let scaled = |x: f64| {
+            if x == 0.0 {
+                0.0
+            } else if exceeds {
+                x * v.scale
+            } else {
+                (x * v.scale).min(v.height_limit)
+            }
+        };
+        let (mut above, mut below) = (scaled(e.above), scaled(e.below));
+        if e.above > v.limit {
+            above = beyond(above);
+        }
+        if e.below > v.limit {
+            below = beyond(below);
+        }
+        bound.above = bound.above.max(above);
+        bound.below = bound.below.max(below);
+        if let Some((sample, e_worst)) = w {
+            let key = if e_worst > v.limit {
+                beyond(e_worst * v.scale)
+            } else {
+                scaled(e_worst)
+            };
+            if worst.is_none_or(|(_, best)| key > best) {
+                worst = Some((sample, key));
+            }
+        }
+    }
+    (bound, worst)
 }
 
 /// Whether some variable's value at `centre` (a sample in the closed triangle `abc`) is

@@ -65,9 +65,7 @@ pub(super) fn coarse_start(
 ) -> Start {
     let full_border = keep_border.is_some();
     let (w, h) = (grid.width() as usize, grid.height() as usize);
-    // Insertion measures the height alone to pick its samples: no start for variables.
     let no_nodata = limit > 0.0
-        && grid.variable_count() == 0
         && matches!(initial_mesh, InitialMesh::Insert | InitialMesh::Auto)
         && grid.valid_cell_count() == w.saturating_sub(1) * h.saturating_sub(1);
     let mut strips = None;
@@ -80,24 +78,35 @@ pub(super) fn coarse_start(
             // few lines decides where it is clear (see `AUTO_LINE_STEP`), the plan where
             // it is not (and the plan is kept for the start then).
             let share = w * h / AUTO_INSERT_SHARE;
-            let kept = if max_edge_squared != i64::MAX {
-                Some(kept_along_rows(grid, limit, full_border, tick))
-            } else if full_border {
-                // A tile's start is decided by the count itself (see `AUTO_LINE_STEP`).
-                strips = StripPlan::new(grid, limit, full_border, tick);
-                strips.as_ref().map(|s| s.kept_count())
+            if grid.variable_count() > 0 {
+                // Several variables: insert where every band alone keeps clearly few
+                // samples, within a budget of what they keep alone, summed (about the
+                // most a joint mesh keeps). A tile's or an edge cap's count is of the
+                // height alone: they take the strips.
+                (max_edge_squared == i64::MAX && !full_border)
+                    .then(|| estimated_kept_by_band(grid, limit))
+                    .filter(|kept| kept.iter().max() <= Some(&(share - share / 4)))
+                    .map(|kept| kept.into_iter().fold(0, usize::saturating_add))
             } else {
-                let estimate = estimated_kept(grid, limit, full_border, AUTO_LINE_STEP);
-                if estimate <= share - share / 4 {
-                    Some(estimate)
-                } else if estimate >= share + share / 2 {
-                    None
-                } else {
+                let kept = if max_edge_squared != i64::MAX {
+                    Some(kept_along_rows(grid, limit, full_border, tick))
+                } else if full_border {
+                    // A tile's start is decided by the count itself (see `AUTO_LINE_STEP`).
                     strips = StripPlan::new(grid, limit, full_border, tick);
                     strips.as_ref().map(|s| s.kept_count())
-                }
-            };
-            kept.filter(|&kept| kept.saturating_mul(AUTO_INSERT_SHARE) <= w * h)
+                } else {
+                    let estimate = estimated_kept(grid, limit, full_border, AUTO_LINE_STEP);
+                    if estimate <= share - share / 4 {
+                        Some(estimate)
+                    } else if estimate >= share + share / 2 {
+                        None
+                    } else {
+                        strips = StripPlan::new(grid, limit, full_border, tick);
+                        strips.as_ref().map(|s| s.kept_count())
+                    }
+                };
+                kept.filter(|&kept| kept.saturating_mul(AUTO_INSERT_SHARE) <= w * h)
+            }
         }
         _ => None,
     };
@@ -126,6 +135,16 @@ pub(super) fn coarse_start(
         bounds,
         border_decided: false,
     }
+}
+
+/// The strips' estimated kept samples ([`estimated_kept`]) of the height and of each
+/// constrained variable, each alone.
+fn estimated_kept_by_band(grid: &Grid, limit: f64) -> Vec<usize> {
+    let height = estimated_kept(grid, limit, false, AUTO_LINE_STEP);
+    let variables = grid.variables().iter().filter(|v| !v.unconstrained());
+    std::iter::once(height)
+        .chain(variables.map(|v| estimated_kept(&v.grid, v.own_limit(), false, AUTO_LINE_STEP)))
+        .collect()
 }
 
 /// The RTIN or the strips (see [`coarse_start`]).

@@ -67,6 +67,7 @@ mod info;
 mod lines;
 mod point_layer;
 mod polygons;
+mod projected;
 mod quiet;
 mod read;
 mod reproject;

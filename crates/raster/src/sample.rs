@@ -14,6 +14,7 @@ use crate::error::Result;
 use crate::geographic::{
     area_of_interest, corner_box, geo_transform, source_crs, warp_error, wgs84, GeoLattice,
 };
+use crate::projected::project_block;
 use crate::read::OpenBand;
 
 /// Lattice points a side of the blocks the lattice is sampled in: the points of one block
@@ -33,8 +34,10 @@ const PIXELS_PER_POINT: usize = 16;
 ///
 /// Each sample is the bilinear interpolation of the band between the centres of the four
 /// pixels around the point's position in the raster: longitude and latitude transformed
-/// exactly to the raster's CRS by PROJ (one transformation over the raster's area, as
-/// GDAL's warper picks it; none when the raster is in WGS84 longitude, latitude), then to
+/// to the raster's CRS by PROJ (one transformation over the raster's area, as GDAL's
+/// warper picks it; none when the raster is in WGS84 longitude, latitude), exactly or, where
+/// that is as good to 1e-4 of a pixel, interpolated between PROJ's nodes (see
+/// `crate::projected`), then to
 /// pixel coordinates by the inverse geotransform (rotated or sheared ones too). The pixels
 /// are decoded as [`crate::read_samples`] decodes them (nodata value, mask or alpha band,
 /// NaN and infinities are nodata; scale and offset applied). Pixels that are nodata or
@@ -57,9 +60,9 @@ const PIXELS_PER_POINT: usize = 16;
 /// seam interpolated together.
 ///
 /// # Guarantees
-/// Each sample depends only on the raster and the point's position ([`GeoLattice::lon`],
-/// [`GeoLattice::lat`]): any window of a lattice gets the very same bits as the whole
-/// lattice at its points. Memory is bounded by blocks of the lattice, whatever its size.
+/// Each sample depends only on the raster, the larger lattice (origin, spacing and row
+/// spacing) and the point's column and row in it: any window of a lattice gets the very
+/// same bits as the whole lattice at its points. Memory is bounded by blocks of the lattice, whatever its size.
 ///
 /// # Errors
 /// As [`crate::geographic_bounds`]; [`crate::Error::Read`] when GDAL fails to read the
@@ -101,6 +104,17 @@ pub fn sample_geographic(
                         rows.push(if inside { y } else { f64::NAN });
                     }
                 }
+            } else if let Some(transform) = &locator.transform {
+                let pixels = |dx: f64, dy: f64| locator.pixel_length(dx, dy);
+                project_block(
+                    transform,
+                    lattice,
+                    (i0..i1, j0..j1),
+                    &pixels,
+                    &mut cols,
+                    &mut rows,
+                );
+                locator.to_pixels(&mut cols, &mut rows);
             } else {
                 let lons: Vec<f64> = (i0..i1).map(|i| lattice.lon(i)).collect();
                 for j in j0..j1 {
@@ -108,7 +122,7 @@ pub fn sample_geographic(
                     cols.extend_from_slice(&lons);
                     rows.extend((i0..i1).map(|_| lat));
                 }
-                locator.locate(&mut cols, &mut rows);
+                locator.to_pixels(&mut cols, &mut rows);
             }
             let footprints: Vec<Option<Footprint>> = cols
                 .iter()
@@ -312,16 +326,11 @@ impl Locator {
         })
     }
 
-    /// Replaces each longitude, latitude in `xs`, `ys` by its column and row in the
-    /// raster (pixel edges at whole numbers), or by NaN when PROJ cannot transform it or
-    /// it lies outside the raster's pixel edges. Each point's result depends on that point
-    /// alone.
-    fn locate(&self, xs: &mut [f64], ys: &mut [f64]) {
-        if let Some(transform) = &self.transform {
-            // A point PROJ cannot transform comes back infinite (GDAL then reports an
-            // error for the call, though the other points are transformed): no sample.
-            let _ = transform.transform_coords(xs, ys, &mut []);
-        }
+    /// Replaces each position in `xs`, `ys` (the raster's CRS; infinite or NaN where
+    /// PROJ could not transform it) by its column and row in the raster (pixel edges at
+    /// whole numbers), or by NaN when it is not finite or lies outside the raster's pixel
+    /// edges. Each point's result depends on that point alone.
+    fn to_pixels(&self, xs: &mut [f64], ys: &mut [f64]) {
         let gt = &self.geo_transform;
         let rotated = self.rotated();
         let det = gt[1] * gt[5] - gt[2] * gt[4];
@@ -345,6 +354,16 @@ impl Locator {
 }
 
 impl Locator {
+    /// The length in pixels of displacement `dx`, `dy` in the raster's CRS: the larger of
+    /// its column and row parts.
+    fn pixel_length(&self, dx: f64, dy: f64) -> f64 {
+        let gt = &self.geo_transform;
+        let det = gt[1] * gt[5] - gt[2] * gt[4];
+        let column = (gt[5] * dx - gt[2] * dy) / det;
+        let row = (gt[1] * dy - gt[4] * dx) / det;
+        column.abs().max(row.abs())
+    }
+
     /// Whether the geotransform is rotated or sheared.
     fn rotated(&self) -> bool {
         let gt = &self.geo_transform;

@@ -43,7 +43,6 @@ import sys
 import time
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-TILE_CELLS = 217
 SHARDS = 4
 WORKERS = 2
 PLANET_SHARDS = 1000
@@ -93,20 +92,20 @@ def pyramid_hashes(root):
 
 def own_level_samples(work):
     """Lattice samples of the input's own level: the tiles `tinsmith tiles` writes there
-    (from the one-process --report) times 217^2 cells each."""
+    (from the one-process --report) times their lattice's cells squared."""
     report = json.loads((work / "one-report.json").read_text())
     finest = report["levels"][-1]
-    return finest["level"], finest["tiles"] * TILE_CELLS ** 2
+    return finest["level"], finest["tiles"] * report["lattice_cells"] ** 2
 
 
-def reach_overhead(split, anchor):
+def reach_overhead(split, anchor, cells):
     """Lattice samples a global pyramid's blocks sample at the anchor level (each block's
     tiles and the band of 3 x 2^(anchor - split) - 2 samples around them that its tiles and
     filters read, clipped at the poles, as blocks.rs's block_level), over the level's own."""
     f = anchor - split
     margin = 3 * (1 << f) - 2
-    side = (1 << f) * TILE_CELLS
-    columns, rows = (2 << anchor) * TILE_CELLS, (1 << anchor) * TILE_CELLS
+    side = (1 << f) * cells
+    columns, rows = (2 << anchor) * cells, (1 << anchor) * cells
     width = min(side + 2 * margin, columns)
     heights = [min((y + 1) * side + margin, rows) - max(y * side - margin, 0)
                for y in range(1 << split)]
@@ -201,8 +200,9 @@ def compare_markdown(c):
     global_ = plan["bounds"][:4] == [-180.0, -90.0, 180.0, 90.0]
     if global_:
         one_split = max(plan["anchor"] - 4, 0)
-        rings = (reach_overhead(one_split, plan["anchor"]),
-                 reach_overhead(plan["split"], plan["anchor"]))
+        cells = plan["options"].get("cells", 217)
+        rings = (reach_overhead(one_split, plan["anchor"], cells),
+                 reach_overhead(plan["split"], plan["anchor"], cells))
         ring_text = (f" Each block samples its tiles and a band around them: at the anchor "
                      f"level {plan['anchor']} the one process (blocks at level {one_split}) "
                      f"samples {rings[0]:.3f} x the level's samples, the {SHARDS} shards "
@@ -316,14 +316,15 @@ def planet_markdown(results, throughput):
     if throughput:
         anchor = results[0]["anchor"]
         tiles = (2 << anchor) * (1 << anchor)
-        samples = tiles * TILE_CELLS ** 2
+        cells = results[0]["shard0"]["lattice_cells"]
+        samples = tiles * cells ** 2
         cpu = samples / throughput
         cores = 200
         lines += [
             "**Projection**, 100 machines of 2 cores (200 shards at a time):",
             "",
             f"- the planet's own level {anchor}: 2^{anchor + 1} x 2^{anchor} = {tiles:,} tiles "
-            f"x 217^2 = {samples / 1e9:.1f} G lattice samples (every tile: a global DEM);",
+            f"x {cells}^2 = {samples / 1e9:.1f} G lattice samples (every tile: a global DEM);",
             f"- at ETOPO5's sharded throughput, {throughput / 1e6:.2f} M samples per "
             f"CPU-second: {samples / 1e9:.1f} G / {throughput / 1e6:.2f} M = {cpu:,.0f} "
             f"CPU-seconds ({cpu / 3600:,.0f} CPU-hours);",
@@ -343,7 +344,7 @@ def planet_markdown(results, throughput):
         ]
         r = results[0]["run"]
         s0 = results[0]["shard0"]
-        s0_samples = s0["levels"][-1]["tiles"] * TILE_CELLS ** 2
+        s0_samples = s0["levels"][-1]["tiles"] * s0["lattice_cells"] ** 2
         s0_rate = s0_samples / r["cpu_s"]
         lines.append(
             f"- the measured planet shard 0 ({s0_samples / 1e6:.0f} M samples at level "

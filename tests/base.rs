@@ -16,8 +16,9 @@ use crate::util::{assert_fails_naming, stderr, Dir};
 /// The input's extent: west, south, east, north.
 const HIGH: [f64; 4] = [9.6, 44.3, 10.6, 45.1];
 
-/// The base's own level: the first whose sample spacing (180° / 2^z / 217 samples a tile)
-/// is at most its 0.05° (level 4: 0.052°, level 5: 0.026°).
+/// The base's own level: the first whose sample spacing (180° / 2^z / the cells of a
+/// tile's lattice) is at most its 0.05°: level 5 with 151 cells (0.037°, the coarser of
+/// the two lattices' own levels; 217 cells would give 0.026°).
 const BASE_LEVEL: u32 = 5;
 
 /// The input's hole of nodata: centre longitude, latitude and radius (degrees).
@@ -185,7 +186,7 @@ fn check_against_gdal(
     let mut checked = 0;
     for (&(z, x, y), t) in tiles.range((from, 0, 0)..) {
         let bound = 0.1 * tiling.level_error(z);
-        let mut samples = stacked_gdal_samples(dir, rasters, tiling, z, x, y);
+        let mut samples = stacked_gdal_samples(dir, rasters, tiling, t.cells(), z, x, y);
         skip_the_rim(&mut samples, tiling, z, x, y);
         let e = max_error(t, &samples);
         assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
@@ -241,9 +242,11 @@ fn each_raster_is_shifted_by_its_own_vertical_datum() {
     let (mut base_samples, mut input_samples) = (0, 0);
     for (&(z, x, y), t) in tiles.range((BASE_LEVEL, 0, 0)..) {
         let bound = 0.005 * Tiling::Geographic.level_error(z);
-        let mut samples = stacked_gdal_samples(&dir, &[&low, &high], Tiling::Geographic, z, x, y);
-        let input = stacked_gdal_samples(&dir, &[&high], Tiling::Geographic, z, x, y);
-        let n = egm96_undulations(z, x, y);
+        let cells = t.cells();
+        let mut samples =
+            stacked_gdal_samples(&dir, &[&low, &high], Tiling::Geographic, cells, z, x, y);
+        let input = stacked_gdal_samples(&dir, &[&high], Tiling::Geographic, cells, z, x, y);
+        let n = egm96_undulations(cells, z, x, y);
         for ((row, input_row), n_row) in samples.iter_mut().zip(&input).zip(&n) {
             for ((s, i), n) in row.iter_mut().zip(input_row).zip(n_row) {
                 if i.is_nan() && s.is_finite() {

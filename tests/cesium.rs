@@ -21,6 +21,12 @@ use crate::util::{fixture, serve, stderr, Dir};
 /// the points of `points_file`, by `tests/oracle/cesium_sample.cjs` on the page at `base`
 /// (with `water_tile` Z/X/Y, that tile's water mask too): its JSON result, asserting it
 /// ran with no console error and no failed request.
+/// Cells a side of the lattice of the quantized-mesh pyramid in `dir`, from its decoded
+/// vertices.
+fn lattice_cells(dir: &Path) -> i64 {
+    decode_pyramid(dir).values().next().expect("a tile").cells()
+}
+
 fn cesium_sample(base: &str, terrain: &str, points_file: &Path, water_tile: Option<&str>) -> Value {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut command = Command::new("node");
@@ -81,16 +87,19 @@ fn cesiumjs_samples_the_served_pyramid_within_the_bound() {
 
     // Points on the finest tile's sample lattice, away from its edges, where the tile's
     // source samples are known (GDAL's warp of the same lattice).
-    let samples = gdal_samples(&dir, &input, z, x, y);
+    let cells = lattice_cells(&dir.path("site/terrain"));
+    let samples = gdal_samples(&dir, &input, cells, z, x, y);
     let size = 180.0 / (1u64 << z) as f64;
-    let d = size / 217.0;
+    let d = size / cells as f64;
     let (west, south) = (-180.0 + x as f64 * size, -90.0 + y as f64 * size);
-    let undulations = egm96_undulations(z, x, y);
+    let undulations = egm96_undulations(cells, z, x, y);
     let mut points = Vec::new();
     let mut expected = Vec::new();
     let mut above_geoid = Vec::new();
-    let valid: Vec<(usize, usize)> = (3..215)
-        .flat_map(|j| (3..215).map(move |i| (i, j)))
+    let inner = 3..cells as usize - 2;
+    let valid: Vec<(usize, usize)> = inner
+        .clone()
+        .flat_map(|j| inner.clone().map(move |i| (i, j)))
         .filter(|&(i, j)| samples[j][i].is_finite())
         .collect();
     for k in 0..6 {
@@ -244,12 +253,15 @@ fn cesiumjs_samples_the_3dtiles_pyramid_as_the_quantized_mesh_one() {
         rect["startY"].as_u64().unwrap() as u32,
     );
     // Lattice points of the finest tile, away from its edges, with GDAL's samples there.
-    let samples = gdal_samples(&dir, &input, z, x, y);
+    let cells = lattice_cells(&dir.path("site/qm"));
+    let samples = gdal_samples(&dir, &input, cells, z, x, y);
     let size = 180.0 / (1u64 << z) as f64;
-    let d = size / 217.0;
+    let d = size / cells as f64;
     let (west, south) = (-180.0 + x as f64 * size, -90.0 + y as f64 * size);
-    let valid: Vec<(usize, usize)> = (3..215)
-        .flat_map(|j| (3..215).map(move |i| (i, j)))
+    let inner = 3..cells as usize - 2;
+    let valid: Vec<(usize, usize)> = inner
+        .clone()
+        .flat_map(|j| inner.clone().map(move |i| (i, j)))
         .filter(|&(i, j)| samples[j][i].is_finite())
         .collect();
     let picks: Vec<(usize, usize)> = (0..8)
@@ -334,17 +346,20 @@ fn cesiumjs_samples_a_web_mercator_pyramid_within_the_bound() {
     let mut expected = Vec::new();
     let mut tile_of = Vec::new();
     for &(x, y) in &finest {
-        let samples = tiled_gdal_samples(&dir, &input, Tiling::Mercator, z, x, y);
+        let cells = tiles[&(z, x, y)].cells();
+        let samples = tiled_gdal_samples(&dir, &input, Tiling::Mercator, cells, z, x, y);
         let [west, south, east, north] = Tiling::Mercator.rectangle(z, x, y);
-        let valid: Vec<(usize, usize)> = (3..215)
-            .flat_map(|j| (3..215).map(move |i| (i, j)))
+        let inner = 3..cells as usize - 2;
+        let valid: Vec<(usize, usize)> = inner
+            .clone()
+            .flat_map(|j| inner.clone().map(move |i| (i, j)))
             .filter(|&(i, j)| samples[j][i].is_finite())
             .collect();
         for k in 0..4 {
             let Some(&(i, j)) = valid.get(k * valid.len() / 4 + valid.len() / 8) else {
                 continue;
             };
-            let (u, v) = (i as f64 / 217.0, j as f64 / 217.0);
+            let (u, v) = (i as f64 / cells as f64, j as f64 / cells as f64);
             points.push([west + u * (east - west), south + v * (north - south)]);
             expected.push(samples[j][i]);
             tile_of.push((x, y));

@@ -282,7 +282,7 @@ fn a_3dtiles_pyramid_is_the_quantized_mesh_pyramid_in_glb_and_validates() {
         }
         if z == max_zoom {
             // The GLB's own heights against GDAL's warp of the tile's lattice.
-            let samples = gdal_samples(&dir, &input, z, x, y);
+            let samples = gdal_samples(&dir, &input, t.cells(), z, x, y);
             let mut mine = t.clone();
             mine.h = heights;
             let e = max_error(&mine, &samples);

@@ -10,8 +10,8 @@ use serde_json::Value;
 
 use crate::util::{assert_fails_naming, fixture, stderr, Dir};
 
-const CELLS: i64 = 217;
-const U_STEP: i64 = 151;
+/// The cells a side of a tile's lattice tinsmith may choose (both divide 32767).
+const LATTICE_CELLS: [i64; 2] = [217, 151];
 const E0: f64 = 77_067.34;
 
 #[derive(Clone)]
@@ -28,6 +28,24 @@ pub(crate) struct Tile {
     /// The water mask extension's bytes, as decoded.
     pub(crate) water_mask: Option<Vec<u64>>,
     metadata: Value,
+    /// `u` (and `v`) per lattice step of the pyramid's tiles: 32767 over the lattice's
+    /// cells a side, inferred from every decoded vertex of the pyramid.
+    pub(crate) u_step: i64,
+}
+
+impl Tile {
+    /// Cells a side of the tile's lattice.
+    pub(crate) fn cells(&self) -> i64 {
+        32767 / self.u_step
+    }
+}
+
+fn gcd(a: i64, b: i64) -> i64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
 }
 
 fn numbers(v: &Value) -> Vec<i64> {
@@ -106,10 +124,24 @@ pub(crate) fn decode_pyramid(dir: &Path) -> BTreeMap<(u32, u32, u32), Tile> {
                 .as_array()
                 .map(|a| a.iter().map(|x| x.as_u64().unwrap()).collect()),
             metadata: t["metadata"].clone(),
+            u_step: 0,
         };
         tiles.insert(*key, tile);
     }
     assert_eq!(tiles.len(), files.len());
+    // The lattice: the largest step every vertex of the pyramid lies on, which must be
+    // one of the lattices tinsmith may choose.
+    let u_step = tiles
+        .values()
+        .flat_map(|t| t.u.iter().chain(&t.v))
+        .fold(0, |g, &q| gcd(g, q));
+    assert!(
+        LATTICE_CELLS.iter().any(|&cells| 32767 == u_step * cells),
+        "vertices on a lattice of step {u_step}, not on one of {LATTICE_CELLS:?} cells"
+    );
+    for t in tiles.values_mut() {
+        t.u_step = u_step;
+    }
     tiles
 }
 
@@ -121,7 +153,7 @@ pub(crate) fn check_tile(key: (u32, u32, u32), t: &Tile) {
     for i in 0..n {
         for q in [t.u[i], t.v[i]] {
             assert!((0..=32767).contains(&q), "{key:?}");
-            assert_eq!(q % U_STEP, 0, "{key:?}: vertex off the sample lattice");
+            assert_eq!(q % t.u_step, 0, "{key:?}: vertex off the sample lattice");
         }
     }
     for tri in &t.triangles {
@@ -236,13 +268,14 @@ pub(crate) fn max_error(t: &Tile, samples: &[Vec<f64>]) -> f64 {
         let p = tri.map(|k| (t.u[k], t.v[k], t.h[k]));
         let det =
             ((p[1].0 - p[0].0) * (p[2].1 - p[0].1) - (p[1].1 - p[0].1) * (p[2].0 - p[0].0)) as f64;
-        let lo_i = p.iter().map(|q| q.0).min().unwrap() / U_STEP;
-        let hi_i = p.iter().map(|q| q.0).max().unwrap() / U_STEP;
-        let lo_j = p.iter().map(|q| q.1).min().unwrap() / U_STEP;
-        let hi_j = p.iter().map(|q| q.1).max().unwrap() / U_STEP;
+        let step = t.u_step;
+        let lo_i = p.iter().map(|q| q.0).min().unwrap() / step;
+        let hi_i = p.iter().map(|q| q.0).max().unwrap() / step;
+        let lo_j = p.iter().map(|q| q.1).min().unwrap() / step;
+        let hi_j = p.iter().map(|q| q.1).max().unwrap() / step;
         for j in lo_j..=hi_j {
             for i in lo_i..=hi_i {
-                let (u, v) = (i * U_STEP, j * U_STEP);
+                let (u, v) = (i * step, j * step);
                 let w = |a: (i64, i64, f64), b: (i64, i64, f64)| {
                     ((b.0 - a.0) * (v - a.1) - (b.1 - a.1) * (u - a.0)) as f64
                 };
@@ -311,24 +344,32 @@ impl Tiling {
     }
 }
 
-/// The geographic tile's lattice warped by the gdalwarp program (bilinear), row 0 the
-/// southernmost.
-pub(crate) fn gdal_samples(dir: &Dir, input: &str, z: u32, x: u32, y: u32) -> Vec<Vec<f64>> {
-    tiled_gdal_samples(dir, input, Tiling::Geographic, z, x, y)
-}
-
-/// The lattice of tile `z/x/y` of `tiling` (218 x 218 points evenly spaced in longitude and
-/// in latitude across the tile's rectangle, as CesiumJS places `u` and `v`) warped by the
-/// gdalwarp program (bilinear), row 0 the southernmost.
-pub(crate) fn tiled_gdal_samples(
+/// The geographic tile's lattice of `cells` cells a side warped by the gdalwarp program
+/// (bilinear), row 0 the southernmost.
+pub(crate) fn gdal_samples(
     dir: &Dir,
     input: &str,
-    tiling: Tiling,
+    cells: i64,
     z: u32,
     x: u32,
     y: u32,
 ) -> Vec<Vec<f64>> {
-    warped_samples(dir, &[input], &[], tiling, z, x, y)
+    tiled_gdal_samples(dir, input, Tiling::Geographic, cells, z, x, y)
+}
+
+/// The lattice of tile `z/x/y` of `tiling` (`cells + 1` points a side evenly spaced in
+/// longitude and in latitude across the tile's rectangle, as CesiumJS places `u` and `v`)
+/// warped by the gdalwarp program (bilinear), row 0 the southernmost.
+pub(crate) fn tiled_gdal_samples(
+    dir: &Dir,
+    input: &str,
+    tiling: Tiling,
+    cells: i64,
+    z: u32,
+    x: u32,
+    y: u32,
+) -> Vec<Vec<f64>> {
+    warped_samples(dir, &[input], &[], (tiling, cells), z, x, y)
 }
 
 /// As [`tiled_gdal_samples`], of several `inputs` warped in turn into the one lattice:
@@ -340,27 +381,28 @@ pub(crate) fn stacked_gdal_samples(
     dir: &Dir,
     inputs: &[&str],
     tiling: Tiling,
+    cells: i64,
     z: u32,
     x: u32,
     y: u32,
 ) -> Vec<Vec<f64>> {
     let point = ["-wo", "XSCALE=1", "-wo", "YSCALE=1"];
-    warped_samples(dir, inputs, &point, tiling, z, x, y)
+    warped_samples(dir, inputs, &point, (tiling, cells), z, x, y)
 }
 
 /// `inputs` warped by gdalwarp (bilinear, with `extra` options) into the lattice of tile
-/// `z/x/y`, row 0 the southernmost.
+/// `z/x/y` of `cells` cells a side, row 0 the southernmost.
 fn warped_samples(
     dir: &Dir,
     inputs: &[&str],
     extra: &[&str],
-    tiling: Tiling,
+    (tiling, cells): (Tiling, i64),
     z: u32,
     x: u32,
     y: u32,
 ) -> Vec<Vec<f64>> {
     let [west, south, east, north] = tiling.rectangle(z, x, y);
-    let (dx, dy) = ((east - west) / CELLS as f64, (north - south) / CELLS as f64);
+    let (dx, dy) = ((east - west) / cells as f64, (north - south) / cells as f64);
     let out = dir.path(&format!("warp_{}_{z}_{x}_{y}.asc", tiling.arg()));
     let status = Command::new("gdalwarp")
         .args([
@@ -385,7 +427,7 @@ fn warped_samples(
             ]
             .map(|v| format!("{v:.17}")),
         )
-        .args(["-ts", "218", "218"])
+        .args(["-ts", &(cells + 1).to_string(), &(cells + 1).to_string()])
         .args(extra)
         .args(inputs)
         .arg(&out)
@@ -413,7 +455,7 @@ fn warped_samples(
                 .collect()
         })
         .collect();
-    assert_eq!(rows.len(), 218);
+    assert_eq!(rows.len() as i64, cells + 1);
     rows.into_iter().rev().collect()
 }
 
@@ -622,7 +664,7 @@ fn check_tiled_pyramid(input: &str, quality: f64, flat_roots: usize, tiling: Til
     let mut checked = 0;
     for (&(z, x, y), t) in tiles.range((max_zoom, 0, 0)..) {
         let bound = quality * tiling.level_error(z);
-        let samples = tiled_gdal_samples(&dir, input, tiling, z, x, y);
+        let samples = tiled_gdal_samples(&dir, input, tiling, t.cells(), z, x, y);
         let e = max_error(t, &samples);
         assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");
         checked += 1;
@@ -1468,14 +1510,14 @@ fn a_tile_does_not_depend_on_the_zoom_range_or_the_threads() {
 /// The geoid's height above the WGS84 ellipsoid at each point of a tile's lattice (row 0
 /// the southernmost), from the gdaltransform program: PROJ's own choice of operation from
 /// EPSG:4326 + EGM96 height to EPSG:4979.
-pub(crate) fn egm96_undulations(z: u32, x: u32, y: u32) -> Vec<Vec<f64>> {
+pub(crate) fn egm96_undulations(cells: i64, z: u32, x: u32, y: u32) -> Vec<Vec<f64>> {
     use std::io::Write as _;
     let size = 180.0 / (1u64 << z) as f64;
-    let d = size / CELLS as f64;
+    let d = size / cells as f64;
     let (west, south) = (-180.0 + x as f64 * size, -90.0 + y as f64 * size);
     let mut points = String::new();
-    for j in 0..=CELLS {
-        for i in 0..=CELLS {
+    for j in 0..=cells {
+        for i in 0..=cells {
             points += &format!(
                 "{:.12} {:.12} 0\n",
                 west + i as f64 * d,
@@ -1499,8 +1541,8 @@ pub(crate) fn egm96_undulations(z: u32, x: u32, y: u32) -> Vec<Vec<f64>> {
         .lines()
         .map(|l| l.split_whitespace().nth(2).unwrap().parse().unwrap())
         .collect();
-    assert_eq!(n.len(), ((CELLS + 1) * (CELLS + 1)) as usize);
-    n.chunks((CELLS + 1) as usize).map(|r| r.to_vec()).collect()
+    assert_eq!(n.len(), ((cells + 1) * (cells + 1)) as usize);
+    n.chunks((cells + 1) as usize).map(|r| r.to_vec()).collect()
 }
 
 #[test]
@@ -1527,8 +1569,8 @@ fn a_geoid_datum_writes_the_ellipsoidal_heights_proj_gives() {
     for (&(z, x, y), t) in tiles.range((max_zoom, 0, 0)..) {
         check_tile((z, x, y), t);
         let bound = E0 / (1u64 << z) as f64;
-        let mut samples = gdal_samples(&dir, &input, z, x, y);
-        let n = egm96_undulations(z, x, y);
+        let mut samples = gdal_samples(&dir, &input, t.cells(), z, x, y);
+        let n = egm96_undulations(t.cells(), z, x, y);
         let shift = n
             .iter()
             .flatten()
@@ -1887,7 +1929,7 @@ fn web_mercator_tiles_the_part_of_a_raster_within_85_degrees_and_refuses_one_bey
     let mut top_row = 0;
     for (&(z, x, y), t) in tiles.range((max_zoom, 0, 0)..) {
         top_row += usize::from(y + 1 == 1 << z);
-        let samples = tiled_gdal_samples(&dir, &arctic, Tiling::Mercator, z, x, y);
+        let samples = tiled_gdal_samples(&dir, &arctic, Tiling::Mercator, t.cells(), z, x, y);
         let bound = Tiling::Mercator.level_error(z);
         let e = max_error(t, &samples);
         assert!(e <= bound + 1e-3, "{z}/{x}/{y}: error {e} above {bound}");

@@ -11,7 +11,7 @@ use tinsmith_raster::GeoBounds;
 
 use crate::rows::{LevelRows, Reach};
 use crate::stream::RowSource;
-use crate::tms::{TileRect, Tiling, TILE_CELLS};
+use crate::tms::{Scheme, TileRect, Tiling};
 use crate::TerrainResult;
 
 /// The most levels from a block's tile down to the raster's own level: a block's window
@@ -22,7 +22,7 @@ pub(super) const BLOCK_DEPTH: u8 = 4;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) struct Cut {
     /// The pyramid's tiling.
-    pub(super) tiling: Tiling,
+    pub(super) tiling: Scheme,
     /// The raster's own level: it is sampled from the raster, and every coarser level is
     /// filtered from it; finer levels are each sampled alone.
     pub(super) anchor: u8,
@@ -33,7 +33,7 @@ pub(super) struct Cut {
 
 impl Cut {
     /// The coarsest split the block depth allows: the fewest blocks.
-    pub(super) fn coarsest(tiling: Tiling, anchor: u8) -> Cut {
+    pub(super) fn coarsest(tiling: Scheme, anchor: u8) -> Cut {
         Cut {
             tiling,
             anchor,
@@ -47,7 +47,7 @@ impl Cut {
 /// [`reach_margin`]): where the margin at the anchor would pass a block window's ring of
 /// one tile, it is split at level 0 instead (one block, whose window is the whole
 /// domain), which happens only for anchors up to level 7 (tiles of 2.8° and coarser).
-pub(super) fn lowest_split(tiling: Tiling, anchor: u8) -> u8 {
+pub(super) fn lowest_split(tiling: Scheme, anchor: u8) -> u8 {
     let split = anchor.saturating_sub(BLOCK_DEPTH);
     if split_fits(tiling, split, anchor) {
         split
@@ -59,15 +59,15 @@ pub(super) fn lowest_split(tiling: Tiling, anchor: u8) -> u8 {
 /// Whether a pyramid anchored at `anchor` may be split at `split`: level 0 (a single
 /// block), or at most [`BLOCK_DEPTH`] levels above the anchor with the reach at the
 /// anchor ([`reach_margin`]) within a block window's ring of one tile.
-pub(super) fn split_fits(tiling: Tiling, split: u8, anchor: u8) -> bool {
+pub(super) fn split_fits(tiling: Scheme, split: u8, anchor: u8) -> bool {
     split == 0
         || (split <= anchor
             && split + BLOCK_DEPTH >= anchor
-            && reach_margin(tiling, split, anchor).1 <= TILE_CELLS as usize)
+            && reach_margin(tiling, split, anchor).1 <= tiling.cells as usize)
 }
 
 /// The tiles of `level` a pyramid over `bounds` covers.
-pub(super) fn domain(bounds: &GeoBounds, tiling: Tiling, level: u8) -> TileRect {
+pub(super) fn domain(bounds: &GeoBounds, tiling: Scheme, level: u8) -> TileRect {
     TileRect::covering(bounds, tiling, level)
 }
 
@@ -94,7 +94,7 @@ pub(super) fn blocks(bounds: &GeoBounds, cut: Cut) -> Vec<TileRect> {
 /// the domain goes all the way round, a turn east when the ring would start west of
 /// column 0). Its samples near the block are those of the whole level: the ring holds
 /// every sample the block's tiles, their halos and the filter down to the block's level
-/// read (at most [`reach_margin`] of [`BLOCK_DEPTH`] levels, 46 of the ring's 217 samples,
+/// read (at most [`reach_margin`] of [`BLOCK_DEPTH`] levels, 46 of the ring's 151 or 217 samples,
 /// which is all [`block_level`] makes of it).
 pub(super) fn block_window(bounds: &GeoBounds, block: TileRect, level: u8) -> TileRect {
     let d = domain(bounds, block.tiling, level);
@@ -158,9 +158,9 @@ pub(super) fn block_window(bounds: &GeoBounds, block: TileRect, level: u8) -> Ti
 /// filtered from rows resampled in latitude ([`LevelRows::coarser_rows`]): each level's
 /// row reach grows by the resampling's offset ([`Tiling::max_row_offset`]) and the row
 /// interpolated beside it, too.
-pub(super) fn reach_margin(tiling: Tiling, top: u8, level: u8) -> (usize, usize) {
+pub(super) fn reach_margin(tiling: Scheme, top: u8, level: u8) -> (usize, usize) {
     let columns = 3 * (1usize << (level - top)) - 2;
-    let rows = (top..level).fold(1usize, |m, z| match tiling {
+    let rows = (top..level).fold(1usize, |m, z| match tiling.tiling {
         Tiling::Geographic => 2 * m + 2,
         Tiling::Mercator => 2 * m + 3 + tiling.max_row_offset(z),
     });
@@ -178,7 +178,7 @@ pub(super) fn block_level(
 ) -> LevelRows {
     let window = block_window(bounds, block, level);
     let rows = LevelRows::new(window);
-    let cells = i64::from(TILE_CELLS);
+    let cells = i64::from(block.tiling.cells);
     let f = level - block.level;
     let (margin, row_margin) = (margin.0 as i64, margin.1 as i64);
     // The block's samples, global lattice columns and rows, widened by the margin.
@@ -217,7 +217,7 @@ impl RowSource for SplitSamples {
         rows: Range<usize>,
         columns: Range<usize>,
     ) -> TerrainResult<Vec<f32>> {
-        let n = TILE_CELLS as usize;
+        let n = level.tiling.cells as usize;
         let side = n + 1;
         let mut out = vec![f32::NAN; level.width * rows.len()];
         for (k, j) in rows.enumerate() {
@@ -262,14 +262,14 @@ mod tests {
     fn windows_ring_their_block_within_the_domain() {
         let b = bounds(0.5, 20.0);
         let block = TileRect {
-            tiling: Tiling::Geographic,
+            tiling: Scheme::GEOGRAPHIC,
             level: 3,
             x0: 8,
             y0: 3,
             width: 1,
             height: 1,
         };
-        let d = domain(&b, Tiling::Geographic, 5);
+        let d = domain(&b, Scheme::GEOGRAPHIC, 5);
         let w = block_window(&b, block, 5);
         // Tiles 32..36 with a ring, clipped to the domain's columns and rows.
         assert_eq!(w.x0, d.x0.max(31));
@@ -294,15 +294,15 @@ mod tests {
             resolution: 0.05,
         };
         let block = TileRect {
-            tiling: Tiling::Geographic,
+            tiling: Scheme::GEOGRAPHIC,
             level: 2,
             x0: 0,
             y0: 1,
             width: 1,
             height: 1,
         };
-        let n = TILE_CELLS as usize;
-        for (level, margin) in [(2, (1, 1)), (4, reach_margin(Tiling::Geographic, 2, 4))] {
+        let n = Scheme::GEOGRAPHIC.cells as usize;
+        for (level, margin) in [(2, (1, 1)), (4, reach_margin(Scheme::GEOGRAPHIC, 2, 4))] {
             let rows = block_level(&globe, block, level, margin);
             let reach = rows.reach().expect("a block's level has a reach");
             let core = n << (level - 2);
@@ -333,7 +333,7 @@ mod tests {
             resolution: 0.05,
         };
         let block = TileRect {
-            tiling: Tiling::Geographic,
+            tiling: Scheme::GEOGRAPHIC,
             level: 2,
             x0: 0,
             y0: 1,

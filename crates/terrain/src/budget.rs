@@ -5,7 +5,7 @@
 //! own samples only, never on other tiles: a tile is a function of its own data.
 
 use crate::quantized_mesh::QUANTIZED_MAX;
-use crate::tms::{max_edge_length, Tiling};
+use crate::tms::{max_edge_length, Scheme, Tiling};
 
 /// Cesium's level-zero geometric error for the geographic scheme, in metres:
 /// `maximumRadius * 2 pi * 0.25 / (65 * 2)` (`TerrainProvider`
@@ -52,8 +52,8 @@ pub(super) struct LevelBudget {
 
 impl LevelBudget {
     /// The budget of `level` of `tiling` at `quality`.
-    pub(super) fn new(tiling: Tiling, level: u8, quality: f64) -> LevelBudget {
-        let bound = quality * level_zero_error(tiling) / (1u64 << level) as f64;
+    pub(super) fn new(tiling: Scheme, level: u8, quality: f64) -> LevelBudget {
+        let bound = quality * level_zero_error(tiling.tiling) / (1u64 << level) as f64;
         let mut step = MIN_HEIGHT_STEP;
         while step * 2.0 <= bound / STEP_SHARE && step < MAX_HEIGHT_STEP {
             step *= 2.0;
@@ -61,7 +61,7 @@ impl LevelBudget {
         LevelBudget {
             bound,
             step,
-            max_edge: max_edge_length(tiling, level, bound),
+            max_edge: max_edge_length(tiling.tiling, tiling.cells, level, bound),
         }
     }
 
@@ -130,7 +130,7 @@ mod tests {
     fn the_step_is_a_power_of_two_within_a_sixteenth_of_the_bound_and_a_metre() {
         for level in 0..=24 {
             for quality in [0.05, 0.3, 1.0, 4.0] {
-                let b = LevelBudget::new(Tiling::Mercator, level, quality);
+                let b = LevelBudget::new(Scheme::MERCATOR, level, quality);
                 assert_eq!(b.step.log2().fract(), 0.0);
                 assert!(b.step == MIN_HEIGHT_STEP || b.step <= b.bound / STEP_SHARE);
                 assert!(b.step * 2.0 > b.bound / STEP_SHARE || b.step == MAX_HEIGHT_STEP);

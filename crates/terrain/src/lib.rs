@@ -46,5 +46,5 @@ pub use quantized_mesh::{
     QUANTIZED_MAX, WGS84_A, WGS84_B,
 };
 pub use shards::{build_shard, merge_shards, ShardReport};
-pub use tms::{tile_rectangle, Tiling, TILE_CELLS};
+pub use tms::{lattice_cells, tile_rectangle, Scheme, Tiling, LATTICE_CELLS};
 pub use water::{Water, MASK_CELLS};

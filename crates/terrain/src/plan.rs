@@ -11,7 +11,7 @@ use tinsmith_raster::GeoBounds;
 
 use crate::blocks::{blocks, domain, lowest_split, split_fits, Cut};
 use crate::records::hex;
-use crate::tms::{TileRect, Tiling};
+use crate::tms::{Scheme, TileRect, Tiling, LATTICE_CELLS};
 use crate::{TerrainOptions, TerrainResult};
 
 /// Cells a side of the coarse read that fingerprints the input and weighs the blocks.
@@ -76,6 +76,10 @@ pub(super) struct TileOptions {
     /// [`TerrainOptions::tiling`]; absent when geographic.
     #[serde(default, skip_serializing_if = "is_geographic")]
     pub(super) tiling: Tiling,
+    /// Cells a side of the tiles' lattices ([`crate::tms::lattice_cells`]); absent for the
+    /// default.
+    #[serde(default = "default_cells", skip_serializing_if = "is_default_cells")]
+    pub(super) cells: u32,
     /// [`TerrainOptions::format`]; absent for quantized-mesh.
     #[serde(default, skip_serializing_if = "is_quantized_mesh")]
     pub(super) format: crate::TileFormat,
@@ -97,6 +101,16 @@ fn is_quantized_mesh(format: &crate::TileFormat) -> bool {
     *format == crate::TileFormat::QuantizedMesh
 }
 
+/// The lattice plans made before the lattice was chosen had.
+fn default_cells() -> u32 {
+    LATTICE_CELLS[0]
+}
+
+/// Whether `cells` is the default (which plans leave unsaid).
+fn is_default_cells(cells: &u32) -> bool {
+    *cells == LATTICE_CELLS[0]
+}
+
 /// Whether `tiling` is the geographic one (which plans leave unsaid).
 fn is_geographic(tiling: &Tiling) -> bool {
     *tiling == Tiling::Geographic
@@ -104,7 +118,7 @@ fn is_geographic(tiling: &Tiling) -> bool {
 
 impl TileOptions {
     /// The options of a run (its `max_zoom` resolved).
-    pub(super) fn new(options: &TerrainOptions, max_zoom: u8) -> TileOptions {
+    pub(super) fn new(options: &TerrainOptions, max_zoom: u8, cells: u32) -> TileOptions {
         TileOptions {
             band: options.band,
             min_zoom: options.min_zoom,
@@ -118,6 +132,7 @@ impl TileOptions {
             water: options.water.clone(),
             whole_globe: options.whole_globe,
             tiling: options.tiling,
+            cells,
             format: options.format,
             base: options.base.as_ref().map(|base| BaseOptions {
                 path: base.path.to_string_lossy().into_owned(),
@@ -219,7 +234,10 @@ impl Plan {
             cells += (coverage.width * coverage.height) as u64;
         }
         let fingerprint = hex(&hash.finalize());
-        let tiling = options.tiling;
+        let tiling = Scheme {
+            tiling: options.tiling,
+            cells: options.cells,
+        };
         let (split, weights) = split_and_weights(bounds, tiling, anchor, shards, &centres, cells);
         Ok(Plan {
             input: input.display().to_string(),
@@ -254,9 +272,17 @@ impl Plan {
         }
     }
 
+    /// The tiling and lattice of the plan's tiles.
+    pub(super) fn scheme(&self) -> Scheme {
+        Scheme {
+            tiling: self.options.tiling,
+            cells: self.options.cells,
+        }
+    }
+
     pub(super) fn cut(&self) -> Cut {
         Cut {
-            tiling: self.options.tiling,
+            tiling: self.scheme(),
             anchor: self.anchor,
             split: self.split,
         }
@@ -305,7 +331,7 @@ impl Plan {
 /// still has 4 cells a block.
 pub(super) fn split_and_weights(
     bounds: &GeoBounds,
-    tiling: Tiling,
+    tiling: Scheme,
     anchor: u8,
     shards: u32,
     centres: &[[f64; 2]],
@@ -354,7 +380,7 @@ fn block_weights(bounds: &GeoBounds, cut: Cut, centres: &[[f64; 2]]) -> Vec<u64>
         let x = ((centre[0] + 180.0) / size)
             .floor()
             .rem_euclid(cut.tiling.columns(split) as f64);
-        let y = match cut.tiling {
+        let y = match cut.tiling.tiling {
             Tiling::Geographic => ((centre[1] + 90.0) / size).floor(),
             Tiling::Mercator => {
                 (tinsmith_raster::web_mercator_y(centre[1]) * (1u64 << split) as f64).floor()
@@ -388,7 +414,7 @@ mod tests {
             name: String::new(),
             fingerprint: String::new(),
             bounds: [0.0; 5],
-            options: TileOptions::new(&TerrainOptions::default(), 3),
+            options: TileOptions::new(&TerrainOptions::default(), 3, LATTICE_CELLS[0]),
             anchor: 3,
             split: 1,
             shards,
@@ -421,18 +447,18 @@ mod tests {
         let cells = 128 * 64;
         // Data everywhere: the coarsest split with 8 blocks a shard (level 2: 32 blocks).
         let (split, weights) =
-            split_and_weights(&globe, Tiling::Geographic, 6, 4, &grid(&|_, _| true), cells);
+            split_and_weights(&globe, Scheme::GEOGRAPHIC, 6, 4, &grid(&|_, _| true), cells);
         assert_eq!((split, weights.len()), (2, 32));
         // Data in one corner: finer, until the heaviest block is at most a quarter of a
         // shard's share, or the coarse read has fewer than 4 cells a block.
         let corner = grid(&|lon, lat| lon < -135.0 && lat < -45.0);
-        let (split, weights) = split_and_weights(&globe, Tiling::Geographic, 6, 4, &corner, cells);
+        let (split, weights) = split_and_weights(&globe, Scheme::GEOGRAPHIC, 6, 4, &corner, cells);
         // Level 2: one block of 257 in 288; level 3: four of 65 in 384; level 4: sixteen
         // of 17 in 768, and 17 x 4 shards x 4 <= 768.
         let total: u64 = weights.iter().sum();
         assert_eq!((split, weights.iter().max(), total), (4, Some(&17), 768));
         // No finer than the coarse read allows: 4 cells a block (level 4 has 512).
-        let (split, _) = split_and_weights(&globe, Tiling::Geographic, 6, 4, &corner, 2047);
+        let (split, _) = split_and_weights(&globe, Scheme::GEOGRAPHIC, 6, 4, &corner, 2047);
         assert_eq!(split, 3);
     }
 

@@ -19,7 +19,7 @@ use crate::records::{
 };
 use crate::rows::LevelRows;
 use crate::stream::{band_tile_rows, stream_levels, RowSource};
-use crate::tms::{bounds_array, TileRect, Tiling, TILE_CELLS};
+use crate::tms::{bounds_array, lattice_cells, own_level, Scheme, TileRect, Tiling};
 use crate::writer::{remove_tile, Scope, TileWriter, Written};
 use crate::{TerrainError, TerrainResult};
 use tinsmith_store::{DirectoryStore, TileStore};
@@ -141,12 +141,15 @@ impl Default for TerrainOptions {
     }
 }
 
-/// The raster's own level: the first whose lattice is at least as fine as the raster
-/// (in longitude; a Web Mercator tile's rows are closer).
-fn own_level(bounds: &GeoBounds, tiling: Tiling) -> u8 {
-    (0..MAX_LEVEL)
-        .find(|&l| tiling.step(l) <= bounds.resolution * (1.0 + 1e-9))
-        .unwrap_or(MAX_LEVEL)
+/// The tiling and tile lattice of a pyramid whose own level is that of a raster over
+/// `bounds` ([`lattice_cells`]), and that level: the first whose lattice is at least as
+/// fine as the raster (in longitude; a Web Mercator tile's rows are closer).
+fn own_scheme(bounds: &GeoBounds, tiling: Tiling) -> (Scheme, u8) {
+    let cells = lattice_cells(bounds.resolution, tiling);
+    (
+        Scheme { tiling, cells },
+        own_level(bounds.resolution, tiling, cells),
+    )
 }
 
 /// About how many bytes building a pyramid over `bounds` down to `max_zoom` takes: the
@@ -157,12 +160,24 @@ fn own_level(bounds: &GeoBounds, tiling: Tiling) -> u8 {
 /// about 48 bytes a tile). An estimate for refusing hopeless runs (a small raster at a far
 /// finer level than its own, a raster too wide), not a bound.
 pub fn streaming_bytes(bounds: &GeoBounds, tiling: Tiling, max_zoom: u8, threads: usize) -> u64 {
-    let cut = Cut::coarsest(tiling, own_level(bounds, tiling));
+    let (scheme, own_level) = own_scheme(bounds, tiling);
+    streaming_bytes_of(bounds, scheme, own_level, max_zoom, threads)
+}
+
+/// [`streaming_bytes`] of a pyramid of `scheme` whose own level is `own_level`.
+fn streaming_bytes_of(
+    bounds: &GeoBounds,
+    tiling: Scheme,
+    own_level: u8,
+    max_zoom: u8,
+    threads: usize,
+) -> u64 {
+    let cut = Cut::coarsest(tiling, own_level);
     let finest = max_zoom.max(cut.anchor);
-    let cells = u64::from(TILE_CELLS + 1);
+    let cells = u64::from(tiling.cells + 1);
     let bands = threads.max(1) as u64 + 3;
     let band_bytes = |tiles_wide: u64| {
-        (tiles_wide.saturating_mul(u64::from(TILE_CELLS)) * cells)
+        (tiles_wide.saturating_mul(u64::from(tiling.cells)) * cells)
             .max(1 << 22)
             .saturating_mul(bands)
             .saturating_mul(4)
@@ -228,7 +243,7 @@ pub struct LevelReport {
 
 impl LevelReport {
     /// The report of a level with no tile yet.
-    pub(crate) fn empty(tiling: Tiling, level: u8, quality: f64) -> LevelReport {
+    pub(crate) fn empty(tiling: Scheme, level: u8, quality: f64) -> LevelReport {
         let budget = LevelBudget::new(tiling, level, quality);
         LevelReport {
             level,
@@ -270,6 +285,10 @@ pub struct TerrainReport {
     pub min_zoom: u8,
     /// Finest level.
     pub max_zoom: u8,
+    /// Cells along each side of every tile's lattice ([`crate::lattice_cells`]): a tile
+    /// samples `(cells + 1)^2` points, vertex `u` (and `v`) of lattice column `i` is
+    /// `i x 32767 / cells`.
+    pub lattice_cells: u32,
     /// Per level, coarsest first.
     pub levels: Vec<LevelReport>,
     /// Tiles left as a previous build recorded them (`--update`, or a shard run again):
@@ -292,7 +311,7 @@ pub struct TerrainReport {
 ///   With [`TerrainOptions::base`], each lattice point is the input's sample where valid,
 ///   else the base's; the base's own level is the anchor, over both rasters' extent, and
 ///   the finer levels cover the input's extent only.
-/// - **Bound.** At every valid sample of a tile's grid (its `(TILE_CELLS + 1)^2` lattice
+/// - **Bound.** At every valid sample of a tile's grid (its `(cells + 1)^2` lattice
 ///   points of its level), the decoded tile (float32 min/max, 16-bit heights) is within
 ///   `quality x e(level)` of the sample, or within half the level's height quantum and
 ///   a rounding margin when that is larger (reported as `achieved_bound`); checked for
@@ -375,12 +394,13 @@ fn build_into(
 ) -> TerrainResult<TerrainReport> {
     let Prepared {
         bounds,
+        scheme,
         own_level,
         max_zoom,
         fine,
     } = prepared;
     let source = Stacked::new(input, options)?;
-    let cut = Cut::coarsest(options.tiling, own_level);
+    let cut = Cut::coarsest(scheme, own_level);
     let pool = worker_pool(
         &bounds,
         cut.tiling,
@@ -426,6 +446,7 @@ fn build_into(
         bounds: bounds_array(&bounds),
         min_zoom: options.min_zoom,
         max_zoom,
+        lattice_cells: cut.tiling.cells,
         levels,
         tiles_kept,
     })
@@ -484,6 +505,9 @@ pub enum Progress<'a> {
 pub(super) struct Prepared {
     /// The pyramid's extent in EPSG:4326: the input's, with a base the base's too.
     pub(super) bounds: GeoBounds,
+    /// The tiling and the tile lattice: the one that fits the anchor's raster best
+    /// ([`lattice_cells`]).
+    pub(super) scheme: Scheme,
     /// The raster's own level (the anchor); with a base, the base's.
     pub(super) own_level: u8,
     /// The finest level written.
@@ -531,7 +555,7 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
         )));
     }
     // The first level whose lattice is at least as fine as the raster.
-    let own_level = own_level(&bounds, options.tiling);
+    let (scheme, own_level) = own_scheme(&bounds, options.tiling);
     let max_zoom = options.max_zoom.unwrap_or(own_level);
     if options.metadata && options.min_zoom > 0 {
         return Err(TerrainError::Options(format!(
@@ -577,14 +601,14 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
             options.min_zoom
         )));
     }
-    let tiles_at = |level: u8| domain(&bounds, options.tiling, level).tiles();
+    let tiles_at = |level: u8| domain(&bounds, scheme, level).tiles();
     let threads = match options.threads {
         0 => rayon::current_num_threads(),
         n => n,
     };
     let fits = |level: u8| {
         options.memory_limit.is_none_or(|limit| {
-            streaming_bytes(&bounds, options.tiling, level.max(own_level), threads) <= limit
+            streaming_bytes_of(&bounds, scheme, own_level, level.max(own_level), threads) <= limit
         })
     };
     let not_overzoomed = |level: u8| {
@@ -614,8 +638,8 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
     if let Some(limit) = options.memory_limit {
         // Levels up to the raster's own are filtered from it, so it is always streamed.
         let streamed = max_zoom.max(own_level);
-        let need = streaming_bytes(&bounds, options.tiling, streamed, threads);
-        if need > limit && streaming_bytes(&bounds, options.tiling, streamed, 1) <= limit {
+        let need = streaming_bytes_of(&bounds, scheme, own_level, streamed, threads);
+        if need > limit && streaming_bytes_of(&bounds, scheme, own_level, streamed, 1) <= limit {
             return Err(TerrainError::Options(format!(
                 "{threads} threads would need about {:.1} GB in memory (each warps a band of \
                  level {streamed}) and {:.1} GB is available; use fewer --threads",
@@ -629,7 +653,7 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
                  {} tiles) and {:.1} GB is available (the raster's own resolution is level \
                  {own_level}, which every coarser level is filtered from); {}",
                 need as f64 / 1e9,
-                domain(&bounds, options.tiling, streamed).width,
+                domain(&bounds, scheme, streamed).width,
                 limit as f64 / 1e9,
                 suggestion()
             )));
@@ -653,6 +677,7 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
     match &options.base {
         None => Ok(Prepared {
             bounds,
+            scheme,
             own_level,
             max_zoom,
             fine: bounds,
@@ -714,9 +739,9 @@ fn prepare_base(
             path.display()
         )));
     }
-    let anchor = own_level(&below, options.tiling);
+    let (scheme, anchor) = own_scheme(&below, options.tiling);
     let bounds = crate::base::union(&below, &fine);
-    let need = streaming_bytes(&bounds, options.tiling, anchor, threads);
+    let need = streaming_bytes_of(&bounds, scheme, anchor, anchor, threads);
     if let Some(limit) = options.memory_limit.filter(|&limit| need > limit) {
         return Err(TerrainError::Options(format!(
             "--base {}: its own level {anchor}, which the levels up to it are filtered from, \
@@ -724,12 +749,13 @@ fn prepare_base(
              {} tiles) and {:.1} GB is available; make a coarser copy of it (gdalwarp -tr)",
             path.display(),
             need as f64 / 1e9,
-            domain(&bounds, options.tiling, anchor).width,
+            domain(&bounds, scheme, anchor).width,
             limit as f64 / 1e9,
         )));
     }
     Ok(Prepared {
         bounds,
+        scheme,
         own_level: anchor,
         max_zoom,
         fine,
@@ -757,6 +783,7 @@ pub(super) fn build_block(
     let scope = Scope {
         levels: (options.min_zoom.max(cut.split), max_zoom),
         under: Some(block),
+        scheme: cut.tiling,
     };
     let mut writer = TileWriter::new(scope, max_zoom, Vec::new(), known, store, options, pool);
     let band = |over: &GeoBounds, z: u8| {
@@ -813,7 +840,7 @@ fn meets(block: TileRect, rect: TileRect) -> bool {
 /// The worker pool of a pyramid whose finest streamed level over `bounds` is `finest`.
 pub(super) fn worker_pool(
     bounds: &GeoBounds,
-    tiling: Tiling,
+    tiling: Scheme,
     finest: u8,
     threads: usize,
 ) -> TerrainResult<rayon::ThreadPool> {
@@ -834,6 +861,7 @@ pub(super) fn worker_pool(
 /// to `written`.
 pub(super) fn write_flat_roots(
     written: &mut Written,
+    scheme: Scheme,
     max_zoom: u8,
     store: &dyn TileStore,
     options: &TerrainOptions,
@@ -846,6 +874,7 @@ pub(super) fn write_flat_roots(
     let scope = Scope {
         levels: (0, 0),
         under: None,
+        scheme,
     };
     let available = written.available.clone();
     let mut writer = TileWriter::new(scope, max_zoom, available, known, store, options, pool);
@@ -862,6 +891,7 @@ pub(super) fn write_flat_roots(
 /// without tiles reported empty).
 pub(super) fn level_reports(
     written: &Written,
+    scheme: Scheme,
     options: &TerrainOptions,
     max_zoom: u8,
 ) -> Vec<LevelReport> {
@@ -872,7 +902,7 @@ pub(super) fn level_reports(
                 .get(usize::from(z))
                 .cloned()
                 .flatten()
-                .unwrap_or_else(|| LevelReport::empty(options.tiling, z, options.quality))
+                .unwrap_or_else(|| LevelReport::empty(scheme, z, options.quality))
         })
         .collect()
 }
@@ -898,6 +928,7 @@ pub(super) fn build_top(
     let scope = Scope {
         levels: (options.min_zoom, max_zoom.min(cut.split - 1)),
         under: None,
+        scheme: cut.tiling,
     };
     let mut writer = TileWriter::new(scope, max_zoom, available, known, store, options, pool);
     let level =
@@ -992,8 +1023,16 @@ pub(super) fn finish_pyramid(
     )?;
     let before = written.entries.len();
     written.absorb(std::mem::take(&mut top));
-    write_flat_roots(&mut written, max_zoom, store, options, pool, known)?;
-    let reports = level_reports(&written, options, max_zoom);
+    write_flat_roots(
+        &mut written,
+        cut.tiling,
+        max_zoom,
+        store,
+        options,
+        pool,
+        known,
+    )?;
+    let reports = level_reports(&written, cut.tiling, options, max_zoom);
     let finest = reports.last().expect("min_zoom <= max_zoom");
     if finest.tiles == finest.flat_tiles {
         return Err(TerrainError::NoTerrain { level: max_zoom });
@@ -1158,28 +1197,34 @@ mod tests {
     use crate::layer::{metadata_json, rectangles};
     use crate::quantized_mesh::QUANTIZED_MAX;
     use crate::stream::Warp;
-    use crate::tms::{max_edge_length, EARTH_RADIUS, U_PER_CELL};
+    use crate::tms::{max_edge_length, EARTH_RADIUS, LATTICE_CELLS};
     use crate::LEVEL_ZERO_ERROR;
     use std::collections::BTreeSet;
     use std::path::PathBuf;
 
     #[test]
     fn u_lands_exactly_on_the_edges() {
-        assert_eq!(U_PER_CELL * TILE_CELLS, u32::from(QUANTIZED_MAX));
+        for cells in LATTICE_CELLS {
+            let scheme = Scheme {
+                tiling: Tiling::Geographic,
+                cells,
+            };
+            assert_eq!(scheme.u_per_cell() * cells, u32::from(QUANTIZED_MAX));
+        }
     }
 
     #[test]
     fn coarse_levels_cap_edges_by_the_ellipsoid_sag() {
         // Level 0: bound 77 km allows an arc of 17.8 degrees; a lattice step is 0.83.
-        let l0 = max_edge_length(Tiling::Geographic, 0, LEVEL_ZERO_ERROR).unwrap();
+        let l0 = max_edge_length(Tiling::Geographic, 217, 0, LEVEL_ZERO_ERROR).unwrap();
         assert_eq!(l0, 21);
-        let arc = f64::from(l0) * Tiling::Geographic.step(0).to_radians();
+        let arc = f64::from(l0) * Tiling::Geographic.step(0, 217).to_radians();
         assert!(EARTH_RADIUS * (1.0 - (arc / 2.0).cos()) <= LEVEL_ZERO_ERROR);
-        let arc = f64::from(l0 + 1) * Tiling::Geographic.step(0).to_radians();
+        let arc = f64::from(l0 + 1) * Tiling::Geographic.step(0, 217).to_radians();
         assert!(EARTH_RADIUS * (1.0 - (arc / 2.0).cos()) > LEVEL_ZERO_ERROR);
         // Deep levels: no cap.
         assert_eq!(
-            max_edge_length(Tiling::Geographic, 12, LEVEL_ZERO_ERROR / 4096.0),
+            max_edge_length(Tiling::Geographic, 217, 12, LEVEL_ZERO_ERROR / 4096.0),
             None
         );
     }
@@ -1303,7 +1348,10 @@ mod tests {
             let band_rows = [1, 100, 1, 3][k % 4];
             let dir = tempfile::tempdir().unwrap();
             let cut = Cut {
-                tiling: options.tiling,
+                tiling: Scheme {
+                    tiling: options.tiling,
+                    cells: LATTICE_CELLS[0],
+                },
                 anchor: max_zoom,
                 split,
             };
@@ -1438,10 +1486,10 @@ mod tests {
                 threads: 2,
                 ..TerrainOptions::default()
             };
-            let anchor = own_level(&bounds, Tiling::Geographic);
-            let coarsest = Cut::coarsest(Tiling::Geographic, anchor);
+            let (scheme, anchor) = own_scheme(&bounds, Tiling::Geographic);
+            let coarsest = Cut::coarsest(scheme, anchor);
             let finer = Cut {
-                tiling: Tiling::Geographic,
+                tiling: scheme,
                 anchor,
                 split: (coarsest.split + 2).min(anchor),
             };
@@ -1460,7 +1508,7 @@ mod tests {
             }
             let finest = outputs[0].0.last().unwrap();
             assert!(
-                finest.tiles > 2 && domain(&bounds, Tiling::Geographic, max_zoom).height > 2,
+                finest.tiles > 2 && domain(&bounds, scheme, max_zoom).height > 2,
                 "{}",
                 input.display()
             );
@@ -1499,7 +1547,7 @@ mod tests {
             .map(|&(split, band_rows)| {
                 let dir = tempfile::tempdir().unwrap();
                 let cut = Cut {
-                    tiling: Tiling::Geographic,
+                    tiling: Scheme::GEOGRAPHIC,
                     anchor: 2,
                     split,
                 };

@@ -18,7 +18,6 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use crate::plan::{Plan, Shard};
-use crate::tms::TILE_CELLS;
 use crate::{LevelReport, TerrainError, TerrainOptions, TerrainResult};
 use tinsmith_store::TileStore;
 
@@ -188,7 +187,11 @@ pub(super) fn gzip_samples(values: &[f32]) -> Vec<u8> {
 }
 
 /// A block's samples from file `name` of `store`.
-pub(super) fn read_samples(store: &dyn TileStore, name: &str) -> TerrainResult<Vec<f32>> {
+pub(super) fn read_samples(
+    store: &dyn TileStore,
+    name: &str,
+    cells: u32,
+) -> TerrainResult<Vec<f32>> {
     let bad = |reason: String| {
         TerrainError::Options(format!(
             "{}/{name}: not a block's samples ({reason}); re-run the shard that built it",
@@ -196,7 +199,7 @@ pub(super) fn read_samples(store: &dyn TileStore, name: &str) -> TerrainResult<V
         ))
     };
     let bytes = store.get_file(name)?.ok_or_else(|| bad("missing".into()))?;
-    let side = TILE_CELLS as usize + 1;
+    let side = cells as usize + 1;
     let mut raw = Vec::new();
     flate2::read::GzDecoder::new(&bytes[..])
         .read_to_end(&mut raw)

@@ -8,17 +8,14 @@ use crate::quantized_mesh::surface_normal;
 use rayon::prelude::*;
 use tinsmith_raster::GeoLattice;
 
-use crate::tms::{TileRect, Tiling, TILE_CELLS};
+use crate::tms::{Scheme, TileRect, Tiling};
 use tinsmith_tiling::EdgeProfile;
-
-/// `TILE_CELLS` as a row or column count.
-const CELLS: usize = TILE_CELLS as usize;
 
 /// The binomial taps of the downsampling filter, by offset in finer lattice steps.
 const TAPS: [(i64, f64); 5] = [(-2, 1.0), (-1, 4.0), (0, 6.0), (1, 4.0), (2, 1.0)];
 
 /// The samples of one level on its lattice, over whole tiles: global lattice column
-/// `217 tx0 + i`, row `217 ty0 + j` (row 0 the southernmost), NaN where there is no data.
+/// `cells tx0 + i`, row `cells ty0 + j` (row 0 the southernmost), NaN where there is no data.
 ///
 /// A level whose tiles go all the way round the globe ([`LevelRows::wraps`]) is periodic:
 /// its last column is its first one a turn east (and holds the same samples), and
@@ -32,7 +29,7 @@ const TAPS: [(i64, f64); 5] = [(-2, 1.0), (-1, 4.0), (0, 6.0), (1, 4.0), (2, 1.0
 /// samples, edges and normals whatever else is held.
 pub(super) struct LevelRows {
     /// The pyramid's tiling.
-    pub(super) tiling: Tiling,
+    pub(super) tiling: Scheme,
     pub(super) level: u8,
     /// First tile column and TMS row covered.
     pub(super) tx0: u32,
@@ -91,8 +88,8 @@ impl LevelRows {
             ty0: rect.y0,
             tiles_x: rect.width,
             tiles_y: rect.height,
-            width: rect.width as usize * CELLS + 1,
-            height: rect.height as usize * CELLS + 1,
+            width: rect.width as usize * rect.tiling.cells as usize + 1,
+            height: rect.height as usize * rect.tiling.cells as usize + 1,
             wraps: rect.wraps(),
             first: 0,
             values: Vec::new(),
@@ -130,8 +127,8 @@ impl LevelRows {
 
     /// Tile `x`, `y` of `level` alone, at height 0 everywhere (the ellipsoid), every row
     /// held: a root tile CesiumJS expects that the raster does not reach (`--metadata`).
-    pub(super) fn flat_tile(tiling: Tiling, level: u8, x: u32, y: u32) -> LevelRows {
-        let side = CELLS + 1;
+    pub(super) fn flat_tile(tiling: Scheme, level: u8, x: u32, y: u32) -> LevelRows {
+        let side = tiling.cells as usize + 1;
         LevelRows {
             tiling,
             level,
@@ -149,6 +146,11 @@ impl LevelRows {
         }
     }
 
+    /// Cells along each side of a tile's lattice.
+    fn cells(&self) -> usize {
+        self.tiling.cells as usize
+    }
+
     /// One past the last row held: the number of rows pushed so far.
     pub(super) fn end(&self) -> usize {
         self.first + self.values.len() / self.width
@@ -164,7 +166,7 @@ impl LevelRows {
     /// [`Tiling::lattice`]): each point's position depends on its global indices only,
     /// whatever the window.
     pub(super) fn lattice(&self, rows: Range<usize>, columns: Range<usize>) -> GeoLattice {
-        let cells = u64::from(TILE_CELLS);
+        let cells = u64::from(self.tiling.cells);
         self.tiling.lattice(
             self.level,
             u64::from(self.tx0) * cells + columns.start as u64,
@@ -176,7 +178,7 @@ impl LevelRows {
 
     /// The latitude of row `j` (level-wide, may lie outside the level).
     fn row_latitude(&self, j: i64) -> f64 {
-        let row = i64::from(self.ty0) * TILE_CELLS as i64 + j;
+        let row = i64::from(self.ty0) * i64::from(self.tiling.cells) + j;
         self.tiling.row_latitude(self.level, row)
     }
 
@@ -254,7 +256,7 @@ impl LevelRows {
     pub(super) fn ready_tile_rows(&self) -> u32 {
         let end = self.end();
         (0..self.tiles_y)
-            .take_while(|&t| ((t as usize + 1) * CELLS + 2).min(self.height) <= end)
+            .take_while(|&t| ((t as usize + 1) * self.cells() + 2).min(self.height) <= end)
             .count() as u32
     }
 
@@ -264,25 +266,25 @@ impl LevelRows {
         if t >= self.tiles_y {
             self.height
         } else {
-            (t as usize * CELLS).saturating_sub(1)
+            (t as usize * self.cells()).saturating_sub(1)
         }
     }
 
     /// Sample (0, 0) of tile `x`, `y` (global tile indices) in level coordinates.
     pub(super) fn tile_origin(&self, x: u32, y: u32) -> (usize, usize) {
         (
-            (x - self.tx0) as usize * CELLS,
-            (y - self.ty0) as usize * CELLS,
+            (x - self.tx0) as usize * self.cells(),
+            (y - self.ty0) as usize * self.cells(),
         )
     }
 
-    /// The `(TILE_CELLS + 1)^2` samples of tile `x`, `y`, row-major from the south-west.
+    /// The `(cells + 1)^2` samples of tile `x`, `y`, row-major from the south-west.
     pub(super) fn tile_values(&self, x: u32, y: u32) -> Vec<f64> {
         let (i0, j0) = self.tile_origin(x, y);
-        let mut values = Vec::with_capacity((CELLS + 1) * (CELLS + 1));
-        for j in j0..=j0 + CELLS {
+        let mut values = Vec::with_capacity((self.cells() + 1) * (self.cells() + 1));
+        for j in j0..=j0 + self.cells() {
             let row = self.row(j as i64).expect("a tile row inside the level");
-            values.extend(row[i0..=i0 + CELLS].iter().map(|&v| f64::from(v)));
+            values.extend(row[i0..=i0 + self.cells()].iter().map(|&v| f64::from(v)));
         }
         values
     }
@@ -295,11 +297,11 @@ impl LevelRows {
         const OUTSIDE: u32 = 0xffff_fffe;
         let (i0, j0) = self.tile_origin(x, y);
         let (i0, j0) = (i0 as i64, j0 as i64);
-        let mut bytes = Vec::with_capacity((CELLS + 3) * 4);
-        for j in j0 - 1..=j0 + CELLS as i64 + 1 {
+        let mut bytes = Vec::with_capacity((self.cells() + 3) * 4);
+        for j in j0 - 1..=j0 + self.cells() as i64 + 1 {
             bytes.clear();
             let row = self.row(j);
-            let (first, last) = (i0 - 1, i0 + CELLS as i64 + 1);
+            let (first, last) = (i0 - 1, i0 + self.cells() as i64 + 1);
             if let Some(r) = row.filter(|_| first >= 0 && last + 1 < self.width as i64) {
                 // Every column inside the level, at its own index (also round a level that
                 // wraps: its last column, which repeats the first, is not reached).
@@ -337,11 +339,11 @@ impl LevelRows {
             .all(|&(a, b)| self.at(a, b).is_finite())
     }
 
-    /// The edge from sample (i, j) along +x (`horizontal`) or +y, `TILE_CELLS` steps,
+    /// The edge from sample (i, j) along +x (`horizontal`) or +y, `cells` steps,
     /// as both tiles beside it see it. Reads rows `j - 1 ..= j + 1` of a horizontal edge,
     /// `j ..= j + TILE_CELLS` of a vertical one.
     pub(super) fn edge(&self, i: usize, j: usize, horizontal: bool) -> EdgeProfile {
-        let n = CELLS;
+        let n = self.cells();
         let (i, j) = (i as i64, j as i64);
         let point = |k: i64| if horizontal { (i + k, j) } else { (i, j + k) };
         let values = (0..=n as i64)
@@ -397,7 +399,7 @@ impl LevelRows {
         };
         let (ii, jj) = (i as i64, j as i64);
         let dx = crate::quantized_mesh::WGS84_A * d * lat.to_radians().cos().max(1e-6);
-        let dy = match self.tiling {
+        let dy = match self.tiling.tiling {
             Tiling::Geographic => {
                 let dy = crate::quantized_mesh::WGS84_A * d;
                 (dy, dy)
@@ -430,9 +432,9 @@ impl LevelRows {
     }
 
     /// This level's row (local) that `coarser`'s row 0 is centred on: coarser row `J` is
-    /// centred on row `2 J + offset` here (`offset` is 0 or -217).
+    /// centred on row `2 J + offset` here (`offset` is 0 or -cells).
     fn offset_to(&self, coarser: &LevelRows) -> i64 {
-        let cells = TILE_CELLS as i64;
+        let cells = i64::from(self.tiling.cells);
         2 * i64::from(coarser.ty0) * cells - i64::from(self.ty0) * cells
     }
 
@@ -440,18 +442,18 @@ impl LevelRows {
     /// of the filter: a row here (local; outside the level it reads the globe beyond) and
     /// the weight of the row after it, `None` past the tiling's edge. Geographic: rows
     /// `2 J + offset - 2 ..= 2 J + offset + 2`, weight 0. Web Mercator: the rows of a
-    /// lattice half as fine as the coarser one's (`2 TILE_CELLS` rows a coarser tile,
+    /// lattice half as fine as the coarser one's (`2 cells` rows a coarser tile,
     /// evenly spaced in latitude), around `2 J`, each placed in latitude among this
     /// level's rows (whose tiles split the coarser tile at its Web Mercator middle, not its
     /// latitude middle) and interpolated linearly in latitude between the two around it.
     fn vertical_taps(&self, coarser: &LevelRows, row: usize) -> [Option<(i64, f64)>; 5] {
-        match self.tiling {
+        match self.tiling.tiling {
             Tiling::Geographic => {
                 let centre = 2 * row as i64 + self.offset_to(coarser);
                 TAPS.map(|(dy, _)| Some((centre + dy, 0.0)))
             }
             Tiling::Mercator => {
-                let cells = i64::from(TILE_CELLS);
+                let cells = i64::from(self.tiling.cells);
                 let tiles = 1u64 << coarser.level;
                 let half = 2 * (i64::from(coarser.ty0) * cells + row as i64);
                 let first = i64::from(self.ty0) * cells;
@@ -462,7 +464,7 @@ impl LevelRows {
                     }
                     let half_lattice = tinsmith_raster::GeoLattice {
                         latitudes: tinsmith_raster::Latitudes::WebMercatorTiles {
-                            cells: 2 * TILE_CELLS,
+                            cells: 2 * self.tiling.cells,
                             tiles,
                         },
                         first_row: h as u64,
@@ -493,7 +495,7 @@ impl LevelRows {
         if self.complete() {
             return coarser.height;
         }
-        if self.tiling == Tiling::Geographic {
+        if self.tiling.tiling == Tiling::Geographic {
             // 2 J + offset + 2 < end, so J <= (end - offset - 3) / 2.
             let limit = self.end() as i64 - self.offset_to(coarser) - 3;
             if limit < 0 {
@@ -529,7 +531,7 @@ impl LevelRows {
     /// # Panics
     /// When a row the filter reads is not held (see [`LevelRows::coarser_rows_ready`]).
     pub(super) fn coarser_rows(&self, coarser: &LevelRows, rows: Range<usize>) -> Vec<f32> {
-        let cells = TILE_CELLS as i64;
+        let cells = i64::from(self.tiling.cells);
         let fx0 = i64::from(self.tx0) * cells;
         let fy0 = i64::from(self.ty0) * cells;
         let cx0 = i64::from(coarser.tx0) * cells;
@@ -554,7 +556,7 @@ impl LevelRows {
             None => (0..coarser.height, &all),
         };
         let mut out = vec![f32::NAN; width * rows.len()];
-        if self.tiling == Tiling::Mercator {
+        if self.tiling.tiling == Tiling::Mercator {
             self.resampled_coarser_rows(coarser, rows, &columns, &mut out);
             return out;
         }

@@ -37,6 +37,8 @@ pub struct ShardReport {
     pub total_weight: u64,
     /// Tiles it wrote.
     pub tiles: u64,
+    /// Cells along each side of every tile's lattice ([`crate::lattice_cells`]).
+    pub lattice_cells: u32,
     /// Tiles left as an earlier run of the same plan (or input) recorded them: their data
     /// had not changed, so they were not built again.
     pub tiles_kept: u64,
@@ -76,6 +78,7 @@ pub fn build_shard(
     let start = std::time::Instant::now();
     let Prepared {
         bounds,
+        scheme,
         own_level,
         max_zoom,
         fine,
@@ -84,7 +87,7 @@ pub fn build_shard(
         input,
         &bounds,
         own_level,
-        TileOptions::new(options, max_zoom),
+        TileOptions::new(options, max_zoom, scheme.cells),
         shard.count,
     )?;
     refuse_other_plans(dest, &plan)?;
@@ -138,13 +141,14 @@ pub fn build_shard(
     };
     let json = serde_json::to_vec_pretty(&record).expect("a record serializes");
     dest.put_file(&shard_name(shard), &json)?;
-    let levels = crate::pyramid::level_reports(&written, options, max_zoom);
+    let levels = crate::pyramid::level_reports(&written, cut.tiling, options, max_zoom);
     Ok(ShardReport {
         shard,
         blocks: blocks.len(),
         weight: plan.weights[mine].iter().sum(),
         total_weight: plan.weights.iter().sum(),
         tiles: levels.iter().map(|l| l.tiles).sum(),
+        lattice_cells: cut.tiling.cells,
         tiles_kept: written.kept,
         levels,
     })
@@ -322,14 +326,14 @@ pub fn merge_shards(
                         one.metadata.insert((tile.z, tile.x, tile.y), bounds);
                     }
                 }
-                let (tiling, quality) = (options.tiling, options.quality);
+                let (tiling, quality) = (cut.tiling, options.quality);
                 let report = one.reports[usize::from(tile.z)]
                     .get_or_insert_with(|| LevelReport::empty(tiling, tile.z, quality));
                 crate::records::count(report, tile);
             }
             written.absorb(one);
             if done.samples {
-                let values = read_samples(dest, &format!("{name}.samples"))?;
+                let values = read_samples(dest, &format!("{name}.samples"), cut.tiling.cells)?;
                 samples.tiles.insert((block[0], block[1]), values);
             }
         }
@@ -356,6 +360,7 @@ pub fn merge_shards(
         bounds: bounds_array(&bounds),
         min_zoom: options.min_zoom,
         max_zoom,
+        lattice_cells: cut.tiling.cells,
         levels,
         tiles_kept,
     })

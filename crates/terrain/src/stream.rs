@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use tinsmith_raster::sample_geographic;
 
 use crate::rows::LevelRows;
-use crate::tms::{TileRect, TILE_CELLS};
+use crate::tms::TileRect;
 use crate::TerrainResult;
 
 /// Where the finest level's samples come from.
@@ -101,14 +101,14 @@ const BAND_SAMPLES: usize = 1 << 22;
 /// Tile rows per warp band of a level over `rect`.
 pub(super) fn band_tile_rows(rect: TileRect) -> u32 {
     let width = LevelRows::new(rect).width;
-    let rows = BAND_SAMPLES / (width * TILE_CELLS as usize);
+    let rows = BAND_SAMPLES / (width * rect.tiling.cells as usize);
     rows.clamp(1, u32::MAX as usize) as u32
 }
 
 /// The finest level's warp bands: `band_tile_rows` tile rows each, the first with the
 /// halo row above, so that each band completes its tile rows.
 fn bands(level: &LevelRows, band_tile_rows: u32) -> Vec<Range<usize>> {
-    let rows = band_tile_rows.max(1) as usize * TILE_CELLS as usize;
+    let rows = band_tile_rows.max(1) as usize * level.tiling.cells as usize;
     let mut out = Vec::new();
     let mut start = 0;
     while start < level.height {
@@ -296,13 +296,13 @@ impl RowSource for Hills {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tms::Tiling;
+    use crate::tms::{Scheme, Tiling, LATTICE_CELLS};
     use tinsmith_raster::GeoBounds;
 
     /// The next coarser level of a whole finer level, as the pipeline made it before it
     /// streamed: a reference that shares no code with [`LevelRows::coarser_rows`].
     fn whole_coarser(fine: &LevelRows, fine_values: &[f32], coarse: &LevelRows) -> Vec<f32> {
-        let c = i64::from(TILE_CELLS);
+        let c = i64::from(fine.tiling.cells);
         let (fx0, fy0) = (i64::from(fine.tx0) * c, i64::from(fine.ty0) * c);
         let (cx0, cy0) = (i64::from(coarse.tx0) * c, i64::from(coarse.ty0) * c);
         let at = |gx: i64, gy: i64| -> f32 {
@@ -363,7 +363,7 @@ mod tests {
                 self.levels[z].handed, tile_rows.start,
                 "tile rows in order, once"
             );
-            let n = TILE_CELLS as usize;
+            let n = level.tiling.cells as usize;
             for t in tile_rows.clone() {
                 let j0 = t as usize * n;
                 for j in j0.saturating_sub(1)..=(j0 + n + 1).min(level.height - 1) {
@@ -418,7 +418,13 @@ mod tests {
             north: 52.0,
             resolution: 0.02,
         };
-        check_streamed_levels(Tiling::Geographic, &bounds, [11.25, 45.0, 1.5], (2, 5));
+        for cells in LATTICE_CELLS {
+            let scheme = Scheme {
+                tiling: Tiling::Geographic,
+                cells,
+            };
+            check_streamed_levels(scheme, &bounds, [11.25, 45.0, 1.5], (2, 5));
+        }
     }
 
     #[test]
@@ -433,7 +439,13 @@ mod tests {
             north: 68.0,
             resolution: 0.04,
         };
-        check_streamed_levels(Tiling::Mercator, &bounds, [22.5, 55.77, 1.5], (1, 5));
+        for cells in LATTICE_CELLS {
+            let scheme = Scheme {
+                tiling: Tiling::Mercator,
+                cells,
+            };
+            check_streamed_levels(scheme, &bounds, [22.5, 55.77, 1.5], (1, 5));
+        }
     }
 
     /// Streams made-up hills over `bounds` (with a nodata disc `hole`) for `zooms` in
@@ -441,7 +453,7 @@ mod tests {
     /// the whole levels made at once (Web Mercator: within float rounding, the reference
     /// placing rows by another computation).
     fn check_streamed_levels(
-        tiling: Tiling,
+        tiling: Scheme,
         bounds: &GeoBounds,
         hole: [f64; 3],
         (min_zoom, max_zoom): (u8, u8),
@@ -458,7 +470,7 @@ mod tests {
         );
         for z in (min_zoom..max_zoom).rev() {
             let (fine, coarse) = (level(z + 1), level(z));
-            let values = match tiling {
+            let values = match tiling.tiling {
                 Tiling::Geographic => whole_coarser(&fine, whole.last().unwrap(), &coarse),
                 Tiling::Mercator => whole_coarser_mercator(&fine, whole.last().unwrap(), &coarse),
             };
@@ -506,7 +518,7 @@ mod tests {
             for z in min_zoom..=max_zoom {
                 let streamed = &recorder.levels[usize::from(z)].values;
                 let reference = &whole[usize::from(z - min_zoom)];
-                let agree = match tiling {
+                let agree = match tiling.tiling {
                     Tiling::Geographic => same(streamed, reference),
                     Tiling::Mercator => close(streamed, reference),
                 };
@@ -536,13 +548,13 @@ mod tests {
         fine_values: &[f32],
         coarse: &LevelRows,
     ) -> Vec<f32> {
-        let c = i64::from(TILE_CELLS);
+        let c = i64::from(fine.tiling.cells);
         let (fx0, fy0) = (i64::from(fine.tx0) * c, i64::from(fine.ty0) * c);
         let (cx0, cy0) = (i64::from(coarse.tx0) * c, i64::from(coarse.ty0) * c);
         let coarse_tiles = 1i64 << coarse.level;
         let fine_rows = 2 * coarse_tiles * c + 1;
         let fine_lat: Vec<f64> = (0..fine_rows)
-            .map(|r| Tiling::Mercator.row_latitude(fine.level, r))
+            .map(|r| fine.tiling.row_latitude(fine.level, r))
             .collect();
         let at = |gx: i64, gy: i64| -> f32 {
             let (i, j) = (gx - fx0, gy - fy0);
@@ -614,9 +626,9 @@ mod tests {
             north: 50.0,
             resolution: 0.1,
         };
-        let level = LevelRows::new(TileRect::covering(&bounds, Tiling::Geographic, 3));
+        let level = LevelRows::new(TileRect::covering(&bounds, Scheme::GEOGRAPHIC, 3));
         assert_eq!(level.tiles_y, 3);
-        let n = TILE_CELLS as usize;
+        let n = Scheme::GEOGRAPHIC.cells as usize;
         assert_eq!(
             bands(&level, 1),
             vec![0..n + 2, n + 2..2 * n + 2, 2 * n + 2..3 * n + 1]

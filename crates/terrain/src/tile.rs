@@ -10,7 +10,7 @@ use crate::budget::{quanta_per_step, slack_scale, LevelBudget};
 use crate::layer::{metadata_json, Available};
 use crate::order::encoding_order;
 use crate::rows::LevelRows;
-use crate::tms::{Tiling, TILE_CELLS, U_PER_CELL};
+use crate::tms::Tiling;
 use crate::{TerrainError, TerrainOptions, TerrainResult, TileFormat};
 use tinsmith_tiling::{edge_limit, edge_span, EdgeProfile};
 
@@ -39,7 +39,8 @@ pub(super) fn build_tile(
     let z = raster.level;
     // Where the tile is written (`x` may be a turn east, see `tile_range`).
     let column = raster.tiling.tile_column(z, x);
-    let n = TILE_CELLS as usize;
+    let cells = raster.tiling.cells;
+    let n = cells as usize;
     let (i0, j0) = raster.tile_origin(x, y);
     let values = raster.tile_values(x, y);
     let scale = slack_scale(values.iter().copied());
@@ -55,7 +56,7 @@ pub(super) fn build_tile(
             max_abs: largest,
         });
     }
-    let grid = Grid::new(TILE_CELLS + 1, TILE_CELLS + 1, values).expect("a 218 x 218 grid");
+    let grid = Grid::new(cells + 1, cells + 1, values).expect("a tile's lattice");
     if grid.valid_cell_count() == 0 {
         return Ok(None);
     }
@@ -75,7 +76,7 @@ pub(super) fn build_tile(
     let north = keep(raster.edge(i0, j0 + n, true));
     let west = keep(raster.edge(i0, j0, false));
     let east = keep(raster.edge(i0 + n, j0, false));
-    let last = TILE_CELLS;
+    let last = cells;
     let keep_border = |gx: u32, gy: u32| {
         if gy == 0 {
             south[gx as usize]
@@ -137,8 +138,8 @@ pub(super) fn build_tile(
         .map(|v| {
             let h = ((v.z / s).round() - k_min) * f64::from(per_step);
             [
-                (v.x * U_PER_CELL) as u16,
-                (v.y * U_PER_CELL) as u16,
+                (v.x * raster.tiling.u_per_cell()) as u16,
+                (v.y * raster.tiling.u_per_cell()) as u16,
                 h.clamp(0.0, f64::from(QUANTIZED_MAX)) as u16,
             ]
         })
@@ -168,9 +169,9 @@ pub(super) fn build_tile(
     let normals: Option<Vec<[f64; 3]>> = options.normals.then(|| {
         let d = raster.tiling.step(z);
         // Rows are evenly spaced in latitude inside the tile, as CesiumJS places `v`.
-        let d_lat = match raster.tiling {
+        let d_lat = match raster.tiling.tiling {
             Tiling::Geographic => d,
-            Tiling::Mercator => (rect.north - rect.south) / f64::from(TILE_CELLS),
+            Tiling::Mercator => (rect.north - rect.south) / f64::from(cells),
         };
         tin.vertices()
             .iter()

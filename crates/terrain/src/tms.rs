@@ -1,13 +1,14 @@
 //! The tilings (TMS geographic, EPSG:4326 with two level-0 tiles; Web Mercator, EPSG:3857
-//! with one) and each tile's lattice of `TILE_CELLS` cells a side.
+//! with one) and each tile's lattice of `cells` cells a side ([`LATTICE_CELLS`]).
 
+use crate::pyramid::MAX_LEVEL;
 use crate::quantized_mesh::{GeoRectangle, QUANTIZED_MAX};
 use tinsmith_raster::{web_mercator_latitude, web_mercator_y, GeoBounds, GeoLattice, Latitudes};
 
 /// How a pyramid's tiles divide the globe (`layer.json`'s `projection`). Part of every
 /// tile's identity: a pyramid, its shards and its updates have one tiling.
 ///
-/// Either way a tile's lattice has `TILE_CELLS + 1` columns evenly spaced in longitude and
+/// Either way a tile's lattice has `cells + 1` columns evenly spaced in longitude and
 /// as many rows evenly spaced in latitude between the tile's southern and northern edges,
 /// which is how CesiumJS places a quantized-mesh vertex (`u`, `v` linear in longitude and
 /// latitude across the tile's rectangle), so the surface it draws is linear in longitude
@@ -59,11 +60,12 @@ impl Tiling {
         }
     }
 
-    /// Lattice spacing of a level in longitude, degrees (in latitude too, geographic).
-    pub(super) fn step(self, level: u8) -> f64 {
+    /// Lattice spacing of a level of tiles of `cells` cells a side in longitude, degrees
+    /// (in latitude too, geographic).
+    pub(super) fn step(self, level: u8, cells: u32) -> f64 {
         match self {
-            Tiling::Geographic => step(level),
-            Tiling::Mercator => 360.0 / (f64::from(TILE_CELLS) * (1u64 << level) as f64),
+            Tiling::Geographic => 180.0 / (f64::from(cells) * (1u64 << level) as f64),
+            Tiling::Mercator => 360.0 / (f64::from(cells) * (1u64 << level) as f64),
         }
     }
 
@@ -95,8 +97,9 @@ impl Tiling {
 
     /// The latitude of global lattice row `row` of `level` (row 0 the southern edge of
     /// the tiling), as [`Tiling::lattice`] places it.
-    pub(super) fn row_latitude(self, level: u8, row: i64) -> f64 {
-        self.lattice(level, 0, row.max(0) as u64, 1, 1).lat(0)
+    pub(super) fn row_latitude(self, level: u8, cells: u32, row: i64) -> f64 {
+        self.lattice(level, cells, 0, row.max(0) as u64, 1, 1)
+            .lat(0)
     }
 
     /// Columns `first_column ..`, rows `first_row ..` (`width` x `height`) of the global
@@ -105,6 +108,7 @@ impl Tiling {
     pub(super) fn lattice(
         self,
         level: u8,
+        cells: u32,
         first_column: u64,
         first_row: u64,
         width: u32,
@@ -113,14 +117,14 @@ impl Tiling {
         let latitudes = match self {
             Tiling::Geographic => Latitudes::Uniform,
             Tiling::Mercator => Latitudes::WebMercatorTiles {
-                cells: TILE_CELLS,
+                cells,
                 tiles: 1u64 << level,
             },
         };
         GeoLattice {
             west: -180.0,
             south: -90.0,
-            step: self.step(level),
+            step: self.step(level, cells),
             first_column,
             first_row,
             width,
@@ -132,11 +136,12 @@ impl Tiling {
     /// Where latitude `lat` falls among the global lattice rows of `level`, as a
     /// fractional row index (rows spaced evenly in latitude inside each tile), clamped to
     /// the level's rows.
-    pub(super) fn row_position(self, level: u8, lat: f64) -> f64 {
-        let cells = f64::from(TILE_CELLS);
+    pub(super) fn row_position(self, level: u8, cells: u32, lat: f64) -> f64 {
+        let step = self.step(level, cells);
+        let cells = f64::from(cells);
         let n = (1u64 << level) as f64;
         match self {
-            Tiling::Geographic => ((lat + 90.0) / step(level)).clamp(0.0, n * cells),
+            Tiling::Geographic => ((lat + 90.0) / step).clamp(0.0, n * cells),
             Tiling::Mercator => {
                 let tile = (web_mercator_y(lat) * n).floor().clamp(0.0, n - 1.0);
                 let south = web_mercator_latitude(tile / n);
@@ -161,17 +166,115 @@ impl Tiling {
     }
 }
 
-/// Cells along each side of a tile's sample grid: each tile samples
-/// `(TILE_CELLS + 1)^2` lattice points. 217 divides 32767 (= 7 x 31 x 151), so sample `i`
-/// is at `u = 151 i` exactly: decoded vertices sit exactly on their source samples.
-pub const TILE_CELLS: u32 = 217;
+/// The cells a tile's lattice may have along each side, the default first: each tile
+/// samples `(cells + 1)^2` lattice points. Both divide 32767 (= 7 x 31 x 151), so sample
+/// `i` is at `u = i x 32767 / cells` exactly: decoded vertices sit exactly on their
+/// source samples. A pyramid takes the one whose lattice at its own level (the first as
+/// fine as the raster, [`own_level`]) is the least finer than the raster (see
+/// [`lattice_cells`]).
+pub const LATTICE_CELLS: [u32; 2] = [217, 151];
 
-/// `u` (and `v`) per cell of the tile grid.
-pub(super) const U_PER_CELL: u32 = QUANTIZED_MAX as u32 / TILE_CELLS;
+/// A tiling with the cells a side of its tiles' lattices: what places every lattice point
+/// of a pyramid. Its methods are [`Tiling`]'s, with the cells given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Scheme {
+    /// How tiles divide the globe.
+    pub tiling: Tiling,
+    /// Cells along each side of a tile's lattice, one of [`LATTICE_CELLS`].
+    pub cells: u32,
+}
 
-/// Lattice spacing of a geographic level, in degrees.
-fn step(level: u8) -> f64 {
-    180.0 / (f64::from(TILE_CELLS) * (1u64 << level) as f64)
+impl Scheme {
+    /// Geographic tiles of the default lattice.
+    pub const GEOGRAPHIC: Scheme = Scheme {
+        tiling: Tiling::Geographic,
+        cells: LATTICE_CELLS[0],
+    };
+
+    /// Web Mercator tiles of the default lattice.
+    pub const MERCATOR: Scheme = Scheme {
+        tiling: Tiling::Mercator,
+        cells: LATTICE_CELLS[0],
+    };
+
+    /// Tile columns of level `z` ([`Tiling::columns`]).
+    pub fn columns(self, z: u8) -> u64 {
+        self.tiling.columns(z)
+    }
+
+    /// The tile rectangle `z/x/y` ([`Tiling::tile_rectangle`]).
+    pub fn tile_rectangle(self, z: u8, x: u32, y: u32) -> GeoRectangle {
+        self.tiling.tile_rectangle(z, x, y)
+    }
+
+    /// Lattice spacing of a level in longitude, degrees ([`Tiling::step`]).
+    pub(super) fn step(self, level: u8) -> f64 {
+        self.tiling.step(level, self.cells)
+    }
+
+    /// The tile column of lattice tile column `x` ([`Tiling::tile_column`]).
+    pub(super) fn tile_column(self, z: u8, x: u32) -> u32 {
+        self.tiling.tile_column(z, x)
+    }
+
+    /// The latitude of global lattice row `row` of `level` ([`Tiling::row_latitude`]).
+    pub(super) fn row_latitude(self, level: u8, row: i64) -> f64 {
+        self.tiling.row_latitude(level, self.cells, row)
+    }
+
+    /// A window of the global lattice of `level` ([`Tiling::lattice`]).
+    pub(super) fn lattice(
+        self,
+        level: u8,
+        first_column: u64,
+        first_row: u64,
+        width: u32,
+        height: u32,
+    ) -> GeoLattice {
+        self.tiling
+            .lattice(level, self.cells, first_column, first_row, width, height)
+    }
+
+    /// Where latitude `lat` falls among the rows of `level` ([`Tiling::row_position`]).
+    pub(super) fn row_position(self, level: u8, lat: f64) -> f64 {
+        self.tiling.row_position(level, self.cells, lat)
+    }
+
+    /// [`Tiling::max_row_offset`], in rows of this scheme's lattice.
+    pub(super) fn max_row_offset(self, level: u8) -> usize {
+        self.tiling.max_row_offset(level)
+    }
+
+    /// `u` (and `v`) per cell of a tile's lattice.
+    pub(super) fn u_per_cell(self) -> u32 {
+        QUANTIZED_MAX as u32 / self.cells
+    }
+}
+
+/// The raster's own level for tiles of `cells` cells a side: the first whose lattice is at
+/// least as fine as the raster's `resolution` (degrees).
+pub(super) fn own_level(resolution: f64, tiling: Tiling, cells: u32) -> u8 {
+    (0..MAX_LEVEL)
+        .find(|&l| tiling.step(l, cells) <= resolution * (1.0 + 1e-9))
+        .unwrap_or(MAX_LEVEL)
+}
+
+/// The cells of a pyramid's tile lattices over a raster of `resolution` degrees: of
+/// [`LATTICE_CELLS`], the one whose lattice at its own level is the coarsest (the fewest
+/// samples for the same detail), the first on a tie. ETOPO5 (5'): 151, 1.1 x finer than
+/// its pixels each way where 217 is 1.6 x; Big Tujunga (30 m) and a 3" SRTM tile: 217.
+pub fn lattice_cells(resolution: f64, tiling: Tiling) -> u32 {
+    let spacing = |cells: u32| tiling.step(own_level(resolution, tiling, cells), cells);
+    LATTICE_CELLS
+        .into_iter()
+        .reduce(|best, cells| {
+            if spacing(cells) > spacing(best) {
+                cells
+            } else {
+                best
+            }
+        })
+        .expect("two cell counts")
 }
 
 /// WGS84 semi-major axis, metres.
@@ -183,11 +286,11 @@ pub(super) const EARTH_RADIUS: f64 = 6_378_137.0;
 /// surface, an error the height check (made in longitude/latitude) does not see. Measured
 /// along the equator (where a lattice step spans the most arc); `None` when even the
 /// tile's diagonal is short enough.
-pub(super) fn max_edge_length(tiling: Tiling, level: u8, bound: f64) -> Option<u32> {
+pub(super) fn max_edge_length(tiling: Tiling, cells: u32, level: u8, bound: f64) -> Option<u32> {
     let arc = 2.0 * (1.0 - (bound / EARTH_RADIUS).min(1.0)).acos();
-    let spacing = tiling.step(level).to_radians();
+    let spacing = tiling.step(level, cells).to_radians();
     let length = (arc / spacing).floor();
-    if length >= f64::from(TILE_CELLS) * std::f64::consts::SQRT_2 {
+    if length >= f64::from(cells) * std::f64::consts::SQRT_2 {
         None
     } else {
         Some((length as u32).max(2))
@@ -255,7 +358,7 @@ pub(super) fn tile_range(bounds: &GeoBounds, tiling: Tiling, level: u8) -> ([u32
 /// height`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) struct TileRect {
-    pub(super) tiling: Tiling,
+    pub(super) tiling: Scheme,
     pub(super) level: u8,
     pub(super) x0: u32,
     pub(super) y0: u32,
@@ -265,8 +368,8 @@ pub(super) struct TileRect {
 
 impl TileRect {
     /// The tiles of `level` that `bounds` touches (see [`tile_range`]).
-    pub(super) fn covering(bounds: &GeoBounds, tiling: Tiling, level: u8) -> TileRect {
-        let ([x0, x1], [y0, y1]) = tile_range(bounds, tiling, level);
+    pub(super) fn covering(bounds: &GeoBounds, tiling: Scheme, level: u8) -> TileRect {
+        let ([x0, x1], [y0, y1]) = tile_range(bounds, tiling.tiling, level);
         TileRect {
             tiling,
             level,
@@ -303,7 +406,7 @@ mod tests {
     /// the lattice half as fine as `level`'s (what the coarser filter reads), over the
     /// tiles `tiles` of `level`.
     fn row_offset(level: u8, tiles: impl Iterator<Item = u64>) -> f64 {
-        let cells = u64::from(TILE_CELLS);
+        let cells = u64::from(LATTICE_CELLS[0]);
         let n = 1u64 << level;
         let mut worst = 0.0f64;
         for t in tiles {
@@ -311,13 +414,14 @@ mod tests {
                 let row = 2 * cells * t + h;
                 let half = GeoLattice {
                     latitudes: Latitudes::WebMercatorTiles {
-                        cells: 2 * TILE_CELLS,
+                        cells: 2 * LATTICE_CELLS[0],
                         tiles: n,
                     },
                     first_row: row,
-                    ..Tiling::Mercator.lattice(level, 0, 0, 1, 1)
+                    ..Tiling::Mercator.lattice(level, LATTICE_CELLS[0], 0, 0, 1, 1)
                 };
-                let position = Tiling::Mercator.row_position(level + 1, half.lat(0));
+                let position =
+                    Tiling::Mercator.row_position(level + 1, LATTICE_CELLS[0], half.lat(0));
                 worst = worst.max((position - row as f64).abs());
             }
         }
@@ -350,6 +454,37 @@ mod tests {
     }
 
     #[test]
+    fn the_lattice_is_the_least_finer_than_the_raster() {
+        let geographic = |resolution: f64| lattice_cells(resolution, Tiling::Geographic);
+        // ETOPO5 (5'): level 4 either way, 0.075° with 151 cells against 0.052° with 217.
+        assert_eq!(geographic(5.0 / 60.0), 151);
+        assert_eq!(own_level(5.0 / 60.0, Tiling::Geographic, 151), 4);
+        // Big Tujunga (30 m, 0.00027°): level 12's 0.00020° with 217; 151 needs level 13.
+        assert_eq!(geographic(0.00027), 217);
+        // A 3" SRTM tile: level 10's 0.00081° with 217 is within 3 % of its pixels.
+        assert_eq!(geographic(3.0 / 3600.0), 217);
+        // Either way, the lattice at the raster's own level is at least as fine as the
+        // raster and less than twice as fine.
+        for k in 0..200 {
+            let resolution = 1e-5 * 1.07f64.powi(k);
+            for tiling in [Tiling::Geographic, Tiling::Mercator] {
+                let cells = lattice_cells(resolution, tiling);
+                let level = own_level(resolution, tiling, cells);
+                let step = tiling.step(level, cells);
+                assert!(step <= resolution * (1.0 + 1e-9) || level == MAX_LEVEL);
+                assert!(step > resolution / 2.0 || level == 0);
+                for other in LATTICE_CELLS {
+                    let other_step = tiling.step(own_level(resolution, tiling, other), other);
+                    assert!(
+                        step >= other_step,
+                        "{resolution}: {cells} {step} {other_step}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
     fn mercator_rectangles_meet_and_end_at_85_degrees() {
         let top = Tiling::Mercator.tile_rectangle(3, 5, 7);
         assert!((top.north - 85.051_128_779_806_59).abs() < 1e-12);
@@ -360,8 +495,10 @@ mod tests {
         );
         assert_eq!(a.north, b.south);
         // The lattice's edge rows are the rectangles' edges, to the bit.
-        let row = |r: i64| Tiling::Mercator.row_latitude(9, r);
-        assert_eq!(row(301 * i64::from(TILE_CELLS)), b.south);
-        assert_eq!(row(302 * i64::from(TILE_CELLS)), b.north);
+        for cells in LATTICE_CELLS {
+            let row = |r: i64| Tiling::Mercator.row_latitude(9, cells, r);
+            assert_eq!(row(301 * i64::from(cells)), b.south);
+            assert_eq!(row(302 * i64::from(cells)), b.north);
+        }
     }
 }

@@ -16,7 +16,7 @@ use crate::records::{count, options_key, tile_sum, Entries, TileEntry};
 use crate::rows::LevelRows;
 use crate::stream::LevelSink;
 use crate::tile::{build_tile, TileOut};
-use crate::tms::TileRect;
+use crate::tms::{Scheme, TileRect};
 use crate::{
     LevelReport, TerrainError, TerrainOptions, TerrainResult, TileFormat, METADATA_AVAILABILITY,
 };
@@ -28,6 +28,8 @@ pub(super) struct Scope {
     pub(super) levels: (u8, u8),
     /// Only the tiles under this tile (a block), or every tile of the levels.
     pub(super) under: Option<TileRect>,
+    /// The tiling and tile lattice.
+    pub(super) scheme: Scheme,
 }
 
 impl Scope {
@@ -140,7 +142,7 @@ impl<'a> TileWriter<'a> {
             options,
             pool,
             budgets: (0..=max_zoom)
-                .map(|z| LevelBudget::new(options.tiling, z, options.quality))
+                .map(|z| LevelBudget::new(scope.scheme, z, options.quality))
                 .collect(),
             written: Written {
                 reports: vec![None; levels],
@@ -160,7 +162,7 @@ impl<'a> TileWriter<'a> {
 
     /// The report of level `z`, started when first needed.
     fn report(&mut self, z: u8) -> &mut LevelReport {
-        let (tiling, quality) = (self.options.tiling, self.options.quality);
+        let (tiling, quality) = (self.scope.scheme, self.options.quality);
         self.written.reports[usize::from(z)]
             .get_or_insert_with(|| LevelReport::empty(tiling, z, quality))
     }
@@ -178,7 +180,7 @@ impl<'a> TileWriter<'a> {
                 Outcome::Kept(entry.clone())
             }
             _ => {
-                let flat = LevelRows::flat_tile(self.options.tiling, 0, x, 0);
+                let flat = LevelRows::flat_tile(self.scope.scheme, 0, x, 0);
                 let tile = build_tile(&flat, x, 0, &self.budgets[0], self.options, available)?;
                 Outcome::Built(0, x, 0, sum, tile)
             }

@@ -5,8 +5,6 @@
 //! (`CesiumTerrainProvider.js`, `createVerticesFromQuantizedTerrainMesh.js`); see
 //! `docs/architecture.md` ("Terrain tiles") for the choices made where they leave room.
 
-use std::io::Write;
-
 /// WGS84 semi-major axis (m).
 pub const WGS84_A: f64 = 6_378_137.0;
 /// WGS84 semi-minor axis (m).
@@ -300,17 +298,33 @@ impl<'a> QuantizedMeshTile<'a> {
     }
 }
 
-/// Gzips `bytes` (default level; the gzip header carries no time or name, so the same
-/// bytes in give the same bytes out).
+/// The libdeflate level tiles are gzipped at. Measured on the tiles of ETOPO5 z0-4, Big
+/// Tujunga z0-12 and Fort Worth z0-10 against zlib's default level (flate2, before): 3.6 %,
+/// 3.5 % and 5.2 % fewer bytes for 34, 39 and 2 ms of CPU (level 12: 4.1 %, 3.8 %, 5.6 %
+/// for twice that; 6 and 9 gain at most 3.5 % on the small tiles and 0.7 % on the larger).
+const GZIP_LEVEL: i32 = 10;
+
+thread_local! {
+    /// Each thread's compressor (one holds a few hundred kB of match-finder tables).
+    static COMPRESSOR: std::cell::RefCell<libdeflater::Compressor> =
+        std::cell::RefCell::new(libdeflater::Compressor::new(
+            libdeflater::CompressionLvl::new(GZIP_LEVEL).expect("a level libdeflate has"),
+        ));
+}
+
+/// Gzips `bytes` with libdeflate at level 10 (the gzip header carries no time or
+/// name, and libdeflate's output depends only on its input and level, so the same bytes
+/// in give the same bytes out on any machine).
 pub fn gzip(bytes: &[u8]) -> Vec<u8> {
-    let mut encoder = flate2::write::GzEncoder::new(
-        Vec::with_capacity(bytes.len() / 2),
-        flate2::Compression::default(),
-    );
-    encoder
-        .write_all(bytes)
-        .and_then(|_| encoder.finish())
-        .expect("writing to a Vec cannot fail")
+    COMPRESSOR.with(|compressor| {
+        let mut compressor = compressor.borrow_mut();
+        let mut out = vec![0; compressor.gzip_compress_bound(bytes.len())];
+        let n = compressor
+            .gzip_compress(bytes, &mut out)
+            .expect("the bound holds any compressed size");
+        out.truncate(n);
+        out
+    })
 }
 
 /// WGS84 geodetic (degrees, metres above the ellipsoid) to ECEF (metres).

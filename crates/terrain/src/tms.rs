@@ -170,7 +170,7 @@ impl Tiling {
 /// samples `(cells + 1)^2` lattice points. Both divide 32767 (= 7 x 31 x 151), so sample
 /// `i` is at `u = i x 32767 / cells` exactly: decoded vertices sit exactly on their
 /// source samples. A pyramid takes the one whose lattice at its own level (the first as
-/// fine as the raster, [`own_level`]) is the least finer than the raster (see
+/// fine as the raster) is the least finer than the raster (see
 /// [`lattice_cells`]).
 pub const LATTICE_CELLS: [u32; 2] = [217, 151];
 

@@ -43,6 +43,20 @@ pub(crate) fn project_block(
     ys: &mut Vec<f64>,
 ) {
     let k = NODE_STEP;
+    xs.clear();
+    ys.clear();
+    if !nodes_repeat_each_turn(lattice) {
+        // A point a turn east would fall in other node cells: each point alone.
+        for j in rows {
+            let lat = lattice.lat(j);
+            for i in columns.clone() {
+                xs.push(lattice.lon(i));
+                ys.push(lat);
+            }
+        }
+        let _ = transform.transform_coords(xs, ys, &mut []);
+        return;
+    }
     let global_column = |i: u32| lattice.first_column + u64::from(i);
     let global_row = |j: u32| lattice.first_row + u64::from(j);
     // The node cells holding the block: from the one at or below its first point to the
@@ -111,8 +125,6 @@ pub(crate) fn project_block(
         })
         .collect();
 
-    xs.clear();
-    ys.clear();
     let mut exact = Vec::new();
     for j in rows.clone() {
         let row = global_row(j);
@@ -149,6 +161,17 @@ pub(crate) fn project_block(
             (xs[n], ys[n]) = (x, y);
         }
     }
+}
+
+/// Whether the node grid is the same a turn east: [`GeoLattice::lon`] counts columns
+/// modulo a turn when a turn is a whole number of steps, so a point has two global columns
+/// a turn apart, which fall in node cells of the same positions only when the turn is a
+/// whole number of cells (every level but the coarsest two or three: a turn is 2^(z+1) or
+/// 2^z times the tile's cells).
+fn nodes_repeat_each_turn(lattice: &GeoLattice) -> bool {
+    let turn = (360.0 / lattice.step).round();
+    let whole = turn >= 1.0 && (turn * lattice.step - 360.0).abs() <= 1e-9;
+    !whole || (turn as u64) % NODE_STEP == 0
 }
 
 /// The bilinear interpolation of `corners` (south-west, south-east, north-west,
@@ -230,6 +253,50 @@ mod tests {
                 interpolates,
                 "level {level}: {differ}"
             );
+        }
+    }
+
+    #[test]
+    fn a_point_a_turn_east_gets_the_same_position() {
+        // NAD83 longitude, latitude: nearly WGS84's, so cells interpolate at any size.
+        let mut nad83 = SpatialRef::from_epsg(4269).expect("EPSG:4269");
+        nad83
+            .set_axis_mapping_strategy(gdal::spatial_ref::AxisMappingStrategy::TraditionalGisOrder);
+        let transform = CoordTransform::new(&wgs84().expect("WGS84"), &nad83).expect("PROJ");
+        let pixels = |dx: f64, dy: f64| dx.abs().max(dy.abs()) / 0.01;
+        // Levels 0 (a turn of 434 columns, not a whole number of node cells) to 3.
+        for level in 0..4 {
+            let step = 180.0 / (217.0 * f64::from(1u32 << level));
+            let turn = (360.0 / step).round() as u64;
+            let window = |first_column: u64| GeoLattice {
+                west: -180.0,
+                south: -90.0,
+                step,
+                first_column,
+                first_row: 10,
+                width: 37,
+                height: 21,
+                latitudes: Latitudes::Uniform,
+            };
+            let (mut ax, mut ay, mut bx, mut by) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            let block = (0..37, 0..21);
+            project_block(
+                &transform,
+                &window(turn - 20),
+                block.clone(),
+                &pixels,
+                &mut ax,
+                &mut ay,
+            );
+            project_block(
+                &transform,
+                &window(2 * turn - 20),
+                block,
+                &pixels,
+                &mut bx,
+                &mut by,
+            );
+            assert_eq!((ax, ay), (bx, by), "level {level}");
         }
     }
 

@@ -171,7 +171,7 @@ pub(crate) fn project_block(
 fn nodes_repeat_each_turn(lattice: &GeoLattice) -> bool {
     let turn = (360.0 / lattice.step).round();
     let whole = turn >= 1.0 && (turn * lattice.step - 360.0).abs() <= 1e-9;
-    !whole || (turn as u64) % NODE_STEP == 0
+    !whole || (turn as u64).is_multiple_of(NODE_STEP)
 }
 
 /// The bilinear interpolation of `corners` (south-west, south-east, north-west,

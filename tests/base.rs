@@ -330,6 +330,33 @@ fn a_tile_over_a_base_does_not_depend_on_the_zoom_range_or_the_threads() {
 }
 
 #[test]
+fn the_finest_level_is_the_inputs_own_on_the_bases_lattice() {
+    // The 0.05° base takes tiles of 151 cells (level 5: 0.037°, where 217 cells give
+    // 0.026°). A 0.0009° input is first sampled at least as finely at level 10 with 217
+    // cells (0.00081°) but at level 11 with 151 (0.00058°; level 10 is 0.00116°).
+    let dir = Dir::new();
+    let (low, _) = inputs(&dir);
+    let fine = ascii_grid(
+        &dir,
+        "fine.asc",
+        (9.6, 44.3, 0.0009),
+        (60, 50),
+        |lon, lat| 500.0 + 40.0 * (300.0 * lon).sin() * (200.0 * lat).cos(),
+    );
+    let o = dir.run(&[
+        "tiles", &fine, "--base", &low, "-o", "p", "--report", "r.json", "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path("r.json")).unwrap()).unwrap();
+    assert_eq!(report["lattice_cells"], 151);
+    assert_eq!(report["max_zoom"], 11);
+    let tiles = decode_pyramid(&dir.path("p"));
+    assert_eq!(tiles.values().next().unwrap().cells(), 151);
+    assert!(tiles.keys().any(|k| k.0 == 11));
+}
+
+#[test]
 fn a_base_that_is_missing_not_a_raster_or_not_placed_is_refused_naming_it() {
     let dir = Dir::new();
     let (_, high) = inputs(&dir);

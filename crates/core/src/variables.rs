@@ -238,6 +238,19 @@ pub(crate) fn worst_with_variables(
         }
         let [va, vb, vc] = corner_samples(&v.grid, [a, b, c]);
         let (e, w) = crate::exact::triangle_worst(&v.grid, &va, &vb, &vc, is_vertex);
+        // Below the rounding slack only an exactly flat plane is measured exactly (as
+        // `with_variables` has it): any other triangle must split.
+        let flat_corners = va.z == vb.z && vb.z == vc.z;
+        if v.limit == 0.0 && !v.grid.integral_heights() && !flat_corners {
+            bound.above = bound.above.max(beyond(0.0));
+            bound.below = bound.below.max(beyond(0.0));
+            if let Some((sample, _)) = w {
+                if worst.is_none_or(|(_, best)| limit.next_up() > best) {
+                    worst = Some((sample, limit.next_up()));
+                }
+            }
+            continue;
+        }
         let exceeds = e.above > v.limit || e.below > v.limit;
         let scaled = |x: f64| {
             if x == 0.0 {

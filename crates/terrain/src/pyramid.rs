@@ -554,8 +554,17 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
             options.band,
         )));
     }
-    // The first level whose lattice is at least as fine as the raster.
-    let (scheme, own_level) = own_scheme(&bounds, options.tiling);
+    // The tiles' lattice is the anchor raster's (the base's, with one), and the input's
+    // own level is the first whose lattice is at least as fine as it.
+    let cells = match &options.base {
+        Some(base) => lattice_cells(geographic_bounds(&base.path, 1)?.resolution, options.tiling),
+        None => lattice_cells(bounds.resolution, options.tiling),
+    };
+    let scheme = Scheme {
+        tiling: options.tiling,
+        cells,
+    };
+    let own_level = own_level(bounds.resolution, options.tiling, cells);
     let max_zoom = options.max_zoom.unwrap_or(own_level);
     if options.metadata && options.min_zoom > 0 {
         return Err(TerrainError::Options(format!(
@@ -682,7 +691,7 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
             max_zoom,
             fine: bounds,
         }),
-        Some(base) => prepare_base(base, bounds, max_zoom, threads, options),
+        Some(base) => prepare_base(base, bounds, scheme, max_zoom, threads, options),
     }
 }
 
@@ -712,6 +721,7 @@ fn clip_to_tiling(
 fn prepare_base(
     base: &crate::BaseRaster,
     fine: GeoBounds,
+    scheme: Scheme,
     max_zoom: u8,
     threads: usize,
     options: &TerrainOptions,
@@ -739,7 +749,7 @@ fn prepare_base(
             path.display()
         )));
     }
-    let (scheme, anchor) = own_scheme(&below, options.tiling);
+    let anchor = own_level(below.resolution, options.tiling, scheme.cells);
     let bounds = crate::base::union(&below, &fine);
     let need = streaming_bytes_of(&bounds, scheme, anchor, anchor, threads);
     if let Some(limit) = options.memory_limit.filter(|&limit| need > limit) {

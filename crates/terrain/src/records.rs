@@ -72,6 +72,11 @@ pub(super) fn options_key(options: &TerrainOptions) -> String {
         "band": options.band, "quality": options.quality, "normals": options.normals,
         "metadata": options.metadata, "gzip": options.gzip, "format": 1,
     });
+    // Tiles gzipped by libdeflate since it replaced zlib: an update rebuilds a pyramid
+    // gzipped before, so that it equals a fresh build byte for byte.
+    if options.gzip {
+        text["gzip_by"] = "libdeflate 10".into();
+    }
     // Absent for the ellipsoid, so that pyramids built before datums were chosen keep
     // their key.
     if options.vertical_datum != tinsmith_raster::VerticalDatum::Ellipsoid {

@@ -172,8 +172,14 @@ impl<'a> TileWriter<'a> {
     pub(super) fn write_flat_root(&mut self, x: u32) -> TerrainResult<()> {
         let available = self.options.metadata.then_some(&self.written.available);
         let metadata = available.map(|a| metadata_json(a, 0, x, 0));
+        let cells = self.scope.scheme.cells;
         let sum = tile_sum(&self.key, (0, x, 0), metadata.as_deref(), |h| {
-            h.update(b"flat")
+            h.update(b"flat");
+            // The lattice shapes a flat tile (its edge cap, its `u` steps); absent for the
+            // default, so that earlier pyramids keep their sums.
+            if cells != crate::tms::LATTICE_CELLS[0] {
+                h.update(cells.to_le_bytes());
+            }
         });
         let outcome = match self.known.get(&(0, x, 0)) {
             Some(entry) if entry.sum == sum && keepable(entry, self.options.format) => {

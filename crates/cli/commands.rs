@@ -21,16 +21,17 @@ pub fn contour(args: &ContourArgs) -> Result<bool> {
 /// `tinsmith tiles`; `Ok(true)` once the pyramid is in place.
 pub fn tiles(args: &TilesArgs) -> Result<bool> {
     if let Some(TilesStep::Merge(merge)) = &args.step {
-        let feedback = Stderr::new(merge.quiet);
-        let report = merge.report.as_deref();
-        tinsmith_pipeline::merge_tiles(&merge.dir, merge.threads, report, &feedback)?;
+        let run = &merge.run;
+        let feedback = Stderr::new(run.quiet);
+        let report = run.report.as_deref();
+        tinsmith_pipeline::merge_tiles(&merge.dir, run.threads, report, &feedback)?;
         return Ok(true);
     }
     let (Some(input), Some(output)) = (&args.input, &args.output) else {
         unreachable!("clap requires INPUT and --output without a subcommand");
     };
     let mut options = args.options(tinsmith_pipeline::available_bytes());
-    let feedback = Stderr::new(args.quiet);
+    let feedback = Stderr::new(args.run.quiet);
     options.vertical_datum = tinsmith_pipeline::vertical_datum(
         input,
         args.band,
@@ -42,7 +43,7 @@ pub fn tiles(args: &TilesArgs) -> Result<bool> {
         let datum = args.vertical_datum.as_deref();
         options.base = Some(tinsmith_pipeline::base_raster(base, datum, &feedback)?);
     }
-    let report = args.report.as_deref();
+    let report = args.run.report.as_deref();
     match args.shard {
         Some(shard) => {
             tinsmith_pipeline::tiles_shard(input, output, report, &options, shard, &feedback)?;

@@ -56,7 +56,7 @@ fn main() -> ExitCode {
     let quiet = match &cli.command {
         Command::Mesh(a) => a.quiet,
         Command::Contour(a) => a.quiet,
-        Command::Tiles(a) => a.quiet,
+        Command::Tiles(a) => a.run.quiet,
         Command::Info(_) | Command::Verify(_) | Command::Serve(_) | Command::Preview(_) => true,
     };
     let result = match cli.command {

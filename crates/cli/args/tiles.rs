@@ -89,6 +89,13 @@ pub struct TilesArgs {
     /// textures), the same tiles, whole globe from level 0, into a directory.
     #[arg(long, value_name = "NAME", default_value = "quantized-mesh", value_parser = parse_tile_format)]
     pub format: TileFormat,
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+/// The flags of a pyramid's run that `tiles` and `tiles merge` share.
+#[derive(Debug, Args)]
+pub struct RunArgs {
     /// Worker threads, at most 1024 (default: all cores); no more are started than there
     /// are cores.
     #[arg(long, default_value_t = 0, value_parser = threads_or_all)]
@@ -121,16 +128,8 @@ pub enum TilesStep {
 pub struct MergeArgs {
     /// The directory the shards wrote into.
     pub dir: PathBuf,
-    /// Worker threads, at most 1024 (default: all cores); no more are started than there
-    /// are cores.
-    #[arg(long, default_value_t = 0, value_parser = threads_or_all)]
-    pub threads: usize,
-    /// Write the per-level report (bounds, measured error, tiles, bytes) as JSON.
-    #[arg(long)]
-    pub report: Option<PathBuf>,
-    /// No per-level lines or summary on stderr.
-    #[arg(short, long)]
-    pub quiet: bool,
+    #[command(flatten)]
+    pub run: RunArgs,
 }
 
 #[derive(Debug, Args)]
@@ -156,7 +155,7 @@ impl TilesArgs {
             normals: self.normals,
             metadata: self.metadata,
             gzip: !self.no_gzip,
-            threads: self.threads,
+            threads: self.run.threads,
             memory_limit,
             update: self.update,
             vertical_datum: tinsmith_raster::VerticalDatum::Ellipsoid,

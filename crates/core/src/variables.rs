@@ -109,6 +109,25 @@ impl Measured {
         self.limit
     }
 
+    /// A difference `x` within the variable's own limit, in height units: scaled, and
+    /// clamped to the height's limit, so the scale's rounding refuses nothing the
+    /// variable allows.
+    fn scaled(&self, x: f64) -> f64 {
+        if x == 0.0 {
+            0.0
+        } else {
+            (x * self.scale).min(self.height_limit)
+        }
+    }
+
+    /// Whether the variable, held at 0 below its rounding slack, cannot be measured over
+    /// the plane through `corners` (its values there): only an exactly flat plane is
+    /// measured exactly (its differences are all zero), as the height's stars are at 0.
+    fn unmeasurable(&self, corners: &[Point; 3]) -> bool {
+        let flat = corners[0].z == corners[1].z && corners[1].z == corners[2].z;
+        self.limit == 0.0 && !self.grid.integral_heights() && !flat
+    }
+
     /// Whether the variable never stops a removal.
     pub(crate) fn unconstrained(&self) -> bool {
         self.limit == f64::INFINITY
@@ -176,20 +195,18 @@ pub(crate) fn with_variables(
         if v.unconstrained() {
             continue;
         }
-        let [va, vb, vc] = corner_samples(&v.grid, [a, b, c]);
+        let corners = corner_samples(&v.grid, [a, b, c]);
+        let [va, vb, vc] = &corners;
         // Stop the scan early only where the verdict is sure to be a refusal.
         let cap = if limit.is_finite() && v.scale > 0.0 {
             v.limit.min(limit / v.scale)
         } else {
             v.limit
         };
-        let flat_corners = va.z == vb.z && vb.z == vc.z;
-        let measured = if v.limit == 0.0 && !v.grid.integral_heights() && !flat_corners {
-            // Below the rounding slack only an exactly flat plane is measured exactly (its
-            // differences are all zero), as the height's stars are at 0.
+        let measured = if v.unmeasurable(&corners) {
             None
         } else {
-            height_error(&v.grid, &va, &vb, &vc, cap)
+            height_error(&v.grid, va, vb, vc, cap)
         };
         let Some(e) = measured.filter(|e| e.above <= v.limit && e.below <= v.limit) else {
             if limit.is_finite() {
@@ -200,15 +217,8 @@ pub(crate) fn with_variables(
                 below: f64::INFINITY,
             });
         };
-        let scaled = |x: f64| {
-            if x == 0.0 {
-                0.0
-            } else {
-                (x * v.scale).min(v.height_limit)
-            }
-        };
-        bound.above = bound.above.max(scaled(e.above));
-        bound.below = bound.below.max(scaled(e.below));
+        bound.above = bound.above.max(v.scaled(e.above));
+        bound.below = bound.below.max(v.scaled(e.below));
     }
     (bound.above <= limit && bound.below <= limit).then_some(bound)
 }
@@ -236,46 +246,25 @@ pub(crate) fn worst_with_variables(
         if v.unconstrained() {
             continue;
         }
-        let [va, vb, vc] = corner_samples(&v.grid, [a, b, c]);
-        let (e, w) = crate::exact::triangle_worst(&v.grid, &va, &vb, &vc, is_vertex);
-        // Below the rounding slack only an exactly flat plane is measured exactly (as
-        // `with_variables` has it): any other triangle must split.
-        let flat_corners = va.z == vb.z && vb.z == vc.z;
-        if v.limit == 0.0 && !v.grid.integral_heights() && !flat_corners {
-            bound.above = bound.above.max(beyond(0.0));
-            bound.below = bound.below.max(beyond(0.0));
-            if let Some((sample, _)) = w {
-                if worst.is_none_or(|(_, best)| limit.next_up() > best) {
-                    worst = Some((sample, limit.next_up()));
-                }
-            }
-            continue;
-        }
-        let exceeds = e.above > v.limit || e.below > v.limit;
-        let scaled = |x: f64| {
-            if x == 0.0 {
-                0.0
-            } else if exceeds {
-                x * v.scale
+        let corners = corner_samples(&v.grid, [a, b, c]);
+        let [va, vb, vc] = &corners;
+        let (e, w) = crate::exact::triangle_worst(&v.grid, va, vb, vc, is_vertex);
+        // A difference in height units: above `limit` where the variable cannot be
+        // measured or is beyond its own limit (the triangle must split), else scaled.
+        let unmeasurable = v.unmeasurable(&corners);
+        let in_height = |x: f64| {
+            if unmeasurable {
+                beyond(0.0)
+            } else if x > v.limit {
+                beyond(x * v.scale)
             } else {
-                (x * v.scale).min(v.height_limit)
+                v.scaled(x)
             }
         };
-        let (mut above, mut below) = (scaled(e.above), scaled(e.below));
-        if e.above > v.limit {
-            above = beyond(above);
-        }
-        if e.below > v.limit {
-            below = beyond(below);
-        }
-        bound.above = bound.above.max(above);
-        bound.below = bound.below.max(below);
+        bound.above = bound.above.max(in_height(e.above));
+        bound.below = bound.below.max(in_height(e.below));
         if let Some((sample, e_worst)) = w {
-            let key = if e_worst > v.limit {
-                beyond(e_worst * v.scale)
-            } else {
-                scaled(e_worst)
-            };
+            let key = in_height(e_worst);
             if worst.is_none_or(|(_, best)| key > best) {
                 worst = Some((sample, key));
             }

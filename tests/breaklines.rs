@@ -63,6 +63,25 @@ fn mesh(dir: &Dir, out: &str, extra: &[&str]) -> std::process::Output {
     dir.run(&args)
 }
 
+/// `tinsmith verify INPUT MESH --max-error BOUND --breaklines LINES`.
+fn verify_lines(
+    dir: &Dir,
+    input: &str,
+    mesh: &str,
+    bound: &str,
+    lines: &str,
+) -> std::process::Output {
+    dir.run(&[
+        "verify",
+        input,
+        mesh,
+        "--max-error",
+        bound,
+        "--breaklines",
+        lines,
+    ])
+}
+
 #[test]
 fn breaklines_are_chains_of_edges_and_every_point_within_the_bound() {
     let dir = Dir::new();
@@ -83,15 +102,7 @@ fn breaklines_are_chains_of_edges_and_every_point_within_the_bound() {
     assert_eq!(r["points_read"], 4000);
     assert!(r["measured_max_error"].as_f64().unwrap() <= 0.05);
     // Independently: every point and every segment.
-    let o = dir.run(&[
-        "verify",
-        "pts.csv",
-        "tin.ply",
-        "--max-error",
-        "0.05",
-        "--breaklines",
-        "lines.geojson",
-    ]);
+    let o = verify_lines(&dir, "pts.csv", "tin.ply", "0.05", "lines.geojson");
     assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
     assert!(
         stdout(&o).contains("4000 points") && stdout(&o).contains("3 breakline segments present"),
@@ -101,15 +112,7 @@ fn breaklines_are_chains_of_edges_and_every_point_within_the_bound() {
     // The mesh made without them does not have them: the check can fail.
     let o = mesh(&dir, "plain.ply", &[]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let o = dir.run(&[
-        "verify",
-        "pts.csv",
-        "plain.ply",
-        "--max-error",
-        "0.05",
-        "--breaklines",
-        "lines.geojson",
-    ]);
+    let o = verify_lines(&dir, "pts.csv", "plain.ply", "0.05", "lines.geojson");
     assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
     assert!(stdout(&o).contains("breakline segments"), "{}", stdout(&o));
     // Same input, same bytes.
@@ -169,15 +172,7 @@ fn three_d_lines_keep_their_heights_from_a_geopackage() {
             "no vertex {want:?}"
         );
     }
-    let o = dir.run(&[
-        "verify",
-        "pts.csv",
-        "tin.obj",
-        "--max-error",
-        "0.05",
-        "--breaklines",
-        "ditch.gpkg",
-    ]);
+    let o = verify_lines(&dir, "pts.csv", "tin.obj", "0.05", "ditch.gpkg");
     assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
 }
 
@@ -501,15 +496,7 @@ fn a_raster_with_breaklines_keeps_them_and_the_bound_at_every_sample() {
     assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
     assert!(stdout(&o).contains("1200 points"), "{}", stdout(&o));
     // At a tenth of the bound the same mesh fails: every sample is measured.
-    let o = dir.run(&[
-        "verify",
-        "dem.asc",
-        "tin.ply",
-        "--max-error",
-        "0.005",
-        "--breaklines",
-        "lines.geojson",
-    ]);
+    let o = verify_lines(&dir, "dem.asc", "tin.ply", "0.005", "lines.geojson");
     assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
 }
 
@@ -543,15 +530,7 @@ fn lines_that_continue_one_another_and_rings_keep_their_vertices_and_lose_points
     );
     let o = mesh(&dir, "tin.obj", &["--breaklines", "lines.geojson"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let o = dir.run(&[
-        "verify",
-        "pts.csv",
-        "tin.obj",
-        "--max-error",
-        "0.05",
-        "--breaklines",
-        "lines.geojson",
-    ]);
+    let o = verify_lines(&dir, "pts.csv", "tin.obj", "0.05", "lines.geojson");
     assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
     // On the plane, the points lying on the lines go; the lines' own vertices stay.
     let obj = std::fs::read_to_string(dir.path("tin.obj")).unwrap();

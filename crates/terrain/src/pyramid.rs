@@ -556,10 +556,12 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
     }
     // The tiles' lattice is the anchor raster's (the base's, with one), and the input's
     // own level is the first whose lattice is at least as fine as it.
-    let cells = match &options.base {
-        Some(base) => lattice_cells(geographic_bounds(&base.path, 1)?.resolution, options.tiling),
-        None => lattice_cells(bounds.resolution, options.tiling),
+    let below = match &options.base {
+        Some(base) => Some(geographic_bounds(&base.path, 1)?),
+        None => None,
     };
+    let anchor_resolution = below.as_ref().unwrap_or(&bounds).resolution;
+    let cells = lattice_cells(anchor_resolution, options.tiling);
     let scheme = Scheme {
         tiling: options.tiling,
         cells,
@@ -683,7 +685,7 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
             }
         }
     }
-    match &options.base {
+    match options.base.as_ref().zip(below) {
         None => Ok(Prepared {
             bounds,
             scheme,
@@ -691,7 +693,9 @@ pub(super) fn prepare(input: &Path, options: &TerrainOptions) -> TerrainResult<P
             max_zoom,
             fine: bounds,
         }),
-        Some(base) => prepare_base(base, bounds, scheme, max_zoom, threads, options),
+        Some((base, below)) => {
+            prepare_base(base, below, bounds, scheme, max_zoom, threads, options)
+        }
     }
 }
 
@@ -715,11 +719,13 @@ fn clip_to_tiling(
 }
 
 /// The extent and anchor of a pyramid of an input over `fine` (its extent) with `base`
-/// under it: the base's own level is the anchor, over both extents; refuses a base that
-/// is not a raster with valid samples in reach of the tiling, or whose own level over
-/// both extents would need more memory than the run may use.
+/// (whose extent is `below`) under it: the base's own level is the anchor, over both
+/// extents; refuses a base that is not a raster with valid samples in reach of the
+/// tiling, or whose own level over both extents would need more memory than the run may
+/// use.
 fn prepare_base(
     base: &crate::BaseRaster,
+    mut below: GeoBounds,
     fine: GeoBounds,
     scheme: Scheme,
     max_zoom: u8,
@@ -727,7 +733,6 @@ fn prepare_base(
     options: &TerrainOptions,
 ) -> TerrainResult<Prepared> {
     let path = &base.path;
-    let mut below = geographic_bounds(path, 1)?;
     clip_to_tiling(&mut below, options.tiling, |beyond| {
         format!(
             "--base {}: the raster lies within latitudes {beyond} that --tiling {} covers",

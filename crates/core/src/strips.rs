@@ -1,6 +1,7 @@
 //! A cheap initial mesh: every row (or every column) simplified as a 1-D polyline within
 //! the limit, and each pair of adjacent simplified lines zipped into triangles (beyond the
-//! paper).
+//! paper). On a grid with variables a line keeps a sample where any field needs it: the
+//! height within the limit, each variable within what the exact model accepts of it.
 //!
 //! A triangle between two adjacent lines holds samples only on those two lines, and on a
 //! line only along its own edge there (a diagonal between adjacent lines passes through
@@ -284,31 +285,6 @@ pub(crate) fn estimated_kept(grid: &Grid, limit: f64, full_border: bool, step: u
         .expect("two directions")
 }
 
-/// Loads positions `span` of `line` into the front of `z` (the samples) and `heights` (the
-/// vertex heights there); returns how many.
-fn load_segment(
-    grid: &Grid,
-    lines: &Lines,
-    line: usize,
-    span: std::ops::RangeInclusive<usize>,
-    z: &mut [f64],
-    heights: &mut [f64],
-) -> usize {
-    let values = grid.values();
-    let n = span.end() - span.start() + 1;
-    for (p, (zp, hp)) in span.zip(z.iter_mut().zip(heights.iter_mut())) {
-        let i = lines.sample(line, p);
-        let (x, y) = if lines.along_rows {
-            (p, line)
-        } else {
-            (line, p)
-        };
-        *zp = values[i];
-        *hp = grid.vertex_height_at(i, x, y);
-    }
-    n
-}
-
 /// [`estimated_kept`] along one direction.
 fn estimated_kept_along(
     grid: &Grid,
@@ -319,9 +295,7 @@ fn estimated_kept_along(
 ) -> usize {
     let (count, len) = (lines.count(), lines.len());
     let step = step.max(1);
-    let mut z = vec![0.0; len];
-    let mut heights = vec![0.0; len];
-    let reciprocals: Vec<f64> = (0..len).map(|k| 1.0 / k as f64).collect();
+    let mut segment = Segment::new(grid, limit, len);
     let mut must = Vec::new();
     let (mut kept, mut sampled) = (0usize, 0usize);
     for line in (0..count).step_by(step) {
@@ -343,8 +317,8 @@ fn estimated_kept_along(
             if next == pos + 1 {
                 continue;
             }
-            let n = load_segment(grid, &lines, line, pos..=next, &mut z, &mut heights);
-            simplify(&z[..n], &heights[..n], limit, &reciprocals, |_| kept += 1);
+            segment.load(&lines, line, pos..=next);
+            segment.simplify(|_| kept += 1);
         }
     }
     kept.saturating_mul(count) / sampled
@@ -360,9 +334,7 @@ fn kept_samples(grid: &Grid, lines: Lines, limit: f64, full_border: bool, tick: 
         positions: Vec::new(),
         starts: Vec::with_capacity(count + 1),
     };
-    let mut z = vec![0.0; len];
-    let mut heights = vec![0.0; len];
-    let reciprocals: Vec<f64> = (0..len).map(|k| 1.0 / k as f64).collect();
+    let mut segment = Segment::new(grid, limit, len);
     let mut must = Vec::new();
     // Cell validity of the strips before and after the current line, one entry per
     // position (the last always invalid: no cell starts there).
@@ -411,56 +383,139 @@ fn kept_samples(grid: &Grid, lines: Lines, limit: f64, full_border: bool, tick: 
             if next == pos + 1 || !(before[pos] || after[pos]) {
                 continue;
             }
-            let n = load_segment(grid, &lines, line, pos..=next, &mut z, &mut heights);
-            simplify(&z[..n], &heights[..n], limit, &reciprocals, |p| {
-                kept.positions.push((pos + p) as u32)
-            });
+            segment.load(&lines, line, pos..=next);
+            segment.simplify(|p| kept.positions.push((pos + p) as u32));
         }
     }
     kept.starts.push(kept.positions.len());
     kept
 }
 
-/// Calls `keep` with the interior positions, in order, of a polyline through vertices at
-/// `heights` (both ends always in it) such that every sample of `z` lies within `limit`
-/// of it vertically: from each kept vertex, the furthest next one that a straight segment
-/// reaches with every sample between within the bound (tracked as the cone of slopes
-/// that keeps them all). Each height must be within `limit` of its sample.
-fn simplify(
-    z: &[f64],
-    heights: &[f64],
+/// A stretch of a line loaded for the 1-D pass: the height's samples and vertex heights,
+/// and each constrained variable's values (its own vertex heights), each field with the
+/// bound it must keep.
+struct Segment<'g> {
+    grid: &'g Grid,
     limit: f64,
-    reciprocals: &[f64],
-    mut keep: impl FnMut(usize),
-) {
-    let n = z.len();
-    // A hair tighter than the limit, so that rounding here rarely admits a segment the
-    // exact measurement then refuses.
-    let bound = limit * (1.0 - 1e-9);
-    let mut start = 0;
-    while start + 2 < n {
-        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
-        let mut reach = start + 1;
-        let zs = heights[start];
-        for (end, &ze) in z.iter().enumerate().skip(start + 1) {
-            let per_run = reciprocals[end - start];
-            let slope = (heights[end] - zs) * per_run;
-            let rise = ze - zs;
-            if lo <= slope && slope <= hi {
-                reach = end;
-            }
-            lo = lo.max((rise - bound) * per_run);
-            hi = hi.min((rise + bound) * per_run);
-            if lo > hi {
-                break;
-            }
+    z: Vec<f64>,
+    heights: Vec<f64>,
+    /// Per constrained variable: its grid, its bound (the difference the exact model
+    /// accepts of it with the height within `limit`, see `Measured::cap`), its values
+    /// along the stretch and its cone of slopes.
+    variables: Vec<VariableStretch<'g>>,
+    /// `1 / k` for every run length `k` of the line.
+    reciprocals: Vec<f64>,
+    /// How many positions are loaded.
+    n: usize,
+}
+
+/// One variable's part of a [`Segment`].
+struct VariableStretch<'g> {
+    grid: &'g Grid,
+    bound: f64,
+    values: Vec<f64>,
+    cone: (f64, f64),
+}
+
+impl<'g> Segment<'g> {
+    /// Buffers for stretches of up to `len` positions of `grid`'s lines, to keep within
+    /// `limit` (the height's; each variable's follows from it).
+    fn new(grid: &'g Grid, limit: f64, len: usize) -> Segment<'g> {
+        let variables = grid
+            .variables()
+            .iter()
+            .filter(|v| !v.unconstrained())
+            .map(|v| VariableStretch {
+                grid: &v.grid,
+                bound: hair_tighter(v.cap(limit)),
+                values: vec![0.0; len],
+                cone: (0.0, 0.0),
+            })
+            .collect();
+        Segment {
+            grid,
+            limit,
+            z: vec![0.0; len],
+            heights: vec![0.0; len],
+            variables,
+            reciprocals: (0..len).map(|k| 1.0 / k as f64).collect(),
+            n: 0,
         }
-        if reach + 1 >= n {
-            return;
-        }
-        keep(reach);
-        start = reach;
     }
+
+    /// Loads positions `span` of `line`.
+    fn load(&mut self, lines: &Lines, line: usize, span: std::ops::RangeInclusive<usize>) {
+        let values = self.grid.values();
+        self.n = span.end() - span.start() + 1;
+        for (k, p) in span.enumerate() {
+            let i = lines.sample(line, p);
+            let (x, y) = if lines.along_rows {
+                (p, line)
+            } else {
+                (line, p)
+            };
+            self.z[k] = values[i];
+            self.heights[k] = self.grid.vertex_height_at(i, x, y);
+            for v in &mut self.variables {
+                v.values[k] = v.grid.values()[i];
+            }
+        }
+    }
+
+    /// Calls `keep` with the interior positions, in order, of a polyline through the
+    /// loaded stretch's vertices (both ends always in it) such that every sample lies
+    /// within the bound of it, in every field: from each kept vertex, the furthest next
+    /// one that a straight segment reaches with every sample between within the bound
+    /// (tracked per field as the cone of slopes that keeps them all). Each vertex height
+    /// must be within the limit of its sample.
+    fn simplify(&mut self, mut keep: impl FnMut(usize)) {
+        let (n, z, heights) = (self.n, &self.z[..self.n], &self.heights[..self.n]);
+        let bound = hair_tighter(self.limit);
+        let mut start = 0;
+        while start + 2 < n {
+            let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+            for v in &mut self.variables {
+                v.cone = (f64::NEG_INFINITY, f64::INFINITY);
+            }
+            let mut reach = start + 1;
+            let zs = heights[start];
+            for (end, &ze) in z.iter().enumerate().skip(start + 1) {
+                let per_run = self.reciprocals[end - start];
+                let slope = (heights[end] - zs) * per_run;
+                let rise = ze - zs;
+                let mut reaches = lo <= slope && slope <= hi;
+                lo = lo.max((rise - bound) * per_run);
+                hi = hi.min((rise + bound) * per_run);
+                let mut empty = lo > hi;
+                for v in &mut self.variables {
+                    let (vs, ve) = (v.values[start], v.values[end]);
+                    let slope = (ve - vs) * per_run;
+                    let (lo, hi) = &mut v.cone;
+                    reaches &= *lo <= slope && slope <= *hi;
+                    *lo = lo.max((ve - vs - v.bound) * per_run);
+                    *hi = hi.min((ve - vs + v.bound) * per_run);
+                    empty |= *lo > *hi;
+                }
+                if reaches {
+                    reach = end;
+                }
+                if empty {
+                    break;
+                }
+            }
+            if reach + 1 >= n {
+                return;
+            }
+            keep(reach);
+            start = reach;
+        }
+    }
+}
+
+/// A hair tighter than `bound`, so that rounding in the 1-D pass rarely admits a segment
+/// the exact measurement then refuses.
+fn hair_tighter(bound: f64) -> f64 {
+    bound * (1.0 - 1e-9)
 }
 
 /// Triangles reordered by the row of their first sample index (stable within a row): the
@@ -494,11 +549,15 @@ fn in_row_order(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Variable;
+    use tinsmith_georef::Samples;
 
     fn kept_interior(z: &[f64], limit: f64) -> Vec<usize> {
-        let reciprocals: Vec<f64> = (0..z.len()).map(|k| 1.0 / k as f64).collect();
+        let grid = Grid::new(z.len() as u32, 1, z.to_vec()).unwrap();
+        let mut segment = Segment::new(&grid, limit, z.len());
+        segment.load(&Lines::new(&grid, true), 0, 0..=z.len() - 1);
         let mut kept = Vec::new();
-        simplify(z, z, limit, &reciprocals, |p| kept.push(p));
+        segment.simplify(|p| kept.push(p));
         kept
     }
 
@@ -581,6 +640,36 @@ mod tests {
         assert_eq!(corners.len(), 6);
         assert!(bounds.iter().all(|b| ErrorBound::from(*b).max() == 0.0));
         assert_eq!(doubled_area_in_domain(&grid, &corners), 2 * 4 * 3);
+    }
+
+    #[test]
+    fn every_variable_is_kept_within_its_bound_by_the_lines() {
+        // A flat height and a variable with a ridge the height cannot see: the lines must
+        // keep the ridge's samples, so that every zipped triangle passes the exact check
+        // of every variable (without them the plan's triangles are refused).
+        let (w, h) = (19u32, 11u32);
+        let height = Samples::new(w, h, vec![3.0; (w * h) as usize]).unwrap();
+        let ridge: Vec<f64> = (0..w * h)
+            .map(|i| {
+                let (x, y) = (f64::from(i % w), f64::from(i / w));
+                10.0 * (-((x - 9.0) * (x - 9.0)) / 8.0).exp() + 0.1 * y
+            })
+            .collect();
+        let variable = Variable::new(Samples::new(w, h, ridge).unwrap(), 0.5).unwrap();
+        let grid = Grid::with_variables(height.clone(), vec![variable])
+            .unwrap()
+            .with_height_limit(1.0);
+        let plain_grid = Grid::from_samples(height);
+        let plain = StripPlan::new(&plain_grid, 1.0, false, &|| {}).unwrap();
+        let plan = StripPlan::new(&grid, 1.0, false, &|| {}).unwrap();
+        assert!(plan.kept_count() > plain.kept_count());
+        let (corners, bounds) = plan.triangles(&|| {}).expect("every triangle passes");
+        assert_eq!(corners.len(), plan.triangle_count());
+        assert!(bounds.iter().all(|b| ErrorBound::from(*b).max() <= 1.0));
+        assert_eq!(
+            doubled_area_in_domain(&grid, &corners),
+            2 * grid.valid_cell_count() as i64
+        );
     }
 
     #[test]

@@ -104,6 +104,18 @@ impl Measured {
         }
     }
 
+    /// The largest difference of the variable from a triangle's plane that a triangle
+    /// within height limit `limit` may have (unscaled): its own limit, or less where its
+    /// scaled error would pass `limit`. A scan may stop as soon as a difference exceeds
+    /// it, the verdict then sure to be a refusal.
+    pub(crate) fn cap(&self, limit: f64) -> f64 {
+        if limit.is_finite() && self.scale > 0.0 {
+            self.limit.min(limit / self.scale)
+        } else {
+            self.limit
+        }
+    }
+
     /// `L_k`, the limit the variable's own errors are held to.
     pub(crate) fn own_limit(&self) -> f64 {
         self.limit
@@ -197,16 +209,10 @@ pub(crate) fn with_variables(
         }
         let corners = corner_samples(&v.grid, [a, b, c]);
         let [va, vb, vc] = &corners;
-        // Stop the scan early only where the verdict is sure to be a refusal.
-        let cap = if limit.is_finite() && v.scale > 0.0 {
-            v.limit.min(limit / v.scale)
-        } else {
-            v.limit
-        };
         let measured = if v.unmeasurable(&corners) {
             None
         } else {
-            height_error(&v.grid, va, vb, vc, cap)
+            height_error(&v.grid, va, vb, vc, v.cap(limit))
         };
         let Some(e) = measured.filter(|e| e.above <= v.limit && e.below <= v.limit) else {
             if limit.is_finite() {
@@ -290,11 +296,7 @@ pub(crate) fn centre_exceeds(
         if v.unconstrained() || v.limit == 0.0 {
             return false;
         }
-        let cap = if cap.is_finite() && v.scale > 0.0 {
-            v.limit.min(cap / v.scale)
-        } else {
-            v.limit
-        };
+        let cap = v.cap(cap);
         let [va, vb, vc, vm] = corner_samples(&v.grid, [a, b, c, centre]);
         error_at(&va, &vb, &vc, [&vm], cap).is_none()
     })

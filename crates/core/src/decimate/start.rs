@@ -81,8 +81,8 @@ pub(super) fn coarse_start(
             if grid.variable_count() > 0 {
                 // Several variables: insert where every band alone keeps clearly few
                 // samples, within a budget of what they keep alone, summed (about the
-                // most a joint mesh keeps). A tile's or an edge cap's count is of the
-                // height alone: they take the strips.
+                // most a joint mesh keeps). A tile or an edge cap takes the strips (or
+                // the RTIN), whose lines honour every variable too.
                 (max_edge_squared == i64::MAX && !full_border)
                     .then(|| estimated_kept_by_band(grid, limit))
                     .filter(|kept| kept.iter().max() <= Some(&(share - share / 4)))

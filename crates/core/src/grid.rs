@@ -130,6 +130,14 @@ impl Grid {
         &self.variables
     }
 
+    /// The heights alone, without the variables (the samples are shared, not copied).
+    pub(crate) fn heights_alone(&self) -> Grid {
+        Grid {
+            variables: Arc::from([]),
+            ..self.clone()
+        }
+    }
+
     /// The grid whose variables are scaled for a run enforcing `height_limit` on heights
     /// (see `crate::variables`); the samples are shared, not copied.
     pub(crate) fn with_height_limit(&self, height_limit: f64) -> Grid {

@@ -644,18 +644,19 @@ mod tests {
 
     #[test]
     fn every_variable_is_kept_within_its_bound_by_the_lines() {
-        // A flat height and a variable with a ridge the height cannot see: the lines must
-        // keep the ridge's samples, so that every zipped triangle passes the exact check
-        // of every variable (without them the plan's triangles are refused).
-        let (w, h) = (19u32, 11u32);
+        // A flat height and a variable with a bump the height cannot see: the lines, along
+        // rows or columns, must keep the bump's samples, so that every zipped triangle
+        // passes the exact check of every variable (without them the plan's triangles
+        // are refused).
+        let (w, h) = (19u32, 17u32);
         let height = Samples::new(w, h, vec![3.0; (w * h) as usize]).unwrap();
-        let ridge: Vec<f64> = (0..w * h)
+        let bump: Vec<f64> = (0..w * h)
             .map(|i| {
                 let (x, y) = (f64::from(i % w), f64::from(i / w));
-                10.0 * (-((x - 9.0) * (x - 9.0)) / 8.0).exp() + 0.1 * y
+                10.0 * (-((x - 9.0).powi(2) + (y - 8.0).powi(2)) / 8.0).exp()
             })
             .collect();
-        let variable = Variable::new(Samples::new(w, h, ridge).unwrap(), 0.5).unwrap();
+        let variable = Variable::new(Samples::new(w, h, bump).unwrap(), 0.5).unwrap();
         let grid = Grid::with_variables(height.clone(), vec![variable])
             .unwrap()
             .with_height_limit(1.0);

@@ -124,8 +124,7 @@ proptest! {
         bound in prop_oneof![Just(0.0), 0.01f64..5.0, 5.0f64..200.0],
     ) {
         // Vertices at their samples: a variable equal to the height measures exactly as
-        // the height does, so it removes nothing the height alone would keep. (Insertion,
-        // which picks samples by height alone, is no start with variables.)
+        // the height does, so it removes nothing the height alone would keep.
         let options = DecimationOptions::new(bound)
             .with_vertex_heights(VertexHeights::Samples)
             .with_initial_mesh(InitialMesh::Strips);

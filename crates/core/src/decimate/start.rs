@@ -81,8 +81,8 @@ pub(super) fn coarse_start(
             if grid.variable_count() > 0 {
                 // Several variables: insert where every band alone keeps clearly few
                 // samples, within a budget of what they keep alone, summed (about the
-                // most a joint mesh keeps). A tile or an edge cap takes the strips (or
-                // the RTIN), whose lines honour every variable too.
+                // most a joint mesh keeps). A tile takes the strips, an edge cap the
+                // RTIN; both honour every variable.
                 (max_edge_squared == i64::MAX && !full_border)
                     .then(|| estimated_kept_by_band(grid, limit))
                     .filter(|kept| kept.iter().max() <= Some(&(share - share / 4)))
@@ -140,7 +140,7 @@ pub(super) fn coarse_start(
 /// The strips' estimated kept samples ([`estimated_kept`]) of the height and of each
 /// constrained variable, each alone.
 fn estimated_kept_by_band(grid: &Grid, limit: f64) -> Vec<usize> {
-    let height = estimated_kept(grid, limit, false, AUTO_LINE_STEP);
+    let height = estimated_kept(&grid.heights_alone(), limit, false, AUTO_LINE_STEP);
     let variables = grid.variables().iter().filter(|v| !v.unconstrained());
     std::iter::once(height)
         .chain(variables.map(|v| estimated_kept(&v.grid, v.own_limit(), false, AUTO_LINE_STEP)))

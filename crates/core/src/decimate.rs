@@ -13,13 +13,13 @@ use remover::remove_border;
 pub(crate) use remover::Remover;
 pub use rounding::{effective_limit, vertex_raise, MAX_ABS_HEIGHT, RAISED_HEIGHT_SHARE};
 use start::{
-    coarse_start, max_edge_squared, resolved_start, target_triangles, COUNT_START_FACTOR,
-    COUNT_START_MIN_TRIANGLES,
+    coarse_start, resolved_start, target_triangles, COUNT_START_FACTOR, COUNT_START_MIN_TRIANGLES,
 };
 
 use crate::hole::Rules;
 use crate::mesh::Mesh;
 use crate::rtin::rtin_for_count;
+use crate::EdgeLimit;
 use crate::{
     DecimationOptions, Error, ErrorModel, Grid, InitialMesh, Order, Result, Tin, TinVertex,
 };
@@ -156,11 +156,12 @@ fn run(
     if max_error.is_nan() || max_error < 0.0 || (max_error.is_infinite() && !count_target) {
         return Err(Error::InvalidMaxError(max_error));
     }
-    if let Some(length) = options.max_edge_length {
-        if length < 2 {
-            return Err(Error::InvalidMaxEdgeLength(length));
-        }
-    }
+    let edge_limit = EdgeLimit::new(
+        &options.edge_metric,
+        options.max_edge_length,
+        grid.width(),
+        grid.height(),
+    )?;
     let max_abs = options
         .max_abs_value
         .unwrap_or_else(|| grid.max_abs_value())
@@ -220,7 +221,7 @@ fn run(
                     .saturating_mul(target_triangles(options))
                     .max(COUNT_START_MIN_TRIANGLES),
                 limit,
-                max_edge_squared(options),
+                &edge_limit,
                 keep_border.is_some(),
                 &tick,
             );
@@ -240,7 +241,7 @@ fn run(
                 grid,
                 resolved_start(options),
                 limit,
-                max_edge_squared(options),
+                &edge_limit,
                 keep_border,
                 &tick,
             );
@@ -262,7 +263,7 @@ fn run(
         method: options.retriangulation,
         dp_max_ring: options.dp_max_ring,
         limit,
-        max_edge_squared: max_edge_squared(options),
+        edge_limit: &edge_limit,
         levels: options.contour_levels.as_deref(),
     };
     let mut remover = Remover::new(rules);

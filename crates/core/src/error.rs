@@ -22,6 +22,9 @@ pub enum Error {
     /// longer than 1).
     #[error("maximum edge length must be at least 2 sample spacings, got {0}")]
     InvalidMaxEdgeLength(u32),
+    /// An [`crate::EdgeMetric`] that does not fit the grid (the message says why).
+    #[error("edge metric: {0}")]
+    EdgeMetric(String),
     /// Some |height| exceeds [`crate::MAX_ABS_HEIGHT`]: errors between such heights could
     /// not be stored or measured.
     #[error(

@@ -4,7 +4,7 @@
 //! changes the stars of the four corners, and some of them can then go.
 
 use crate::exact::triangle_error;
-use crate::hole::{squared_length, Rules};
+use crate::hole::Rules;
 use crate::mesh::{Mesh, NONE};
 use crate::predicates::{orient, Point};
 
@@ -68,10 +68,7 @@ pub(crate) fn flip_within(
     cap: f64,
 ) -> bool {
     let [pa, pb, pc, pd] = points;
-    if orient(pc, pa, pd) <= 0
-        || orient(pc, pd, pb) <= 0
-        || squared_length(pc, pd) > rules.max_edge_squared
-    {
+    if orient(pc, pa, pd) <= 0 || orient(pc, pd, pb) <= 0 || !rules.edge_limit.allows(pc, pd) {
         return false;
     }
     let Some(first) = triangle_error(rules.grid, pc, pa, pd, cap) else {

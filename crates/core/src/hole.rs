@@ -15,7 +15,7 @@ mod propagation;
 use crate::coverage::Coverage;
 use crate::exact::error_at;
 use crate::predicates::{in_closed_triangle, orient, plane_gradient, Point};
-use crate::{EdgeSelection, ErrorBound, ErrorModel, Grid, Retriangulation};
+use crate::{EdgeLimit, EdgeSelection, ErrorBound, ErrorModel, Grid, Retriangulation};
 use dp::Solved;
 use ears::Ear;
 
@@ -96,8 +96,8 @@ pub(crate) struct Rules<'g, S: Coverage + ?Sized = Grid> {
     /// Holes with more ring vertices than this use ears even when `method` is `Dp`.
     pub dp_max_ring: usize,
     pub limit: f64,
-    /// Largest squared edge length (in sample spacings) a new triangle may have.
-    pub max_edge_squared: i64,
+    /// The longest edge a new triangle may have.
+    pub edge_limit: &'g EdgeLimit,
     /// Contour levels (sorted) the DP minimizes the spanned count of, if any.
     pub levels: Option<&'g [f64]>,
 }
@@ -236,7 +236,7 @@ impl Retriangulator {
         let (pa, pb, pc) = (&self.ring[a], &self.ring[b], &self.ring[c]);
         if [(pa, pb), (pb, pc), (pc, pa)]
             .iter()
-            .any(|(p, q)| squared_length(p, q) > rules.max_edge_squared)
+            .any(|(p, q)| !rules.edge_limit.allows(p, q))
         {
             return None;
         }
@@ -309,12 +309,6 @@ impl Retriangulator {
     }
 }
 
-/// Squared length of the segment `pq` in sample spacings.
-pub(crate) fn squared_length(p: &Point, q: &Point) -> i64 {
-    let (dx, dy) = (p.x - q.x, p.y - q.y);
-    dx * dx + dy * dy
-}
-
 fn within(bound: ErrorBound, limit: f64) -> bool {
     bound.above <= limit && bound.below <= limit
 }
@@ -342,7 +336,7 @@ mod tests {
             method,
             dp_max_ring: 16,
             limit,
-            max_edge_squared: i64::MAX,
+            edge_limit: &crate::edge_limit::NO_EDGE_LIMIT,
             levels: None,
         }
     }

@@ -37,7 +37,7 @@
 use crate::exact::triangle_worst;
 use crate::mesh::CompactBound;
 use crate::predicates::{orient, Point};
-use crate::{ErrorBound, Grid};
+use crate::{EdgeLimit, ErrorBound, Grid};
 
 /// Insertion calls its `tick` once every this many vertices inserted.
 const TICK_INSERTIONS: usize = 1024;
@@ -53,7 +53,7 @@ const NONE: u32 = u32::MAX;
 pub(crate) fn insertion_triangles(
     grid: &Grid,
     limit: f64,
-    max_edge_squared: i64,
+    edge_limit: &EdgeLimit,
     keep_border: Option<&dyn Fn(u32, u32) -> bool>,
     max_vertices: usize,
     tick: &dyn Fn(),
@@ -64,7 +64,7 @@ pub(crate) fn insertion_triangles(
     }
     debug_assert_eq!(grid.valid_cell_count() as i64, (w - 1) * (h - 1));
     let (x1, y1) = (w - 1, h - 1);
-    let mut t = Triangulation::new(grid, limit, max_edge_squared, keep_border.is_some());
+    let mut t = Triangulation::new(grid, limit, edge_limit, keep_border.is_some());
     let corners = [(0, 0), (x1, 0), (x1, y1), (0, y1)].map(|(x, y)| t.index(x, y));
     for &c in &corners {
         t.is_vertex[c as usize] = true;
@@ -230,7 +230,7 @@ impl Queue {
 struct Triangulation<'g> {
     grid: &'g Grid,
     limit: f64,
-    max_edge_squared: i64,
+    edge_limit: &'g EdgeLimit,
     /// Whether the outline is decided (its edges are never split).
     fixed_outline: bool,
     width: i64,
@@ -256,13 +256,13 @@ impl<'g> Triangulation<'g> {
     fn new(
         grid: &'g Grid,
         limit: f64,
-        max_edge_squared: i64,
+        edge_limit: &'g EdgeLimit,
         fixed_outline: bool,
     ) -> Triangulation<'g> {
         Triangulation {
             grid,
             limit,
-            max_edge_squared,
+            edge_limit,
             fixed_outline,
             width: i64::from(grid.width()),
             width_u32: grid.width(),
@@ -356,9 +356,9 @@ impl<'g> Triangulation<'g> {
             let long = [(a, b, n[0]), (b, c, n[1]), (c, a, n[2])]
                 .into_iter()
                 .filter(|e| !(self.fixed_outline && e.2 == NONE))
-                .map(|(p, q, _)| ((p.x - q.x).pow(2) + (p.y - q.y).pow(2), p, q))
-                .max_by_key(|e| e.0)
-                .filter(|e| e.0 > self.max_edge_squared);
+                .map(|(p, q, _)| (self.edge_limit.measure(&p, &q), p, q))
+                .max_by(|e, f| e.0.total_cmp(&f.0))
+                .filter(|e| !self.edge_limit.allows_measure(e.0));
             match long {
                 None => {
                     self.candidate[s] = None;
@@ -497,6 +497,7 @@ fn in_circle(a: &Point, b: &Point, c: &Point, d: &Point) -> i128 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::edge_limit::NO_EDGE_LIMIT;
     use crate::mesh::Mesh;
 
     fn grid(w: u32, h: u32, f: impl Fn(i64, i64) -> f64) -> Grid {
@@ -539,7 +540,7 @@ mod tests {
     fn every_triangle_is_within_the_limit() {
         let g = grid(41, 29, bumpy);
         for limit in [0.05, 0.5, 2.0, 50.0] {
-            let (c, b) = insertion_triangles(&g, limit, i64::MAX, None, usize::MAX, &|| {})
+            let (c, b) = insertion_triangles(&g, limit, &NO_EDGE_LIMIT, None, usize::MAX, &|| {})
                 .expect("no nodata");
             check(&g, limit, &c, &b);
         }
@@ -550,7 +551,7 @@ mod tests {
         let g = grid(41, 29, |x, y| if y == 0 { 0.0 } else { bumpy(x, y) });
         let keep = |x: u32, y: u32| y != 0 || x.is_multiple_of(10);
         let (c, b) =
-            insertion_triangles(&g, 0.5, i64::MAX, Some(&keep), usize::MAX, &|| {}).unwrap();
+            insertion_triangles(&g, 0.5, &NO_EDGE_LIMIT, Some(&keep), usize::MAX, &|| {}).unwrap();
         check(&g, 0.5, &c, &b);
         for t in &c {
             for &v in t {
@@ -565,7 +566,9 @@ mod tests {
     #[test]
     fn long_edges_split() {
         let g = grid(33, 33, |x, y| (x + y) as f64);
-        let (c, b) = insertion_triangles(&g, 1.0, 9, None, usize::MAX, &|| {}).unwrap();
+        let three =
+            EdgeLimit::new(&crate::EdgeMetric::Grid, Some(3), g.width(), g.height()).unwrap();
+        let (c, b) = insertion_triangles(&g, 1.0, &three, None, usize::MAX, &|| {}).unwrap();
         check(&g, 1.0, &c, &b);
         let w = 33;
         for t in &c {
@@ -580,9 +583,10 @@ mod tests {
     #[test]
     fn a_plane_is_two_triangles_and_a_budget_stops_it() {
         let g = grid(20, 20, |x, y| 2.0 * x as f64 - y as f64);
-        let (c, _) = insertion_triangles(&g, 0.1, i64::MAX, None, usize::MAX, &|| {}).unwrap();
+        let (c, _) =
+            insertion_triangles(&g, 0.1, &NO_EDGE_LIMIT, None, usize::MAX, &|| {}).unwrap();
         assert_eq!(c.len(), 2);
         let rough = grid(20, 20, bumpy);
-        assert!(insertion_triangles(&rough, 0.01, i64::MAX, None, 10, &|| {}).is_none());
+        assert!(insertion_triangles(&rough, 0.01, &NO_EDGE_LIMIT, None, 10, &|| {}).is_none());
     }
 }

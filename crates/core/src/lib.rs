@@ -30,6 +30,7 @@
 
 mod coverage;
 mod decimate;
+mod edge_limit;
 mod error;
 mod error_bound;
 mod exact;
@@ -52,6 +53,7 @@ pub use decimate::{
     decimate, decimate_with_border, decimate_with_progress, effective_limit, vertex_raise,
     Decimation, DecimationReport, Progress, MAX_ABS_HEIGHT, RAISED_HEIGHT_SHARE,
 };
+pub use edge_limit::{EdgeLimit, EdgeMetric};
 pub use error::{Error, Result};
 pub use error_bound::ErrorBound;
 pub use grid::Grid;

@@ -197,6 +197,8 @@ pub struct DecimationOptions {
     /// would need a longer edge is refused. For renderers that interpolate in another space
     /// than the grid's (e.g. terrain on a globe, where long edges cut below the surface).
     pub max_edge_length: Option<u32>,
+    /// How an edge's length is measured against `max_edge_length`.
+    pub edge_metric: crate::EdgeMetric,
     /// Contour levels to shape the TIN for (see [`DecimationOptions::with_contour_levels`]);
     /// sorted, finite, without duplicates.
     pub contour_levels: Option<std::sync::Arc<[f64]>>,
@@ -228,6 +230,7 @@ impl DecimationOptions {
             max_triangles: None,
             max_vertices: None,
             max_edge_length: None,
+            edge_metric: crate::EdgeMetric::Grid,
             contour_levels: None,
             flip_rounds: 0,
             extend_rounds: 0,
@@ -267,6 +270,12 @@ impl DecimationOptions {
     /// [`DecimationOptions::max_edge_length`]).
     pub fn with_max_edge_length(mut self, samples: u32) -> DecimationOptions {
         self.max_edge_length = Some(samples);
+        self
+    }
+
+    /// Sets how an edge's length is measured (see [`DecimationOptions::edge_metric`]).
+    pub fn with_edge_metric(mut self, metric: crate::EdgeMetric) -> DecimationOptions {
+        self.edge_metric = metric;
         self
     }
 

@@ -39,24 +39,24 @@
 use crate::exact::triangle_error;
 use crate::mesh::CompactBound;
 use crate::predicates::{orient, Point};
-use crate::Grid;
+use crate::{EdgeLimit, Grid};
 
 type Xy = (i64, i64);
 
 /// Triangles (counter-clockwise sample indices) of the coarsest conforming RTIN over the
 /// grid's domain whose triangles all have exact error at most `limit`, with those errors.
 ///
-/// Triangles with an edge longer than `sqrt(max_edge_squared)` sample spacings split too.
+/// Triangles with an edge beyond `edge_limit` split too.
 /// With `full_border`, every triangle that reaches the grid's outer rows or columns is a
 /// half cell, so the strip of cells along the border is triangulated as in the full grid
 /// (what [`crate::decimate_with_border`] needs to remove border samples inside the strip).
 pub(crate) fn rtin_triangles(
     grid: &Grid,
     limit: f64,
-    max_edge_squared: i64,
+    edge_limit: &EdgeLimit,
     full_border: bool,
 ) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
-    let rtin = Rtin::new(grid, limit, max_edge_squared, full_border);
+    let rtin = Rtin::new(grid, limit, edge_limit, full_border);
     let need = rtin.refinement();
     rtin.triangles(&need)
 }
@@ -67,11 +67,11 @@ pub(crate) fn rtin_triangles(
 pub(crate) fn cheap_rtin_with_fewer_triangles(
     grid: &Grid,
     limit: f64,
-    max_edge_squared: i64,
+    edge_limit: &EdgeLimit,
     full_border: bool,
     fewer_than: usize,
 ) -> Option<(Vec<[u32; 3]>, Vec<CompactBound>)> {
-    let rtin = Rtin::new(grid, limit, max_edge_squared, full_border);
+    let rtin = Rtin::new(grid, limit, edge_limit, full_border);
     if rtin.finest_split_fraction() > TOP_DOWN_BELOW {
         return None;
     }
@@ -92,7 +92,7 @@ pub(crate) fn rtin_for_count(
     grid: &Grid,
     triangles: usize,
     limit: f64,
-    max_edge_squared: i64,
+    edge_limit: &EdgeLimit,
     full_border: bool,
     tick: &dyn Fn(),
 ) -> (Vec<[u32; 3]>, Vec<CompactBound>, f64) {
@@ -108,7 +108,7 @@ pub(crate) fn rtin_for_count(
     // the edges of a grid that is not a power-of-two square) do not count towards the
     // start's room: on ETOPO5 they are 7,392.
     let forced = {
-        let rtin = Rtin::new(grid, f64::INFINITY, max_edge_squared, full_border);
+        let rtin = Rtin::new(grid, f64::INFINITY, edge_limit, full_border);
         rtin.count(&rtin.refinement())
     };
     let triangles = triangles.saturating_add(forced);
@@ -118,7 +118,7 @@ pub(crate) fn rtin_for_count(
     for _ in 0..40 {
         tick();
         if bound <= limit {
-            let rtin = Rtin::new(grid, bound, max_edge_squared, full_border);
+            let rtin = Rtin::new(grid, bound, edge_limit, full_border);
             let need = rtin.refinement();
             if rtin.count(&need) >= triangles {
                 let (c, b) = rtin.triangles(&need);
@@ -127,7 +127,7 @@ pub(crate) fn rtin_for_count(
         }
         bound /= 2.0;
     }
-    let (c, b) = rtin_triangles(grid, bound.min(limit), max_edge_squared, full_border);
+    let (c, b) = rtin_triangles(grid, bound.min(limit), edge_limit, full_border);
     (c, b, bound.min(limit))
 }
 
@@ -153,12 +153,12 @@ struct Rtin<'g> {
     invalid: Option<Vec<u32>>,
     /// Whether triangles reaching the outer rows or columns always split (to half cells).
     full_border: bool,
-    /// Triangles with a longer (squared) hypotenuse always split.
-    max_edge_squared: i64,
+    /// Triangles with an edge beyond it always split.
+    edge_limit: &'g EdgeLimit,
 }
 
 impl<'g> Rtin<'g> {
-    fn new(grid: &'g Grid, limit: f64, max_edge_squared: i64, full_border: bool) -> Rtin<'g> {
+    fn new(grid: &'g Grid, limit: f64, edge_limit: &'g EdgeLimit, full_border: bool) -> Rtin<'g> {
         let (w, h) = (grid.width() as i64, grid.height() as i64);
         let mut size = 1;
         while size < (w - 1).max(h - 1) {
@@ -184,7 +184,7 @@ impl<'g> Rtin<'g> {
             size,
             invalid,
             full_border,
-            max_edge_squared,
+            edge_limit,
         }
     }
 
@@ -216,10 +216,20 @@ impl<'g> Rtin<'g> {
         if self.full_border && (x0 == 0 || y0 == 0 || x1 == self.max_x || y1 == self.max_y) {
             return true;
         }
-        // The hypotenuse (the longest edge) is the one between t[0] and t[1].
-        let (dx, dy) = (t[0].0 - t[1].0, t[0].1 - t[1].1);
-        if dx * dx + dy * dy > self.max_edge_squared {
-            return true;
+        // On the grid the hypotenuse (between t[0] and t[1]) is the longest edge; on a
+        // sphere the legs are measured too.
+        if !self.edge_limit.is_none() {
+            let p = |k: usize| Point {
+                x: t[k].0,
+                y: t[k].1,
+                z: 0.0,
+            };
+            if [(0, 1), (1, 2), (2, 0)]
+                .iter()
+                .any(|&(i, j)| !self.edge_limit.allows(&p(i), &p(j)))
+            {
+                return true;
+            }
         }
         if let Some(sat) = &self.invalid {
             let cw = self.max_x as usize + 1;
@@ -556,6 +566,8 @@ fn mid(a: Xy, b: Xy) -> Xy {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::edge_limit::NO_EDGE_LIMIT;
+    use crate::EdgeMetric;
     use std::collections::{HashMap, HashSet};
     use tinsmith_testkit::{terrain, with_nodata_disc, GridSpec};
 
@@ -625,7 +637,14 @@ mod tests {
                 for spec in [smooth, holed] {
                     let g = grid(spec);
                     for limit in [0.05, 0.5, 3.0] {
-                        for (edge, border) in [(i64::MAX, false), (64, false), (i64::MAX, true)] {
+                        let eight =
+                            EdgeLimit::new(&EdgeMetric::Grid, Some(8), g.width(), g.height())
+                                .unwrap();
+                        for (edge, border) in [
+                            (&NO_EDGE_LIMIT, false),
+                            (&eight, false),
+                            (&NO_EDGE_LIMIT, true),
+                        ] {
                             let rtin = Rtin::new(&g, limit, edge, border);
                             let bottom_up = check_mesh(&g, &rtin, &rtin.saturate(), limit);
                             let top_down = check_mesh(&g, &rtin, &rtin.refine(), limit);
@@ -641,7 +660,7 @@ mod tests {
     #[test]
     fn the_probe_picks_top_down_for_smooth_data_at_a_large_bound() {
         let g = grid(terrain(200, 150, 0.2, 7));
-        let fraction = |limit| Rtin::new(&g, limit, i64::MAX, false).finest_split_fraction();
+        let fraction = |limit| Rtin::new(&g, limit, &NO_EDGE_LIMIT, false).finest_split_fraction();
         assert!(fraction(20.0) < TOP_DOWN_BELOW);
         assert!(fraction(0.001) > TOP_DOWN_BELOW);
     }

@@ -287,7 +287,7 @@ pub fn decimate_scatter_constrained(
         method: options.retriangulation,
         dp_max_ring: options.dp_max_ring,
         limit,
-        max_edge_squared: i64::MAX,
+        edge_limit: &crate::edge_limit::NO_EDGE_LIMIT,
         levels: None,
     };
     let mut remover = ScatterRemover::new(&mesh, rules, lines);
@@ -662,7 +662,7 @@ impl ScatterRemover {
             method: self.method,
             dp_max_ring: self.dp_max_ring,
             limit: self.limit,
-            max_edge_squared: i64::MAX,
+            edge_limit: &crate::edge_limit::NO_EDGE_LIMIT,
             levels: None,
         };
         let (new, worst) = self.hole.retriangulate(&rules)?;

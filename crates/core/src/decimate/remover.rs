@@ -152,7 +152,7 @@ impl<'g> Remover<'g> {
             // Exactly planar holes only, decided exactly, at a bound of 0 on integer heights.
             limit: if exact_zero { 0.0 } else { f64::INFINITY },
             // The caller's 1-D rule already spaced the kept border samples.
-            max_edge_squared: i64::MAX,
+            edge_limit: &crate::edge_limit::NO_EDGE_LIMIT,
             ..saved
         };
         self.max_ring = usize::MAX;

@@ -4,7 +4,7 @@ use crate::insert::insertion_triangles;
 use crate::mesh::CompactBound;
 use crate::rtin::{cheap_rtin_with_fewer_triangles, rtin_triangles};
 use crate::strips::{estimated_kept, kept_along_rows, StripPlan};
-use crate::{DecimationOptions, Grid, InitialMesh};
+use crate::{DecimationOptions, EdgeLimit, Grid, InitialMesh};
 
 /// The start [`InitialMesh::Auto`] stands for given the other options: with contour
 /// levels, the RTIN. The strips' 1-D pass drops samples without regard to the levels,
@@ -59,7 +59,7 @@ pub(super) fn coarse_start(
     grid: &Grid,
     initial_mesh: InitialMesh,
     limit: f64,
-    max_edge_squared: i64,
+    edge_limit: &EdgeLimit,
     keep_border: Option<&dyn Fn(u32, u32) -> bool>,
     tick: &dyn Fn(),
 ) -> Start {
@@ -83,12 +83,12 @@ pub(super) fn coarse_start(
                 // samples, within a budget of what they keep alone, summed (about the
                 // most a joint mesh keeps). A tile takes the strips, an edge cap the
                 // RTIN; both honour every variable.
-                (max_edge_squared == i64::MAX && !full_border)
+                (edge_limit.is_none() && !full_border)
                     .then(|| estimated_kept_by_band(grid, limit))
                     .filter(|kept| kept.iter().max() <= Some(&(share - share / 4)))
                     .map(|kept| kept.into_iter().fold(0, usize::saturating_add))
             } else {
-                let kept = if max_edge_squared != i64::MAX {
+                let kept = if !edge_limit.is_none() {
                     Some(kept_along_rows(grid, limit, full_border, tick))
                 } else if full_border {
                     // A tile's start is decided by the count itself (see `AUTO_LINE_STEP`).
@@ -112,7 +112,7 @@ pub(super) fn coarse_start(
     };
     if let Some(budget) = budget {
         if let Some((corners, bounds)) =
-            insertion_triangles(grid, limit, max_edge_squared, keep_border, budget, tick)
+            insertion_triangles(grid, limit, edge_limit, keep_border, budget, tick)
         {
             return Start {
                 corners,
@@ -125,7 +125,7 @@ pub(super) fn coarse_start(
         grid,
         initial_mesh,
         limit,
-        max_edge_squared,
+        edge_limit,
         full_border,
         strips,
         tick,
@@ -152,13 +152,13 @@ fn bottom_up_start(
     grid: &Grid,
     initial_mesh: InitialMesh,
     limit: f64,
-    max_edge_squared: i64,
+    edge_limit: &EdgeLimit,
     full_border: bool,
     strips: Option<StripPlan<'_>>,
     tick: &dyn Fn(),
 ) -> (Vec<[u32; 3]>, Vec<CompactBound>) {
-    let rtin = || rtin_triangles(grid, limit, max_edge_squared, full_border);
-    if initial_mesh == InitialMesh::Rtin || max_edge_squared != i64::MAX {
+    let rtin = || rtin_triangles(grid, limit, edge_limit, full_border);
+    if initial_mesh == InitialMesh::Rtin || !edge_limit.is_none() {
         return rtin();
     }
     let Some(strips) = strips.or_else(|| StripPlan::new(grid, limit, full_border, tick)) else {
@@ -168,7 +168,7 @@ fn bottom_up_start(
         cheap_rtin_with_fewer_triangles(
             grid,
             limit,
-            max_edge_squared,
+            edge_limit,
             full_border,
             strips.triangle_count(),
         )
@@ -200,11 +200,4 @@ pub(super) fn target_triangles(options: &DecimationOptions) -> usize {
         .max_vertices
         .map_or(usize::MAX, |v| v.saturating_mul(2));
     options.max_triangles.unwrap_or(usize::MAX).min(by_vertices)
-}
-
-/// The squared maximum edge length, `i64::MAX` when there is none.
-pub(super) fn max_edge_squared(options: &DecimationOptions) -> i64 {
-    options
-        .max_edge_length
-        .map_or(i64::MAX, |l| i64::from(l) * i64::from(l))
 }

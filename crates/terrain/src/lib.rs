@@ -14,6 +14,7 @@ mod blocks;
 mod budget;
 mod error;
 mod glb_tile;
+mod globe_edges;
 mod implicit;
 mod layer;
 mod order;

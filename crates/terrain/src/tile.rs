@@ -7,6 +7,7 @@ use tinsmith_core::{decimate_with_border, DecimationOptions, Grid, VertexHeights
 use tinsmith_tiling::check_tin;
 
 use crate::budget::{quanta_per_step, slack_scale, LevelBudget};
+use crate::globe_edges::globe_edges;
 use crate::layer::{metadata_json, Available};
 use crate::order::encoding_order;
 use crate::rows::LevelRows;
@@ -61,21 +62,26 @@ pub(super) fn build_tile(
         return Ok(None);
     }
 
+    // Where edges are capped (coarse levels), they are measured on the globe.
+    let globe = budget
+        .max_edge
+        .map(|max_edge| globe_edges(raster.tiling, z, column, y, max_edge));
     // Shared edges, each decided from the level raster alone (its samples and their
-    // magnitude): both neighbours agree.
-    let keep = |edge: EdgeProfile| {
+    // magnitude) and the edge's place on the globe: both neighbours agree.
+    let keep = |edge: EdgeProfile, side: usize| {
         let scale = slack_scale(edge.values().iter().copied());
         let limit = edge_limit(budget.decimation(scale), scale);
+        let span = globe.as_ref().map_or(edge_span(None), |g| g.spans[side]);
         if limit > 0.0 {
-            edge.simplify(limit, edge_span(budget.max_edge))
+            edge.simplify(limit, span)
         } else {
             vec![true; n + 1]
         }
     };
-    let south = keep(raster.edge(i0, j0, true));
-    let north = keep(raster.edge(i0, j0 + n, true));
-    let west = keep(raster.edge(i0, j0, false));
-    let east = keep(raster.edge(i0 + n, j0, false));
+    let south = keep(raster.edge(i0, j0, true), 0);
+    let north = keep(raster.edge(i0, j0 + n, true), 1);
+    let west = keep(raster.edge(i0, j0, false), 2);
+    let east = keep(raster.edge(i0 + n, j0, false), 3);
     let last = cells;
     let keep_border = |gx: u32, gy: u32| {
         if gy == 0 {
@@ -96,6 +102,9 @@ pub(super) fn build_tile(
         .with_vertex_heights(VertexHeights::Samples);
     decimation_options.max_abs_value = Some(scale);
     decimation_options.max_edge_length = budget.max_edge;
+    if let Some(globe) = globe {
+        decimation_options.edge_metric = globe.metric;
+    }
     let tin = decimate_with_border(&grid, &decimation_options, &keep_border, &mut |_| {})
         .map_err(|source| TerrainError::Decimate {
             z,

@@ -1,0 +1,229 @@
+//! How long a coarse tile's edges may be, measured on the globe. CesiumJS draws each
+//! triangle flat between its corners, so an edge may span no more arc than the level's
+//! bound lets its chord sink ([`crate::tms::max_edge_length`], in lattice spacings at the
+//! equator). Measured along the sphere instead of across the lattice, a tile's rows draw
+//! together towards the poles, and edges along them may cross more lattice points.
+
+use tinsmith_core::{EdgeLimit, EdgeMetric};
+
+use crate::tms::Scheme;
+
+/// A tile's edge metric and the longest skip between kept samples on each of its four
+/// edges.
+pub(super) struct GlobeEdges {
+    /// The metric of the tile's lattice, for its decimation.
+    pub(super) metric: EdgeMetric,
+    /// South, north, west and east: the longest skip, in samples, between kept samples
+    /// of the edge such that every edge of the border fans is within the limit, on both
+    /// sides of the edge (so both tiles beside it compute the same).
+    pub(super) spans: [usize; 4],
+}
+
+/// Relative tightening of the arc the border spans are decided with, so that rounding
+/// can never make the tile's own decimation refuse a fan edge the span allowed.
+const SPAN_MARGIN: f64 = 1e-9;
+
+/// The globe edges of tile `z`/`column`/`y` of `scheme` whose edges may span at most
+/// `max_edge` lattice spacings of arc at the equator.
+pub(super) fn globe_edges(scheme: Scheme, z: u8, column: u32, y: u32, max_edge: u32) -> GlobeEdges {
+    let cells = scheme.cells as usize;
+    let step = scheme.step(z);
+    let rect = scheme.tile_rectangle(z, column, y);
+    let d_lat = row_spacing(scheme, z, column, y);
+    let longitudes: Vec<f64> = (0..=cells).map(|i| i as f64 * step).collect();
+    let latitudes: Vec<f64> = (0..=cells).map(|j| rect.south + j as f64 * d_lat).collect();
+    let metric = EdgeMetric::Sphere {
+        longitudes: longitudes.clone().into(),
+        latitudes: latitudes.clone().into(),
+        spacing: step,
+    };
+    let rows = 1u32 << z;
+    // A parallel edge at `lat`, with the rows beside it: `below` and `above` spacings
+    // where a tile lies there.
+    let parallel = |lat: f64, below: Option<f64>, above: Option<f64>| {
+        let beside = [below.map(|d| lat - d), Some(lat), above.map(|d| lat + d)];
+        span(step, max_edge, &longitudes, &beside, true)
+    };
+    // A meridian edge: the columns beside it are one step away on both sides.
+    let meridian = || {
+        let beside = [Some(-step), Some(0.0), Some(step)];
+        span(step, max_edge, &latitudes, &beside, false)
+    };
+    let neighbour = |dy: i64| {
+        let y = i64::from(y) + dy;
+        (0..i64::from(rows))
+            .contains(&y)
+            .then(|| row_spacing(scheme, z, column, y as u32))
+    };
+    let south = parallel(rect.south, neighbour(-1), Some(d_lat));
+    let north = parallel(rect.north, Some(d_lat), neighbour(1));
+    let west_east = meridian();
+    GlobeEdges {
+        metric,
+        spans: [south, north, west_east, west_east],
+    }
+}
+
+/// The latitude between a tile's rows (evenly spaced inside it, as CesiumJS places `v`).
+fn row_spacing(scheme: Scheme, z: u8, column: u32, y: u32) -> f64 {
+    let rect = scheme.tile_rectangle(z, column, y);
+    (rect.north - rect.south) / f64::from(scheme.cells)
+}
+
+/// The longest skip `s` along an edge of samples at `along` (degrees: longitudes of a
+/// parallel edge, relative to its first; latitudes of a meridian edge) such that, from
+/// every sample `i`, the segment to `i + s` and the fan edges to the samples `i` and
+/// `i + s` of each line beside the edge that exists are within `max_edge` spacings of
+/// `step` degrees (less [`SPAN_MARGIN`]). `beside` holds the three lines' positions
+/// across the edge (latitudes, or longitudes), the edge's own in the middle.
+fn span(
+    step: f64,
+    max_edge: u32,
+    along: &[f64],
+    beside: &[Option<f64>; 3],
+    parallel: bool,
+) -> usize {
+    let n = along.len() - 1;
+    let across: Vec<f64> = beside.iter().map(|b| b.unwrap_or(0.0)).collect();
+    let (longitudes, latitudes) = if parallel {
+        (along.to_vec(), across)
+    } else {
+        (across, along.to_vec())
+    };
+    let metric = EdgeMetric::Sphere {
+        longitudes: longitudes.into(),
+        latitudes: latitudes.into(),
+        spacing: step * (1.0 - SPAN_MARGIN),
+    };
+    let (w, h) = if parallel { (n + 1, 3) } else { (3, n + 1) };
+    let limit = EdgeLimit::new(&metric, Some(max_edge), w as u32, h as u32)
+        .expect("a lattice of finite positions");
+    let at = |i: usize, line: usize| {
+        if parallel {
+            (i as u32, line as u32)
+        } else {
+            (line as u32, i as u32)
+        }
+    };
+    let sides: Vec<usize> = [0, 2]
+        .into_iter()
+        .filter(|&l| beside[l].is_some())
+        .collect();
+    let fits = |s: usize| {
+        (0..=n - s).all(|i| {
+            limit.allows_samples(at(i, 1), at(i + s, 1))
+                && sides.iter().all(|&l| {
+                    limit.allows_samples(at(i, 1), at(i + s, l))
+                        && limit.allows_samples(at(i + s, 1), at(i, l))
+                })
+        })
+    };
+    // Arcs grow with the skip, so the skips that fit are 1..=s: search for s.
+    let (mut lo, mut hi) = (1, n);
+    if fits(hi) {
+        return usize::MAX;
+    }
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if fits(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::budget::LevelBudget;
+    use crate::tms::{Tiling, LATTICE_CELLS};
+
+    fn schemes() -> Vec<Scheme> {
+        LATTICE_CELLS
+            .into_iter()
+            .flat_map(|cells| {
+                [Tiling::Geographic, Tiling::Mercator].map(|tiling| Scheme { tiling, cells })
+            })
+            .collect()
+    }
+
+    /// The capped levels of `scheme` with their longest edge.
+    fn capped(scheme: Scheme) -> Vec<(u8, u32)> {
+        (0..8)
+            .filter_map(|z| LevelBudget::new(scheme, z, 1.0).max_edge.map(|e| (z, e)))
+            .collect()
+    }
+
+    #[test]
+    fn both_tiles_beside_an_edge_decide_the_same_span() {
+        for scheme in schemes() {
+            for (z, max_edge) in capped(scheme) {
+                let column = 0;
+                for y in 1..1u32 << z {
+                    let below = globe_edges(scheme, z, column, y - 1, max_edge);
+                    let above = globe_edges(scheme, z, column, y, max_edge);
+                    assert_eq!(below.spans[1], above.spans[0], "{scheme:?} {z}/{y}");
+                    // West and east neighbours share a meridian edge.
+                    let east = globe_edges(scheme, z, column + 1, y, max_edge);
+                    assert_eq!(above.spans[3], east.spans[2]);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn every_fan_edge_of_a_span_is_within_the_tiles_own_limit() {
+        for scheme in schemes() {
+            let n = scheme.cells;
+            for (z, max_edge) in capped(scheme) {
+                for y in 0..1u32 << z {
+                    let g = globe_edges(scheme, z, 0, y, max_edge);
+                    let limit = EdgeLimit::new(&g.metric, Some(max_edge), n + 1, n + 1).unwrap();
+                    // South (row 0, inner row 1) and west (column 0, inner column 1).
+                    let cases = [
+                        (g.spans[0], (|i, l| (i, l)) as fn(u32, u32) -> (u32, u32)),
+                        (g.spans[2], |i, l| (l, i)),
+                    ];
+                    for (span, at) in cases {
+                        let s = span.min(n as usize) as u32;
+                        for i in 0..=n - s {
+                            assert!(limit.allows_samples(at(i, 0), at(i + s, 0)));
+                            assert!(limit.allows_samples(at(i, 0), at(i + s, 1)));
+                            assert!(limit.allows_samples(at(i + s, 0), at(i, 1)));
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn at_the_equator_a_span_is_the_grids_and_towards_a_pole_longer() {
+        let scheme = Scheme {
+            tiling: Tiling::Geographic,
+            cells: 217,
+        };
+        let (z, max_edge) = (2, LevelBudget::new(scheme, 2, 1.0).max_edge.unwrap());
+        let grid_span = tinsmith_tiling::edge_span(Some(max_edge));
+        // Level 2 has rows 0..4 of 45 degrees: row 2 starts at the equator.
+        let equator = globe_edges(scheme, z, 0, 2, max_edge);
+        assert_eq!(equator.spans[0], grid_span);
+        assert_eq!(
+            equator.spans[2], grid_span,
+            "meridians are the grid's everywhere"
+        );
+        let polar = globe_edges(scheme, z, 0, 3, max_edge);
+        assert!(
+            polar.spans[1] > 3 * grid_span,
+            "{} at the pole",
+            polar.spans[1]
+        );
+        assert!(
+            polar.spans[0] > grid_span,
+            "{} at 45 degrees",
+            polar.spans[0]
+        );
+    }
+}

@@ -264,7 +264,14 @@ fn a_3dtiles_pyramid_is_the_quantized_mesh_pyramid_in_glb_and_validates() {
         let points: Vec<(f64, f64, f64)> = glb.ecef.iter().map(|&p| geodetic(p)).collect();
         let mut heights = Vec::new();
         for (i, &(lon, lat, h)) in points.iter().enumerate() {
-            let lon = if lon < west - 1.0 { lon + 360.0 } else { lon };
+            // Into the tile's turn: on the antimeridian -180 and 180 are one longitude.
+            let lon = if lon < west - 1.0 {
+                lon + 360.0
+            } else if lon > west + size + 1.0 {
+                lon - 360.0
+            } else {
+                lon
+            };
             let u = (lon - west) / size * 32767.0;
             let v = (lat - south) / size * 32767.0;
             // At a pole any longitude is the same place. A hundredth of a u (a lattice step

@@ -744,6 +744,27 @@ fn a_global_pyramid_bends_with_the_globe() {
             "{key:?}: an edge of {:.1} degrees sinks {sag:.0} m below the ellipsoid (bound {bound:.0} m)",
             longest.to_degrees()
         );
+        // Every triangle faces outwards as drawn (flat between its corners on the
+        // globe): none turned over near a pole. Corners at one point (a pole) have no face.
+        let size = 180.0 / f64::from(1u32 << key.0);
+        let unit = |i: usize| {
+            let lon = (-180.0 + size * (f64::from(key.1) + t.u[i] as f64 / 32767.0)).to_radians();
+            let lat = (-90.0 + size * (f64::from(key.2) + t.v[i] as f64 / 32767.0)).to_radians();
+            [lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin()]
+        };
+        for tri in &t.triangles {
+            let [a, b, c] = tri.map(unit);
+            let cross = [
+                b[1] * c[2] - b[2] * c[1],
+                b[2] * c[0] - b[0] * c[2],
+                b[0] * c[1] - b[1] * c[0],
+            ];
+            let triple = a[0] * cross[0] + a[1] * cross[1] + a[2] * cross[2];
+            assert!(
+                triple > -1e-12,
+                "{key:?}: triangle {tri:?} is turned over ({triple:e})"
+            );
+        }
         // Edges of at most ~17 degrees across a 180-degree tile need many vertices.
         if key.0 == 0 {
             assert!(t.u.len() >= 100, "{key:?}: only {} vertices", t.u.len());

@@ -39,12 +39,19 @@ pub struct EdgeLimit {
     max: f64,
 }
 
-/// `(cos, sin)` of each column's longitude and of each row's latitude.
+/// `(cos, sin, degrees)` of each column's longitude and `(cos, sin)` of each row's
+/// latitude.
 #[derive(Debug, Clone)]
 struct SphereTables {
-    columns: Arc<[[f64; 2]]>,
+    columns: Arc<[[f64; 3]]>,
     rows: Arc<[[f64; 2]]>,
 }
+
+/// The triple product of unit vectors below which [`EdgeLimit::faces_out`] calls a
+/// triangle turned over: far above its rounding where two corners coincide (a pole's row,
+/// whose points differ by about 1e-16) and far below a face of one lattice cell of the
+/// finest capped level (0.1 degree a side: about 1e-6).
+const FACE_TOLERANCE: f64 = 1e-12;
 
 /// No limit.
 pub(crate) static NO_EDGE_LIMIT: EdgeLimit = EdgeLimit {
@@ -98,19 +105,17 @@ impl EdgeLimit {
                     ));
                 }
                 let arc = f64::from(length) * spacing.to_radians();
-                let trig = |degrees: &[f64]| -> Arc<[[f64; 2]]> {
-                    degrees
-                        .iter()
-                        .map(|d| {
-                            let r = d.to_radians();
-                            [r.cos(), r.sin()]
-                        })
-                        .collect()
-                };
+                let trig = |d: f64| [d.to_radians().cos(), d.to_radians().sin()];
                 Ok(EdgeLimit {
                     sphere: Some(SphereTables {
-                        columns: trig(longitudes),
-                        rows: trig(latitudes),
+                        columns: longitudes
+                            .iter()
+                            .map(|&d| {
+                                let [c, s] = trig(d);
+                                [c, s, d]
+                            })
+                            .collect(),
+                        rows: latitudes.iter().map(|&d| trig(d)).collect(),
                     }),
                     // 1 - cos(arc): the measure of an edge spanning `arc`; a half turn or
                     // more allows any edge.
@@ -130,7 +135,9 @@ impl EdgeLimit {
     }
 
     /// A measure of segment `pq`'s length that grows with it: its squared length in
-    /// spacings on the grid, `1 - cos` of its arc on a sphere.
+    /// spacings on the grid, `1 - cos` of its arc on a sphere (infinite for a segment
+    /// across half a turn of longitude or more, which the arc would take for the other
+    /// way round).
     #[inline]
     pub(crate) fn measure(&self, p: &Point, q: &Point) -> f64 {
         match &self.sphere {
@@ -139,11 +146,38 @@ impl EdgeLimit {
                 (dx * dx + dy * dy) as f64
             }
             Some(SphereTables { columns, rows }) => {
-                let ([cl1, sl1], [cl2, sl2]) = (columns[p.x as usize], columns[q.x as usize]);
+                let ([cl1, sl1, l1], [cl2, sl2, l2]) =
+                    (columns[p.x as usize], columns[q.x as usize]);
+                if (l1 - l2).abs() >= 180.0 {
+                    return f64::INFINITY;
+                }
                 let ([cp1, sp1], [cp2, sp2]) = (rows[p.y as usize], rows[q.y as usize]);
                 1.0 - (cp1 * cp2 * (cl1 * cl2 + sl1 * sl2) + sp1 * sp2)
             }
         }
+    }
+
+    /// Whether counter-clockwise triangle `abc` (grid positions) faces outwards where it
+    /// is drawn flat between its corners' positions: always on the grid; on a sphere,
+    /// unless its corners' triple product is negative (beyond rounding). Edges within the
+    /// arc alone do not ensure it: near a pole, a corner can sit between the chord of a
+    /// long edge along a row and the row itself. A triangle with two corners at one point
+    /// (a pole's row) has no face and passes.
+    pub(crate) fn faces_out(&self, a: &Point, b: &Point, c: &Point) -> bool {
+        let Some(SphereTables { columns, rows }) = &self.sphere else {
+            return true;
+        };
+        let unit = |p: &Point| {
+            let ([cl, sl, _], [cp, sp]) = (columns[p.x as usize], rows[p.y as usize]);
+            [cp * cl, cp * sl, sp]
+        };
+        let (a, b, c) = (unit(a), unit(b), unit(c));
+        let cross = [
+            b[1] * c[2] - b[2] * c[1],
+            b[2] * c[0] - b[0] * c[2],
+            b[0] * c[1] - b[1] * c[0],
+        ];
+        a[0] * cross[0] + a[1] * cross[1] + a[2] * cross[2] > -FACE_TOLERANCE
     }
 
     /// Whether a measure ([`EdgeLimit::measure`]) is within the limit.
@@ -200,9 +234,38 @@ mod tests {
         assert!(!limit.allows_samples((0, 1), (11, 1)));
         assert!(limit.allows_samples((0, 61), (19, 61)));
         assert!(!limit.allows_samples((0, 61), (21, 61)));
+        // Half a turn of longitude or more is refused, even where it spans little arc.
+        let near_pole = EdgeMetric::Sphere {
+            longitudes: vec![0.0, 100.0, 200.0].into(),
+            latitudes: vec![89.0, 89.5].into(),
+            spacing: 1.0,
+        };
+        let wide = EdgeLimit::new(&near_pole, Some(4), 3, 2).unwrap();
+        assert!(wide.allows_samples((0, 1), (1, 1)));
+        assert!(!wide.allows_samples((0, 1), (2, 1)));
         // Along a meridian a spacing is a spacing of arc everywhere.
         assert!(limit.allows_samples((5, 61), (5, 70)));
         assert!(!limit.allows_samples((5, 61), (5, 72)));
+    }
+
+    #[test]
+    fn a_triangle_turned_over_near_a_pole_is_refused_though_its_edges_fit() {
+        // A (0, 80), B (100, 80), C (50, 80.83): every edge under 16 degrees of arc, and
+        // counter-clockwise on the grid, but C lies between the chord AB and the row.
+        let metric = EdgeMetric::Sphere {
+            longitudes: vec![0.0, 50.0, 100.0].into(),
+            latitudes: vec![80.0, 80.83].into(),
+            spacing: 1.0,
+        };
+        let limit = EdgeLimit::new(&metric, Some(16), 3, 2).unwrap();
+        let p = |x, y| Point { x, y, z: 0.0 };
+        let (a, b, c) = (p(0, 0), p(2, 0), p(1, 1));
+        assert!(limit.allows(&a, &b) && limit.allows(&b, &c) && limit.allows(&c, &a));
+        assert!(!limit.faces_out(&a, &b, &c));
+        assert!(limit.faces_out(&a, &p(1, 0), &p(0, 1)));
+        // On the grid every counter-clockwise triangle faces out.
+        let grid = EdgeLimit::new(&EdgeMetric::Grid, Some(16), 3, 2).unwrap();
+        assert!(grid.faces_out(&a, &b, &c));
     }
 
     #[test]

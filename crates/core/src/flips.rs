@@ -68,7 +68,12 @@ pub(crate) fn flip_within(
     cap: f64,
 ) -> bool {
     let [pa, pb, pc, pd] = points;
-    if orient(pc, pa, pd) <= 0 || orient(pc, pd, pb) <= 0 || !rules.edge_limit.allows(pc, pd) {
+    if orient(pc, pa, pd) <= 0
+        || orient(pc, pd, pb) <= 0
+        || !rules.edge_limit.allows(pc, pd)
+        || !rules.edge_limit.faces_out(pc, pa, pd)
+        || !rules.edge_limit.faces_out(pc, pd, pb)
+    {
         return false;
     }
     let Some(first) = triangle_error(rules.grid, pc, pa, pd, cap) else {

@@ -237,6 +237,7 @@ impl Retriangulator {
         if [(pa, pb), (pb, pc), (pc, pa)]
             .iter()
             .any(|(p, q)| !rules.edge_limit.allows(p, q))
+            || !rules.edge_limit.faces_out(pa, pb, pc)
         {
             return None;
         }

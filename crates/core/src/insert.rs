@@ -353,12 +353,14 @@ impl<'g> Triangulation<'g> {
             (error.to_bits(), Some(sample))
         } else {
             let n = self.neighbours[s];
+            // A triangle turned over on the globe splits its longest edge too.
+            let turned_over = !self.edge_limit.faces_out(&a, &b, &c);
             let long = [(a, b, n[0]), (b, c, n[1]), (c, a, n[2])]
                 .into_iter()
                 .filter(|e| !(self.fixed_outline && e.2 == NONE))
                 .map(|(p, q, _)| (self.edge_limit.measure(&p, &q), p, q))
                 .max_by(|e, f| e.0.total_cmp(&f.0))
-                .filter(|e| !self.edge_limit.allows_measure(e.0));
+                .filter(|e| turned_over || !self.edge_limit.allows_measure(e.0));
             match long {
                 None => {
                     self.candidate[s] = None;

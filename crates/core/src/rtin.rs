@@ -210,7 +210,8 @@ impl<'g> Rtin<'g> {
 
     /// Whether a triangle inside the grid (and larger than a half cell) must be split: it
     /// may cover an invalid cell (its bounding box holds one), it reaches the outer border
-    /// in full-border mode, its hypotenuse is too long, or its exact error exceeds the limit.
+    /// in full-border mode, an edge is too long or it is turned over on the globe
+    /// ([`EdgeLimit::faces_out`]), or its exact error exceeds the limit.
     fn must_split(&self, t: [Xy; 3]) -> bool {
         let (x0, x1, y0, y1) = bbox(t);
         if self.full_border && (x0 == 0 || y0 == 0 || x1 == self.max_x || y1 == self.max_y) {
@@ -228,6 +229,15 @@ impl<'g> Rtin<'g> {
                 .iter()
                 .any(|&(i, j)| !self.edge_limit.allows(&p(i), &p(j)))
             {
+                return true;
+            }
+            let [a, b, c] = [p(0), p(1), p(2)];
+            let faces_out = if orient(&a, &b, &c) > 0 {
+                self.edge_limit.faces_out(&a, &b, &c)
+            } else {
+                self.edge_limit.faces_out(&a, &c, &b)
+            };
+            if !faces_out {
                 return true;
             }
         }

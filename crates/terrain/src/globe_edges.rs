@@ -19,8 +19,9 @@ pub(super) struct GlobeEdges {
     pub(super) spans: [usize; 4],
 }
 
-/// Relative tightening of the arc the border spans are decided with, so that rounding
-/// can never make the tile's own decimation refuse a fan edge the span allowed.
+/// Relative tightening of the arc the border spans are decided with, so that the fans
+/// the span allows (which the core makes without measuring them) stay within the tile's
+/// own limit whatever the rounding of their lattice against the tile's.
 const SPAN_MARGIN: f64 = 1e-9;
 
 /// The globe edges of tile `z`/`column`/`y` of `scheme` whose edges may span at most
@@ -118,7 +119,8 @@ fn span(
                 })
         })
     };
-    // Arcs grow with the skip, so the skips that fit are 1..=s: search for s.
+    // Arcs grow with the skip up to half a turn of longitude, and the limit refuses
+    // anything wider: the skips that fit are 1..=s. Search for s.
     let (mut lo, mut hi) = (1, n);
     if fits(hi) {
         return usize::MAX;
@@ -149,10 +151,17 @@ mod tests {
             .collect()
     }
 
-    /// The capped levels of `scheme` with their longest edge.
+    /// The capped levels of `scheme` with their longest edge, at two `--quality`s.
     fn capped(scheme: Scheme) -> Vec<(u8, u32)> {
-        (0..8)
-            .filter_map(|z| LevelBudget::new(scheme, z, 1.0).max_edge.map(|e| (z, e)))
+        [0.1, 1.0]
+            .into_iter()
+            .flat_map(|quality| {
+                (0..8).filter_map(move |z| {
+                    LevelBudget::new(scheme, z, quality)
+                        .max_edge
+                        .map(|e| (z, e))
+                })
+            })
             .collect()
     }
 
@@ -181,17 +190,17 @@ mod tests {
                 for y in 0..1u32 << z {
                     let g = globe_edges(scheme, z, 0, y, max_edge);
                     let limit = EdgeLimit::new(&g.metric, Some(max_edge), n + 1, n + 1).unwrap();
-                    // South (row 0, inner row 1) and west (column 0, inner column 1).
-                    let cases = [
-                        (g.spans[0], (|i, l| (i, l)) as fn(u32, u32) -> (u32, u32)),
-                        (g.spans[2], |i, l| (l, i)),
-                    ];
-                    for (span, at) in cases {
+                    // Each edge (its line, and the line inside it) with its span.
+                    let cases = [(g.spans[0], 0, 1, true), (g.spans[1], n, n - 1, true)]
+                        .into_iter()
+                        .chain([(g.spans[2], 0, 1, false), (g.spans[3], n, n - 1, false)]);
+                    for (span, line, inner, along_rows) in cases {
+                        let at = |i: u32, l: u32| if along_rows { (i, l) } else { (l, i) };
                         let s = span.min(n as usize) as u32;
                         for i in 0..=n - s {
-                            assert!(limit.allows_samples(at(i, 0), at(i + s, 0)));
-                            assert!(limit.allows_samples(at(i, 0), at(i + s, 1)));
-                            assert!(limit.allows_samples(at(i + s, 0), at(i, 1)));
+                            assert!(limit.allows_samples(at(i, line), at(i + s, line)));
+                            assert!(limit.allows_samples(at(i, line), at(i + s, inner)));
+                            assert!(limit.allows_samples(at(i + s, line), at(i, inner)));
                         }
                     }
                 }

@@ -77,6 +77,9 @@ pub(super) fn options_key(options: &TerrainOptions) -> String {
     if options.gzip {
         text["gzip_by"] = "libdeflate 10".into();
     }
+    // Coarse tiles' edges measured on the globe since they replaced lattice spacings: an
+    // update rebuilds a pyramid built before, so that shared edges agree.
+    text["edges"] = "globe".into();
     // Absent for the ellipsoid, so that pyramids built before datums were chosen keep
     // their key.
     if options.vertical_datum != tinsmith_raster::VerticalDatum::Ellipsoid {

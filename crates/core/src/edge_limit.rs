@@ -29,8 +29,8 @@ pub enum EdgeMetric {
     },
 }
 
-/// An edge length limit made ready to test edges with: the same test, bit for bit, for the
-/// decimation and for a caller deciding a tile's border by it.
+/// An edge length limit made ready to test edges with: the test the decimation makes, for
+/// a caller to decide by it too (a tile's border skips).
 #[derive(Debug, Clone)]
 pub struct EdgeLimit {
     /// For [`EdgeMetric::Sphere`].
@@ -101,7 +101,8 @@ impl EdgeLimit {
                     .all(|v| v.is_finite());
                 if !finite || !spacing.is_finite() || *spacing <= 0.0 {
                     return Err(Error::EdgeMetric(
-                        "a longitude, latitude or the spacing is not a finite number".into(),
+                        "a longitude, latitude or the spacing is not finite, or the spacing not positive"
+                            .into(),
                     ));
                 }
                 let arc = f64::from(length) * spacing.to_radians();
@@ -193,6 +194,9 @@ impl EdgeLimit {
     }
 
     /// Whether the segment between samples `(x, y)` of `a` and `b` is within the limit.
+    ///
+    /// # Panics
+    /// On a sphere, when a sample is outside the grid the limit was made for.
     pub fn allows_samples(&self, a: (u32, u32), b: (u32, u32)) -> bool {
         let point = |(x, y): (u32, u32)| Point {
             x: i64::from(x),

@@ -193,7 +193,8 @@ pub struct DecimationOptions {
     /// Stop once the mesh has at most this many vertices (greedy order only; with
     /// `max_triangles` too, once both are met).
     pub max_vertices: Option<usize>,
-    /// Longest edge allowed in the output, in sample spacings (at least 2): a removal that
+    /// Longest edge allowed in the output, in sample spacings (at least 2; measured by
+    /// [`DecimationOptions::edge_metric`]): a removal that
     /// would need a longer edge is refused. For renderers that interpolate in another space
     /// than the grid's (e.g. terrain on a globe, where long edges cut below the surface).
     pub max_edge_length: Option<u32>,

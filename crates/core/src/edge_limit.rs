@@ -193,6 +193,20 @@ impl EdgeLimit {
         self.is_none() || self.allows_measure(self.measure(p, q))
     }
 
+    /// [`EdgeLimit::faces_out`] of the triangle of samples `(x, y)` `a`, `b`, `c`,
+    /// counter-clockwise on the grid.
+    ///
+    /// # Panics
+    /// On a sphere, when a sample is outside the grid the limit was made for.
+    pub fn faces_out_samples(&self, a: (u32, u32), b: (u32, u32), c: (u32, u32)) -> bool {
+        let point = |(x, y): (u32, u32)| Point {
+            x: i64::from(x),
+            y: i64::from(y),
+            z: 0.0,
+        };
+        self.faces_out(&point(a), &point(b), &point(c))
+    }
+
     /// Whether the segment between samples `(x, y)` of `a` and `b` is within the limit.
     ///
     /// # Panics

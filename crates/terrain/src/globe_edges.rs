@@ -75,7 +75,9 @@ fn row_spacing(scheme: Scheme, z: u8, column: u32, y: u32) -> f64 {
 /// parallel edge, relative to its first; latitudes of a meridian edge) such that, from
 /// every sample `i`, the segment to `i + s` and the fan edges to the samples `i` and
 /// `i + s` of each line beside the edge that exists are within `max_edge` spacings of
-/// `step` degrees (less [`SPAN_MARGIN`]). `beside` holds the three lines' positions
+/// `step` degrees (less [`SPAN_MARGIN`]), and the fan triangles to that line's ends and
+/// middle face outwards as drawn (a chord along a row bulges poleward, past the next row
+/// where the skip is long). `beside` holds the three lines' positions
 /// across the edge (latitudes, or longitudes), the edge's own in the middle.
 fn span(
     step: f64,
@@ -110,12 +112,27 @@ fn span(
         .into_iter()
         .filter(|&l| beside[l].is_some())
         .collect();
+    // A fan triangle of the skip `i..i + s` with its apex at `k` on line `l`, taken
+    // counter-clockwise on the lattice: it must face outwards as drawn.
+    let fan_faces_out = |i: usize, s: usize, k: usize, l: usize| {
+        let (p, q, apex) = (at(i, 1), at(i + s, 1), at(k, l));
+        // Line 2 lies north (parallel) or east (meridian) of the edge.
+        if (l == 2) == parallel {
+            limit.faces_out_samples(p, q, apex)
+        } else {
+            limit.faces_out_samples(q, p, apex)
+        }
+    };
     let fits = |s: usize| {
         (0..=n - s).all(|i| {
             limit.allows_samples(at(i, 1), at(i + s, 1))
                 && sides.iter().all(|&l| {
                     limit.allows_samples(at(i, 1), at(i + s, l))
                         && limit.allows_samples(at(i + s, 1), at(i, l))
+                        // A chord along a row bulges poleward most at its middle.
+                        && [i, i + s / 2, i + s.div_ceil(2), i + s]
+                            .into_iter()
+                            .all(|k| fan_faces_out(i, s, k, l))
                 })
         })
     };
@@ -201,6 +218,18 @@ mod tests {
                             assert!(limit.allows_samples(at(i, line), at(i + s, line)));
                             assert!(limit.allows_samples(at(i, line), at(i + s, inner)));
                             assert!(limit.allows_samples(at(i + s, line), at(i, inner)));
+                            // Every fan triangle faces outwards (taken counter-clockwise:
+                            // the inner line lies north of the south edge, east of the west).
+                            let (p, q) = (at(i, line), at(i + s, line));
+                            let counter_clockwise = (inner > line) == along_rows;
+                            for k in i..=i + s {
+                                let apex = at(k, inner);
+                                assert!(if counter_clockwise {
+                                    limit.faces_out_samples(p, q, apex)
+                                } else {
+                                    limit.faces_out_samples(q, p, apex)
+                                });
+                            }
                         }
                     }
                 }

@@ -193,8 +193,10 @@ impl EdgeLimit {
         self.is_none() || self.allows_measure(self.measure(p, q))
     }
 
-    /// [`EdgeLimit::faces_out`] of the triangle of samples `(x, y)` `a`, `b`, `c`,
-    /// counter-clockwise on the grid.
+    /// Whether the triangle of samples `(x, y)` `a`, `b`, `c`, counter-clockwise on the
+    /// grid, faces outwards where it is drawn flat between its corners' positions: always
+    /// on the grid; on a sphere, unless its corners' triple product is negative (beyond
+    /// rounding; two corners at one point, a pole's row, pass).
     ///
     /// # Panics
     /// On a sphere, when a sample is outside the grid the limit was made for.

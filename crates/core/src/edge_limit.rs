@@ -202,12 +202,7 @@ impl EdgeLimit {
     /// # Panics
     /// On a sphere, when a sample is outside the grid the limit was made for.
     pub fn faces_out_samples(&self, a: (u32, u32), b: (u32, u32), c: (u32, u32)) -> bool {
-        let point = |(x, y): (u32, u32)| Point {
-            x: i64::from(x),
-            y: i64::from(y),
-            z: 0.0,
-        };
-        self.faces_out(&point(a), &point(b), &point(c))
+        self.faces_out(&sample_point(a), &sample_point(b), &sample_point(c))
     }
 
     /// Whether the segment between samples `(x, y)` of `a` and `b` is within the limit.
@@ -215,12 +210,16 @@ impl EdgeLimit {
     /// # Panics
     /// On a sphere, when a sample is outside the grid the limit was made for.
     pub fn allows_samples(&self, a: (u32, u32), b: (u32, u32)) -> bool {
-        let point = |(x, y): (u32, u32)| Point {
-            x: i64::from(x),
-            y: i64::from(y),
-            z: 0.0,
-        };
-        self.allows(&point(a), &point(b))
+        self.allows(&sample_point(a), &sample_point(b))
+    }
+}
+
+/// Sample `(x, y)` as a grid position (its height unused here).
+fn sample_point((x, y): (u32, u32)) -> Point {
+    Point {
+        x: i64::from(x),
+        y: i64::from(y),
+        z: 0.0,
     }
 }
 

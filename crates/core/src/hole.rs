@@ -142,7 +142,7 @@ impl Retriangulator {
         &mut self,
         rules: &Rules<'_, S>,
     ) -> Option<(&[HoleTriangle], f64)> {
-        if !self.centre_can_fit(rules.limit) {
+        if !self.centre_can_fit(rules) {
             return None;
         }
         let dp = rules.method == Retriangulation::Dp && self.ring.len() <= rules.dp_max_ring;
@@ -174,7 +174,13 @@ impl Retriangulator {
     /// A necessary condition, cheap to test: whatever the triangulation, the removed vertex
     /// lies in a triangle of ring vertices, and its own error there must be within the
     /// limit (both error models count it). Tries every such triangle for small rings.
-    fn centre_can_fit(&self, limit: f64) -> bool {
+    fn centre_can_fit<S: Coverage + ?Sized>(&self, rules: &Rules<'_, S>) -> bool {
+        let limit = rules.limit;
+        // Under the exact model a triangle holding the centre is refused when some
+        // variable fails there (`Coverage::variables_refuse_at`, as the retriangulation
+        // asks), so the condition holds for every field; the bounds model folds variables
+        // into one bound, and keeps to the height's test here.
+        let variables = rules.model == ErrorModel::Exact && rules.grid.has_variables();
         let m = self.ring.len();
         if m > 12 {
             return true;
@@ -199,7 +205,9 @@ impl Retriangulator {
                     debug_assert!(orient(a, b, c) > 0 && in_closed_triangle(a, b, c, &centre));
                     let g = plane_gradient(a, b, c);
                     let at = a.z + g[0] * (centre.x - a.x) as f64 + g[1] * (centre.y - a.y) as f64;
-                    if (at - centre.z).abs() <= limit {
+                    if (at - centre.z).abs() <= limit
+                        && !(variables && rules.grid.variables_refuse_at(a, b, c, &centre, limit))
+                    {
                         return true;
                     }
                 }
@@ -319,6 +327,8 @@ mod tests {
     use super::propagation::clip_segment;
     use super::*;
     use crate::exact::triangle_error;
+    use crate::Variable;
+    use tinsmith_georef::Samples;
 
     fn pt(x: i64, y: i64, z: f64) -> Point {
         Point { x, y, z }
@@ -373,6 +383,31 @@ mod tests {
                 .unwrap();
             assert_eq!(tris.len(), 2);
             assert_eq!(worst, 10.0);
+        }
+    }
+
+    #[test]
+    fn a_variable_failing_at_the_centre_in_every_triangle_refuses_the_hole() {
+        // Flat heights; a variable of 0 and 20 on alternate ring corners and 10 at the
+        // centre: either diagonal puts 0 or 20 there, 10 away, though 10 lies within the
+        // ring's range (so only the centre's own test, not the ring's range, refuses it).
+        let height = Samples::new(3, 3, vec![0.0; 9]).unwrap();
+        let mut values = vec![0.0; 9];
+        values[2] = 20.0;
+        values[6] = 20.0;
+        values[4] = 10.0;
+        let ring = [pt(0, 0, 0.0), pt(2, 0, 0.0), pt(2, 2, 0.0), pt(0, 2, 0.0)];
+        let mut r = Retriangulator::default();
+        r.load(pt(1, 1, 0.0), &ring, &[ErrorBound::default(); 4]);
+        for (bound, fits) in [(9.5, false), (10.5, true)] {
+            let variable = Variable::new(Samples::new(3, 3, values.clone()).unwrap(), bound);
+            let grid = Grid::with_variables(height.clone(), vec![variable.unwrap()]).unwrap();
+            let exact = Rules {
+                model: ErrorModel::Exact,
+                ..rules(&grid, EdgeSelection::Hybrid, Retriangulation::Dp, 5.0)
+            };
+            assert_eq!(r.centre_can_fit(&exact), fits, "bound {bound}");
+            assert_eq!(r.retriangulate(&exact).is_some(), fits, "bound {bound}");
         }
     }
 

@@ -62,7 +62,8 @@ pub(crate) static NO_EDGE_LIMIT: EdgeLimit = EdgeLimit {
 
 impl EdgeLimit {
     /// Edges of at most `max_edge_length` spacings by `metric`, on a grid `width` x
-    /// `height` samples; no limit for `None`.
+    /// `height` samples; no length limit for `None`, though on a sphere triangles must
+    /// still face outwards ([`EdgeLimit::faces_out_samples`]).
     ///
     /// # Errors
     /// [`Error::InvalidMaxEdgeLength`] below 2 spacings; [`Error::EdgeMetric`] when a
@@ -73,22 +74,23 @@ impl EdgeLimit {
         width: u32,
         height: u32,
     ) -> Result<EdgeLimit> {
-        let Some(length) = max_edge_length else {
-            return Ok(NO_EDGE_LIMIT.clone());
-        };
-        if length < 2 {
+        if let Some(length) = max_edge_length.filter(|&l| l < 2) {
             return Err(Error::InvalidMaxEdgeLength(length));
         }
-        match metric {
-            EdgeMetric::Grid => Ok(EdgeLimit {
+        match (metric, max_edge_length) {
+            (EdgeMetric::Grid, None) => Ok(NO_EDGE_LIMIT.clone()),
+            (EdgeMetric::Grid, Some(length)) => Ok(EdgeLimit {
                 sphere: None,
                 max: f64::from(length) * f64::from(length),
             }),
-            EdgeMetric::Sphere {
-                longitudes,
-                latitudes,
-                spacing,
-            } => {
+            (
+                EdgeMetric::Sphere {
+                    longitudes,
+                    latitudes,
+                    spacing,
+                },
+                _,
+            ) => {
                 if longitudes.len() != width as usize || latitudes.len() != height as usize {
                     return Err(Error::EdgeMetric(format!(
                         "{} longitudes and {} latitudes for a grid of {width} x {height}",
@@ -106,7 +108,9 @@ impl EdgeLimit {
                             .into(),
                     ));
                 }
-                let arc = f64::from(length) * spacing.to_radians();
+                let arc = max_edge_length.map_or(f64::INFINITY, |length| {
+                    f64::from(length) * spacing.to_radians()
+                });
                 let trig = |d: f64| [d.to_radians().cos(), d.to_radians().sin()];
                 Ok(EdgeLimit {
                     sphere: Some(SphereTables {
@@ -131,9 +135,14 @@ impl EdgeLimit {
         }
     }
 
-    /// Whether there is no limit.
+    /// Whether there is no length limit (on a sphere, triangles must still face out).
     pub(crate) fn is_none(&self) -> bool {
         self.max == f64::INFINITY
+    }
+
+    /// Whether triangles may turn over as drawn ([`EdgeLimit::faces_out`] can refuse).
+    pub(crate) fn on_sphere(&self) -> bool {
+        self.sphere.is_some()
     }
 
     /// A measure of segment `pq`'s length that grows with it: its squared length in

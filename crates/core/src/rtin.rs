@@ -219,7 +219,7 @@ impl<'g> Rtin<'g> {
         }
         // On the grid the hypotenuse (between t[0] and t[1]) is the longest edge; on a
         // sphere the legs are measured too.
-        if !self.edge_limit.is_none() {
+        if !self.edge_limit.is_none() || self.edge_limit.on_sphere() {
             let p = |k: usize| Point {
                 x: t[k].0,
                 y: t[k].1,

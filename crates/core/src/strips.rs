@@ -18,6 +18,7 @@
 //! With `full_border`, every triangle that reaches the grid's outer rows or columns is a
 //! half cell, as [`crate::decimate_with_border`] needs.
 
+use crate::edge_limit::EdgeLimit;
 use crate::exact::triangle_error;
 use crate::mesh::CompactBound;
 use crate::predicates::{orient, Point};
@@ -91,9 +92,15 @@ impl<'g> StripPlan<'g> {
 
     /// The triangles (counter-clockwise sample indices, in row-major order of their
     /// first corner's row) with their exact errors; `None` if one measured above the
-    /// limit after all (the 1-D pass works in floating point, the measurement decides).
+    /// limit after all (the 1-D pass works in floating point, the measurement decides),
+    /// or one is turned over on `edge_limit`'s sphere ([`EdgeLimit::faces_out`]: a strip
+    /// triangle is thin, and a long edge along a row bulges poleward as drawn).
     /// `tick` is called every [`TICK_TRIANGLES`] triangles.
-    pub(crate) fn triangles(&self, tick: &dyn Fn()) -> Option<(Vec<[u32; 3]>, Vec<CompactBound>)> {
+    pub(crate) fn triangles(
+        &self,
+        edge_limit: &EdgeLimit,
+        tick: &dyn Fn(),
+    ) -> Option<(Vec<[u32; 3]>, Vec<CompactBound>)> {
         let grid = self.grid;
         let width = self.lines.width;
         let point = |i: usize| Point {
@@ -110,6 +117,9 @@ impl<'g> StripPlan<'g> {
             } else {
                 (c, b, pc, pb)
             };
+            if !edge_limit.faces_out(&pa, &pb, &pc) {
+                return None;
+            }
             let bound = triangle_error(grid, &pa, &pb, &pc, self.limit)?;
             if corners.len().is_multiple_of(TICK_TRIANGLES) {
                 tick();
@@ -549,6 +559,7 @@ fn in_row_order(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::edge_limit::NO_EDGE_LIMIT;
     use crate::Variable;
     use tinsmith_georef::Samples;
 
@@ -636,7 +647,7 @@ mod tests {
         let grid = Grid::new(5, 4, values).unwrap();
         let plan = StripPlan::new(&grid, 0.25, false, &|| {}).unwrap();
         assert_eq!(plan.triangle_count(), 6);
-        let (corners, bounds) = plan.triangles(&|| {}).unwrap();
+        let (corners, bounds) = plan.triangles(&NO_EDGE_LIMIT, &|| {}).unwrap();
         assert_eq!(corners.len(), 6);
         assert!(bounds.iter().all(|b| ErrorBound::from(*b).max() == 0.0));
         assert_eq!(doubled_area_in_domain(&grid, &corners), 2 * 4 * 3);
@@ -664,7 +675,9 @@ mod tests {
         let plain = StripPlan::new(&plain_grid, 1.0, false, &|| {}).unwrap();
         let plan = StripPlan::new(&grid, 1.0, false, &|| {}).unwrap();
         assert!(plan.kept_count() > plain.kept_count());
-        let (corners, bounds) = plan.triangles(&|| {}).expect("every triangle passes");
+        let (corners, bounds) = plan
+            .triangles(&NO_EDGE_LIMIT, &|| {})
+            .expect("every triangle passes");
         assert_eq!(corners.len(), plan.triangle_count());
         assert!(bounds.iter().all(|b| ErrorBound::from(*b).max() <= 1.0));
         assert_eq!(
@@ -689,7 +702,7 @@ mod tests {
         for full_border in [false, true] {
             for limit in [0.3, 2.0, 50.0] {
                 let plan = StripPlan::new(&grid, limit, full_border, &|| {}).unwrap();
-                let (corners, bounds) = plan.triangles(&|| {}).unwrap();
+                let (corners, bounds) = plan.triangles(&NO_EDGE_LIMIT, &|| {}).unwrap();
                 assert_eq!(corners.len(), plan.triangle_count());
                 assert!(bounds.iter().all(|b| ErrorBound::from(*b).max() <= limit));
                 let area = doubled_area_in_domain(&grid, &corners);

@@ -1,8 +1,10 @@
-//! How long a coarse tile's edges may be, measured on the globe. CesiumJS draws each
-//! triangle flat between its corners, so an edge may span no more arc than the level's
-//! bound lets its chord sink ([`crate::tms::max_edge_length`], in lattice spacings at the
-//! equator). Measured along the sphere instead of across the lattice, a tile's rows draw
-//! together towards the poles, and edges along them may cross more lattice points.
+//! A tile's edges measured on the globe. CesiumJS draws each triangle flat between its
+//! corners, so on a coarse level an edge may span no more arc than the level's bound lets
+//! its chord sink ([`crate::tms::max_edge_length`], in lattice spacings at the equator).
+//! Measured along the sphere instead of across the lattice, a tile's rows draw together
+//! towards the poles, and edges along them may cross more lattice points. On every level,
+//! capped or not, no triangle may turn over as drawn: a long edge along a row bulges
+//! poleward, past a thin triangle's third corner.
 
 use tinsmith_core::{EdgeLimit, EdgeMetric};
 
@@ -25,8 +27,14 @@ pub(super) struct GlobeEdges {
 const SPAN_MARGIN: f64 = 1e-9;
 
 /// The globe edges of tile `z`/`column`/`y` of `scheme` whose edges may span at most
-/// `max_edge` lattice spacings of arc at the equator.
-pub(super) fn globe_edges(scheme: Scheme, z: u8, column: u32, y: u32, max_edge: u32) -> GlobeEdges {
+/// `max_edge` lattice spacings of arc at the equator (any length for `None`).
+pub(super) fn globe_edges(
+    scheme: Scheme,
+    z: u8,
+    column: u32,
+    y: u32,
+    max_edge: Option<u32>,
+) -> GlobeEdges {
     let cells = scheme.cells as usize;
     let step = scheme.step(z);
     let rect = scheme.tile_rectangle(z, column, y);
@@ -75,13 +83,14 @@ fn row_spacing(scheme: Scheme, z: u8, column: u32, y: u32) -> f64 {
 /// parallel edge, relative to its first; latitudes of a meridian edge) such that, from
 /// every sample `i`, the segment to `i + s` and the fan edges to the samples `i` and
 /// `i + s` of each line beside the edge that exists are within `max_edge` spacings of
-/// `step` degrees (less [`SPAN_MARGIN`]), and the core's fan triangles on that line
-/// face outwards as drawn (a chord along a row bulges poleward, past the next row where
-/// the skip is long). `beside` holds the three lines' positions
-/// across the edge (latitudes, or longitudes), the edge's own in the middle.
+/// `step` degrees (less [`SPAN_MARGIN`]; any length for `None`), and the core's fan
+/// triangles on that line face outwards as drawn (a chord along a row bulges poleward,
+/// past the next row where the skip is long); `usize::MAX` when every skip fits.
+/// `beside` holds the three lines' positions across the edge (latitudes, or
+/// longitudes), the edge's own in the middle.
 fn span(
     step: f64,
-    max_edge: u32,
+    max_edge: Option<u32>,
     along: &[f64],
     beside: &[Option<f64>; 3],
     parallel: bool,
@@ -99,7 +108,7 @@ fn span(
         spacing: step * (1.0 - SPAN_MARGIN),
     };
     let (w, h) = if parallel { (n + 1, 3) } else { (3, n + 1) };
-    let limit = EdgeLimit::new(&metric, Some(max_edge), w as u32, h as u32)
+    let limit = EdgeLimit::new(&metric, max_edge, w as u32, h as u32)
         .expect("a lattice of finite positions");
     let at = |i: usize, line: usize| {
         if parallel {
@@ -177,16 +186,13 @@ mod tests {
             .collect()
     }
 
-    /// The capped levels of `scheme` with their longest edge, at two `--quality`s.
-    fn capped(scheme: Scheme) -> Vec<(u8, u32)> {
+    /// Levels 0 to 11 of `scheme` with their longest edge (`None` past the cap), at two
+    /// `--quality`s.
+    fn levels(scheme: Scheme) -> Vec<(u8, Option<u32>)> {
         [0.1, 1.0]
             .into_iter()
             .flat_map(|quality| {
-                (0..12).filter_map(move |z| {
-                    LevelBudget::new(scheme, z, quality)
-                        .max_edge
-                        .map(|e| (z, e))
-                })
+                (0..12).map(move |z| (z, LevelBudget::new(scheme, z, quality).max_edge))
             })
             .collect()
     }
@@ -194,7 +200,7 @@ mod tests {
     #[test]
     fn both_tiles_beside_an_edge_decide_the_same_span() {
         for scheme in schemes() {
-            for (z, max_edge) in capped(scheme) {
+            for (z, max_edge) in levels(scheme) {
                 let column = 0;
                 // Every row up to level 5, then 32 spread from pole to pole.
                 let rows = 1u32 << z;
@@ -214,12 +220,12 @@ mod tests {
     fn every_fan_edge_of_a_span_is_within_the_tiles_own_limit() {
         for scheme in schemes() {
             let n = scheme.cells;
-            for (z, max_edge) in capped(scheme) {
+            for (z, max_edge) in levels(scheme) {
                 // Every row up to level 5, then 32 spread from pole to pole.
                 let rows = 1u32 << z;
                 for y in (0..rows).step_by((rows as usize / 32).max(1)) {
                     let g = globe_edges(scheme, z, 0, y, max_edge);
-                    let limit = EdgeLimit::new(&g.metric, Some(max_edge), n + 1, n + 1).unwrap();
+                    let limit = EdgeLimit::new(&g.metric, max_edge, n + 1, n + 1).unwrap();
                     // Each edge (its line, and the line inside it) with its span.
                     let cases = [(g.spans[0], 0, 1, true), (g.spans[1], n, n - 1, true)]
                         .into_iter()
@@ -264,8 +270,9 @@ mod tests {
             tiling: Tiling::Geographic,
             cells: 217,
         };
-        let (z, max_edge) = (2, LevelBudget::new(scheme, 2, 1.0).max_edge.unwrap());
-        let grid_span = tinsmith_tiling::edge_span(Some(max_edge));
+        let (z, max_edge) = (2, LevelBudget::new(scheme, 2, 1.0).max_edge);
+        assert!(max_edge.is_some(), "level 2 is capped");
+        let grid_span = tinsmith_tiling::edge_span(max_edge);
         // Level 2 has rows 0..4 of 45 degrees: row 2 starts at the equator.
         let equator = globe_edges(scheme, z, 0, 2, max_edge);
         assert_eq!(equator.spans[0], grid_span);
@@ -284,5 +291,29 @@ mod tests {
         // skips of 84 turned fans from the 34th sample on).
         let fans = polar.spans[0];
         assert!(fans > 1 && fans < grid_span, "{fans} at 45 degrees");
+    }
+
+    #[test]
+    fn past_the_cap_fans_still_may_not_turn_over() {
+        let scheme = Scheme {
+            tiling: Tiling::Geographic,
+            cells: 217,
+        };
+        // Level 7 at `--quality` 2 has no cap. Row 96 spans 45.0 to 46.4 degrees north,
+        // and the row inside its south edge lies poleward: a skip across the whole tile
+        // would bulge its chord past the thin fans beside it.
+        let z = 7;
+        assert_eq!(LevelBudget::new(scheme, z, 2.0).max_edge, None, "no cap");
+        let north = globe_edges(scheme, z, 0, 96, None);
+        assert!(
+            north.spans[0] > 1 && north.spans[0] < 217,
+            "{:?}",
+            north.spans
+        );
+        // Along meridians nothing bulges: any skip.
+        assert_eq!(north.spans[2..], [usize::MAX; 2], "{:?}", north.spans);
+        // Near the equator nothing turns over either.
+        let equator = globe_edges(scheme, z, 0, 64, None);
+        assert_eq!(equator.spans, [usize::MAX; 4]);
     }
 }

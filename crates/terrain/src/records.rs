@@ -77,9 +77,10 @@ pub(super) fn options_key(options: &TerrainOptions) -> String {
     if options.gzip {
         text["gzip_by"] = "libdeflate 10".into();
     }
-    // Coarse tiles' edges measured on the globe since they replaced lattice spacings: an
-    // update rebuilds a pyramid built before, so that shared edges agree.
-    text["edges"] = "globe".into();
+    // Coarse tiles' edges measured on the globe since they replaced lattice spacings, and
+    // every level's triangles facing outwards there: an update rebuilds a pyramid built
+    // before either, so that shared edges agree.
+    text["edges"] = "globe, faces".into();
     // Absent for the ellipsoid, so that pyramids built before datums were chosen keep
     // their key.
     if options.vertical_datum != tinsmith_raster::VerticalDatum::Ellipsoid {

@@ -13,7 +13,7 @@ use crate::order::encoding_order;
 use crate::rows::LevelRows;
 use crate::tms::Tiling;
 use crate::{TerrainError, TerrainOptions, TerrainResult, TileFormat};
-use tinsmith_tiling::{edge_limit, edge_span, EdgeProfile};
+use tinsmith_tiling::{edge_limit, EdgeProfile};
 
 /// One tile done on a worker.
 pub(super) struct TileOut {
@@ -62,16 +62,15 @@ pub(super) fn build_tile(
         return Ok(None);
     }
 
-    // Where edges are capped (coarse levels), they are measured on the globe.
-    let globe = budget
-        .max_edge
-        .map(|max_edge| globe_edges(raster.tiling, z, column, y, max_edge));
+    // Edges are measured on the globe: capped at coarse levels, and at every level no
+    // triangle may turn over as drawn there.
+    let globe = globe_edges(raster.tiling, z, column, y, budget.max_edge);
     // Shared edges, each decided from the level raster alone (its samples and their
     // magnitude) and the edge's place on the globe: both neighbours agree.
     let keep = |edge: EdgeProfile, side: usize| {
         let scale = slack_scale(edge.values().iter().copied());
         let limit = edge_limit(budget.decimation(scale), scale);
-        let span = globe.as_ref().map_or(edge_span(None), |g| g.spans[side]);
+        let span = globe.spans[side];
         if limit > 0.0 {
             edge.simplify(limit, span)
         } else {
@@ -102,9 +101,7 @@ pub(super) fn build_tile(
         .with_vertex_heights(VertexHeights::Samples);
     decimation_options.max_abs_value = Some(scale);
     decimation_options.max_edge_length = budget.max_edge;
-    if let Some(globe) = globe {
-        decimation_options.edge_metric = globe.metric;
-    }
+    decimation_options.edge_metric = globe.metric;
     let tin = decimate_with_border(&grid, &decimation_options, &keep_border, &mut |_| {})
         .map_err(|source| TerrainError::Decimate {
             z,

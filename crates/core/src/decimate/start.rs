@@ -176,7 +176,7 @@ fn bottom_up_start(
         None
     };
     cheap_rtin
-        .or_else(|| strips.triangles(tick))
+        .or_else(|| strips.triangles(edge_limit, tick))
         .unwrap_or_else(rtin)
 }
 

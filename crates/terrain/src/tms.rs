@@ -329,7 +329,8 @@ pub fn tile_rectangle(z: u8, x: u32, y: u32) -> GeoRectangle {
 
 /// The tiles of `level` that the bounds touch: columns and rows, inclusive. Across the
 /// antimeridian the last column is past the level's last ([`Tiling::columns`]): column
-/// `x` is then tile `x mod columns` (see [`Tiling::tile_column`]), at most one full turn.
+/// `x` is then tile `x mod columns` (see [`Tiling::tile_column`]), at most one full turn;
+/// bounds given east of 180° (longitudes in 0..360) start a turn east, on the same tiles.
 /// Web Mercator rows hold only latitudes within ±85.0511°: the part of the bounds beyond
 /// is not tiled.
 pub(super) fn tile_range(bounds: &GeoBounds, tiling: Tiling, level: u8) -> ([u32; 2], [u32; 2]) {
@@ -337,7 +338,8 @@ pub(super) fn tile_range(bounds: &GeoBounds, tiling: Tiling, level: u8) -> ([u32
     let rows = 1u64 << level;
     let size = 360.0 / columns as f64;
     let clamp = |v: f64, max: u64| (v.floor().max(0.0) as u64).min(max - 1) as u32;
-    let west = clamp((bounds.west + 180.0) / size, columns);
+    // A raster whose longitudes run from 180 on (given in 0..360) starts a turn east.
+    let west = clamp((bounds.west + 180.0) / size, 2 * columns);
     let x = [
         west,
         clamp((bounds.east + 180.0) / size, u64::from(west) + columns),
@@ -426,6 +428,27 @@ mod tests {
             }
         }
         worst
+    }
+
+    #[test]
+    fn bounds_east_of_180_cover_the_tiles_they_would_west_of_it() {
+        // Fort Worth given in 0..360 (262.5 degrees) and in -180..180 (-97.5 degrees).
+        let at = |west: f64| GeoBounds {
+            west,
+            south: 32.5,
+            east: west + 0.3,
+            north: 32.8,
+            resolution: 0.001,
+        };
+        for tiling in [Tiling::Geographic, Tiling::Mercator] {
+            for level in [0, 3, 10] {
+                let columns = tiling.columns(level) as u32;
+                let ([w0, w1], rows) = tile_range(&at(-97.5), tiling, level);
+                let ([e0, e1], same_rows) = tile_range(&at(262.5), tiling, level);
+                assert_eq!([e0, e1], [w0 + columns, w1 + columns], "{tiling:?} {level}");
+                assert_eq!(rows, same_rows);
+            }
+        }
     }
 
     #[test]

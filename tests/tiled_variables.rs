@@ -213,6 +213,25 @@ fn tiled_nodata_in_one_band_only_shrinks_the_domain_across_tiles() {
     let file = tinsmith_formats::read_mesh(&d.path("m.ply")).expect("mesh");
     let inside = |v: &[f64; 3]| (13.0..18.0).contains(&v[0]) && (11.0..19.0).contains(&v[1]);
     assert!(!file.vertices.iter().any(inside));
+    // A tiled mesh's picture is drawn from the written file: it checks the mesh on the
+    // domain of every band too, not on the height's alone (where the hole is uncovered).
+    mesh_ok(
+        &d,
+        &[
+            "-o",
+            "p.ply",
+            "--bands",
+            "1,2",
+            "--max-error",
+            "1,0.5",
+            "--tile-size",
+            TILE,
+            "--pixel-coords",
+            "--preview",
+            "p.png",
+        ],
+    );
+    assert!(d.path("p.png").exists(), "the picture is written");
 }
 
 #[test]

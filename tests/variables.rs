@@ -648,6 +648,28 @@ fn attributes_from_another_raster_on_the_same_grid() {
     ]);
     assert_fails_naming(&o, &["far.asc", "does not overlap"]);
     assert!(!d.path("n.ply").exists());
+
+    // A band list that is not one, or lists a band twice: said so, not "no such file".
+    for (spec, problem) in [
+        ("other.asc:1,x", "comma-separated list of band numbers"),
+        ("other.asc:", "comma-separated list of band numbers"),
+        ("other.asc:1,1", "lists band 1 twice"),
+    ] {
+        let o = d.run(&[
+            "mesh",
+            "dem.asc",
+            "-o",
+            "n.ply",
+            "--max-error",
+            "1",
+            "--attributes",
+            spec,
+            "--attribute-error",
+            "0.5",
+        ]);
+        assert_fails_naming(&o, &["other.asc", problem]);
+        assert!(!d.path("n.ply").exists());
+    }
 }
 
 #[test]

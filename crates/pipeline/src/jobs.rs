@@ -286,6 +286,9 @@ pub struct PreviewJob {
     /// The mesh was made with heights converted from this geoid: the band is read the
     /// same way.
     pub vertical_datum: Option<VerticalDatum>,
+    /// The variables the mesh was made with (`mesh --bands` or `--attributes`): its
+    /// domain is where every one of them is valid too, and the picture checks it there.
+    pub variables: Vec<BandVariable>,
 }
 
 impl PreviewJob {
@@ -309,6 +312,7 @@ impl PreviewJob {
             max_error: None,
             mesh_label: None,
             vertical_datum: None,
+            variables: Vec::new(),
         }
     }
 }

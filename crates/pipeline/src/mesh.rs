@@ -100,6 +100,7 @@ pub fn mesh(job: &MeshJob, feedback: &dyn Feedback) -> Result<()> {
         picture.band = job.band;
         picture.pixel_coords = job.pixel_coords;
         picture.vertical_datum = job.vertical_datum.clone();
+        picture.variables = job.variables.clone();
         picture.size = PREVIEW_SIZE;
         crate::preview::check_fits(&picture)?;
         crate::tiled_mesh::run(job, feedback)?;

@@ -75,7 +75,29 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
             format,
             job.pixel_coords,
         )?;
-        let grid = &raster.samples;
+        // With variables the domain is where every band is valid, as the mesh made it.
+        let joined = match job.variables.is_empty() {
+            true => None,
+            false => Some(crate::variables::read(
+                &job.input,
+                (raster.samples.clone(), &raster.info),
+                &job.variables,
+                false,
+            )?),
+        };
+        let joined_samples;
+        let grid = match &joined {
+            None => &raster.samples,
+            Some((grid, _, _)) => {
+                joined_samples = tinsmith_georef::Samples::new(
+                    grid.width(),
+                    grid.height(),
+                    grid.values().to_vec(),
+                )
+                .map_err(tinsmith_core::Error::from)?;
+                &joined_samples
+            }
+        };
         let report = tinsmith_verify::verify(
             GridRef::new(grid.width(), grid.height(), grid.values()),
             MeshRef::new(&positions, &heights, &triangles),

@@ -50,6 +50,14 @@ pub fn attribute_variables(
                 .collect();
             (PathBuf::from(path), bands)
         }
+        Some((path, list))
+            if !path.is_empty() && !Path::new(spec).exists() && Path::new(path).exists() =>
+        {
+            bail!(
+                "{path}: --attributes: after the colon comes a comma-separated list of band \
+                 numbers (FILE:1,2,3), not \"{list}\""
+            );
+        }
         _ => {
             let path = PathBuf::from(spec);
             let count = tinsmith_raster::open_info(&path, 1)?.band_count;
@@ -59,6 +67,13 @@ pub fn attribute_variables(
     let name = path.display();
     if bands.contains(&0) {
         bail!("{name}: --attributes: bands are numbered from 1");
+    }
+    if let Some((_, &twice)) = bands
+        .iter()
+        .enumerate()
+        .find(|&(i, b)| bands[..i].contains(b))
+    {
+        bail!("{name}: --attributes lists band {twice} twice");
     }
     if let Some(&bad) = bounds.iter().find(|e| e.is_nan() || **e < 0.0) {
         bail!("{name}: --attribute-error {bad}: every bound must be a number >= 0");
@@ -277,7 +292,7 @@ pub(crate) fn check_tiled(job: &crate::MeshJob) -> Result<()> {
     if !format.carries_attributes() {
         bail!(
             "{input}: a raster larger than --tile-size {} is meshed tile by tile, and then \
-             --bands writes PLY (.ply), glTF (.glb, .gltf), GeoJSON or FlatGeobuf (.geojson, \
+             --bands writes PLY (.ply), glTF (.glb), GeoJSON or FlatGeobuf (.geojson, \
              .fgb); {format} is not among them (or raise --tile-size to mesh it in one piece)",
             job.tile_size
         );

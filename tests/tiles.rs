@@ -479,6 +479,51 @@ pub(crate) fn layer_json(root: &Path) -> (Value, Vec<f64>) {
     (layer, bounds)
 }
 
+/// Every directory under `root`, relative to it.
+fn all_directories(root: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(p) = stack.pop() {
+        for e in std::fs::read_dir(&p).unwrap() {
+            let e = e.unwrap().path();
+            if e.is_dir() {
+                out.push(e.strip_prefix(root).unwrap().to_path_buf());
+                stack.push(e);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn an_update_that_drops_tiles_leaves_the_tree_of_a_fresh_build() {
+    // The DEM, then its western third alone: the update removes the tiles east of it,
+    // and with a column's or a level's last tile its directory, as a fresh build has none.
+    let dir = Dir::new();
+    let input = fixture("becmodel_dem_bc_albers_50m.tif");
+    let west = dir.path("west.tif");
+    let status = Command::new("gdal_translate")
+        .args(["-q", "-srcwin", "0", "0", "140", "516"])
+        .arg(&input)
+        .arg(&west)
+        .status()
+        .expect("gdal_translate runs");
+    assert!(status.success());
+    let west = west.to_string_lossy().into_owned();
+    pyramid(&dir, &input, "p", &["-q"]);
+    let before = all_directories(&dir.path("p"));
+    pyramid(&dir, &west, "p", &["-q", "--update"]);
+    pyramid(&dir, &west, "fresh", &["-q"]);
+    let after = all_directories(&dir.path("p"));
+    assert!(
+        after.len() < before.len(),
+        "the update removed no directory"
+    );
+    assert_eq!(after, all_directories(&dir.path("fresh")));
+    assert_eq!(all_files(&dir.path("p")), all_files(&dir.path("fresh")));
+}
+
 pub(crate) fn all_files(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     let mut out = BTreeMap::new();
     let mut stack = vec![root.to_path_buf()];

@@ -46,22 +46,46 @@ impl DirectoryStore {
             location: path.display().to_string(),
             source,
         };
-        if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent).map_err(io)?;
+        // A removal beside this write may take its directory away while empty (see
+        // `remove`): made again, a few times at most.
+        let mut attempts = 0;
+        loop {
+            if let Some(parent) = path.parent() {
+                std::fs::create_dir_all(parent).map_err(io)?;
+            }
+            match tinsmith_output::write_bytes_atomically(&path, bytes) {
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound && attempts < 3 => {
+                    attempts += 1;
+                }
+                result => return result.map_err(io),
+            }
         }
-        tinsmith_output::write_bytes_atomically(&path, bytes).map_err(io)
     }
 
+    /// Removes the file at `key`, and the directories above it that it leaves empty (a
+    /// level's or a column's last tile), so that an updated pyramid's tree is a fresh
+    /// build's.
     fn remove(&self, key: &str) -> StoreResult<()> {
         let path = self.root.join(key);
         match std::fs::remove_file(&path) {
-            Ok(()) => Ok(()),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-            Err(source) => Err(StoreError::Io {
-                location: path.display().to_string(),
-                source,
-            }),
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+            Err(source) => {
+                return Err(StoreError::Io {
+                    location: path.display().to_string(),
+                    source,
+                })
+            }
         }
+        // `remove_dir` takes only an empty directory; any other outcome ends the walk.
+        let mut dir = path.parent();
+        while let Some(d) = dir.filter(|d| *d != self.root && d.starts_with(&self.root)) {
+            if std::fs::remove_dir(d).is_err() {
+                break;
+            }
+            dir = d.parent();
+        }
+        Ok(())
     }
 
     fn read(&self, key: &str) -> StoreResult<Option<Vec<u8>>> {

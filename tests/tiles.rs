@@ -898,6 +898,46 @@ fn a_pyramid_across_the_antimeridian_wraps_its_columns() {
     assert!(seams > 0, "no tile pair across 180 degrees");
 }
 
+#[test]
+#[ignore = "needs the oracles `make deps` installs (run by `make test`)"]
+fn normals_agree_across_the_antimeridian() {
+    // Flat ground from 179 to 181 degrees: every normal points up, and its east
+    // component, 0 up to rounding, used to round to either side of the oct encoding's 0
+    // on the two sides of 180 degrees (+180 and -180 of one point).
+    let dir = Dir::new();
+    let input = dir.path("flat.tif");
+    let status = Command::new("gdal_create")
+        .args([
+            "-q", "-outsize", "40", "40", "-bands", "1", "-burn", "5", "-ot", "Int16",
+        ])
+        .args(["-a_srs", "EPSG:4326", "-a_ullr", "179", "1", "181", "-1"])
+        .arg(&input)
+        .status()
+        .expect("gdal_create runs");
+    assert!(status.success());
+    let input = input.to_string_lossy().into_owned();
+    pyramid(&dir, &input, "p", &["-q", "--normals", "--max-zoom", "6"]);
+    let tiles = decode_pyramid(&dir.path("p"));
+    let mut seams = 0;
+    for (&(z, x, y), t) in &tiles {
+        if x != (2u32 << z) - 1 {
+            continue;
+        }
+        let other = &tiles[&(z, 0, y)];
+        let normals = |t: &Tile, side: usize| -> BTreeMap<i64, (u64, u64)> {
+            let n = t.normals.as_ref().expect("normals");
+            t.edges[side]
+                .iter()
+                .map(|&i| (t.v[i], (n[2 * i], n[2 * i + 1])))
+                .collect()
+        };
+        let (east, west) = (normals(t, 2), normals(other, 0));
+        assert_eq!(east, west, "{z}/{x}/{y}: normals differ across 180 degrees");
+        seams += east.len();
+    }
+    assert!(seams > 0, "no tile pair across 180 degrees");
+}
+
 /// The share of the tile's square its triangles cover.
 fn covered(t: &Tile) -> f64 {
     let doubled: i64 = t

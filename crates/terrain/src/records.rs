@@ -77,6 +77,11 @@ pub(super) fn options_key(options: &TerrainOptions) -> String {
     if options.gzip {
         text["gzip_by"] = "libdeflate 10".into();
     }
+    // Normals at longitudes counted round the globe since they came from each tile's
+    // west edge: an update rebuilds a pyramid with normals built before.
+    if options.normals {
+        text["normals_at"] = "lattice longitudes".into();
+    }
     // Coarse tiles' edges measured on the globe since they replaced lattice spacings, and
     // every level's triangles facing outwards there: an update rebuilds a pyramid built
     // before either, so that shared edges agree.

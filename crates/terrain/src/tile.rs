@@ -179,14 +179,19 @@ pub(super) fn build_tile(
             Tiling::Geographic => d,
             Tiling::Mercator => (rect.north - rect.south) / f64::from(cells),
         };
+        // A vertex's longitude from its lattice column round the globe, so that the
+        // tiles either side of 180 degrees see one longitude (180 and -180 gave normals
+        // whose east component, near 0, rounded to either side of the oct encoding's 0).
+        let turn = raster.tiling.columns(z) * u64::from(cells);
         tin.vertices()
             .iter()
             .map(|v| {
                 let (gi, gj) = (i0 + v.x as usize, j0 + v.y as usize);
+                let lattice_column = (u64::from(column) * u64::from(cells) + v.x as u64) % turn;
                 raster.normal(
                     gi,
                     gj,
-                    rect.west + f64::from(v.x) * d,
+                    -180.0 + lattice_column as f64 * d,
                     rect.south + f64::from(v.y) * d_lat,
                 )
             })

@@ -1504,6 +1504,48 @@ fn heights_beyond_1e37_are_refused_with_one_message() {
 }
 
 #[test]
+fn a_spike_too_tall_for_a_tiles_heights_is_named_whatever_its_height() {
+    // Flat ground at 3" with one spike: a spike of 1e9 was said to span more than a
+    // tile's heights hold; one of 1e12 failed first in the border's rule ("border sample
+    // (91, 0) cannot be removed: skipping it exceeds the error bound").
+    let d = Dir::new();
+    for spike in ["1e9", "1e12", "1e20"] {
+        let rows: String = (0..200)
+            .map(|y| {
+                let row: Vec<&str> = (0..200)
+                    .map(|x| if (x, y) == (100, 100) { spike } else { "100" })
+                    .collect();
+                row.join(" ") + "\n"
+            })
+            .collect();
+        d.write(
+            "spike.asc",
+            &format!(
+                "ncols 200\nnrows 200\nxllcorner -97.485\nyllcorner 32.655\n\
+                 cellsize 0.00083333333333333\n{rows}"
+            ),
+        );
+        let status = std::process::Command::new("gdal_translate")
+            .args([
+                "-q",
+                "-a_srs",
+                "EPSG:4326",
+                "-ot",
+                "Float32",
+                "spike.asc",
+                "spike.tif",
+            ])
+            .current_dir(d.path(""))
+            .status()
+            .expect("gdal_translate runs");
+        assert!(status.success());
+        let o = d.run(&["tiles", "spike.tif", "-o", "p", "-q"]);
+        assert_fails_naming(&o, &["spike.tif", "span more than"]);
+        assert!(!d.path("p").exists(), "{spike}: output left behind");
+    }
+}
+
+#[test]
 fn a_pipe_closed_early_ends_the_run_quietly_with_141() {
     // The reader of `-o /dev/stdout` stops after a few bytes: exit 128 + SIGPIPE, as a
     // shell reports it, in every writer (FlatGeobuf's error hid the broken pipe: exit 2

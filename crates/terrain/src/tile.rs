@@ -61,6 +61,26 @@ pub(super) fn build_tile(
     if grid.valid_cell_count() == 0 {
         return Ok(None);
     }
+    // Vertices are samples, and every sample is within the bound of the mesh: its heights
+    // span at least the samples' less twice the bound. Beyond what the level's heights
+    // hold, that is said now (the border's 1-D rule could fail first on such a span).
+    let (low, high) = grid
+        .values()
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    if high - low - 2.0 * budget.bound > budget.capacity() + 2.0 * budget.step {
+        return Err(TerrainError::TileHeights {
+            z,
+            x: column,
+            y,
+            low,
+            high,
+            capacity: budget.capacity(),
+        });
+    }
 
     // Edges are measured on the globe: capped at coarse levels, and at every level no
     // triangle may turn over as drawn there.

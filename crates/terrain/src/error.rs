@@ -33,7 +33,8 @@ pub enum TerrainError {
     #[error(
         "tile {z}/{x}/{y}: heights from {low} to {high} m span more than the {capacity} m that \
          16-bit quantized-mesh heights hold at this level's height step (or lie too far from 0 for it); is a \
-         nodata value missing from the input, or is --quality too small?"
+         nodata value missing from the input, or is --quality too small? (Beyond the raster the \
+         globe is at 0 m, which counts too, unless --data-only.)"
     )]
     TileHeights {
         /// Level.

@@ -61,9 +61,12 @@ pub(super) fn build_tile(
     if grid.valid_cell_count() == 0 {
         return Ok(None);
     }
-    // Vertices are samples, and every sample is within the bound of the mesh: its heights
-    // span at least the samples' less twice the bound. Beyond what the level's heights
-    // hold, that is said now (the border's 1-D rule could fail first on such a span).
+    // Vertices are samples, and every sample is within the decimation's bound of the mesh
+    // (at most the level's bound plus a step where heights lie close enough to 0 for the
+    // check below to pass): the mesh's heights span at least the samples' less twice
+    // that. Past the level's capacity by more than a step, the check after decimation
+    // would refuse the tile; that is said now (the border's 1-D rule could fail first on
+    // such a span).
     let (low, high) = grid
         .values()
         .iter()
@@ -71,7 +74,7 @@ pub(super) fn build_tile(
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
             (lo.min(v), hi.max(v))
         });
-    if high - low - 2.0 * budget.bound > budget.capacity() + 2.0 * budget.step {
+    if high - low - 2.0 * budget.bound > budget.capacity() + 3.0 * budget.step {
         return Err(TerrainError::TileHeights {
             z,
             x: column,

@@ -198,7 +198,9 @@ pub struct DecimationOptions {
     /// would need a longer edge is refused. For renderers that interpolate in another space
     /// than the grid's (e.g. terrain on a globe, where long edges cut below the surface).
     pub max_edge_length: Option<u32>,
-    /// How an edge's length is measured against `max_edge_length`.
+    /// How an edge's length is measured against `max_edge_length`. On a sphere
+    /// ([`crate::EdgeMetric::Sphere`]) no triangle may turn over as drawn, with a length
+    /// limit or without one.
     pub edge_metric: crate::EdgeMetric,
     /// Contour levels to shape the TIN for (see [`DecimationOptions::with_contour_levels`]);
     /// sorted, finite, without duplicates.

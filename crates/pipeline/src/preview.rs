@@ -194,7 +194,10 @@ pub(crate) fn check_fits(job: &PreviewJob) -> Result<tinsmith_formats::MeshForma
         Err(_) => 0,
     };
     if reads_whole(&reader) {
-        let per_sample = if mesh_bytes == 0 { 80 } else { 40 };
+        // With variables: each band read, and the joined grid's copy of the heights.
+        let variables =
+            8 * job.variables.len() as u64 + if job.variables.is_empty() { 0 } else { 16 };
+        let per_sample = if mesh_bytes == 0 { 80 } else { 40 } + variables;
         crate::memory::check_whole_raster_fits(
             &job.input,
             size,

@@ -46,17 +46,19 @@ impl DirectoryStore {
             location: path.display().to_string(),
             source,
         };
-        // A removal beside this write may take its directory away while empty (see
-        // `remove`): made again, a few times at most.
-        let mut attempts = 0;
+        // A removal beside this write may take its directory, or one above it, away while
+        // empty (see `remove`), between making it and writing: made again, up to
+        // `WRITE_ATTEMPTS` times.
+        let vanished = |e: &std::io::Error| e.kind() == std::io::ErrorKind::NotFound;
+        let mut attempt = 1;
         loop {
-            if let Some(parent) = path.parent() {
-                std::fs::create_dir_all(parent).map_err(io)?;
-            }
-            match tinsmith_output::write_bytes_atomically(&path, bytes) {
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound && attempts < 3 => {
-                    attempts += 1;
-                }
+            let made = match path.parent() {
+                Some(parent) => std::fs::create_dir_all(parent),
+                None => Ok(()),
+            };
+            let written = made.and_then(|()| tinsmith_output::write_bytes_atomically(&path, bytes));
+            match written {
+                Err(e) if vanished(&e) && attempt < WRITE_ATTEMPTS => attempt += 1,
                 result => return result.map_err(io),
             }
         }
@@ -100,6 +102,10 @@ impl DirectoryStore {
         }
     }
 }
+
+/// How many times a write makes its directories and writes, when a removal beside it
+/// takes a directory away in between (each time needs another removal to empty it).
+const WRITE_ATTEMPTS: u32 = 16;
 
 impl TileStore for DirectoryStore {
     fn location(&self) -> String {

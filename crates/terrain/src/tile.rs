@@ -61,19 +61,13 @@ pub(super) fn build_tile(
     if grid.valid_cell_count() == 0 {
         return Ok(None);
     }
-    // Vertices are samples, and every sample is within the decimation's bound of the mesh
-    // (at most the level's bound plus a step where heights lie close enough to 0 for the
-    // check below to pass): the mesh's heights span at least the samples' less twice
-    // that. Past the level's capacity by more than a step, the check after decimation
-    // would refuse the tile; that is said now (the border's 1-D rule could fail first on
-    // such a span).
-    let (low, high) = grid
-        .values()
-        .iter()
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        });
+    // Vertices are samples, and every sample of a valid cell is within the decimation's
+    // bound of the mesh (at most the level's bound plus a step where heights lie close
+    // enough to 0 for the check below to pass): the mesh's heights span at least those
+    // samples' less twice that. Past the level's capacity by more than a step, the check
+    // after decimation would refuse the tile; that is said now (the border's 1-D rule
+    // could fail first on such a span). Samples of no valid cell are never measured.
+    let (low, high) = valid_cell_range(&grid);
     if high - low - 2.0 * budget.bound > budget.capacity() + 3.0 * budget.step {
         return Err(TerrainError::TileHeights {
             z,
@@ -284,4 +278,45 @@ pub(super) fn build_tile(
         verified_bound: budget.verify(scale),
         bounds,
     }))
+}
+
+/// The lowest and highest samples of `grid` that are corners of a valid cell (infinite
+/// the wrong way round when there is none).
+fn valid_cell_range(grid: &Grid) -> (f64, f64) {
+    let (w, h) = (grid.width() as usize, grid.height() as usize);
+    let values = grid.values();
+    let mut range = (f64::INFINITY, f64::NEG_INFINITY);
+    for y in 0..h.saturating_sub(1) {
+        for x in 0..w - 1 {
+            let corners =
+                [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)].map(|(i, j)| values[j * w + i]);
+            if corners.iter().all(|v| v.is_finite()) {
+                for v in corners {
+                    range = (range.0.min(v), range.1.max(v));
+                }
+            }
+        }
+    }
+    range
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_sample_of_no_valid_cell_does_not_count_towards_the_heights_range() {
+        // A 4 x 4 lattice: a valid block of 2 x 2 cells at 10 to 13, and an isolated
+        // sample of 5000 whose cells all have a nodata corner (never a vertex).
+        let n = f64::NAN;
+        #[rustfmt::skip]
+        let values = vec![
+            10.0, 11.0, 12.0, n,
+            11.0, 12.0, 13.0, n,
+            12.0, 13.0, 12.0, n,
+            n,    n,    n,    5000.0,
+        ];
+        let grid = Grid::new(4, 4, values).unwrap();
+        assert_eq!(valid_cell_range(&grid), (10.0, 13.0));
+    }
 }

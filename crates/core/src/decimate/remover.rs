@@ -145,18 +145,27 @@ impl<'g> Remover<'g> {
         }
         let saved = self.rules;
         let exact_zero = self.exact_zero();
-        self.rules = Rules {
-            model: crate::ErrorModel::Exact,
-            selection: crate::EdgeSelection::MinError,
-            method: crate::Retriangulation::Ears,
-            // Exactly planar holes only, decided exactly, at a bound of 0 on integer heights.
-            limit: if exact_zero { 0.0 } else { f64::INFINITY },
-            // The caller's 1-D rule already spaced the kept border samples.
-            edge_limit: &crate::edge_limit::NO_EDGE_LIMIT,
-            ..saved
-        };
         self.max_ring = usize::MAX;
-        let planned = self.plan(mesh, v);
+        // Within the run's edge limit (lengths and, on a sphere, faces) where the hole
+        // allows it; else with none, the caller's 1-D rule having spaced the kept border
+        // samples.
+        let mut planned = None;
+        for edge_limit in [saved.edge_limit, &crate::edge_limit::NO_EDGE_LIMIT] {
+            self.rules = Rules {
+                model: crate::ErrorModel::Exact,
+                selection: crate::EdgeSelection::MinError,
+                method: crate::Retriangulation::Ears,
+                // Exactly planar holes only, decided exactly, at a bound of 0 on integer
+                // heights.
+                limit: if exact_zero { 0.0 } else { f64::INFINITY },
+                edge_limit,
+                ..saved
+            };
+            planned = self.plan(mesh, v);
+            if planned.is_some() {
+                break;
+            }
+        }
         self.max_ring = MAX_HOLE_RING;
         self.rules = saved;
         match planned {

@@ -1,7 +1,7 @@
 //! `tinsmith preview`: a picture of a raster and a TIN of it, as a PNG.
 
 use tinsmith_preview::{encode_png, render, DrawnSamples, Layers, Scene};
-use tinsmith_verify::{GridRef, MeshRef, VerifyOptions};
+use tinsmith_verify::{MeshRef, VerifyOptions};
 
 use crate::error::{bail, Context};
 use crate::mesh_file::{
@@ -75,31 +75,15 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
             format,
             job.pixel_coords,
         )?;
-        // With variables the domain is where every band is valid, as the mesh made it.
-        let joined = match job.variables.is_empty() {
-            true => None,
-            false => Some(crate::variables::read(
-                &job.input,
-                (raster.samples.clone(), &raster.info),
-                &job.variables,
-                false,
-            )?),
-        };
-        let joined_samples;
-        let grid = match &joined {
-            None => &raster.samples,
-            Some((grid, _, _)) => {
-                joined_samples = tinsmith_georef::Samples::new(
-                    grid.width(),
-                    grid.height(),
-                    grid.values().to_vec(),
-                )
-                .map_err(tinsmith_core::Error::from)?;
-                &joined_samples
-            }
-        };
+        let mut joined = None;
+        let grid = crate::variables::read_for_check(
+            &job.input,
+            (&raster.samples, &raster.info),
+            &job.variables,
+            &mut joined,
+        )?;
         let report = tinsmith_verify::verify(
-            GridRef::new(grid.width(), grid.height(), grid.values()),
+            grid,
             MeshRef::new(&positions, &heights, &triangles),
             &VerifyOptions::new().with_orientation(orientation),
         )
@@ -115,7 +99,7 @@ pub fn preview(job: &PreviewJob) -> Result<Previewed> {
                     .map_or("the verifier found problems", String::as_str)
             );
         }
-        let values = drawn_values(grid.values(), grid.width() as usize, &drawn);
+        let values = drawn_values(grid.values, grid.width as usize, &drawn);
         let mesh = MeshOnLattice {
             positions,
             heights,

@@ -195,6 +195,24 @@ pub fn resolve_bands(
 /// A variable's band and bound, with the name files give it.
 pub(crate) type Named = (BandVariable, String);
 
+/// The variables of a mesh read beside its heights `samples` for checking it (`None`
+/// without variables), and the grid the verifier measures: the heights where every band
+/// is valid, the domain `mesh --bands` made.
+pub(crate) fn read_for_check<'a>(
+    input: &Path,
+    (samples, info): (&'a Samples, &RasterInfo),
+    variables: &[BandVariable],
+    joined: &'a mut Option<(Grid, Vec<Named>, bool)>,
+) -> Result<GridRef<'a>> {
+    if !variables.is_empty() {
+        *joined = Some(read(input, (samples.clone(), info), variables, false)?);
+    }
+    Ok(match joined {
+        None => GridRef::new(samples.width(), samples.height(), samples.values()),
+        Some((grid, _, _)) => GridRef::new(grid.width(), grid.height(), grid.values()),
+    })
+}
+
 /// Reads every variable's band of `input` beside the `height` samples already read, into
 /// one grid (the domain is where every band is valid), with each variable's band, bound
 /// and the name files give it. For a `float32` file each band is decimated within its

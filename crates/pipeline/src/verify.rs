@@ -1,6 +1,6 @@
 //! `tinsmith verify`: measure a mesh file's true error against its raster.
 
-use tinsmith_verify::{GridRef, MeshRef, Report, VerifyOptions};
+use tinsmith_verify::{MeshRef, Report, VerifyOptions};
 
 use crate::error::{bail, Context};
 use crate::mesh_file::{mesh_format, read_onto_raster, MeshOnRaster};
@@ -58,32 +58,19 @@ pub fn verify(job: &VerifyJob) -> Result<Verified> {
         format,
         job.pixel_coords,
     )?;
-    // With variables the domain is where every band is valid, as `mesh --bands` made it.
-    let joined = match job.variables.is_empty() {
-        true => None,
-        false => Some(crate::variables::read(
-            &job.input,
-            (raster.samples.clone(), &raster.info),
-            &job.variables,
-            false,
-        )?),
-    };
-    let joined_samples;
-    let grid = match &joined {
-        None => &raster.samples,
-        Some((grid, _, _)) => {
-            joined_samples =
-                tinsmith_georef::Samples::new(grid.width(), grid.height(), grid.values().to_vec())
-                    .map_err(tinsmith_core::Error::from)?;
-            &joined_samples
-        }
-    };
+    let mut joined = None;
+    let grid = crate::variables::read_for_check(
+        &job.input,
+        (&raster.samples, &raster.info),
+        &job.variables,
+        &mut joined,
+    )?;
     let mut options = VerifyOptions::new().with_orientation(orientation);
     if let Some(e) = job.max_error {
         options = options.with_max_error(e);
     }
     let report = tinsmith_verify::verify(
-        GridRef::new(grid.width(), grid.height(), grid.values()),
+        grid,
         MeshRef::new(&positions, &heights, &triangles),
         &options,
     )
